@@ -1,0 +1,108 @@
+#include "assets/assets.h"
+
+#include <cmath>
+
+#include "assets/image_io.h"
+#include "assets/procedural.h"
+#include "scene/error.h"
+
+namespace portalsim {
+
+namespace {
+
+bool has_alpha(const Image& img) { return img.channels == 2 || img.channels == 4; }
+
+int luminance(const Image& img, int x, int y) {
+  if (img.channels < 3) return img.at(x, y, 0);
+  return (299 * img.at(x, y, 0) + 587 * img.at(x, y, 1) + 114 * img.at(x, y, 2) + 500) / 1000;
+}
+
+Image load(const ImageSource& src) { return read_image(src.path, src.origin); }
+
+Image sized(Image img, int w, int h) { return resize_image(img, w, h); }
+
+}  // namespace
+
+Image to_gray(const Image& img, bool keep_alpha) {
+  Image out(img.width, img.height, keep_alpha ? 2 : 1);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      out.at(x, y, 0) = static_cast<uint8_t>(luminance(img, x, y));
+      if (keep_alpha) out.at(x, y, 1) = has_alpha(img) ? img.at(x, y, img.channels - 1) : 255;
+    }
+  return out;
+}
+
+Image to_temperature(const Image& img, const Palette& palette, bool keep_alpha) {
+  if (img.channels < 3) return to_gray(img, keep_alpha);
+  Image out(img.width, img.height, keep_alpha ? 2 : 1);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      int best = 0, best_d = 1 << 30;
+      for (int t = 0; t < 256; ++t) {
+        int d = 0;
+        for (int c = 0; c < 3; ++c) {
+          const int e = img.at(x, y, c) - palette[t][c];
+          d += e * e;
+        }
+        if (d < best_d) best_d = d, best = t;
+      }
+      out.at(x, y, 0) = static_cast<uint8_t>(best);
+      if (keep_alpha) out.at(x, y, 1) = has_alpha(img) ? img.at(x, y, img.channels - 1) : 255;
+    }
+  return out;
+}
+
+Image colourise(const Image& temperature, const Palette& palette) {
+  Image out(temperature.width, temperature.height, 3);
+  const size_t n = static_cast<size_t>(temperature.width) * temperature.height;
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) out.pixels[i * 3 + c] = palette[temperature.pixels[i * temperature.channels]][c];
+  return out;
+}
+
+AssetSet build_assets(const Catalogue& cat) {
+  AssetSet a;
+  a.palette = procedural::ir_palette();
+  const ImagesConfig& ic = cat.images;
+  for (size_t s = 0; s < cat.subjects.size(); ++s) {
+    const Subject& sub = cat.subjects[s];
+    procedural::Body body;
+    body.subject = static_cast<int>(s);
+    body.build = sub.build;
+    body.mmw_level = sub.mmw_level;
+    body.ir_core = sub.ir_core;
+    body.ir_limb = sub.ir_limb;
+    std::array<Image, 3> views;
+    views[0] = sub.mmw_upper.path.empty() ? procedural::mmw_body(body, true, ic.mmw_width, ic.mmw_height)
+                                          : sized(to_gray(load(sub.mmw_upper), false), ic.mmw_width, ic.mmw_height);
+    views[1] = sub.mmw_lower.path.empty() ? procedural::mmw_body(body, false, ic.mmw_width, ic.mmw_height)
+                                          : sized(to_gray(load(sub.mmw_lower), false), ic.mmw_width, ic.mmw_height);
+    views[2] = sub.ir.path.empty() ? procedural::ir_body(body, ic.ir_width, ic.ir_height)
+                                   : sized(to_temperature(load(sub.ir), a.palette, false), ic.ir_width, ic.ir_height);
+    a.bases.push_back(std::move(views));
+  }
+  // IR sprites keep the objects' physical size: scale by the IR view's pixels per MMW pixel.
+  const double sx = static_cast<double>(ic.ir_width) / ic.mmw_width;
+  const double sy = static_cast<double>(ic.ir_height) / (2.0 * ic.mmw_height);
+  for (size_t v = 0; v < cat.variant_list.size(); ++v) {
+    const Object& o = cat.object_of(static_cast<int>(v));
+    const Variant& var = cat.variant(static_cast<int>(v));
+    const bool vertical = var.code == "v";
+    const int w = vertical ? o.height : o.width, h = vertical ? o.width : o.height;
+    a.mmw_sprites.push_back(var.mmw.path.empty() ? procedural::sprite(o.shape, vertical, w, h, o.mmw_level)
+                                                 : to_gray(load(var.mmw), true));
+    const int iw = std::max(1, static_cast<int>(std::lround(w * sx)));
+    const int ih = std::max(1, static_cast<int>(std::lround(h * sy)));
+    a.ir_sprites.push_back(var.ir.path.empty() ? procedural::sprite(o.shape, vertical, iw, ih, o.ir_level)
+                                               : to_temperature(load(var.ir), a.palette, true));
+  }
+  for (size_t k = 0; k < cat.noise.size(); ++k) {
+    const NoisePattern& p = cat.noise[k];
+    a.noise.push_back(p.image.path.empty() ? procedural::noise_pattern(static_cast<int>(k), ic.noise_size)
+                                           : sized(to_gray(load(p.image), false), ic.noise_size, ic.noise_size));
+  }
+  return a;
+}
+
+}  // namespace portalsim

@@ -1,0 +1,840 @@
+// Procedural default images. Geometry is signed distance fields (negative inside) built
+// from a handful of primitives; texture comes from an integer hash, so the bytes depend
+// only on IEEE arithmetic (+, *, /, sqrt, floor), never on libm or a platform RNG.
+#include "assets/procedural.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace portalsim::procedural {
+namespace {
+
+// Refuse absurd sizes with an exception rather than an allocation failure deep inside.
+constexpr int64_t kMaxPixels = int64_t{1} << 28;
+
+void check_size(int w, int h, const char* what) {
+  if (w < 1 || h < 1)
+    throw std::invalid_argument(std::string(what) + ": width and height must be at least 1");
+  if (static_cast<int64_t>(w) * h > kMaxPixels)
+    throw std::invalid_argument(std::string(what) + ": image too large");
+}
+
+// ---- hashing and texture -------------------------------------------------------------
+
+uint64_t mix64(uint64_t z) {  // splitmix64 finaliser
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+uint64_t hash3(int64_t x, int64_t y, uint64_t seed) {
+  uint64_t h = mix64(seed ^ 0x632be59bd9b4e019ULL);
+  h = mix64(h ^ static_cast<uint64_t>(x));
+  return mix64(h ^ (static_cast<uint64_t>(y) * 0xd1b54a32d192ed03ULL));
+}
+
+// Uniform in [0, 1) and [-1, 1).
+double hash01(int64_t x, int64_t y, uint64_t seed) {
+  return static_cast<double>(hash3(x, y, seed) >> 11) * (1.0 / 9007199254740992.0);
+}
+double hash_signed(int64_t x, int64_t y, uint64_t seed) { return 2.0 * hash01(x, y, seed) - 1.0; }
+
+double clamp01(double t) { return t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t); }
+double smooth(double t) {
+  t = clamp01(t);
+  return t * t * (3.0 - 2.0 * t);
+}
+double smoothstep(double e0, double e1, double x) { return smooth((x - e0) / (e1 - e0)); }
+double lerp(double a, double b, double t) { return a + (b - a) * t; }
+
+// Bilinear value noise with a smooth fade, in [-1, 1].
+double value_noise(double x, double y, uint64_t seed) {
+  const double fx = std::floor(x), fy = std::floor(y);
+  const auto ix = static_cast<int64_t>(fx), iy = static_cast<int64_t>(fy);
+  const double tx = smooth(x - fx), ty = smooth(y - fy);
+  const double a = hash_signed(ix, iy, seed), b = hash_signed(ix + 1, iy, seed);
+  const double c = hash_signed(ix, iy + 1, seed), d = hash_signed(ix + 1, iy + 1, seed);
+  return lerp(lerp(a, b, tx), lerp(c, d, tx), ty);
+}
+
+// Two octaves, still roughly in [-1, 1].
+double fbm(double x, double y, uint64_t seed) {
+  return 0.67 * value_noise(x, y, seed) + 0.33 * value_noise(2.03 * x + 17.1, 2.03 * y - 5.3,
+                                                             seed + 1);
+}
+
+// Triangle wave in [0, 1] with period 1, smoothed to a cosine-like shape (1 at integers).
+double wave(double t) {
+  const double f = t - std::floor(t);
+  return smooth(std::fabs(2.0 * f - 1.0));
+}
+
+uint8_t to_u8(double v) {
+  if (!(v > 0.0)) return 0;  // also maps NaN to 0
+  if (v >= 255.0) return 255;
+  return static_cast<uint8_t>(std::floor(v + 0.5));
+}
+
+// ---- signed distance primitives (negative inside) -------------------------------------
+
+struct P {
+  double x, y;
+};
+
+double len(double x, double y) { return std::sqrt(x * x + y * y); }
+
+double sd_circle(P p, P c, double r) { return len(p.x - c.x, p.y - c.y) - r; }
+
+// Scaled-circle approximation: exact sign, 1-Lipschitz, underestimates along the long axis.
+double sd_ellipse(P p, P c, double rx, double ry) {
+  rx = std::max(rx, 1e-3);
+  ry = std::max(ry, 1e-3);
+  return (len((p.x - c.x) / rx, (p.y - c.y) / ry) - 1.0) * std::min(rx, ry);
+}
+
+// Box with centre c, half sizes hx, hy and corner radius r.
+double sd_box(P p, P c, double hx, double hy, double r) {
+  r = std::clamp(r, 0.0, std::min(hx, hy));
+  const double qx = std::fabs(p.x - c.x) - hx + r, qy = std::fabs(p.y - c.y) - hy + r;
+  return len(std::max(qx, 0.0), std::max(qy, 0.0)) + std::min(std::max(qx, qy), 0.0) - r;
+}
+
+// Box given by its edges.
+double sd_rect(P p, double x0, double y0, double x1, double y1, double r) {
+  return sd_box(p, {0.5 * (x0 + x1), 0.5 * (y0 + y1)}, 0.5 * std::fabs(x1 - x0),
+                0.5 * std::fabs(y1 - y0), r);
+}
+
+double sd_capsule(P p, P a, P b, double r) {
+  const double pax = p.x - a.x, pay = p.y - a.y, bax = b.x - a.x, bay = b.y - a.y;
+  const double bb = bax * bax + bay * bay;
+  const double h = bb > 0.0 ? clamp01((pax * bax + pay * bay) / bb) : 0.0;
+  return len(pax - bax * h, pay - bay * h) - r;
+}
+
+// Segment a-b whose radius goes from ra to rb (a tapered capsule, exact).
+double sd_round_cone(P p, P a, P b, double ra, double rb) {
+  const double bx = b.x - a.x, by = b.y - a.y;
+  const double h = bx * bx + by * by;
+  const double dr = ra - rb;
+  if (h <= dr * dr + 1e-9) return std::min(sd_circle(p, a, ra), sd_circle(p, b, rb));
+  const double px = p.x - a.x, py = p.y - a.y;
+  const double qx = std::fabs(px * by - py * bx) / h, qy = (px * bx + py * by) / h;
+  const double cx = std::sqrt(h - dr * dr), cy = dr;
+  const double k = cx * qy - cy * qx;
+  const double m = cx * qx + cy * qy;
+  const double n = qx * qx + qy * qy;
+  if (k < 0.0) return std::sqrt(h * n) - ra;
+  if (k > cx) return std::sqrt(h * (n + 1.0 - 2.0 * qy)) - rb;
+  return m - ra;
+}
+
+// Exact distance to a simple polygon.
+double sd_polygon(P p, const std::vector<P>& v) {
+  const size_t n = v.size();
+  double d = (p.x - v[0].x) * (p.x - v[0].x) + (p.y - v[0].y) * (p.y - v[0].y);
+  double s = 1.0;
+  for (size_t i = 0, j = n - 1; i < n; j = i, ++i) {
+    const double ex = v[j].x - v[i].x, ey = v[j].y - v[i].y;
+    const double wx = p.x - v[i].x, wy = p.y - v[i].y;
+    const double ee = ex * ex + ey * ey;
+    const double t = ee > 0.0 ? clamp01((wx * ex + wy * ey) / ee) : 0.0;
+    const double bx = wx - ex * t, by = wy - ey * t;
+    d = std::min(d, bx * bx + by * by);
+    const bool c1 = p.y >= v[i].y, c2 = p.y < v[j].y, c3 = ex * wy > ey * wx;
+    if ((c1 && c2 && c3) || (!c1 && !c2 && !c3)) s = -s;
+  }
+  return s * std::sqrt(d);
+}
+
+// Polynomial smooth minimum: rounds the joint between two shapes over a width k.
+double smin(double a, double b, double k) {
+  if (k <= 0.0) return std::min(a, b);
+  const double h = clamp01(0.5 + 0.5 * (b - a) / k);
+  return lerp(b, a, h) - k * h * (1.0 - h);
+}
+
+// ---- the body --------------------------------------------------------------------------
+
+// The whole body in one frame: U across (0..200), Y down, 0..200 the upper MMW view and
+// 200..400 the lower one, so the IR view is the same field at half scale.
+struct BodyField {
+  double d;       // union
+  double d_core;  // torso, shoulders, pelvis
+  double d_head;  // neck and chin
+  double d_arm;
+  double d_leg;
+  double chin;  // 0..1 crease darkening along the jaw line
+};
+
+class BodyModel {
+ public:
+  explicit BodyModel(const Body& body) {
+    b_ = std::clamp(body.build, 0.5, 1.6);
+    seed_ = mix64(static_cast<uint64_t>(static_cast<int64_t>(body.subject)) + 0x5eed);
+    auto var = [&](int k) { return hash01(k, 0, seed_); };
+    arm_spread_ = 4.0 * var(1);
+    shoulder_dy_ = 4.0 * var(2) - 2.0;
+    stance_ = 3.0 * var(3);
+    lean_ = 3.0 * var(4) - 1.5;
+    arm_off_ = 64.5 + (b_ - 1.0) * 52.0;
+  }
+
+  uint64_t seed() const { return seed_; }
+
+  BodyField eval(double u, double y) const {
+    BodyField f{};
+    const double far = 1e9;
+    const double sdy = shoulder_dy_;
+    // Head: neck and the underside of the chin, only near the top.
+    double head = far;
+    double jaw = far, neck = far;
+    if (y < 60.0) {
+      neck = sd_round_cone({u, y}, {100, -6}, {100, 17}, 11.5, 13.0);
+      jaw = sd_round_cone({u, y}, {100, -34}, {100, -9}, 30.0, 16.5);
+      head = smin(neck, jaw, 2.0);
+    }
+    // Core: shoulder girdle, trapezius slopes, torso and pelvis.
+    double core = torso(u, y);
+    if (y < 80.0) {
+      // Trapezius slopes from the neck down to round deltoids.
+      const double tx = arm_off_ - 12.0;
+      const double trap =
+          std::min(sd_round_cone({u, y}, {100, 13}, {100 - tx, 31 + sdy}, 13, 11),
+                   sd_round_cone({u, y}, {100, 13}, {100 + tx, 31 + sdy}, 13, 11));
+      core = smin(core, trap, 6.0);
+    }
+    double arm = far;
+    if (y < 215.0) arm = std::min(limb_arm(u, y, -1.0), limb_arm(u, y, 1.0));
+    if (y < 80.0) {  // shoulders round over into the deltoids
+      const double delt = std::min(sd_circle({u, y}, {100 - arm_off_, 41 + sdy}, 10.5),
+                                   sd_circle({u, y}, {100 + arm_off_, 41 + sdy}, 10.5));
+      core = smin(core, delt, 8.0);
+    }
+    double leg = far;
+    if (y > 180.0) leg = std::min(limb_leg(u, y, -1.0), limb_leg(u, y, 1.0));
+    f.d_core = core;
+    f.d_head = head;
+    f.d_arm = arm;
+    f.d_leg = leg;
+    core = smin(core, leg, 5.0);  // the hips flow into the thighs
+    f.d = smin(smin(core, head, 6.0), arm, 2.5);
+    // The jaw line shows as a soft dark crease where the chin overhangs the neck.
+    if (y < 60.0 && neck < 0.0) f.chin = std::max(0.0, 1.0 - std::fabs(jaw) / 2.5);
+    return f;
+  }
+
+ private:
+  // Torso half width along Y (before build), a smooth curve through key points.
+  static double torso_half_width(double y) {
+    static constexpr double kY[] = {14, 30, 45, 70, 100, 125, 160, 200, 228, 245, 262, 280};
+    static constexpr double kW[] = {36, 50, 53, 51.5, 47.5, 45.5, 48.5, 53.5, 55, 53.5, 48, 40};
+    constexpr int n = sizeof(kY) / sizeof(kY[0]);
+    if (y <= kY[0]) return kW[0];
+    if (y >= kY[n - 1]) return kW[n - 1];
+    int i = 0;
+    while (y > kY[i + 1]) ++i;
+    auto slope = [&](int k) {
+      const int a = std::max(k - 1, 0), b = std::min(k + 1, n - 1);
+      return (kW[b] - kW[a]) / (kY[b] - kY[a]);
+    };
+    const double dx = kY[i + 1] - kY[i], t = (y - kY[i]) / dx;
+    const double t2 = t * t, t3 = t2 * t;
+    return (2 * t3 - 3 * t2 + 1) * kW[i] + (t3 - 2 * t2 + t) * dx * slope(i) +
+           (-2 * t3 + 3 * t2) * kW[i + 1] + (t3 - t2) * dx * slope(i + 1);
+  }
+
+  double centre_x(double y) const { return 100.0 + lean_ * smoothstep(150.0, 300.0, y); }
+
+  double torso(double u, double y) const {
+    const double side = std::fabs(u - centre_x(y)) - torso_half_width(y) * b_;
+    return std::max({side, 14.0 - y, y - 262.0});
+  }
+
+  // sgn -1: the subject's right arm, on the image's left.
+  double limb_arm(double u, double y, double sgn) const {
+    const double x0 = 100.0 + sgn * arm_off_;
+    const P p{u, y};
+    const P top{x0, 41 + shoulder_dy_};
+    const P elbow{x0 + sgn * (2.5 + 0.4 * arm_spread_), 113};
+    const P wrist{x0 + sgn * (5.0 + arm_spread_), 171};
+    const P hand{x0 + sgn * (6.0 + 1.1 * arm_spread_), 186};
+    const double upper = sd_round_cone(p, top, elbow, 10.5, 8.2);
+    const double fore = sd_round_cone(p, elbow, wrist, 8.2, 6.3);
+    const double palm = sd_round_cone(p, wrist, hand, 6.3, 7.2);
+    return smin(smin(upper, fore, 1.5), palm, 1.5);
+  }
+
+  double limb_leg(double u, double y, double sgn) const {
+    const double bl = 0.5 + 0.5 * b_;
+    const double x0 = 100.0 + lean_ + sgn * (26.5 * b_ + 0.3 * stance_);
+    const P p{u, y};
+    const P hip{x0, 212}, mid{x0 + sgn * 0.3, 270};
+    const P knee{x0 + sgn * (1.0 + 0.5 * stance_), 310};
+    const P calf{x0 + sgn * (1.6 + 0.7 * stance_), 333};
+    const P ankle{x0 + sgn * (1.5 + stance_), 382};
+    const double thigh = smin(sd_round_cone(p, hip, mid, 26.0 * b_, 24.0 * b_),
+                              sd_round_cone(p, mid, knee, 24.0 * b_, 14.5 * bl), 3.0);
+    const double shin = smin(sd_round_cone(p, knee, calf, 14.5 * bl, 16.5 * bl),
+                             sd_round_cone(p, calf, ankle, 16.5 * bl, 7.8 * bl), 2.5);
+    // Feet seen from the front: low, wider than the ankle, turned a little outwards.
+    const double foot = sd_round_cone(p, {ankle.x + sgn * 1.0, 389}, {ankle.x + sgn * 7.0, 393},
+                                      7.5 * bl, 5.0 * bl);
+    return smin(smin(thigh, shin, 2.0), foot, 4.0);
+  }
+
+  double b_ = 1.0;
+  uint64_t seed_ = 0;
+  double arm_spread_ = 0, shoulder_dy_ = 0, stance_ = 0, lean_ = 0, arm_off_ = 64.5;
+};
+
+// Edge ramp width in body units: about a pixel and a half, and never razor sharp.
+double edge_width(double unit_per_px) { return 0.75 * unit_per_px + 0.7; }
+
+double coverage(double d, double e) { return smooth(0.5 - d / (2.0 * e)); }
+
+// ---- sprites ----------------------------------------------------------------------------
+
+// A shape in the horizontal frame: a W x H box in pixels, y down.
+class Shape {
+ public:
+  Shape(double w, double h) : w_(w), h_(h), m_(std::min(w, h)) {}
+  virtual ~Shape() = default;
+  virtual double sd(P p) const = 0;
+  // Offset from the material level at a point inside.
+  virtual double shade(P p) const = 0;
+
+ protected:
+  P at(double u, double v) const { return {u * w_, v * h_}; }
+  // Gentle darkening over the outer rim, so every object reads as having volume.
+  double rim(double d, double width, double amount) const {
+    const double t = clamp01(-d / std::max(width, 0.5));
+    return -amount * (1.0 - t) * (1.0 - t);
+  }
+  double grain(P p, uint64_t seed) const {
+    return hash_signed(static_cast<int64_t>(std::floor(p.x)), static_cast<int64_t>(std::floor(p.y)),
+                       seed);
+  }
+  double w_, h_, m_;
+};
+
+// Cylinder shading across a coordinate c in [-1, 1]: dark edges and a bright band.
+double cylinder(double c, double band_at, double band_width) {
+  const double body = 8.0 - 30.0 * c * c;
+  const double t = std::max(0.0, 1.0 - ((c - band_at) / band_width) * ((c - band_at) / band_width));
+  return body + 28.0 * t * t;
+}
+
+class Gun : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override {
+    const double slide = sd_rect(p, 0.07 * w_, 0.04 * h_, 0.95 * w_, 0.31 * h_, 0.05 * m_);
+    const double muzzle = sd_rect(p, 0.90 * w_, 0.10 * h_, 1.0 * w_, 0.24 * h_, 0.02 * m_);
+    const double frame = sd_rect(p, 0.10 * w_, 0.28 * h_, 0.86 * w_, 0.43 * h_, 0.03 * m_);
+    const double grip = sd_polygon(p, {at(0.07, 0.38), at(0.35, 0.38), at(0.29, 0.99),
+                                       at(0.02, 0.99)}) - 0.01 * m_;
+    const double hammer = sd_rect(p, 0.02 * w_, 0.03 * h_, 0.12 * w_, 0.17 * h_, 0.03 * m_);
+    const double t = std::max(0.9, 0.045 * m_);
+    const P gc = at(0.48, 0.42);
+    const double outer = sd_ellipse(p, gc, 0.14 * w_, 0.22 * h_);
+    const double inner = sd_ellipse(p, gc, 0.14 * w_ - t, 0.22 * h_ - t);
+    const double guard = std::max({outer, -inner, gc.y - p.y});
+    const double trigger =
+        sd_capsule(p, at(0.47, 0.40), at(0.44, 0.55), std::max(0.45, 0.025 * m_));
+    return std::min({slide, muzzle, frame, grip, hammer, guard, trigger});
+  }
+  double shade(P p) const override {
+    const double u = p.x / w_, v = p.y / h_;
+    double s = rim(sd(p), 0.06 * m_ + 0.8, 16.0);
+    if (v < 0.31 && u > 0.07) {  // slide: brighter, highlight along the top, port, serrations
+      s += 10.0 + 18.0 * std::max(0.0, 1.0 - std::fabs(v - 0.10) / 0.05);
+      if (u > 0.52 && u < 0.68 && v > 0.12 && v < 0.21) s -= 26.0;
+      if (u > 0.12 && u < 0.25) s -= 10.0 * wave(p.x / std::max(1.6, 0.05 * w_));
+      if (u > 0.90) s -= 8.0;
+    } else if (v > 0.42 && u < 0.36) {  // grip: darker, checkered panel
+      const double panel = sd_polygon(p, {at(0.11, 0.47), at(0.30, 0.47), at(0.25, 0.93),
+                                          at(0.07, 0.93)});
+      s -= 10.0;
+      if (panel < 0.0) s -= 8.0 + 7.0 * wave((p.x + p.y) / 2.2) * wave((p.x - p.y) / 2.2);
+    } else {
+      s -= 2.0;
+    }
+    return s + 2.0 * grain(p, 11);
+  }
+};
+
+class Handle : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override {
+    const double bar = sd_rect(p, 0, 0, w_, 0.36 * h_, 0.18 * h_);
+    const double post_l = sd_rect(p, 0.15 * w_, 0.2 * h_, 0.27 * w_, 0.88 * h_, 0.02 * m_);
+    const double post_r = sd_rect(p, 0.73 * w_, 0.2 * h_, 0.85 * w_, 0.88 * h_, 0.02 * m_);
+    const double base_l = sd_rect(p, 0.08 * w_, 0.80 * h_, 0.34 * w_, h_, 0.06 * m_);
+    const double base_r = sd_rect(p, 0.66 * w_, 0.80 * h_, 0.92 * w_, h_, 0.06 * m_);
+    return std::min({bar, post_l, post_r, base_l, base_r});
+  }
+  double shade(P p) const override {
+    const double u = p.x / w_, v = p.y / h_;
+    double s;
+    if (v < 0.36) {
+      s = cylinder((v - 0.18) / 0.18, -0.35, 0.35);
+    } else if (v < 0.80) {
+      const double cx = u < 0.5 ? 0.21 : 0.79;
+      s = cylinder((u - cx) / 0.06, -0.3, 0.4) - 6.0;
+    } else {
+      s = -14.0 + 10.0 * std::max(0.0, 1.0 - std::fabs(v - 0.86) / 0.06);
+    }
+    return s + rim(sd(p), 0.6, 8.0) + 1.5 * grain(p, 12);
+  }
+};
+
+// Long thin shapes (rod, strip, pipe) follow the box's long axis.
+class Elongated : public Shape {
+ public:
+  using Shape::Shape;
+
+ protected:
+  bool horizontal() const { return w_ >= h_; }
+  double along(P p) const { return horizontal() ? p.x / w_ : p.y / h_; }
+  double across(P p) const {  // -1..1 over the thickness
+    return horizontal() ? (p.y - 0.5 * h_) / (0.5 * h_) : (p.x - 0.5 * w_) / (0.5 * w_);
+  }
+  double length() const { return std::max(w_, h_); }
+};
+
+class Rod : public Elongated {
+ public:
+  using Elongated::Elongated;
+  double sd(P p) const override { return sd_rect(p, 0, 0, w_, h_, 0.45 * m_); }
+  double shade(P p) const override {
+    return cylinder(across(p), -0.35, 0.32) + rim(sd(p), 0.8, 6.0) +
+           3.0 * value_noise(along(p) * length() / 5.0, 0.5, 21);
+  }
+};
+
+class Strip : public Elongated {
+ public:
+  using Elongated::Elongated;
+  double sd(P p) const override { return sd_rect(p, 0, 0, w_, h_, 0.5 * m_); }
+  double shade(P p) const override {
+    const double c = across(p);
+    // Flat: nearly even, a thin sheen along one edge and a faint ripple along the length.
+    double s = 4.0 - 10.0 * smoothstep(0.55, 1.0, c) + 12.0 * smoothstep(-0.95, -0.6, -c) *
+                                                           smoothstep(-0.95, -0.6, c + 0.3);
+    s += 5.0 * (along(p) - 0.5) + 3.0 * value_noise(along(p) * length() / 7.0, 3.5, 22);
+    return s + rim(sd(p), 0.7, 8.0);
+  }
+};
+
+class Disk : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override {
+    const P c = at(0.5, 0.5);
+    const double outer = sd_ellipse(p, c, 0.5 * w_, 0.5 * h_);
+    const double hole = sd_ellipse(p, c, 0.15 * w_, 0.15 * h_);
+    return std::max(outer, -hole);
+  }
+  double shade(P p) const override {
+    const double dx = (p.x - 0.5 * w_) / (0.5 * w_), dy = (p.y - 0.5 * h_) / (0.5 * h_);
+    const double r2 = dx * dx + dy * dy, r = std::sqrt(r2);
+    double s;
+    if (r < 0.36) {  // clear plastic hub with a stacking ring
+      s = -14.0 + 10.0 * std::max(0.0, 1.0 - std::fabs(r - 0.25) / 0.04);
+    } else {  // data area: fine tracks and a two-lobed sheen
+      const double sin2 = r2 > 0.0 ? 2.0 * dx * dy / r2 : 0.0;
+      s = 6.0 + 4.0 * wave(r * 0.5 * m_ / 1.5) + 20.0 * sin2 * sin2 - 8.0;
+      if (r > 0.94) s += 8.0;
+    }
+    return s + rim(sd(p), 0.7, 10.0);
+  }
+};
+
+class Plate : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override { return sd_rect(p, 0, 0, w_, h_, 0.09 * m_); }
+  double shade(P p) const override {
+    const double d = sd(p);
+    const double bw = std::max(1.2, 0.09 * m_);
+    double s = 2.0 * value_noise(p.x / 9.0, p.y / 1.5, 31);  // brushed grain
+    if (-d < bw) {  // bevel lit from the top left
+      const double e = 0.25;
+      const double gx = sd({p.x + e, p.y}) - sd({p.x - e, p.y});
+      const double gy = sd({p.x, p.y + e}) - sd({p.x, p.y - e});
+      const double g = len(gx, gy);
+      const double lit = g > 0.0 ? -(gx + gy) / g * 0.7071 : 0.0;
+      s += 18.0 * lit * (1.0 - (-d) / bw);
+    }
+    const double inset = std::max(2.0, 0.16 * m_), rr = std::max(0.8, 0.06 * m_);
+    for (const P& c : {P{inset, inset}, P{w_ - inset, inset}, P{inset, h_ - inset},
+                       P{w_ - inset, h_ - inset}}) {
+      const double dc = sd_circle(p, c, rr);
+      if (dc < 0.0) s += 18.0 * (1.0 + dc / rr) - 4.0;
+      else if (dc < 0.8) s -= 12.0 * (1.0 - dc / 0.8);
+    }
+    return s + rim(d, 0.6, 6.0);
+  }
+};
+
+class Pendant : public Shape {
+ public:
+  Pendant(double w, double h) : Shape(w, h) {
+    big_r_ = std::max(0.5, std::min(0.42 * w_, 0.27 * h_));
+    centre_ = {0.5 * w_, h_ - big_r_ - 0.02 * h_};
+    loop_c_ = at(0.5, 0.16);
+    loop_rx_ = 0.28 * w_;
+    loop_ry_ = 0.155 * h_;
+    loop_t_ = std::max(0.9, 0.1 * w_);
+  }
+  double sd(P p) const override {
+    const double outer = sd_ellipse(p, loop_c_, loop_rx_, loop_ry_);
+    const double inner = sd_ellipse(p, loop_c_, loop_rx_ - loop_t_, loop_ry_ - loop_t_);
+    const double loop = std::max(outer, -inner);
+    const double drop =
+        sd_round_cone(p, centre_, at(0.5, 0.30), big_r_, std::max(0.5, 0.08 * w_));
+    return std::min(loop, drop);
+  }
+  double shade(P p) const override {
+    if (p.y < 0.30 * h_) {  // chain: bright beads
+      const double dx = p.x - loop_c_.x, dy = p.y - loop_c_.y;
+      const double a = dy / (std::fabs(dx) + std::fabs(dy) + 1e-9) + (dx < 0 ? 4.0 : 0.0);
+      return 6.0 + 16.0 * wave(a * 2.2) - 12.0;
+    }
+    const double dc = sd_circle(p, centre_, big_r_);
+    const double rim_w = std::max(0.8, 0.2 * big_r_);
+    double s = 2.0;
+    if (-dc < rim_w) s += 14.0;                       // raised rim
+    const double gem = sd_circle(p, centre_, 0.42 * big_r_);
+    if (gem < 0.0) s += 24.0 * (-gem / (0.42 * big_r_)) - 6.0;  // domed centre stone
+    s -= 10.0 * clamp01((p.x - centre_.x + p.y - centre_.y) / (2.0 * big_r_));
+    return s + rim(sd(p), 0.6, 8.0);
+  }
+
+ private:
+  double big_r_;
+  P centre_, loop_c_;
+  double loop_rx_, loop_ry_, loop_t_;
+};
+
+class Pipe : public Elongated {
+ public:
+  using Elongated::Elongated;
+  double sd(P p) const override { return sd_rect(p, 0, 0, w_, h_, 0.12 * m_); }
+  double shade(P p) const override {
+    double s = cylinder(across(p), -0.4, 0.22) + 4.0;
+    // Fitting collars near both ends.
+    const double a = along(p) * length(), cw = std::max(1.0, 0.08 * m_);
+    for (double x : {0.09 * length(), 0.91 * length()})
+      if (std::fabs(a - x) < cw) s -= 16.0 * (1.0 - std::fabs(a - x) / cw);
+    if (a < 0.04 * length() || a > 0.96 * length()) s += 6.0;
+    return s + rim(sd(p), 0.7, 6.0) + 2.0 * grain(p, 41);
+  }
+};
+
+class Buckle : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override {
+    const double outer = sd_rect(p, 0, 0, w_, h_, 0.2 * m_);
+    const double hole = sd_rect(p, 0.24 * w_, 0.25 * h_, 0.84 * w_, 0.75 * h_, 0.06 * m_);
+    const double frame = std::max(outer, -hole);
+    const double prong = sd_round_cone(p, at(0.13, 0.5), at(0.89, 0.5), std::max(0.7, 0.065 * h_),
+                                       std::max(0.45, 0.03 * h_));
+    return std::min(frame, prong);
+  }
+  double shade(P p) const override {
+    const double outer = sd_rect(p, 0, 0, w_, h_, 0.2 * m_);
+    const double hole = sd_rect(p, 0.24 * w_, 0.25 * h_, 0.84 * w_, 0.75 * h_, 0.06 * m_);
+    const double frame = std::max(outer, -hole);
+    if (frame > 0.0 || std::fabs(p.y - 0.5 * h_) < 0.05 * h_) {  // prong
+      if (hole < 0.0) return 14.0 - 10.0 * clamp01(std::fabs(p.y - 0.5 * h_) / (0.06 * h_));
+    }
+    // Frame bars look rounded: bright along their middle, dark at both edges.
+    const double half = 0.5 * std::min(0.24 * w_, 0.25 * h_);
+    const double c = clamp01(-frame / std::max(half, 0.5));
+    return cylinder(1.0 - c, -0.1, 0.5) + 2.0 * grain(p, 51);
+  }
+};
+
+class Tile : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override { return sd_rect(p, 0, 0, w_, h_, std::max(0.5, 0.05 * m_)); }
+  double shade(P p) const override {
+    const double d = sd(p);
+    double s = 4.0 * value_noise(p.x / 5.0, p.y / 5.0, 61) + 5.0 * grain(p, 62);
+    s += 6.0 * (1.0 - (p.x + p.y) / (w_ + h_));  // glaze catching light from the top left
+    const double gw = std::max(1.0, 0.08 * m_);
+    if (-d < gw) s -= 14.0 + 6.0 * grain(p, 63);  // grout left on the edges
+    return s;
+  }
+};
+
+class Slab : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override { return sd_rect(p, 0, 0, w_, h_, 0.3 * m_); }
+  double shade(P p) const override {
+    const double sc = std::max(3.0, 0.22 * m_);
+    double s = 14.0 * fbm(p.x / sc, p.y / sc, 71) + 6.0 * grain(p, 72);
+    if (hash01(static_cast<int64_t>(std::floor(p.x / 2.0)),
+               static_cast<int64_t>(std::floor(p.y / 2.0)), 73) > 0.96)
+      s -= 18.0;  // pores
+    return s + rim(sd(p), std::max(1.0, 0.1 * m_), 14.0);
+  }
+};
+
+class Phone : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override {
+    const double body = sd_rect(p, 0, 0, 0.93 * w_, h_, 0.17 * std::min(0.93 * w_, h_));
+    const double b1 = sd_rect(p, 0.9 * w_, 0.22 * h_, w_, 0.29 * h_, 0.02 * m_);
+    const double b2 = sd_rect(p, 0.9 * w_, 0.34 * h_, w_, 0.48 * h_, 0.02 * m_);
+    return std::min({body, b1, b2});
+  }
+  double shade(P p) const override {
+    const double u = p.x / w_;
+    if (u > 0.93) return -8.0;  // side buttons
+    const double screen = sd_rect(p, 0.09 * w_, 0.11 * h_, 0.84 * w_, 0.84 * h_, 0.02 * m_);
+    if (screen < 0.0) {
+      // Glass: darker, with a diagonal reflection.
+      const double k = (p.x / w_ + p.y / h_) * 2.2;
+      return -24.0 + 10.0 * std::max(0.0, 1.0 - std::fabs(k - 1.0) / 0.25) +
+             rim(screen, 0.8, 6.0);
+    }
+    double s = 6.0 + rim(sd(p), std::max(0.8, 0.06 * m_), 16.0);
+    if (sd_capsule(p, at(0.34, 0.055), at(0.58, 0.055), std::max(0.4, 0.012 * h_)) < 0.0)
+      s -= 28.0;  // earpiece
+    if (sd_circle(p, at(0.22, 0.055), std::max(0.4, 0.02 * h_)) < 0.0) s -= 24.0;  // camera
+    const double button = sd_circle(p, at(0.465, 0.92), std::max(0.6, 0.045 * h_));
+    if (std::fabs(button) < std::max(0.45, 0.012 * h_)) s -= 20.0;
+    return s;
+  }
+};
+
+// Shading offset squeezed smoothly into the room between the level and 0 or 255, so bright
+// metals keep their highlights instead of clipping flat.
+double fit_shade(double s, double level) {
+  s = std::clamp(s, -40.0, 40.0);
+  const double room = s > 0.0 ? 255.0 - level : level;
+  if (room <= 0.0) return 0.0;
+  return s * room / (room + std::fabs(s));
+}
+
+std::unique_ptr<Shape> make_shape(const std::string& name, double w, double h) {
+  if (name == "gun") return std::make_unique<Gun>(w, h);
+  if (name == "handle") return std::make_unique<Handle>(w, h);
+  if (name == "rod") return std::make_unique<Rod>(w, h);
+  if (name == "disk") return std::make_unique<Disk>(w, h);
+  if (name == "strip") return std::make_unique<Strip>(w, h);
+  if (name == "plate") return std::make_unique<Plate>(w, h);
+  if (name == "pendant") return std::make_unique<Pendant>(w, h);
+  if (name == "pipe") return std::make_unique<Pipe>(w, h);
+  if (name == "buckle") return std::make_unique<Buckle>(w, h);
+  if (name == "tile") return std::make_unique<Tile>(w, h);
+  if (name == "slab") return std::make_unique<Slab>(w, h);
+  if (name == "phone") return std::make_unique<Phone>(w, h);
+  return nullptr;
+}
+
+// ---- palette ------------------------------------------------------------------------------
+
+struct Stop {
+  int at;
+  int r, g, b;
+};
+constexpr Stop kIron[] = {{0, 0, 0, 0},         {36, 22, 0, 92},      {78, 92, 0, 150},
+                          {118, 168, 6, 140},   {152, 218, 38, 64},   {186, 246, 108, 0},
+                          {222, 255, 196, 24},  {255, 255, 252, 236}};
+
+}  // namespace
+
+bool is_shape(const std::string& name) { return make_shape(name, 1.0, 1.0) != nullptr; }
+
+Image mmw_body(const Body& body, bool upper, int width, int height) {
+  check_size(width, height, "mmw_body");
+  const BodyModel model(body);
+  Image img(width, height, 1);
+  const double pu = 200.0 / width, pv = 200.0 / height;
+  const double e = edge_width(std::max(pu, pv));
+  const double level = body.mmw_level, bg = body.mmw_background;
+  const uint64_t seed = model.seed();
+  for (int y = 0; y < height; ++y) {
+    const double v = (y + 0.5) * pv + (upper ? 0.0 : 200.0);
+    for (int x = 0; x < width; ++x) {
+      const double u = (x + 0.5) * pu;
+      const double back = bg + 2.0 * value_noise(u / 9.0, v / 9.0, seed + 2) +
+                          1.5 * hash_signed(x, y, seed + 3);
+      const BodyField f = model.eval(u, v);
+      const double c = coverage(f.d, e);
+      double val = back;
+      if (c > 0.0) {
+        const double depth = clamp01(-f.d / 14.0);
+        const double s = 1.0 - (1.0 - depth) * (1.0 - depth);
+        const double skin = level + 30.0 * (s - 0.75) + 4.0 * fbm(u / 22.0, v / 22.0, seed + 4) +
+                            2.5 * hash_signed(x, y, seed + 5) - 18.0 * f.chin * f.chin;
+        val = lerp(back, skin, c);
+      }
+      img.at(x, y) = to_u8(val);
+    }
+  }
+  return img;
+}
+
+Image ir_body(const Body& body, int width, int height) {
+  check_size(width, height, "ir_body");
+  const BodyModel model(body);
+  Image img(width, height, 1);
+  const double pu = 200.0 / width, pv = 400.0 / height;
+  const double e = edge_width(std::max(pu, pv));
+  const double core = body.ir_core, limb = body.ir_limb, bg = body.ir_background;
+  const uint64_t seed = model.seed();
+  for (int y = 0; y < height; ++y) {
+    const double v = (y + 0.5) * pv;
+    for (int x = 0; x < width; ++x) {
+      const double u = (x + 0.5) * pu;
+      const double back = bg + 3.0 * v / 400.0 + 1.5 * value_noise(u / 12.0, v / 12.0, seed + 6);
+      const BodyField f = model.eval(u, v);
+      const double c = coverage(f.d, e);
+      double val = back;
+      if (c > 0.0) {
+        // Each part's own temperature, blended by how close the point is to each part.
+        const double sa = clamp01((v - 45.0) / 147.0), sl = clamp01((v - 240.0) / 158.0);
+        const double t_core = core - 8.0 * (1.0 - clamp01(-f.d_core / 20.0));
+        const double t_head = limb + 0.55 * (core - limb);
+        const double t_arm = limb + 0.4 * (core - limb) * (1.0 - sa) * (1.0 - sa) - 26.0 * sa * sa;
+        const double t_leg = limb + 0.55 * (core - limb) * (1.0 - sl) * (1.0 - sl) - 30.0 * sl * sl;
+        // Trunk and legs are one piece: a gradient down from the hips, not a seam.
+        const double t_trunk = lerp(t_core, t_leg, smoothstep(235.0, 300.0, v));
+        const double d_trunk = std::min(f.d_core, f.d_leg);
+        const double dm = std::min({d_trunk, f.d_head, f.d_arm});
+        auto weight = [&](double d) { return smooth(1.0 - (d - dm) / 14.0); };
+        const double wc = weight(d_trunk), wh = weight(f.d_head), wa = weight(f.d_arm);
+        double t = (wc * t_trunk + wh * t_head + wa * t_arm) / (wc + wh + wa);
+        const double depth = clamp01(-f.d / 9.0);
+        t -= 16.0 * (1.0 - depth) * (1.0 - depth);  // the surface turns away at the edges
+        t += 1.5 * fbm(u / 15.0, v / 15.0, seed + 7);
+        val = lerp(back, t, c);
+      }
+      img.at(x, y) = to_u8(val);
+    }
+  }
+  return img;
+}
+
+Image sprite(const std::string& shape, bool vertical, int width, int height, int level) {
+  check_size(width, height, "sprite");
+  // The drawing lives in the horizontal frame; a vertical sprite is it turned clockwise.
+  const int hw = vertical ? height : width, hh = vertical ? width : height;
+  const auto s = make_shape(shape, hw, hh);
+  if (!s) throw std::invalid_argument("sprite: unknown shape '" + shape + "'");
+  const double lv = std::clamp(level, 0, 255);
+  Image img(width, height, 2);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      // Horizontal-frame pixel this output pixel shows.
+      const int hx = vertical ? y : x, hy = vertical ? hh - 1 - x : y;
+      const P centre{hx + 0.5, hy + 0.5};
+      const double dc = s->sd(centre);
+      double value = lv, alpha = 0.0;
+      if (dc < -2.0) {
+        value = lv + fit_shade(s->shade(centre), lv);
+        alpha = 255.0;
+      } else if (dc <= 2.0) {
+        // 4x4 supersampled coverage; the value averages the covered samples.
+        int inside = 0;
+        double sum = 0.0;
+        for (int j = 0; j < 4; ++j) {
+          for (int i = 0; i < 4; ++i) {
+            const P q{hx + (i + 0.5) / 4.0, hy + (j + 0.5) / 4.0};
+            if (s->sd(q) < 0.0) {
+              ++inside;
+              sum += fit_shade(s->shade(q), lv);
+            }
+          }
+        }
+        if (inside > 0) value = lv + sum / inside;
+        alpha = 255.0 * inside / 16.0;
+      }
+      img.at(x, y, 0) = to_u8(value);
+      img.at(x, y, 1) = to_u8(alpha);
+    }
+  }
+  return img;
+}
+
+Image noise_pattern(int k, int size) {
+  if (k < 0 || k >= kNoisePatterns)
+    throw std::invalid_argument("noise_pattern: k must be in 0.." +
+                                std::to_string(kNoisePatterns - 1));
+  check_size(size, size, "noise_pattern");
+  Image img(size, size, 1, 128);
+  if (size < 3) return img;  // all border
+  const uint64_t seed = 0x6e6f697365ULL + static_cast<uint64_t>(k);
+  const double n = size, half = 0.5 * (size - 1);
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      // Envelope: flat in the middle, smoothly to exactly 0 on the border pixels.
+      const double ex = std::fabs(x - half) / half, ey = std::fabs(y - half) / half;
+      const double env = smoothstep(0.0, 0.45, 1.0 - ex) * smoothstep(0.0, 0.45, 1.0 - ey);
+      if (env <= 0.0) continue;
+      double a = 0.0;
+      switch (k) {
+        case 0:  // fine speckle: independent pixels, a few strong ones
+        {
+          const double h = hash_signed(x, y, seed);
+          a = h * std::fabs(h) * 0.6 + 0.4 * h;
+          break;
+        }
+        case 1:  // horizontal streaks: long along x, a few pixels across
+          a = 0.8 * value_noise(x / std::max(6.0, n / 5.0), y / 2.2, seed) +
+              0.3 * hash_signed(x, y, seed + 1);
+          break;
+        case 2: {  // low-frequency blotches, contrast-stretched
+          const double b = fbm(x / std::max(3.0, n / 5.0), y / std::max(3.0, n / 5.0), seed);
+          a = std::clamp(1.8 * b, -1.0, 1.0);
+          break;
+        }
+        case 3: {  // concentric rings, slightly wobbly
+          const double dx = x - half, dy = y - half;
+          const double r = len(dx, dy) + 1.2 * value_noise(x / 8.0, y / 8.0, seed);
+          a = 2.0 * wave(r / std::max(3.0, n / 10.0)) - 1.0;
+          break;
+        }
+        default:  // vertical banding: columns of varying brightness
+          a = 0.75 * value_noise(x / 2.5, y / std::max(8.0, n / 3.0), seed) +
+              0.25 * value_noise(x / 7.0, 0.5, seed + 1);
+          a = std::clamp(1.4 * a, -1.0, 1.0);
+          break;
+      }
+      img.at(x, y) = to_u8(128.0 + 45.0 * env * a);
+    }
+  }
+  return img;
+}
+
+std::array<std::array<uint8_t, 3>, 256> ir_palette() {
+  std::array<std::array<uint8_t, 3>, 256> pal{};
+  constexpr int n = sizeof(kIron) / sizeof(kIron[0]);
+  for (int i = 0; i < 256; ++i) {
+    int k = 0;
+    while (k + 2 < n && i > kIron[k + 1].at) ++k;
+    const Stop& a = kIron[k];
+    const Stop& b = kIron[k + 1];
+    const double t = static_cast<double>(i - a.at) / (b.at - a.at);
+    pal[i] = {to_u8(lerp(a.r, b.r, t)), to_u8(lerp(a.g, b.g, t)), to_u8(lerp(a.b, b.b, t))};
+  }
+  return pal;
+}
+
+}  // namespace portalsim::procedural

@@ -1,0 +1,49 @@
+// The default images, drawn by portalsim itself so that nothing is downloaded.
+// Every function is a pure function of its arguments: integer and double arithmetic
+// with an integer hash for texture, no platform RNG, so the bytes are the same on
+// every machine and every run.
+#pragma once
+#include <array>
+#include <string>
+
+#include "assets/image.h"
+
+namespace portalsim::procedural {
+
+// Body geometry is given for the MMW views (200x200 each, subject facing the camera,
+// so the subject's right side is on the image's left). The IR view covers the whole
+// body at half scale: IR(x, y) = MMW upper(2x, 2y) for y < h/2, MMW lower(2x, 2(y - h/2))
+// below. Functions scale these proportions to the width and height asked for.
+struct Body {
+  int subject = 0;      // 0-based; varies posture and texture a little
+  double build = 1.0;   // torso/leg width scale, 0.8..1.2
+  int mmw_level = 150;  // gray of the body in MMW (passive emission of skin)
+  int mmw_background = 25;
+  int ir_core = 215;    // IR temperature index of the torso (warmest)
+  int ir_limb = 175;    // IR temperature index of the limbs and head edges
+  int ir_background = 35;
+};
+
+// 1 channel gray: the upper (shoulders to hips) or lower (hips to feet) MMW view.
+Image mmw_body(const Body& body, bool upper, int width, int height);
+// 1 channel temperature index (0 cold .. 255 hot), whole body.
+Image ir_body(const Body& body, int width, int height);
+
+// The object outlines of the thesis (section 4.3.1). width/height are the sprite's
+// final size (already swapped for a vertical variant); `vertical` turns the drawing.
+// Returns 2 channels: value (gray for MMW, temperature index for IR) and alpha
+// (coverage, 255 inside, 0 outside, anti-aliased edge). `level` is the mean value of
+// the object's material; the drawing adds shading and detail around it.
+bool is_shape(const std::string& name);
+Image sprite(const std::string& shape, bool vertical, int width, int height, int level);
+
+// The k-th (0..4) MMW noise pattern: 1 channel, 128 means no change, value-128 is added
+// to the image. Its amplitude falls to 0 at the tile's border, so it stays local.
+constexpr int kNoisePatterns = 5;
+Image noise_pattern(int k, int size);
+
+// 256-entry RGB palette for IR temperature indices, like the thesis's figure 4.13:
+// black, blue, magenta, red, orange, yellow, white.
+std::array<std::array<uint8_t, 3>, 256> ir_palette();
+
+}  // namespace portalsim::procedural

@@ -1,0 +1,234 @@
+#include "backend/opencl/opencl_backend.h"
+
+#include <cmath>
+
+namespace portalsim {
+
+namespace {
+
+cl_uint2 split(uint64_t v) {
+  cl_uint2 r;
+  r.s[0] = static_cast<cl_uint>(v);
+  r.s[1] = static_cast<cl_uint>(v >> 32);
+  return r;
+}
+
+// A device buffer that grows to the largest batch seen and is then reused.
+struct Grown {
+  cl::Buffer buf;
+  size_t bytes = 0;
+  cl::Buffer& at_least(cl::Context& ctx, size_t want) {
+    if (want > bytes || bytes == 0) {
+      bytes = std::max<size_t>(want, 1);
+      buf = cl::Buffer(ctx, CL_MEM_READ_WRITE, bytes);
+    }
+    return buf;
+  }
+};
+
+template <class T>
+cl::Buffer constant(cl::Context& ctx, const std::vector<T>& v) {
+  std::vector<T> copy = v;
+  if (copy.empty()) copy.resize(1);
+  return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, copy.size() * sizeof(T), copy.data());
+}
+
+class OpenCLBackend final : public Backend {
+ public:
+  OpenCLBackend(const Catalogue& cat, const AssetSet& assets, std::shared_ptr<OpenCLRuntime> rt)
+      : cat_(cat), rt_(std::move(rt)) {
+    std::vector<uint8_t> atlas;
+    auto add = [&](const Image& img) {
+      const int off = static_cast<int>(atlas.size());
+      atlas.insert(atlas.end(), img.pixels.begin(), img.pixels.end());
+      return off;
+    };
+    std::vector<cl_int> bases;
+    for (const auto& views : assets.bases)
+      for (const Image& img : views) bases.push_back(add(img));
+    const size_t V = cat.variant_list.size();
+    std::vector<cl_int4> sprites(V * 2), places(V * kRegions);
+    for (size_t v = 0; v < V; ++v) {
+      const Image* sp[2] = {&assets.mmw_sprites[v], &assets.ir_sprites[v]};
+      for (int s = 0; s < 2; ++s) sprites[v * 2 + s] = {{add(*sp[s]), sp[s]->width, sp[s]->height, 0}};
+      for (int r = 0; r < kRegions; ++r) {
+        const Region& reg = cat.regions[r];
+        // Sprite centred in the region; >> 1 floors negative differences too.
+        places[v * kRegions + r] = {{reg.mmw.x + ((reg.mmw.w - sp[0]->width) >> 1),
+                                     reg.mmw.y + ((reg.mmw.h - sp[0]->height) >> 1),
+                                     reg.ir.x + ((reg.ir.w - sp[1]->width) >> 1),
+                                     reg.ir.y + ((reg.ir.h - sp[1]->height) >> 1)}};
+      }
+    }
+    std::vector<cl_int> noise_offsets;
+    std::vector<cl_float> noise_gains;
+    for (size_t k = 0; k < assets.noise.size(); ++k) {
+      noise_offsets.push_back(add(assets.noise[k]));
+      noise_gains.push_back(static_cast<float>(cat.noise[k].gain));
+    }
+    if (atlas.size() > 0x7fffffffu) throw std::runtime_error("catalogue images exceed 2 GiB");
+    std::vector<cl_int4> rects;
+    for (const Region& r : cat.regions) rects.push_back({{r.mmw.x, r.mmw.y, r.mmw.w, r.mmw.h}});
+    std::vector<uint8_t> influence, categories, base_zones;
+    for (const auto& table : cat.influence)
+      for (const auto& row : table)
+        for (int z : row) influence.push_back(static_cast<uint8_t>(z));
+    for (size_t v = 0; v < V; ++v) categories.push_back(static_cast<uint8_t>(cat.object_of(static_cast<int>(v)).metal));
+    for (const Subject& s : cat.subjects)
+      for (int z : s.base_zones) base_zones.push_back(static_cast<uint8_t>(z));
+
+    cl::Context& ctx = rt_->context();
+    atlas_ = constant(ctx, atlas);
+    bases_ = constant(ctx, bases);
+    sprites_ = constant(ctx, sprites);
+    places_ = constant(ctx, places);
+    noise_offsets_ = constant(ctx, noise_offsets);
+    noise_gains_ = constant(ctx, noise_gains);
+    rects_ = constant(ctx, rects);
+    influence_ = constant(ctx, influence);
+    categories_ = constant(ctx, categories);
+    base_zones_ = constant(ctx, base_zones);
+    render_ = cl::Kernel(rt_->program(), "render_view");
+    pool_blocks_ = cl::Kernel(rt_->program(), "pool_blocks");
+    pool_regions_ = cl::Kernel(rt_->program(), "pool_regions");
+    metal_ = cl::Kernel(rt_->program(), "metal_zones");
+  }
+
+  std::string name() const override { return "opencl"; }
+
+  void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) override {
+    const ImagesConfig& ic = cat_.images;
+    const size_t n = batch.size();
+    out.n = n;
+    out.mmw_width = ic.mmw_width;
+    out.mmw_height = ic.mmw_height;
+    out.ir_width = ic.ir_width;
+    out.ir_height = ic.ir_height;
+    out.layout = FeatureLayout::of(cat_, plan.model.block);
+    const size_t mmw_px = static_cast<size_t>(ic.mmw_width) * ic.mmw_height;
+    const size_t ir_px = static_cast<size_t>(ic.ir_width) * ic.ir_height;
+    const int row_len = out.layout.image_features();
+    out.upper.resize(plan.mmw_images ? n * mmw_px : 0);
+    out.lower.resize(plan.mmw_images ? n * mmw_px : 0);
+    out.ir.resize(plan.ir_image ? n * ir_px : 0);
+    out.metal.resize(plan.metal ? n * kZones : 0);
+    out.features.resize(plan.features ? n * row_len : 0);
+    if (n == 0) return;
+
+    cl::Context& ctx = rt_->context();
+    cl::CommandQueue& q = rt_->queue();
+    cl::Buffer& subject = subject_.at_least(ctx, n);
+    cl::Buffer& objects = objects_.at_least(ctx, n * kRegions * sizeof(int16_t));
+    q.enqueueWriteBuffer(subject, CL_FALSE, 0, n, batch.subject.data());
+    q.enqueueWriteBuffer(objects, CL_FALSE, 0, n * kRegions * sizeof(int16_t), batch.objects.data());
+    const cl_uint2 seed = split(plan.model.seed), first = split(batch.first_index);
+    const cl_uint count = static_cast<cl_uint>(n);
+    const cl_int flags = (plan.model.pattern_noise ? 1 : 0) | (plan.model.pixel_sigma > 0 ? 2 : 0);
+
+    auto render = [&](int view, cl::Buffer& dst, int W, int H) {
+      cl::Kernel& k = render_;
+      int a = 0;
+      k.setArg(a++, atlas_);
+      k.setArg(a++, bases_);
+      k.setArg(a++, sprites_);
+      k.setArg(a++, places_);
+      k.setArg(a++, noise_offsets_);
+      k.setArg(a++, noise_gains_);
+      k.setArg(a++, subject);
+      k.setArg(a++, objects);
+      k.setArg(a++, count);
+      k.setArg(a++, static_cast<cl_int>(view));
+      k.setArg(a++, static_cast<cl_int>(W));
+      k.setArg(a++, static_cast<cl_int>(H));
+      k.setArg(a++, static_cast<cl_float>(ic.alpha));
+      k.setArg(a++, seed);
+      k.setArg(a++, first);
+      k.setArg(a++, static_cast<cl_int>(cat_.noise.size()));
+      k.setArg(a++, static_cast<cl_int>(ic.noise_size));
+      k.setArg(a++, static_cast<cl_float>(plan.model.pixel_sigma));
+      k.setArg(a++, flags);
+      k.setArg(a++, dst);
+      q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n * H)), cl::NDRange(kLocalSize));
+    };
+
+    if (plan.renders_mmw()) {
+      cl::Buffer& upper = upper_.at_least(ctx, n * mmw_px);
+      cl::Buffer& lower = lower_.at_least(ctx, n * mmw_px);
+      render(0, upper, ic.mmw_width, ic.mmw_height);
+      render(1, lower, ic.mmw_width, ic.mmw_height);
+      if (plan.features) {
+        cl::Buffer& feats = features_.at_least(ctx, n * row_len * sizeof(float));
+        const FeatureLayout& f = out.layout;
+        int a = 0;
+        pool_blocks_.setArg(a++, upper);
+        pool_blocks_.setArg(a++, lower);
+        pool_blocks_.setArg(a++, count);
+        pool_blocks_.setArg(a++, static_cast<cl_int>(ic.mmw_width));
+        pool_blocks_.setArg(a++, static_cast<cl_int>(ic.mmw_height));
+        pool_blocks_.setArg(a++, static_cast<cl_int>(f.block));
+        pool_blocks_.setArg(a++, static_cast<cl_int>(f.blocks_x));
+        pool_blocks_.setArg(a++, static_cast<cl_int>(f.blocks_y));
+        pool_blocks_.setArg(a++, static_cast<cl_int>(row_len));
+        pool_blocks_.setArg(a++, feats);
+        q.enqueueNDRangeKernel(pool_blocks_, cl::NullRange, cl::NDRange(padded(n * 2 * f.blocks_x * f.blocks_y)),
+                               cl::NDRange(kLocalSize));
+        a = 0;
+        pool_regions_.setArg(a++, upper);
+        pool_regions_.setArg(a++, lower);
+        pool_regions_.setArg(a++, count);
+        pool_regions_.setArg(a++, static_cast<cl_int>(ic.mmw_width));
+        pool_regions_.setArg(a++, static_cast<cl_int>(ic.mmw_height));
+        pool_regions_.setArg(a++, rects_);
+        pool_regions_.setArg(a++, static_cast<cl_int>(2 * f.blocks_x * f.blocks_y));
+        pool_regions_.setArg(a++, static_cast<cl_int>(row_len));
+        pool_regions_.setArg(a++, feats);
+        q.enqueueNDRangeKernel(pool_regions_, cl::NullRange, cl::NDRange(padded(n * kRegions)),
+                               cl::NDRange(kLocalSize));
+        q.enqueueReadBuffer(feats, CL_FALSE, 0, n * row_len * sizeof(float), out.features.data());
+      }
+      if (plan.mmw_images) {
+        q.enqueueReadBuffer(upper, CL_FALSE, 0, n * mmw_px, out.upper.data());
+        q.enqueueReadBuffer(lower, CL_FALSE, 0, n * mmw_px, out.lower.data());
+      }
+    }
+    if (plan.ir_image) {
+      cl::Buffer& ir = ir_.at_least(ctx, n * ir_px);
+      render(2, ir, ic.ir_width, ic.ir_height);
+      q.enqueueReadBuffer(ir, CL_FALSE, 0, n * ir_px, out.ir.data());
+    }
+    if (plan.metal) {
+      cl::Buffer& metal = metal_out_.at_least(ctx, n * kZones);
+      int a = 0;
+      metal_.setArg(a++, influence_);
+      metal_.setArg(a++, categories_);
+      metal_.setArg(a++, base_zones_);
+      metal_.setArg(a++, subject);
+      metal_.setArg(a++, objects);
+      metal_.setArg(a++, count);
+      metal_.setArg(a++, seed);
+      metal_.setArg(a++, first);
+      metal_.setArg(a++, static_cast<cl_int>(plan.model.metal_noise));
+      metal_.setArg(a++, metal);
+      q.enqueueNDRangeKernel(metal_, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
+      q.enqueueReadBuffer(metal, CL_FALSE, 0, n * kZones, out.metal.data());
+    }
+    q.finish();
+  }
+
+ private:
+  const Catalogue& cat_;
+  std::shared_ptr<OpenCLRuntime> rt_;
+  cl::Buffer atlas_, bases_, sprites_, places_, noise_offsets_, noise_gains_, rects_, influence_, categories_,
+      base_zones_;
+  cl::Kernel render_, pool_blocks_, pool_regions_, metal_;
+  Grown subject_, objects_, upper_, lower_, ir_, metal_out_, features_;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> make_opencl_backend(const Catalogue& cat, const AssetSet& assets,
+                                             std::shared_ptr<OpenCLRuntime> runtime) {
+  return std::make_unique<OpenCLBackend>(cat, assets, std::move(runtime));
+}
+
+}  // namespace portalsim

@@ -1,0 +1,64 @@
+#include "backend/opencl/runtime.h"
+
+#include <chrono>
+#include <stdexcept>
+#include <string_view>
+
+namespace portalsim {
+
+namespace embedded {
+extern const std::string_view kernel_philox, kernel_composite, kernel_noise, kernel_pool, kernel_metal,
+    kernel_render;
+}
+
+std::string OpenCLRuntime::source() {
+  std::string s;
+  for (std::string_view part : {embedded::kernel_philox, embedded::kernel_composite, embedded::kernel_noise,
+                                embedded::kernel_pool, embedded::kernel_metal, embedded::kernel_render}) {
+    s += part;
+    s += "\n";
+  }
+  return s;
+}
+
+OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
+  std::vector<cl::Platform> platforms;
+  cl::Platform::get(&platforms);
+  bool found = false;
+  for (const cl::Platform& p : platforms) {
+    std::vector<cl::Device> devices;
+    try {
+      p.getDevices(CL_DEVICE_TYPE_ALL, &devices);
+    } catch (const cl::Error&) {
+      continue;
+    }
+    for (const cl::Device& d : devices) {
+      const std::string name = p.getInfo<CL_PLATFORM_NAME>() + " / " + d.getInfo<CL_DEVICE_NAME>();
+      const bool wanted = options.device.empty() ? (d.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0
+                                                 : name.find(options.device) != std::string::npos;
+      if (wanted) {
+        device_ = d;
+        device_name_ = name;
+        found = true;
+        break;
+      }
+    }
+    if (found) break;
+  }
+  if (!found)
+    throw std::runtime_error(options.device.empty()
+                                 ? "no OpenCL CPU device found (is pocl-opencl-icd installed?)"
+                                 : "no OpenCL device matches \"" + options.device + "\"");
+  context_ = cl::Context(device_);
+  queue_ = cl::CommandQueue(context_, device_);
+  program_ = cl::Program(context_, source());
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    program_.build({device_}, ("-cl-std=CL1.2 " + options.build_options).c_str());
+  } catch (const cl::Error&) {
+    throw std::runtime_error("OpenCL program build failed:\n" + program_.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_));
+  }
+  build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace portalsim

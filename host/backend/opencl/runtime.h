@@ -1,0 +1,37 @@
+// The OpenCL runtime: one device, context, queue and the built portalsim program.
+#pragma once
+#include <CL/opencl.hpp>
+#include <string>
+
+namespace portalsim {
+
+struct OpenCLOptions {
+  std::string device;        // substring of the platform or device name; empty = first CPU device
+  std::string build_options; // extra options for clBuildProgram
+};
+
+class OpenCLRuntime {
+ public:
+  explicit OpenCLRuntime(const OpenCLOptions& options = {});
+  cl::Context& context() { return context_; }
+  cl::CommandQueue& queue() { return queue_; }
+  cl::Program& program() { return program_; }
+  const std::string& device_name() const { return device_name_; }
+  double build_seconds() const { return build_seconds_; }
+  static std::string source();  // the kernels/ files, concatenated in build order
+
+ private:
+  cl::Context context_;
+  cl::Device device_;
+  cl::CommandQueue queue_;
+  cl::Program program_;
+  std::string device_name_;
+  double build_seconds_ = 0;
+};
+
+// Rounds a work size up to the fixed local size: PoCL compiles a work-group function per
+// local size, so every launch uses the same one.
+constexpr size_t kLocalSize = 64;
+inline size_t padded(size_t n) { return (n + kLocalSize - 1) / kLocalSize * kLocalSize; }
+
+}  // namespace portalsim

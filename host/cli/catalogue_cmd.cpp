@@ -1,0 +1,71 @@
+// portalsim catalogue: what a scenario can name, and the default images to look at.
+#include <cstdio>
+
+#include "assets/image_io.h"
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "sink/staging.h"
+
+namespace portalsim::cli {
+
+namespace {
+struct CatalogueOptions {
+  CommonOptions common;
+  std::string images;  // folder to write every resolved image into
+};
+
+int list(CatalogueOptions& o) {
+  Session s;
+  open_catalogue(s, o.common);
+  const Catalogue& c = s.catalogue;
+  std::printf("catalogue %s (hash %s)\n", c.source.c_str(), c.hash.c_str());
+  std::printf("images: MMW %dx%d per view, IR %dx%d, alpha %.3g\n", c.images.mmw_width, c.images.mmw_height,
+              c.images.ir_width, c.images.ir_height, c.images.alpha);
+  std::printf("\nsubjects:\n");
+  for (size_t i = 0; i < c.subjects.size(); ++i) std::printf("  %zu  %s\n", i + 1, c.subjects[i].name.c_str());
+  std::printf("\nregions:\n");
+  for (const Region& r : c.regions)
+    std::printf("  %2d  %-15s %s\n", r.id, r.name.c_str(), r.view == View::upper ? "upper" : "lower");
+  std::printf("\nobjects (name [variants] metal category: aliases):\n");
+  for (const Object& ob : c.objects) {
+    std::string vars, aliases;
+    for (const Variant& v : ob.variants)
+      if (!v.code.empty()) vars += (vars.empty() ? "" : ",") + v.code;
+    for (const std::string& a : ob.aliases) aliases += (aliases.empty() ? "" : ", ") + a;
+    std::printf("  %-14s %-6s %-7s %s\n", ob.name.c_str(), vars.empty() ? "" : ("[" + vars + "]").c_str(),
+                c.metal_categories[ob.metal].c_str(), aliases.c_str());
+  }
+  if (!o.images.empty()) {
+    StagedFolder folder(o.images);
+    for (size_t i = 0; i < s.assets.bases.size(); ++i) {
+      const std::string p = "subject" + std::to_string(i + 1);
+      write_image(folder.path(p + "_mmw_upper.png"), s.assets.bases[i][0]);
+      write_image(folder.path(p + "_mmw_lower.png"), s.assets.bases[i][1]);
+      write_image(folder.path(p + "_ir.png"), colourise(s.assets.bases[i][2], s.assets.palette));
+    }
+    for (size_t v = 0; v < c.variant_list.size(); ++v) {
+      std::string n = c.variant_name(static_cast<int>(v));
+      for (char& ch : n)
+        if (ch == ':') ch = '_';
+      write_image(folder.path(n + "_mmw.png"), s.assets.mmw_sprites[v]);
+      write_image(folder.path(n + "_ir.png"), s.assets.ir_sprites[v]);
+    }
+    for (size_t k = 0; k < s.assets.noise.size(); ++k)
+      write_image(folder.path("noise" + std::to_string(k + 1) + "_" + c.noise[k].name + ".png"), s.assets.noise[k]);
+    folder.commit();
+    std::printf("\nimages written to %s\n", o.images.c_str());
+  }
+  return 0;
+}
+}  // namespace
+
+std::function<int()> add_catalogue(CLI::App& app) {
+  auto o = std::make_shared<CatalogueOptions>();
+  CLI::App* sub = app.add_subcommand("catalogue", "list the subjects, regions and objects; optionally dump the images");
+  sub->add_option("--catalogue", o->common.catalogue, "catalogue TOML file (default: the built-in one)");
+  sub->add_option("--assets", o->common.assets, "folder in which the catalogue's image files are looked up first");
+  sub->add_option("--images", o->images, "write every base image, sprite and noise pattern into this folder");
+  return [o] { return list(*o); };
+}
+
+}  // namespace portalsim::cli

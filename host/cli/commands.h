@@ -1,0 +1,15 @@
+// The subcommands of the portalsim command line.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace portalsim::cli {
+
+// Each registers its subcommand and returns the function that runs it (exit status).
+std::function<int()> add_simulate(CLI::App& app);
+std::function<int()> add_catalogue(CLI::App& app);
+
+// Parses argv and runs the chosen subcommand; prints errors, returns the exit status.
+int run(int argc, char** argv);
+
+}  // namespace portalsim::cli

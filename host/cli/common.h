@@ -1,0 +1,43 @@
+// What every subcommand shares: the catalogue and assets it runs on, the backend, and
+// parsing of numbers given on the command line.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "assets/assets.h"
+#include "backend/backend.h"
+#include "backend/opencl/runtime.h"
+#include "scene/catalogue.h"
+
+namespace portalsim::cli {
+
+struct CommonOptions {
+  std::string catalogue;  // empty = built-in
+  std::string assets;
+  std::string backend = "opencl";
+  std::string device;
+  std::string seed = "0";
+  bool timing = false;
+};
+
+void add_common_options(CLI::App& app, CommonOptions& o);
+
+// Parses a decimal or 0x-hexadecimal unsigned 64-bit integer; throws InputError naming `field`.
+uint64_t parse_u64(const std::string& text, const std::string& field);
+
+// The catalogue, its assets and a backend, with the time each took.
+struct Session {
+  Catalogue catalogue;
+  AssetSet assets;
+  std::shared_ptr<OpenCLRuntime> runtime;  // null for the reference backend
+  std::unique_ptr<Backend> backend;
+  double catalogue_seconds = 0, assets_seconds = 0, backend_seconds = 0;
+};
+Session open_session(const CommonOptions& o);
+// Catalogue and assets only (no backend yet): lets a command check its arguments first.
+void open_catalogue(Session& s, const CommonOptions& o);
+void open_backend(Session& s, const CommonOptions& o);
+
+}  // namespace portalsim::cli

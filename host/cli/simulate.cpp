@@ -1,0 +1,96 @@
+// portalsim simulate: the thesis's command line (sections 4.2, 4.4) for one scenario.
+#include <chrono>
+#include <cstdio>
+
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "scene/error.h"
+#include "scene/rules.h"
+#include "sink/scenario_folder.h"
+
+namespace portalsim::cli {
+
+namespace {
+struct SimulateOptions {
+  CommonOptions common;
+  int subject = 1;
+  std::string rule, threat, out = "portalsim-out", image_format = "png";
+  std::vector<std::string> objects;
+  ModelSettings model;
+  std::string pattern_noise = "on";
+};
+
+int simulate(SimulateOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Session s;
+  open_catalogue(s, o.common);
+  const Catalogue& cat = s.catalogue;
+
+  // Everything the user gave is checked before any backend work or any file is written.
+  Scenario scene = parse_object_list(cat, o.objects);
+  const int subjects = static_cast<int>(cat.subjects.size());
+  if (o.subject < 1 || o.subject > subjects)
+    throw InputError("--subject: " + std::to_string(o.subject) + " is out of range (1 to " +
+                     std::to_string(subjects) + ")");
+  scene.subject = o.subject - 1;
+  if (!o.rule.empty() && !o.threat.empty()) throw InputError("--rule and --threat: give one or the other");
+  if (!o.rule.empty())
+    scene.label = ThreatRule(cat, o.rule)(scene) ? 1 : 0;
+  else
+    scene.label = o.threat == "yes" ? 1 : 0;
+
+  Plan plan;
+  plan.model = o.model;
+  plan.model.seed = parse_u64(o.common.seed, "--seed");
+  plan.model.pattern_noise = o.pattern_noise == "on";
+  validate(plan, cat);
+
+  StagedFolder folder(o.out);
+  open_backend(s, o.common);
+
+  SceneBatch batch;
+  batch.push(scene);
+  BatchOutput out;
+  const auto t_run = std::chrono::steady_clock::now();
+  s.backend->run(batch, plan, out);
+  const double run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_run).count();
+
+  const auto t_write = std::chrono::steady_clock::now();
+  write_scenario_folder(folder, out, 0, scene.label == 1, s.assets.palette, FolderOptions{o.image_format});
+  folder.commit();
+  const double write_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_write).count();
+
+  std::printf("%s: subject %d, threat %s, metal", o.out.c_str(), o.subject, scene.label ? "yes" : "no");
+  for (int z = 0; z < kZones; ++z) std::printf("%s%d", z ? "," : " ", out.metal_of(0)[z]);
+  std::printf("\n");
+  if (o.common.timing) {
+    const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("timing: catalogue %.4f s, assets %.4f s, backend setup %.4f s", s.catalogue_seconds,
+                s.assets_seconds, s.backend_seconds);
+    if (s.runtime) std::printf(" (kernel build %.4f s on %s)", s.runtime->build_seconds(), s.runtime->device_name().c_str());
+    std::printf(", run %.4f s, write %.4f s, total %.4f s\n", run_seconds, write_seconds, total);
+  }
+  return 0;
+}
+}  // namespace
+
+std::function<int()> add_simulate(CLI::App& app) {
+  auto o = std::make_shared<SimulateOptions>();
+  CLI::App* sub = app.add_subcommand("simulate", "simulate the three sensors for one person carrying objects");
+  add_common_options(*sub, o->common);
+  sub->add_option("objects", o->objects,
+                  "objects for regions 1..13 in order (none = empty region; gun:v = vertical variant)");
+  sub->add_option("--subject", o->subject, "subject 1..5 (base images and base metal values)");
+  sub->add_option("--rule", o->rule, "threat rule, e.g. gun or 'iron-rod&metal-plate'");
+  sub->add_option("--threat", o->threat, "label the scenario yes or no")->check(CLI::IsMember({"yes", "no"}));
+  sub->add_option("--out", o->out, "output folder (default portalsim-out)");
+  sub->add_option("--image-format", o->image_format, "png or jpg")->check(CLI::IsMember({"png", "jpg"}));
+  sub->add_option("--block", o->model.block, "block side for the averaged features (default 10)");
+  sub->add_option("--pattern-noise", o->pattern_noise, "the thesis's MMW noise patterns: on (default) or off")
+      ->check(CLI::IsMember({"on", "off"}));
+  sub->add_option("--pixel-noise", o->model.pixel_sigma, "per-pixel Gaussian sensor noise sigma, gray levels (default 0)");
+  sub->add_option("--metal-noise", o->model.metal_noise, "metal detector noise half-width in counts (default 0: off)");
+  return [o] { return simulate(*o); };
+}
+
+}  // namespace portalsim::cli

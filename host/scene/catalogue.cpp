@@ -1,0 +1,407 @@
+#include "scene/catalogue.h"
+
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "assets/procedural.h"
+#include "scene/error.h"
+
+namespace portalsim {
+
+namespace embedded {
+extern const std::string_view default_catalogue;
+}
+
+namespace {
+
+struct Reader {
+  std::string file;
+  std::string base_dir;
+  std::string assets_dir;
+
+  [[noreturn]] void fail(const toml::node* node, const std::string& field, const std::string& msg) const {
+    std::ostringstream s;
+    s << file;
+    if (node && node->source().begin.line > 0) s << ":" << node->source().begin.line;
+    s << ": " << field << ": " << msg;
+    throw InputError(s.str());
+  }
+
+  const toml::node* need(const toml::table& t, const std::string& key, const std::string& field) const {
+    const toml::node* n = t.get(key);
+    if (!n) fail(&t, field, "missing");
+    return n;
+  }
+
+  long long integer(const toml::node* n, const std::string& field, long long lo, long long hi) const {
+    if (!n->is_integer()) fail(n, field, "expected an integer");
+    const long long v = n->as_integer()->get();
+    if (v < lo || v > hi)
+      fail(n, field, "value " + std::to_string(v) + " is out of range [" + std::to_string(lo) + ", " +
+                         std::to_string(hi) + "]");
+    return v;
+  }
+  int integer(const toml::table& t, const std::string& key, const std::string& field, long long lo, long long hi,
+              std::optional<int> dflt = std::nullopt) const {
+    const toml::node* n = t.get(key);
+    if (!n) {
+      if (dflt) return *dflt;
+      fail(&t, field + "." + key, "missing");
+    }
+    return static_cast<int>(integer(n, field + "." + key, lo, hi));
+  }
+
+  double number(const toml::table& t, const std::string& key, const std::string& field, double lo, double hi,
+                std::optional<double> dflt = std::nullopt) const {
+    const toml::node* n = t.get(key);
+    const std::string f = field + "." + key;
+    if (!n) {
+      if (dflt) return *dflt;
+      fail(&t, f, "missing");
+    }
+    double v;
+    if (n->is_integer())
+      v = static_cast<double>(n->as_integer()->get());
+    else if (n->is_floating_point())
+      v = n->as_floating_point()->get();
+    else
+      fail(n, f, "expected a number");
+    if (!std::isfinite(v)) fail(n, f, "must be a finite number, not NaN or infinity");
+    if (v < lo || v > hi) {
+      std::ostringstream s;
+      s << "value " << v << " is out of range [" << lo << ", " << hi << "]";
+      fail(n, f, s.str());
+    }
+    return v;
+  }
+
+  std::string string(const toml::table& t, const std::string& key, const std::string& field,
+                     std::optional<std::string> dflt = std::nullopt) const {
+    const toml::node* n = t.get(key);
+    if (!n) {
+      if (dflt) return *dflt;
+      fail(&t, field + "." + key, "missing");
+    }
+    if (!n->is_string()) fail(n, field + "." + key, "expected a string");
+    return n->as_string()->get();
+  }
+
+  std::vector<int> ints(const toml::node* n, const std::string& field, size_t count, long long lo,
+                        long long hi) const {
+    const toml::array* a = n->as_array();
+    if (!a) fail(n, field, "expected an array of " + std::to_string(count) + " integers");
+    if (a->size() != count)
+      fail(n, field, "expected " + std::to_string(count) + " values, found " + std::to_string(a->size()));
+    std::vector<int> out;
+    for (size_t i = 0; i < a->size(); ++i)
+      out.push_back(static_cast<int>(integer(a->get(i), field + "[" + std::to_string(i) + "]", lo, hi)));
+    return out;
+  }
+
+  Rect rect(const toml::table& t, const std::string& key, const std::string& field, int view_w, int view_h) const {
+    const std::string f = field + "." + key;
+    const toml::node* n = need(t, key, f);
+    const std::vector<int> v = ints(n, f, 4, -100000, 100000);
+    const Rect r{v[0], v[1], v[2], v[3]};
+    if (r.w < 1 || r.h < 1) fail(n, f, "width and height must be at least 1");
+    if (r.x < 0 || r.y < 0 || r.x + r.w > view_w || r.y + r.h > view_h)
+      fail(n, f,
+           "rectangle lies outside the " + std::to_string(view_w) + "x" + std::to_string(view_h) + " view");
+    return r;
+  }
+
+  ImageSource image(const toml::table& t, const std::string& key, const std::string& field) const {
+    ImageSource src;
+    const toml::node* n = t.get(key);
+    if (!n) return src;
+    if (!n->is_string()) fail(n, field + "." + key, "expected a file name");
+    std::string p = n->as_string()->get();
+    if (p.empty()) fail(n, field + "." + key, "empty file name");
+    namespace fs = std::filesystem;
+    fs::path path(p);
+    if (path.is_relative()) {
+      if (!assets_dir.empty() && fs::exists(fs::path(assets_dir) / path))
+        path = fs::path(assets_dir) / path;
+      else if (!base_dir.empty())
+        path = fs::path(base_dir) / path;
+    }
+    src.path = path.string();
+    src.origin = file + ":" + std::to_string(n->source().begin.line) + ": " + field + "." + key;
+    return src;
+  }
+
+  const toml::array& array_of_tables(const toml::table& root, const std::string& key) const {
+    const toml::node* n = need(root, key, key);
+    const toml::array* a = n->as_array();
+    if (!a || !a->is_array_of_tables()) fail(n, key, "expected [[" + key + "]] tables");
+    return *a;
+  }
+};
+
+std::string fnv1a_hex(std::string_view text) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+}  // namespace
+
+std::string normalise_name(std::string_view name) {
+  std::string out;
+  for (unsigned char c : name)
+    if (std::isalnum(c)) out.push_back(static_cast<char>(std::tolower(c)));
+  return out;
+}
+
+std::string Catalogue::variant_name(int variant_id) const {
+  const Object& o = object_of(variant_id);
+  const Variant& v = variant(variant_id);
+  return v.code.empty() ? o.name : o.name + ":" + v.code;
+}
+
+int Catalogue::find_object(std::string_view name) const {
+  const std::string key = normalise_name(name);
+  if (key.empty()) return -1;
+  for (size_t i = 0; i < objects.size(); ++i) {
+    if (normalise_name(objects[i].name) == key) return static_cast<int>(i);
+    for (const std::string& a : objects[i].aliases)
+      if (normalise_name(a) == key) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+Catalogue parse_catalogue(std::string_view text, const std::string& source_name, const std::string& base_dir,
+                          const std::string& assets_dir) {
+  Reader rd{source_name, base_dir, assets_dir};
+  toml::table root;
+  try {
+    root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream s;
+    s << source_name << ":" << e.source().begin.line << ": syntax: " << e.description();
+    throw InputError(s.str());
+  }
+  Catalogue cat;
+  cat.source = source_name;
+  cat.hash = fnv1a_hex(text);
+
+  if (const toml::node* f = root.get("format")) rd.integer(f, "format", 1, 1);
+
+  // [images]
+  const toml::node* imgs_node = rd.need(root, "images", "images");
+  const toml::table* imgs = imgs_node->as_table();
+  if (!imgs) rd.fail(imgs_node, "images", "expected a table");
+  ImagesConfig& ic = cat.images;
+  ic.mmw_width = rd.integer(*imgs, "mmw_width", "images", 1, 4096);
+  ic.mmw_height = rd.integer(*imgs, "mmw_height", "images", 1, 4096);
+  ic.ir_width = rd.integer(*imgs, "ir_width", "images", 1, 4096);
+  ic.ir_height = rd.integer(*imgs, "ir_height", "images", 1, 4096);
+  ic.alpha = rd.number(*imgs, "alpha", "images", 0.0, 1.0);
+  ic.noise_size = rd.integer(*imgs, "noise_size", "images", 1, 4096, 64);
+
+  // [metal] first: objects refer to its categories.
+  const toml::node* metal_node = rd.need(root, "metal", "metal");
+  const toml::table* metal = metal_node->as_table();
+  if (!metal) rd.fail(metal_node, "metal", "expected a table");
+  {
+    const toml::node* cn = rd.need(*metal, "categories", "metal.categories");
+    const toml::array* ca = cn->as_array();
+    if (!ca || ca->empty()) rd.fail(cn, "metal.categories", "expected a non-empty array of names");
+    for (size_t i = 0; i < ca->size(); ++i) {
+      const toml::node* e = ca->get(i);
+      if (!e->is_string()) rd.fail(e, "metal.categories[" + std::to_string(i) + "]", "expected a string");
+      cat.metal_categories.push_back(e->as_string()->get());
+    }
+    const toml::node* inf_node = rd.need(*metal, "influence", "metal.influence");
+    const toml::table* inf = inf_node->as_table();
+    if (!inf) rd.fail(inf_node, "metal.influence", "expected a table");
+    for (const auto& [key, node] : *inf) {
+      bool known = false;
+      for (const std::string& c : cat.metal_categories) known |= (c == key.str());
+      if (!known)
+        rd.fail(&node, "metal.influence." + std::string(key.str()), "not one of metal.categories");
+    }
+    for (const std::string& c : cat.metal_categories) {
+      const std::string f = "metal.influence." + c;
+      const toml::node* rows_node = rd.need(*inf, c, f);
+      const toml::array* rows = rows_node->as_array();
+      if (!rows || rows->size() != kRegions)
+        rd.fail(rows_node, f, "expected " + std::to_string(kRegions) + " rows, one per region");
+      std::array<std::array<int, kZones>, kRegions> table{};
+      for (int r = 0; r < kRegions; ++r) {
+        const std::vector<int> v =
+            rd.ints(rows->get(r), f + "[region " + std::to_string(r + 1) + "]", kZones, 0, 199);
+        std::copy(v.begin(), v.end(), table[r].begin());
+      }
+      cat.influence.push_back(table);
+    }
+  }
+
+  // [[subjects]]
+  const toml::array& subjects = rd.array_of_tables(root, "subjects");
+  if (subjects.empty() || subjects.size() > 255) rd.fail(&subjects, "subjects", "expected 1 to 255 subjects");
+  for (size_t i = 0; i < subjects.size(); ++i) {
+    const toml::table& t = *subjects.get(i)->as_table();
+    const std::string f = "subjects[" + std::to_string(i + 1) + "]";
+    Subject s;
+    s.name = rd.string(t, "name", f);
+    s.build = rd.number(t, "build", f, 0.5, 1.5, 1.0);
+    s.mmw_level = rd.integer(t, "mmw_level", f, 0, 255, 150);
+    s.ir_core = rd.integer(t, "ir_core", f, 0, 255, 215);
+    s.ir_limb = rd.integer(t, "ir_limb", f, 0, 255, 175);
+    const std::vector<int> z = rd.ints(rd.need(t, "base_zones", f + ".base_zones"), f + ".base_zones", kZones, 1, 200);
+    std::copy(z.begin(), z.end(), s.base_zones.begin());
+    s.mmw_upper = rd.image(t, "mmw_upper", f);
+    s.mmw_lower = rd.image(t, "mmw_lower", f);
+    s.ir = rd.image(t, "ir", f);
+    cat.subjects.push_back(std::move(s));
+  }
+
+  // [[regions]]
+  const toml::array& regions = rd.array_of_tables(root, "regions");
+  if (regions.size() != kRegions)
+    rd.fail(&regions, "regions", "expected exactly 13 regions, found " + std::to_string(regions.size()));
+  std::array<bool, kRegions> seen{};
+  for (size_t i = 0; i < regions.size(); ++i) {
+    const toml::table& t = *regions.get(i)->as_table();
+    const std::string f = "regions[" + std::to_string(i + 1) + "]";
+    const int id = rd.integer(t, "id", f, 1, kRegions);
+    if (seen[id - 1]) rd.fail(t.get("id"), f + ".id", "region " + std::to_string(id) + " is defined twice");
+    seen[id - 1] = true;
+    Region& r = cat.regions[id - 1];
+    r.id = id;
+    r.name = rd.string(t, "name", f);
+    const std::string view = rd.string(t, "view", f);
+    if (view == "upper")
+      r.view = View::upper;
+    else if (view == "lower")
+      r.view = View::lower;
+    else
+      rd.fail(t.get("view"), f + ".view", "expected \"upper\" or \"lower\", got \"" + view + "\"");
+    const bool must_upper = id <= kUpperRegions;
+    if ((r.view == View::upper) != must_upper)
+      rd.fail(t.get("view"), f + ".view",
+              "regions 1-6 are in the upper view and 7-13 in the lower view (thesis 4.2)");
+    r.mmw = rd.rect(t, "mmw", f, ic.mmw_width, ic.mmw_height);
+    r.ir = rd.rect(t, "ir", f, ic.ir_width, ic.ir_height);
+  }
+
+  // [[objects]]
+  const toml::array& objects = rd.array_of_tables(root, "objects");
+  if (objects.empty() || objects.size() > 1000) rd.fail(&objects, "objects", "expected 1 to 1000 objects");
+  for (size_t i = 0; i < objects.size(); ++i) {
+    const toml::table& t = *objects.get(i)->as_table();
+    const std::string f = "objects[" + std::to_string(i + 1) + "]";
+    Object o;
+    o.name = rd.string(t, "name", f);
+    if (normalise_name(o.name).empty() || normalise_name(o.name) == "none")
+      rd.fail(t.get("name"), f + ".name", "\"" + o.name + "\" cannot name an object");
+    if (const toml::node* an = t.get("aliases")) {
+      const toml::array* a = an->as_array();
+      if (!a) rd.fail(an, f + ".aliases", "expected an array of strings");
+      for (size_t k = 0; k < a->size(); ++k) {
+        if (!a->get(k)->is_string())
+          rd.fail(a->get(k), f + ".aliases[" + std::to_string(k) + "]", "expected a string");
+        o.aliases.push_back(a->get(k)->as_string()->get());
+      }
+    }
+    for (const std::string& n : [&] {
+           std::vector<std::string> all{o.name};
+           all.insert(all.end(), o.aliases.begin(), o.aliases.end());
+           return all;
+         }()) {
+      if (cat.find_object(n) >= 0)
+        rd.fail(&t, f + ".name", "\"" + n + "\" already names " + cat.objects[cat.find_object(n)].name);
+    }
+    o.material = rd.string(t, "material", f, "");
+    const std::string metal_name = rd.string(t, "metal", f);
+    o.metal = -1;
+    for (size_t c = 0; c < cat.metal_categories.size(); ++c)
+      if (cat.metal_categories[c] == metal_name) o.metal = static_cast<int>(c);
+    if (o.metal < 0) rd.fail(t.get("metal"), f + ".metal", "\"" + metal_name + "\" is not in metal.categories");
+    o.shape = rd.string(t, "shape", f);
+    const std::vector<int> size = rd.ints(rd.need(t, "size", f + ".size"), f + ".size", 2, 1, 4096);
+    o.width = size[0];
+    o.height = size[1];
+    o.mmw_level = rd.integer(t, "mmw_level", f, 0, 255);
+    o.ir_level = rd.integer(t, "ir_level", f, 0, 255);
+    std::vector<std::string> codes;
+    if (const toml::node* vn = t.get("variants")) {
+      const toml::array* va = vn->as_array();
+      if (!va || va->empty()) rd.fail(vn, f + ".variants", "expected a non-empty array such as [\"h\", \"v\"]");
+      for (size_t k = 0; k < va->size(); ++k) {
+        const toml::node* e = va->get(k);
+        const std::string vf = f + ".variants[" + std::to_string(k) + "]";
+        if (!e->is_string()) rd.fail(e, vf, "expected \"h\" or \"v\"");
+        const std::string code = e->as_string()->get();
+        if (code != "h" && code != "v") rd.fail(e, vf, "expected \"h\" or \"v\", got \"" + code + "\"");
+        for (const std::string& c : codes)
+          if (c == code) rd.fail(e, vf, "variant \"" + code + "\" listed twice");
+        codes.push_back(code);
+      }
+    } else {
+      codes.push_back("");
+    }
+    const bool file_images = t.get("mmw") || t.get("ir") || t.get("mmw_h") || t.get("mmw_v") ||
+                             t.get("ir_h") || t.get("ir_v");
+    if (!procedural::is_shape(o.shape) && !file_images)
+      rd.fail(t.get("shape"), f + ".shape", "unknown shape \"" + o.shape + "\" and no image files given");
+    o.first_variant = static_cast<int>(cat.variant_list.size());
+    for (size_t k = 0; k < codes.size(); ++k) {
+      Variant v;
+      v.code = codes[k];
+      const std::string sfx = v.code.empty() ? "" : "_" + v.code;
+      v.mmw = rd.image(t, "mmw" + sfx, f);
+      v.ir = rd.image(t, "ir" + sfx, f);
+      if (v.code.empty() || codes.size() == 1) {
+        if (v.mmw.path.empty()) v.mmw = rd.image(t, "mmw", f);
+        if (v.ir.path.empty()) v.ir = rd.image(t, "ir", f);
+      }
+      o.variants.push_back(v);
+      cat.variant_list.push_back({static_cast<int>(cat.objects.size()), static_cast<int>(k)});
+    }
+    if (cat.variant_list.size() > 30000) rd.fail(&t, f, "too many object variants (at most 30000)");
+    cat.objects.push_back(std::move(o));
+  }
+
+  // [[noise]]
+  const toml::array& noise = rd.array_of_tables(root, "noise");
+  if (noise.empty() || noise.size() > 255) rd.fail(&noise, "noise", "expected 1 to 255 noise patterns");
+  for (size_t i = 0; i < noise.size(); ++i) {
+    const toml::table& t = *noise.get(i)->as_table();
+    const std::string f = "noise[" + std::to_string(i + 1) + "]";
+    NoisePattern p;
+    p.name = rd.string(t, "name", f);
+    p.gain = rd.number(t, "gain", f, 0.0, 100.0, 1.0);
+    p.image = rd.image(t, "image", f);
+    if (p.image.path.empty() && i >= static_cast<size_t>(procedural::kNoisePatterns))
+      rd.fail(&t, f, "only the first 5 noise patterns have procedural defaults; give an image");
+    cat.noise.push_back(std::move(p));
+  }
+  return cat;
+}
+
+Catalogue load_catalogue(const std::string& path, const std::string& assets_dir) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot read the catalogue file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) throw InputError(path + ": error while reading the catalogue file");
+  const std::string dir = std::filesystem::absolute(path).parent_path().string();
+  return parse_catalogue(s.str(), path, dir, assets_dir);
+}
+
+Catalogue default_catalogue(const std::string& assets_dir) {
+  return parse_catalogue(embedded::default_catalogue, "<built-in catalogue>", "", assets_dir);
+}
+
+}  // namespace portalsim

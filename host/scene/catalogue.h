@@ -1,0 +1,113 @@
+// The catalogue: everything a scenario can name (thesis chapter 4), read from TOML.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace portalsim {
+
+constexpr int kRegions = 13;
+constexpr int kZones = 19;
+constexpr int kUpperRegions = 6;
+
+struct Rect {
+  int x = 0, y = 0, w = 0, h = 0;
+};
+
+enum class View : int { upper = 0, lower = 1 };
+
+// Where an image comes from: a file, or (path empty) the procedural default.
+struct ImageSource {
+  std::string path;    // resolved path, empty for procedural
+  std::string origin;  // "file:line: field", for error messages
+};
+
+struct Subject {
+  std::string name;
+  double build = 1.0;
+  int mmw_level = 150, ir_core = 215, ir_limb = 175;
+  std::array<int, kZones> base_zones{};
+  ImageSource mmw_upper, mmw_lower, ir;
+};
+
+struct Region {
+  int id = 0;
+  std::string name;
+  View view = View::upper;
+  Rect mmw, ir;
+};
+
+struct Variant {
+  std::string code;  // "h", "v", or "" for an object with one drawing
+  ImageSource mmw, ir;
+};
+
+struct Object {
+  std::string name;
+  std::vector<std::string> aliases;
+  std::string material;
+  int metal = 0;  // index into Catalogue::metal_categories
+  std::string shape;
+  int width = 0, height = 0;  // MMW sprite of the horizontal drawing
+  int mmw_level = 0, ir_level = 0;
+  std::vector<Variant> variants;
+  int first_variant = 0;  // index of variants[0] in Catalogue::variant_list
+};
+
+struct NoisePattern {
+  std::string name;
+  double gain = 1.0;
+  ImageSource image;
+};
+
+struct ImagesConfig {
+  int mmw_width = 200, mmw_height = 200;
+  int ir_width = 100, ir_height = 200;
+  double alpha = 0.9;
+  int noise_size = 64;
+};
+
+// A drawable thing: one variant of one object. Scenes refer to these by index.
+struct VariantRef {
+  int object = 0;
+  int variant = 0;
+};
+
+struct Catalogue {
+  std::string source;  // the file it came from, or "<built-in catalogue>"
+  std::string hash;    // FNV-1a 64 of the text, hex
+  ImagesConfig images;
+  std::vector<Subject> subjects;
+  std::array<Region, kRegions> regions;
+  std::vector<Object> objects;
+  std::vector<NoisePattern> noise;
+  std::vector<std::string> metal_categories;
+  // influence[category][region][zone]
+  std::vector<std::array<std::array<int, kZones>, kRegions>> influence;
+  std::vector<VariantRef> variant_list;
+
+  const Object& object_of(int variant_id) const { return objects[variant_list[variant_id].object]; }
+  const Variant& variant(int variant_id) const {
+    const VariantRef& r = variant_list[variant_id];
+    return objects[r.object].variants[r.variant];
+  }
+  // "gun:v" for display; "gun" where the object has one drawing.
+  std::string variant_name(int variant_id) const;
+  // Finds an object by name or alias, ignoring case and punctuation ("Iron Rod",
+  // "iron_rod", "IRON-ROD" are all iron-rod). Returns -1 when unknown.
+  int find_object(std::string_view name) const;
+};
+
+// Reads a catalogue. `source_name` is used in messages; `base_dir` resolves relative
+// image paths (assets_dir, when given, takes precedence). Throws InputError naming
+// file, line and field for anything malformed.
+Catalogue parse_catalogue(std::string_view text, const std::string& source_name, const std::string& base_dir,
+                          const std::string& assets_dir = "");
+Catalogue load_catalogue(const std::string& path, const std::string& assets_dir = "");
+Catalogue default_catalogue(const std::string& assets_dir = "");
+
+std::string normalise_name(std::string_view name);
+
+}  // namespace portalsim

@@ -1,0 +1,124 @@
+#include "scene/rules.h"
+
+#include <cctype>
+#include <functional>
+
+#include "scene/error.h"
+
+namespace portalsim {
+
+struct ThreatRule::Node {
+  enum Kind { any_of, all_of, negate, object, variant } kind = object;
+  int id = 0;  // object index or variant id
+  std::vector<std::unique_ptr<Node>> kids;
+
+  bool eval(const Catalogue* cat, const Scenario& s) const {
+    switch (kind) {
+      case any_of:
+        for (const auto& k : kids)
+          if (k->eval(cat, s)) return true;
+        return false;
+      case all_of:
+        for (const auto& k : kids)
+          if (!k->eval(cat, s)) return false;
+        return true;
+      case negate:
+        return !kids[0]->eval(cat, s);
+      case object:
+        for (int16_t v : s.objects)
+          if (v != kNoObject && cat->variant_list[v].object == id) return true;
+        return false;
+      case variant:
+        for (int16_t v : s.objects)
+          if (v == id) return true;
+        return false;
+    }
+    return false;
+  }
+};
+
+namespace {
+struct Parser {
+  const Catalogue& cat;
+  const std::string& s;
+  const std::string& where;
+  size_t pos = 0;
+
+  [[noreturn]] void fail(const std::string& msg) const {
+    throw InputError(where + ": \"" + s + "\" at character " + std::to_string(pos + 1) + ": " + msg);
+  }
+  void skip() {
+    while (pos < s.size() && std::isspace(static_cast<unsigned char>(s[pos]))) ++pos;
+  }
+  bool eat(char c) {
+    skip();
+    if (pos < s.size() && s[pos] == c) {
+      ++pos;
+      return true;
+    }
+    return false;
+  }
+};
+}  // namespace
+
+ThreatRule::ThreatRule(ThreatRule&&) noexcept = default;
+ThreatRule& ThreatRule::operator=(ThreatRule&&) noexcept = default;
+ThreatRule::~ThreatRule() = default;
+
+ThreatRule::ThreatRule(const Catalogue& cat, const std::string& text, const std::string& where) : text_(text) {
+  Parser p{cat, text, where};
+  std::function<std::unique_ptr<Node>()> rule, term, factor;
+  factor = [&]() -> std::unique_ptr<Node> {
+    if (p.eat('!')) {
+      auto n = std::make_unique<Node>();
+      n->kind = Node::negate;
+      n->kids.push_back(factor());
+      return n;
+    }
+    if (p.eat('(')) {
+      auto n = rule();
+      if (!p.eat(')')) p.fail("expected ')'");
+      return n;
+    }
+    p.skip();
+    const size_t start = p.pos;
+    while (p.pos < text.size() && (std::isalnum(static_cast<unsigned char>(text[p.pos])) ||
+                                   text[p.pos] == '-' || text[p.pos] == '_' || text[p.pos] == ':'))
+      ++p.pos;
+    if (p.pos == start) p.fail("expected an object name");
+    const std::string token = text.substr(start, p.pos - start);
+    const int16_t v = parse_object_token(cat, token, where);
+    if (v == kNoObject) p.fail("\"none\" cannot be part of a rule");
+    auto n = std::make_unique<Node>();
+    if (token.find(':') != std::string::npos) {
+      n->kind = Node::variant;
+      n->id = v;
+    } else {
+      n->kind = Node::object;
+      n->id = cat.variant_list[v].object;
+    }
+    return n;
+  };
+  term = [&]() {
+    auto n = std::make_unique<Node>();
+    n->kind = Node::all_of;
+    do n->kids.push_back(factor());
+    while (p.eat('&'));
+    return n;
+  };
+  rule = [&]() {
+    auto n = std::make_unique<Node>();
+    n->kind = Node::any_of;
+    do n->kids.push_back(term());
+    while (p.eat('|'));
+    return n;
+  };
+  root_ = rule();
+  p.skip();
+  if (p.pos != text.size()) p.fail("unexpected character '" + std::string(1, text[p.pos]) + "'");
+  cat_ = &cat;
+}
+
+bool ThreatRule::operator()(const Scenario& s) const { return root_->eval(cat_, s); }
+
+}  // namespace portalsim

@@ -1,0 +1,55 @@
+// Scenarios and the structure-of-arrays batch that the backends consume.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "scene/catalogue.h"
+
+namespace portalsim {
+
+constexpr int16_t kNoObject = -1;
+
+struct Scenario {
+  int subject = 0;                         // 0-based
+  std::array<int16_t, kRegions> objects;   // variant id per region, kNoObject for none
+  int label = 0;                           // 1 threat, 0 not
+  Scenario() { objects.fill(kNoObject); }
+};
+
+// n scenarios with global indices first_index .. first_index + n - 1. The index, not the
+// position in the batch, feeds the random generator, so results never depend on batching.
+struct SceneBatch {
+  uint64_t first_index = 0;
+  std::vector<uint8_t> subject;   // n
+  std::vector<int16_t> objects;   // n * 13, region-major within a scenario
+  std::vector<uint8_t> label;     // n
+
+  size_t size() const { return subject.size(); }
+  void clear() {
+    subject.clear();
+    objects.clear();
+    label.clear();
+  }
+  void push(const Scenario& s) {
+    subject.push_back(static_cast<uint8_t>(s.subject));
+    objects.insert(objects.end(), s.objects.begin(), s.objects.end());
+    label.push_back(static_cast<uint8_t>(s.label));
+  }
+  Scenario at(size_t i) const {
+    Scenario s;
+    s.subject = subject[i];
+    for (int r = 0; r < kRegions; ++r) s.objects[r] = objects[i * kRegions + r];
+    s.label = label[i];
+    return s;
+  }
+};
+
+// Parses the thesis's command line: up to 13 object tokens for regions 1..13 in order,
+// "none" for an empty region, "name:v" / "name:h" for a variant. `where` prefixes errors
+// (e.g. "argument 3" or "scenes.csv:12: region3").
+int16_t parse_object_token(const Catalogue& cat, const std::string& token, const std::string& where);
+Scenario parse_object_list(const Catalogue& cat, const std::vector<std::string>& tokens);
+
+}  // namespace portalsim

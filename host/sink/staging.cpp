@@ -1,0 +1,79 @@
+#include "sink/staging.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "scene/error.h"
+
+namespace portalsim {
+
+namespace fs = std::filesystem;
+
+StagedFolder::StagedFolder(const std::string& final_dir) : final_dir_(final_dir) {
+  std::error_code ec;
+  if (fs::exists(final_dir_, ec) && !fs::is_directory(final_dir_, ec))
+    throw OutputError(final_dir_ + ": exists and is not a folder");
+  if (!fs::exists(final_dir_, ec)) {
+    fs::create_directories(final_dir_, ec);
+    if (ec) throw OutputError(final_dir_ + ": cannot create the output folder: " + ec.message());
+    created_final_ = true;
+  }
+  staging_ = (fs::path(final_dir_) / (".portalsim-staging-" + std::to_string(::getpid()))).string();
+  fs::remove_all(staging_, ec);
+  fs::create_directory(staging_, ec);
+  if (ec) {
+    if (created_final_) fs::remove(final_dir_, ec);
+    throw OutputError(final_dir_ + ": cannot write into the output folder: " + ec.message());
+  }
+}
+
+StagedFolder::~StagedFolder() {
+  std::error_code ec;
+  fs::remove_all(staging_, ec);
+  if (!committed_ && created_final_) fs::remove(final_dir_, ec);  // only succeeds while empty
+}
+
+std::string StagedFolder::path(const std::string& name) {
+  names_.push_back(name);
+  return (fs::path(staging_) / name).string();
+}
+
+void StagedFolder::commit() {
+  std::vector<std::string> moved;
+  for (const std::string& name : names_) {
+    std::error_code ec;
+    fs::rename(fs::path(staging_) / name, fs::path(final_dir_) / name, ec);
+    if (ec) {
+      for (const std::string& m : moved) fs::remove(fs::path(final_dir_) / m, ec);
+      throw OutputError((fs::path(final_dir_) / name).string() + ": cannot move into place: " + ec.message());
+    }
+    moved.push_back(name);
+  }
+  committed_ = true;
+}
+
+void write_text_atomic(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw OutputError(path + ": cannot open for writing");
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    out.flush();
+    if (!out) {
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw OutputError(path + ": write failed (disk full?)");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw OutputError(path + ": cannot move into place: " + ec.message());
+  }
+}
+
+}  // namespace portalsim

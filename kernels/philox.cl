@@ -1,0 +1,32 @@
+// Philox4x32-10: the same generator as host/scene/philox.h (see there for the layout).
+// key = (seed lo, seed hi); counter = (element, stream, scenario lo, scenario hi).
+
+#define STREAM_NOISE_PATTERN 1u
+#define STREAM_METAL_NOISE 2u
+#define STREAM_PIXEL_NOISE 3u
+
+inline uint4 philox4x32_10(uint4 c, uint2 k) {
+  for (int r = 0; r < 10; ++r) {
+    const uint lo0 = 0xD2511F53u * c.x, hi0 = mul_hi(0xD2511F53u, c.x);
+    const uint lo1 = 0xCD9E8D57u * c.z, hi1 = mul_hi(0xCD9E8D57u, c.z);
+    c = (uint4)(hi1 ^ c.y ^ k.x, lo1, hi0 ^ c.w ^ k.y, lo0);
+    k += (uint2)(0x9E3779B9u, 0xBB67AE85u);
+  }
+  return c;
+}
+
+inline uint4 draw(uint2 seed, ulong index, uint stream, uint element) {
+  return philox4x32_10((uint4)(element, stream, (uint)index, (uint)(index >> 32)), seed);
+}
+
+inline float uniform24(uint r) { return (float)(r >> 8) * (1.0f / 16777216.0f); }
+inline uint below(uint r, uint n) { return mul_hi(r, n); }
+
+// Box-Muller from two 24-bit uniforms; u1 is shifted into (0, 1] so log() is finite.
+inline float2 gauss2(uint r0, uint r1) {
+  const float u1 = 1.0f - uniform24(r0);
+  const float u2 = uniform24(r1);
+  const float rad = sqrt(-2.0f * log(u1));
+  const float th = 6.283185307179586f * u2;
+  return (float2)(rad * cos(th), rad * sin(th));
+}

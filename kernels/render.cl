@@ -1,0 +1,47 @@
+// Renders one sensor view for a batch: one work-item per (scenario, image row).
+// view: 0 MMW upper (regions 1-6), 1 MMW lower (regions 7-13), 2 IR (all regions).
+
+#define FLAG_PATTERN_NOISE 1
+#define FLAG_PIXEL_NOISE 2
+
+kernel void render_view(global const uchar* atlas, global const int* bases, global const int4* sprites,
+                        global const int4* places, global const int* noise_offsets,
+                        global const float* noise_gains, global const uchar* subject,
+                        global const short* objects, uint n, int view, int W, int H, float alpha,
+                        uint2 seed, uint2 first, int patterns, int tile_size, float sigma, int flags,
+                        global uchar* out) {
+  const size_t gid = get_global_id(0);
+  const uint i = (uint)(gid / (size_t)H);
+  const int y = (int)(gid % (size_t)H);
+  if (i >= n) return;
+  const ulong index = upsample(first.y, first.x) + i;
+  const int sensor = view == 2 ? 1 : 0;
+  const int r_begin = view == 1 ? 6 : 0;
+  const int r_end = view == 0 ? 6 : 13;
+  global const short* objs = objects + (size_t)i * 13;
+  global const uchar* base = atlas + bases[subject[i] * 3 + view] + (size_t)y * W;
+  global uchar* row = out + ((size_t)i * H + y) * W;
+
+  Layers L;
+  composite_layers(&L, objs, sprites, places, sensor, r_begin, r_end, y);
+
+  Tiles T;
+  T.count = 0;
+  float gain = 0.0f;
+  if (sensor == 0 && (flags & FLAG_PATTERN_NOISE)) {
+    const uint k = below(draw(seed, index, STREAM_NOISE_PATTERN, 0u).x, (uint)patterns);
+    gain = noise_gains[k];
+    noise_tiles(&T, objs, sprites, places, noise_offsets[k], tile_size, r_begin, r_end, y);
+  }
+
+  if (L.count == 0 && T.count == 0 && !(flags & FLAG_PIXEL_NOISE)) {
+    for (int x = 0; x < W; ++x) row[x] = base[x];
+    return;
+  }
+  for (int x = 0; x < W; ++x) {
+    float v = composite_pixel(&L, atlas, (float)base[x], x, alpha);
+    v += pattern_noise_pixel(&T, atlas, tile_size, gain, x);
+    if (flags & FLAG_PIXEL_NOISE) v = mad(sigma, pixel_noise(seed, index, view, y * W + x), v);
+    row[x] = (uchar)clamp(floor(v + 0.5f), 0.0f, 255.0f);
+  }
+}

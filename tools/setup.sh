@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs portalsim's Debian 12 packages (as root, apt-get update first) and builds
+# it into build/ (Release). Safe to run again: it only installs what is missing and
+# rebuilds what changed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(build-essential cmake pkg-config
+  pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
+  libopenimageio-dev openimageio-tools
+  libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
+  libgtest-dev libbenchmark-dev
+  weka default-jre-headless python3 python3-matplotlib)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ "$(id -u)" = 0 ]; then
+  apt-get update -q
+  [ ${#missing[@]} -eq 0 ] || DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
+elif [ ${#missing[@]} -ne 0 ]; then
+  echo "portalsim setup: missing packages (run as root to install): ${missing[*]}" >&2
+  exit 1
+fi
+
+build_dir=${PORTALSIM_BUILD_DIR:-build}
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release ${PORTALSIM_CMAKE_ARGS:-} >/dev/null
+cmake --build "$build_dir" -j "$(nproc)"
