@@ -197,24 +197,24 @@ class BodyModel {
     double jaw = far, neck = far;
     if (y < 60.0) {
       neck = sd_round_cone({u, y}, {100, -6}, {100, 17}, 11.5, 13.0);
-      jaw = sd_round_cone({u, y}, {100, -34}, {100, -9}, 30.0, 16.5);
+      jaw = sd_round_cone({u, y}, {100, -36}, {100, -10}, 30.0, 19.0);
       head = smin(neck, jaw, 2.0);
     }
     // Core: shoulder girdle, trapezius slopes, torso and pelvis.
     double core = torso(u, y);
     if (y < 80.0) {
       // Trapezius slopes from the neck down to round deltoids.
-      const double tx = arm_off_ - 12.0;
+      const double tx = arm_off_ - 9.0;
       const double trap =
-          std::min(sd_round_cone({u, y}, {100, 13}, {100 - tx, 31 + sdy}, 13, 11),
-                   sd_round_cone({u, y}, {100, 13}, {100 + tx, 31 + sdy}, 13, 11));
+          std::min(sd_round_cone({u, y}, {100, 13}, {100 - tx, 33 + sdy}, 13, 10),
+                   sd_round_cone({u, y}, {100, 13}, {100 + tx, 33 + sdy}, 13, 10));
       core = smin(core, trap, 6.0);
     }
     double arm = far;
     if (y < 215.0) arm = std::min(limb_arm(u, y, -1.0), limb_arm(u, y, 1.0));
     if (y < 80.0) {  // shoulders round over into the deltoids
-      const double delt = std::min(sd_circle({u, y}, {100 - arm_off_, 41 + sdy}, 10.5),
-                                   sd_circle({u, y}, {100 + arm_off_, 41 + sdy}, 10.5));
+      const double delt = std::min(sd_circle({u, y}, {100 - arm_off_, 43 + sdy}, 10.5),
+                                   sd_circle({u, y}, {100 + arm_off_, 43 + sdy}, 10.5));
       core = smin(core, delt, 8.0);
     }
     double leg = far;
@@ -233,7 +233,7 @@ class BodyModel {
  private:
   // Torso half width along Y (before build), a smooth curve through key points.
   static double torso_half_width(double y) {
-    static constexpr double kY[] = {14, 30, 45, 70, 100, 125, 160, 200, 228, 245, 262, 280};
+    static constexpr double kY[] = {18, 30, 45, 70, 100, 125, 160, 200, 228, 245, 262, 280};
     static constexpr double kW[] = {36, 50, 53, 51.5, 47.5, 45.5, 48.5, 53.5, 55, 53.5, 48, 40};
     constexpr int n = sizeof(kY) / sizeof(kY[0]);
     if (y <= kY[0]) return kW[0];
@@ -254,14 +254,14 @@ class BodyModel {
 
   double torso(double u, double y) const {
     const double side = std::fabs(u - centre_x(y)) - torso_half_width(y) * b_;
-    return std::max({side, 14.0 - y, y - 262.0});
+    return std::max({side, 18.0 - y, y - 262.0});
   }
 
   // sgn -1: the subject's right arm, on the image's left.
   double limb_arm(double u, double y, double sgn) const {
     const double x0 = 100.0 + sgn * arm_off_;
     const P p{u, y};
-    const P top{x0, 41 + shoulder_dy_};
+    const P top{x0, 43 + shoulder_dy_};
     const P elbow{x0 + sgn * (2.5 + 0.4 * arm_spread_), 113};
     const P wrist{x0 + sgn * (5.0 + arm_spread_), 171};
     const P hand{x0 + sgn * (6.0 + 1.1 * arm_spread_), 186};
@@ -337,17 +337,18 @@ class Gun : public Shape {
   double sd(P p) const override {
     const double slide = sd_rect(p, 0.07 * w_, 0.04 * h_, 0.95 * w_, 0.31 * h_, 0.05 * m_);
     const double muzzle = sd_rect(p, 0.90 * w_, 0.10 * h_, 1.0 * w_, 0.24 * h_, 0.02 * m_);
-    const double frame = sd_rect(p, 0.10 * w_, 0.28 * h_, 0.86 * w_, 0.43 * h_, 0.03 * m_);
-    const double grip = sd_polygon(p, {at(0.07, 0.38), at(0.35, 0.38), at(0.29, 0.99),
-                                       at(0.02, 0.99)}) - 0.01 * m_;
+    const double frame = sd_rect(p, 0.10 * w_, 0.28 * h_, 0.80 * w_, 0.41 * h_, 0.03 * m_);
+    // The grip rakes back about 18 degrees, as on most pistols.
+    const double grip = sd_polygon(p, {at(0.08, 0.36), at(0.38, 0.36), at(0.27, 0.99),
+                                       at(0.03, 0.96)}) - 0.01 * m_;
     const double hammer = sd_rect(p, 0.02 * w_, 0.03 * h_, 0.12 * w_, 0.17 * h_, 0.03 * m_);
-    const double t = std::max(0.9, 0.045 * m_);
-    const P gc = at(0.48, 0.42);
-    const double outer = sd_ellipse(p, gc, 0.14 * w_, 0.22 * h_);
-    const double inner = sd_ellipse(p, gc, 0.14 * w_ - t, 0.22 * h_ - t);
+    const double t = std::max(1.0, 0.06 * m_);
+    const P gc = at(0.50, 0.40);
+    const double outer = sd_ellipse(p, gc, 0.15 * w_, 0.24 * h_);
+    const double inner = sd_ellipse(p, gc, 0.15 * w_ - t, 0.24 * h_ - t);
     const double guard = std::max({outer, -inner, gc.y - p.y});
     const double trigger =
-        sd_capsule(p, at(0.47, 0.40), at(0.44, 0.55), std::max(0.45, 0.025 * m_));
+        sd_capsule(p, at(0.49, 0.40), at(0.46, 0.55), std::max(0.45, 0.03 * m_));
     return std::min({slide, muzzle, frame, grip, hammer, guard, trigger});
   }
   double shade(P p) const override {
@@ -358,10 +359,10 @@ class Gun : public Shape {
       if (u > 0.52 && u < 0.68 && v > 0.12 && v < 0.21) s -= 26.0;
       if (u > 0.12 && u < 0.25) s -= 10.0 * wave(p.x / std::max(1.6, 0.05 * w_));
       if (u > 0.90) s -= 8.0;
-    } else if (v > 0.42 && u < 0.36) {  // grip: darker, checkered panel
-      const double panel = sd_polygon(p, {at(0.11, 0.47), at(0.30, 0.47), at(0.25, 0.93),
-                                          at(0.07, 0.93)});
-      s -= 10.0;
+    } else if (v > 0.40 && u < 0.40) {  // grip: darker, checkered panel
+      const double panel = sd_polygon(p, {at(0.14, 0.45), at(0.32, 0.45), at(0.23, 0.92),
+                                          at(0.07, 0.91)});
+      s -= 12.0;
       if (panel < 0.0) s -= 8.0 + 7.0 * wave((p.x + p.y) / 2.2) * wave((p.x - p.y) / 2.2);
     } else {
       s -= 2.0;
@@ -545,15 +546,15 @@ class Buckle : public Shape {
   using Shape::Shape;
   double sd(P p) const override {
     const double outer = sd_rect(p, 0, 0, w_, h_, 0.2 * m_);
-    const double hole = sd_rect(p, 0.24 * w_, 0.25 * h_, 0.84 * w_, 0.75 * h_, 0.06 * m_);
+    const double hole = sd_rect(p, 0.24 * w_, 0.22 * h_, 0.84 * w_, 0.78 * h_, 0.06 * m_);
     const double frame = std::max(outer, -hole);
-    const double prong = sd_round_cone(p, at(0.13, 0.5), at(0.89, 0.5), std::max(0.7, 0.065 * h_),
-                                       std::max(0.45, 0.03 * h_));
+    const double prong = sd_round_cone(p, at(0.12, 0.5), at(0.90, 0.5), std::max(0.6, 0.05 * h_),
+                                       std::max(0.4, 0.02 * h_));
     return std::min(frame, prong);
   }
   double shade(P p) const override {
     const double outer = sd_rect(p, 0, 0, w_, h_, 0.2 * m_);
-    const double hole = sd_rect(p, 0.24 * w_, 0.25 * h_, 0.84 * w_, 0.75 * h_, 0.06 * m_);
+    const double hole = sd_rect(p, 0.24 * w_, 0.22 * h_, 0.84 * w_, 0.78 * h_, 0.06 * m_);
     const double frame = std::max(outer, -hole);
     if (frame > 0.0 || std::fabs(p.y - 0.5 * h_) < 0.05 * h_) {  // prong
       if (hole < 0.0) return 14.0 - 10.0 * clamp01(std::fabs(p.y - 0.5 * h_) / (0.06 * h_));
@@ -679,9 +680,9 @@ Image mmw_body(const Body& body, bool upper, int width, int height) {
       const double c = coverage(f.d, e);
       double val = back;
       if (c > 0.0) {
-        const double depth = clamp01(-f.d / 14.0);
+        const double depth = clamp01(-f.d / 26.0);
         const double s = 1.0 - (1.0 - depth) * (1.0 - depth);
-        const double skin = level + 30.0 * (s - 0.75) + 4.0 * fbm(u / 22.0, v / 22.0, seed + 4) +
+        const double skin = level + 34.0 * (s - 0.7) + 4.0 * fbm(u / 22.0, v / 22.0, seed + 4) +
                             2.5 * hash_signed(x, y, seed + 5) - 18.0 * f.chin * f.chin;
         val = lerp(back, skin, c);
       }

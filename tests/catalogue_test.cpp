@@ -1,0 +1,92 @@
+// The default catalogue's contents, object names and the threat rules.
+#include <gtest/gtest.h>
+
+#include "scene/error.h"
+#include "scene/rules.h"
+#include "support.h"
+
+namespace portalsim {
+namespace {
+
+using test::catalogue;
+
+TEST(Catalogue, DefaultHoldsTheThesisInventory) {
+  const Catalogue& c = catalogue();
+  EXPECT_EQ(c.subjects.size(), 5u);
+  EXPECT_EQ(c.objects.size(), 12u);
+  EXPECT_EQ(c.noise.size(), 5u);
+  EXPECT_EQ(c.metal_categories.size(), 6u);
+  EXPECT_EQ(c.influence.size(), 6u);
+  int upper = 0;
+  for (const Region& r : c.regions) upper += r.view == View::upper;
+  EXPECT_EQ(upper, 6);
+  EXPECT_EQ(c.regions[2].name, "left-chest");
+  EXPECT_EQ(c.regions[3].name, "right-abdomen");
+  EXPECT_EQ(c.subjects[0].base_zones, (std::array<int, kZones>{200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200,
+                                                                200, 200, 200, 200, 200, 200, 200, 200}));
+  // Gun and rod have horizontal and vertical drawings; the rest one.
+  for (const Object& o : c.objects) {
+    const bool two = o.name == "gun" || o.name == "iron-rod";
+    EXPECT_EQ(o.variants.size(), two ? 2u : 1u) << o.name;
+  }
+}
+
+TEST(Catalogue, NamesIgnoreCaseAndPunctuationAndAcceptThesisSpellings) {
+  const Catalogue& c = catalogue();
+  EXPECT_EQ(c.find_object("Gun"), c.find_object("gun"));
+  EXPECT_EQ(c.objects[c.find_object("Rod")].name, "iron-rod");
+  EXPECT_EQ(c.objects[c.find_object("Mobile")].name, "mobile-phone");
+  EXPECT_EQ(c.objects[c.find_object("Metal Barrel")].name, "iron-pipe");
+  EXPECT_EQ(c.objects[c.find_object("iron_pipe")].name, "iron-pipe");
+  EXPECT_EQ(c.objects[c.find_object("Compact Disk")].name, "compact-disk");
+  EXPECT_EQ(c.find_object("flamethrower"), -1);
+  EXPECT_EQ(c.find_object(""), -1);
+}
+
+TEST(Catalogue, ObjectTokens) {
+  const Catalogue& c = catalogue();
+  const int16_t gv = parse_object_token(c, "gun:v", "t");
+  EXPECT_EQ(c.variant_name(gv), "gun:v");
+  EXPECT_EQ(c.variant_name(parse_object_token(c, "GUN:Vertical", "t")), "gun:v");
+  EXPECT_EQ(c.variant_name(parse_object_token(c, "gun", "t")), "gun:h");
+  EXPECT_EQ(parse_object_token(c, "None", "t"), kNoObject);
+  EXPECT_THROW(parse_object_token(c, "gun:x", "t"), InputError);
+  EXPECT_THROW(parse_object_token(c, "disk:v", "t"), InputError);
+  EXPECT_THROW(parse_object_token(c, "none:v", "t"), InputError);
+  const Scenario s = parse_object_list(c, {"none", "none", "gun"});
+  EXPECT_EQ(s.objects[2], parse_object_token(c, "gun", "t"));
+  for (int r = 3; r < kRegions; ++r) EXPECT_EQ(s.objects[r], kNoObject);
+  EXPECT_THROW(parse_object_list(c, std::vector<std::string>(14, "none")), InputError);
+  try {
+    parse_object_list(c, {"none", "none", "bazooka"});
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("region 3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bazooka"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Rules, ThesisCasesAndCombinations) {
+  const Catalogue& c = catalogue();
+  const auto scene = [&](std::vector<std::string> objs) { return parse_object_list(c, objs); };
+  const ThreatRule gun(c, "gun");
+  EXPECT_TRUE(gun(scene({"none", "gun:v"})));
+  EXPECT_FALSE(gun(scene({"iron-rod", "metal-plate"})));
+  const ThreatRule both(c, "iron-rod&metal-plate");
+  EXPECT_TRUE(both(scene({"rod:v", "none", "none", "none", "none", "none", "plate"})));
+  EXPECT_FALSE(both(scene({"rod"})));
+  EXPECT_FALSE(both(scene({"plate"})));
+  const ThreatRule either(c, "gun | iron-rod & metal-plate");
+  EXPECT_TRUE(either(scene({"gun"})));
+  EXPECT_TRUE(either(scene({"rod", "plate"})));
+  EXPECT_FALSE(either(scene({"rod", "disk"})));
+  const ThreatRule vertical(c, "gun:v & !(metal-plate)");
+  EXPECT_TRUE(vertical(scene({"gun:v"})));
+  EXPECT_FALSE(vertical(scene({"gun:h"})));
+  EXPECT_FALSE(vertical(scene({"gun:v", "plate"})));
+  for (const char* bad : {"", "gun &", "gun | | rod", "(gun", "gun)", "laser", "none", "gun:q"})
+    EXPECT_THROW(ThreatRule(c, bad), InputError) << bad;
+}
+
+}  // namespace
+}  // namespace portalsim

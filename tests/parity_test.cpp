@@ -1,0 +1,212 @@
+// Kernel against reference, stage by stage, over hundreds of random scenarios that
+// cover every object variant, region and subject.
+//
+// Tolerances (the core tier, fp32 kernels against the fp64 reference):
+//   metal zones and labels   exact
+//   image pixels             |kernel - reference| <= 1 gray level (rounding of x.5 ties)
+//   features                 |kernel - reference| <= 1.0 (a mean of pixels each within 1),
+//                            and the mean absolute feature error <= 0.01
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "support.h"
+
+namespace portalsim {
+namespace {
+
+using test::assets;
+using test::catalogue;
+
+struct Diff {
+  int max_abs = 0;
+  size_t off = 0, total = 0;
+};
+Diff compare(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
+  Diff d;
+  EXPECT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    const int e = std::abs(int(a[i]) - int(b[i]));
+    d.max_abs = std::max(d.max_abs, e);
+    d.off += e > 0;
+  }
+  d.total = a.size();
+  return d;
+}
+
+std::vector<Scenario> coverage_set(size_t n, int max_objects) {
+  const Catalogue& c = catalogue();
+  std::vector<Scenario> v;
+  // Every variant in every region, on rotating subjects...
+  for (size_t var = 0; var < c.variant_list.size(); ++var)
+    for (int r = 0; r < kRegions; ++r) {
+      Scenario s;
+      s.subject = static_cast<int>((var + r) % c.subjects.size());
+      s.objects[r] = static_cast<int16_t>(var);
+      v.push_back(s);
+    }
+  // ...then random crowds.
+  for (size_t k = 0; v.size() < n; ++k) v.push_back(test::random_scenario(c, k, max_objects));
+  return v;
+}
+
+struct Outputs {
+  BatchOutput ref, cl;
+};
+
+Outputs run_both(const std::vector<Scenario>& scenes, const Plan& plan, uint64_t first = 0) {
+  Outputs o;
+  const SceneBatch batch = test::batch_of(scenes, first);
+  make_reference_backend(catalogue(), assets())->run(batch, plan, o.ref);
+  make_opencl_backend(catalogue(), assets(), test::runtime())->run(batch, plan, o.cl);
+  return o;
+}
+
+Plan images_only(bool pattern, double sigma) {
+  Plan p;
+  p.features = false;
+  p.metal = false;
+  p.model.pattern_noise = pattern;
+  p.model.pixel_sigma = sigma;
+  p.model.seed = 20260101;
+  return p;
+}
+
+void expect_images_within_one(const Outputs& o, const char* stage) {
+  for (auto [name, a, b] : {std::tuple{"upper", &o.ref.upper, &o.cl.upper}, std::tuple{"lower", &o.ref.lower, &o.cl.lower},
+                            std::tuple{"ir", &o.ref.ir, &o.cl.ir}}) {
+    const Diff d = compare(*a, *b);
+    EXPECT_LE(d.max_abs, 1) << stage << " " << name;
+    // Ties are rare: fewer than 1 pixel in 1000 may round the other way.
+    EXPECT_LT(static_cast<double>(d.off) / d.total, 1e-3) << stage << " " << name;
+  }
+}
+
+TEST(Parity, CompositeStage) {
+  const auto scenes = coverage_set(400, 13);
+  const Outputs o = run_both(scenes, images_only(false, 0));
+  expect_images_within_one(o, "composite");
+  // The stage did something: objects changed pixels away from the base.
+  size_t changed = 0;
+  for (size_t i = 0; i < scenes.size(); ++i) {
+    const Image& base = assets().bases[scenes[i].subject][0];
+    for (size_t p = 0; p < base.pixels.size(); ++p) changed += o.cl.upper_of(i)[p] != base.pixels[p];
+  }
+  EXPECT_GT(changed, 100000u);
+}
+
+TEST(Parity, NoiseStagePatterns) {
+  const auto scenes = coverage_set(400, 13);
+  const Outputs with = run_both(scenes, images_only(true, 0));
+  expect_images_within_one(with, "pattern noise");
+  const Outputs without = run_both(scenes, images_only(false, 0));
+  EXPECT_NE(with.cl.upper, without.cl.upper) << "noise patterns must change the MMW images";
+  EXPECT_EQ(with.cl.ir, without.cl.ir) << "the thesis's noise patterns are MMW only";
+}
+
+TEST(Parity, NoiseStagePerPixelGaussian) {
+  const auto scenes = coverage_set(200, 4);
+  const Outputs o = run_both(scenes, images_only(true, 6.0), 1ull << 40);
+  expect_images_within_one(o, "pixel noise");
+  // The noise has the asked-for spread where nothing clips: base pixels of an empty scene.
+  Scenario empty;
+  const Outputs e = run_both({empty}, images_only(false, 6.0));
+  const Image& base = assets().bases[0][0];
+  double sum = 0, sum2 = 0;
+  size_t n = 0;
+  for (size_t p = 0; p < base.pixels.size(); ++p) {
+    if (base.pixels[p] < 40 || base.pixels[p] > 215) continue;
+    const double d = double(e.cl.upper_of(0)[p]) - base.pixels[p];
+    sum += d;
+    sum2 += d * d;
+    ++n;
+  }
+  ASSERT_GT(n, 1000u);
+  const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+  EXPECT_NEAR(mean, 0.0, 0.2);
+  EXPECT_NEAR(sd, std::sqrt(36.0 + 1.0 / 12.0), 0.3);  // sigma with rounding to integers
+}
+
+TEST(Parity, MetalStageExact) {
+  Plan p;
+  p.mmw_images = p.ir_image = p.features = false;
+  for (int noise : {0, 7}) {
+    p.model.metal_noise = noise;
+    p.model.seed = 99;
+    const Outputs o = run_both(coverage_set(600, 13), p);
+    EXPECT_EQ(o.ref.metal, o.cl.metal) << "metal noise " << noise;
+  }
+}
+
+TEST(Parity, PoolStageFeatures) {
+  for (int block : {10, 7, 1, 200}) {
+    Plan p;
+    p.model.block = block;
+    p.model.seed = 5;
+    const Outputs o = run_both(coverage_set(block == 1 ? 120 : 300, 13), p);
+    ASSERT_EQ(o.ref.features.size(), o.cl.features.size());
+    double max_err = 0, sum_err = 0;
+    for (size_t k = 0; k < o.ref.features.size(); ++k) {
+      const double e = std::abs(double(o.ref.features[k]) - o.cl.features[k]);
+      max_err = std::max(max_err, e);
+      sum_err += e;
+    }
+    EXPECT_LE(max_err, 1.0) << "block " << block;
+    EXPECT_LE(sum_err / o.ref.features.size(), 0.01) << "block " << block;
+    EXPECT_EQ(o.ref.metal, o.cl.metal);
+  }
+}
+
+TEST(Parity, FeaturesAreMeansOfTheImages) {
+  // Pool over the kernel's own images, recomputed here: exact integer sums, so equal to
+  // float rounding.
+  Plan p;
+  p.model.block = 7;
+  const auto scenes = coverage_set(60, 6);
+  BatchOutput out;
+  make_opencl_backend(catalogue(), assets(), test::runtime())->run(test::batch_of(scenes), p, out);
+  const int W = out.mmw_width, H = out.mmw_height;
+  for (size_t i = 0; i < scenes.size(); ++i) {
+    const float* f = out.features_of(i);
+    // The bottom-right partial block of the lower view: 200 = 28 * 7 + 4.
+    const int bx = out.layout.blocks_x - 1, by = out.layout.blocks_y - 1;
+    double sum = 0;
+    for (int y = by * 7; y < H; ++y)
+      for (int x = bx * 7; x < W; ++x) sum += out.lower_of(i)[y * W + x];
+    EXPECT_FLOAT_EQ(f[out.layout.blocks_x * out.layout.blocks_y + by * out.layout.blocks_x + bx], sum / 16.0);
+    // Region 3 (left chest, upper view).
+    const Rect& r = catalogue().regions[2].mmw;
+    sum = 0;
+    for (int y = r.y; y < r.y + r.h; ++y)
+      for (int x = r.x; x < r.x + r.w; ++x) sum += out.upper_of(i)[y * W + x];
+    EXPECT_NEAR(f[2 * out.layout.blocks_x * out.layout.blocks_y + 2], sum / (r.w * r.h), 1e-3);
+  }
+}
+
+TEST(Determinism, ScenarioDependsOnlyOnSeedAndIndexNotOnBatch) {
+  Plan p;
+  p.model.pixel_sigma = 3;
+  p.model.metal_noise = 5;
+  p.model.seed = 77;
+  std::vector<Scenario> scenes;
+  for (uint64_t k = 0; k < 40; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 5));
+  auto cl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  BatchOutput whole;
+  cl->run(test::batch_of(scenes, 1000), p, whole);
+  // Scenario 1000 + 17 alone, as the first of a batch.
+  BatchOutput one;
+  cl->run(test::batch_of({scenes[17]}, 1017), p, one);
+  const size_t px = size_t(whole.mmw_width) * whole.mmw_height;
+  EXPECT_TRUE(std::equal(one.upper.begin(), one.upper.end(), whole.upper.begin() + 17 * px));
+  EXPECT_TRUE(std::equal(one.metal.begin(), one.metal.end(), whole.metal.begin() + 17 * kZones));
+  const size_t F = whole.layout.image_features();
+  EXPECT_TRUE(std::equal(one.features.begin(), one.features.end(), whole.features.begin() + 17 * F));
+  // Another seed changes the noise.
+  p.model.seed = 78;
+  BatchOutput other;
+  cl->run(test::batch_of({scenes[17]}, 1017), p, other);
+  EXPECT_NE(one.upper, other.upper);
+}
+
+}  // namespace
+}  // namespace portalsim

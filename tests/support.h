@@ -1,0 +1,50 @@
+// Shared test fixtures: the default catalogue and its assets built once, one OpenCL
+// runtime for the whole run, and random scenarios covering the catalogue.
+#pragma once
+#include <memory>
+
+#include "assets/assets.h"
+#include "backend/backend.h"
+#include "backend/opencl/opencl_backend.h"
+#include "scene/catalogue.h"
+#include "scene/philox.h"
+
+namespace portalsim::test {
+
+inline const Catalogue& catalogue() {
+  static const Catalogue c = default_catalogue();
+  return c;
+}
+inline const AssetSet& assets() {
+  static const AssetSet a = build_assets(catalogue());
+  return a;
+}
+inline std::shared_ptr<OpenCLRuntime> runtime() {
+  static std::shared_ptr<OpenCLRuntime> rt = std::make_shared<OpenCLRuntime>();
+  return rt;
+}
+
+// Scenario k of a test set: every subject, 0 to `max_objects` objects in random regions
+// with random variants, all drawn from the counter generator (stream 99).
+inline Scenario random_scenario(const Catalogue& cat, uint64_t k, int max_objects = 13) {
+  Scenario s;
+  const Philox4 r = draw(12345, k, 99, 0);
+  s.subject = static_cast<int>(below(r[0], static_cast<uint32_t>(cat.subjects.size())));
+  const int count = static_cast<int>(below(r[1], static_cast<uint32_t>(max_objects + 1)));
+  for (int j = 0; j < count; ++j) {
+    const Philox4 q = draw(12345, k, 99, 1 + j);
+    const int region = static_cast<int>(below(q[0], kRegions));
+    s.objects[region] = static_cast<int16_t>(below(q[1], static_cast<uint32_t>(cat.variant_list.size())));
+  }
+  s.label = static_cast<int>(r[2] & 1);
+  return s;
+}
+
+inline SceneBatch batch_of(const std::vector<Scenario>& scenes, uint64_t first_index = 0) {
+  SceneBatch b;
+  b.first_index = first_index;
+  for (const Scenario& s : scenes) b.push(s);
+  return b;
+}
+
+}  // namespace portalsim::test
