@@ -18,10 +18,8 @@ namespace {
 constexpr int64_t kMaxPixels = int64_t{1} << 28;
 
 void check_size(int w, int h, const char* what) {
-  if (w < 1 || h < 1)
-    throw std::invalid_argument(std::string(what) + ": width and height must be at least 1");
-  if (static_cast<int64_t>(w) * h > kMaxPixels)
-    throw std::invalid_argument(std::string(what) + ": image too large");
+  if (w < 1 || h < 1) throw std::invalid_argument(std::string(what) + ": width and height must be at least 1");
+  if (static_cast<int64_t>(w) * h > kMaxPixels) throw std::invalid_argument(std::string(what) + ": image too large");
 }
 
 // ---- hashing and texture -------------------------------------------------------------
@@ -33,10 +31,11 @@ uint64_t mix64(uint64_t z) {  // splitmix64 finaliser
   return z ^ (z >> 31);
 }
 
+// One finaliser over a lattice-scrambled key: cheap, and no visible pattern for texture.
 uint64_t hash3(int64_t x, int64_t y, uint64_t seed) {
-  uint64_t h = mix64(seed ^ 0x632be59bd9b4e019ULL);
-  h = mix64(h ^ static_cast<uint64_t>(x));
-  return mix64(h ^ (static_cast<uint64_t>(y) * 0xd1b54a32d192ed03ULL));
+  const uint64_t k = static_cast<uint64_t>(x) * 0xd1b54a32d192ed03ULL ^
+                     static_cast<uint64_t>(y) * 0xabc98388fb8fac03ULL ^ seed * 0x8cb92ba72f3d8dd7ULL;
+  return mix64(k ^ (k >> 29));
 }
 
 // Uniform in [0, 1) and [-1, 1).
@@ -65,8 +64,7 @@ double value_noise(double x, double y, uint64_t seed) {
 
 // Two octaves, still roughly in [-1, 1].
 double fbm(double x, double y, uint64_t seed) {
-  return 0.67 * value_noise(x, y, seed) + 0.33 * value_noise(2.03 * x + 17.1, 2.03 * y - 5.3,
-                                                             seed + 1);
+  return 0.67 * value_noise(x, y, seed) + 0.33 * value_noise(2.03 * x + 17.1, 2.03 * y - 5.3, seed + 1);
 }
 
 // Triangle wave in [0, 1] with period 1, smoothed to a cosine-like shape (1 at integers).
@@ -107,8 +105,7 @@ double sd_box(P p, P c, double hx, double hy, double r) {
 
 // Box given by its edges.
 double sd_rect(P p, double x0, double y0, double x1, double y1, double r) {
-  return sd_box(p, {0.5 * (x0 + x1), 0.5 * (y0 + y1)}, 0.5 * std::fabs(x1 - x0),
-                0.5 * std::fabs(y1 - y0), r);
+  return sd_box(p, {0.5 * (x0 + x1), 0.5 * (y0 + y1)}, 0.5 * std::fabs(x1 - x0), 0.5 * std::fabs(y1 - y0), r);
 }
 
 double sd_capsule(P p, P a, P b, double r) {
@@ -147,7 +144,7 @@ double sd_polygon(P p, const std::vector<P>& v) {
     const double t = ee > 0.0 ? clamp01((wx * ex + wy * ey) / ee) : 0.0;
     const double bx = wx - ex * t, by = wy - ey * t;
     d = std::min(d, bx * bx + by * by);
-    const bool c1 = p.y >= v[i].y, c2 = p.y < v[j].y, c3 = ex * wy > ey * wx;
+    const bool c1 = p.y >= v[i].y, c2 = p.y<v[j].y, c3 = ex * wy> ey * wx;
     if ((c1 && c2 && c3) || (!c1 && !c2 && !c3)) s = -s;
   }
   return s * std::sqrt(d);
@@ -205,13 +202,17 @@ class BodyModel {
     if (y < 80.0) {
       // Trapezius slopes from the neck down to round deltoids.
       const double tx = arm_off_ - 9.0;
-      const double trap =
-          std::min(sd_round_cone({u, y}, {100, 13}, {100 - tx, 33 + sdy}, 13, 10),
-                   sd_round_cone({u, y}, {100, 13}, {100 + tx, 33 + sdy}, 13, 10));
+      const double trap = std::min(sd_round_cone({u, y}, {100, 13}, {100 - tx, 33 + sdy}, 13, 10),
+                                   sd_round_cone({u, y}, {100, 13}, {100 + tx, 33 + sdy}, 13, 10));
       core = smin(core, trap, 6.0);
     }
     double arm = far;
-    if (y < 215.0) arm = std::min(limb_arm(u, y, -1.0), limb_arm(u, y, 1.0));
+    if (y < 215.0) {
+      // Arms keep |u - 100| >= arm_off_ - 12, so deep inside the torso they cannot change
+      // the union or the IR weights (both ignore a part 14 units further than the nearest).
+      const double bound = arm_off_ - 12.0 - std::fabs(u - 100.0);
+      arm = bound >= core + 14.0 ? bound : std::min(limb_arm(u, y, -1.0), limb_arm(u, y, 1.0));
+    }
     if (y < 80.0) {  // shoulders round over into the deltoids
       const double delt = std::min(sd_circle({u, y}, {100 - arm_off_, 43 + sdy}, 10.5),
                                    sd_circle({u, y}, {100 + arm_off_, 43 + sdy}, 10.5));
@@ -246,8 +247,8 @@ class BodyModel {
     };
     const double dx = kY[i + 1] - kY[i], t = (y - kY[i]) / dx;
     const double t2 = t * t, t3 = t2 * t;
-    return (2 * t3 - 3 * t2 + 1) * kW[i] + (t3 - 2 * t2 + t) * dx * slope(i) +
-           (-2 * t3 + 3 * t2) * kW[i + 1] + (t3 - t2) * dx * slope(i + 1);
+    return (2 * t3 - 3 * t2 + 1) * kW[i] + (t3 - 2 * t2 + t) * dx * slope(i) + (-2 * t3 + 3 * t2) * kW[i + 1] +
+           (t3 - t2) * dx * slope(i + 1);
   }
 
   double centre_x(double y) const { return 100.0 + lean_ * smoothstep(150.0, 300.0, y); }
@@ -278,14 +279,13 @@ class BodyModel {
     const P hip{x0, 212}, mid{x0 + sgn * 0.3, 270};
     const P knee{x0 + sgn * (1.0 + 0.5 * stance_), 310};
     const P calf{x0 + sgn * (1.6 + 0.7 * stance_), 333};
-    const P ankle{x0 + sgn * (1.5 + stance_), 382};
-    const double thigh = smin(sd_round_cone(p, hip, mid, 26.0 * b_, 24.0 * b_),
-                              sd_round_cone(p, mid, knee, 24.0 * b_, 14.5 * bl), 3.0);
+    const P ankle{x0 + sgn * (0.5 + 0.5 * stance_), 382};
+    const double thigh =
+        smin(sd_round_cone(p, hip, mid, 26.0 * b_, 24.0 * b_), sd_round_cone(p, mid, knee, 24.0 * b_, 14.5 * bl), 3.0);
     const double shin = smin(sd_round_cone(p, knee, calf, 14.5 * bl, 16.5 * bl),
                              sd_round_cone(p, calf, ankle, 16.5 * bl, 7.8 * bl), 2.5);
     // Feet seen from the front: low, wider than the ankle, turned a little outwards.
-    const double foot = sd_round_cone(p, {ankle.x + sgn * 1.0, 389}, {ankle.x + sgn * 7.0, 393},
-                                      7.5 * bl, 5.0 * bl);
+    const double foot = sd_round_cone(p, {ankle.x + sgn * 0.5, 389}, {ankle.x + sgn * 5.5, 393}, 7.5 * bl, 5.0 * bl);
     return smin(smin(thigh, shin, 2.0), foot, 4.0);
   }
 
@@ -293,6 +293,13 @@ class BodyModel {
   uint64_t seed_ = 0;
   double arm_spread_ = 0, shoulder_dy_ = 0, stance_ = 0, lean_ = 0, arm_off_ = 64.5;
 };
+
+// How many following pixels of a row a 1-Lipschitz field stays above zero for, given its
+// margin above the threshold now; lets the outside be skipped without evaluating it.
+int skip_pixels(double margin, double unit_per_px, int limit) {
+  if (!(margin > 0.0)) return 0;
+  return static_cast<int>(std::min(margin / unit_per_px, static_cast<double>(limit)));
+}
 
 // Edge ramp width in body units: about a pixel and a half, and never razor sharp.
 double edge_width(double unit_per_px) { return 0.75 * unit_per_px + 0.7; }
@@ -318,8 +325,7 @@ class Shape {
     return -amount * (1.0 - t) * (1.0 - t);
   }
   double grain(P p, uint64_t seed) const {
-    return hash_signed(static_cast<int64_t>(std::floor(p.x)), static_cast<int64_t>(std::floor(p.y)),
-                       seed);
+    return hash_signed(static_cast<int64_t>(std::floor(p.x)), static_cast<int64_t>(std::floor(p.y)), seed);
   }
   double w_, h_, m_;
 };
@@ -339,16 +345,14 @@ class Gun : public Shape {
     const double muzzle = sd_rect(p, 0.90 * w_, 0.10 * h_, 1.0 * w_, 0.24 * h_, 0.02 * m_);
     const double frame = sd_rect(p, 0.10 * w_, 0.28 * h_, 0.80 * w_, 0.41 * h_, 0.03 * m_);
     // The grip rakes back about 18 degrees, as on most pistols.
-    const double grip = sd_polygon(p, {at(0.08, 0.36), at(0.38, 0.36), at(0.27, 0.99),
-                                       at(0.03, 0.96)}) - 0.01 * m_;
+    const double grip = sd_polygon(p, {at(0.08, 0.36), at(0.38, 0.36), at(0.27, 0.99), at(0.03, 0.96)}) - 0.01 * m_;
     const double hammer = sd_rect(p, 0.02 * w_, 0.03 * h_, 0.12 * w_, 0.17 * h_, 0.03 * m_);
     const double t = std::max(1.0, 0.06 * m_);
     const P gc = at(0.50, 0.40);
     const double outer = sd_ellipse(p, gc, 0.15 * w_, 0.24 * h_);
     const double inner = sd_ellipse(p, gc, 0.15 * w_ - t, 0.24 * h_ - t);
     const double guard = std::max({outer, -inner, gc.y - p.y});
-    const double trigger =
-        sd_capsule(p, at(0.49, 0.40), at(0.46, 0.55), std::max(0.45, 0.03 * m_));
+    const double trigger = sd_capsule(p, at(0.49, 0.40), at(0.46, 0.55), std::max(0.45, 0.03 * m_));
     return std::min({slide, muzzle, frame, grip, hammer, guard, trigger});
   }
   double shade(P p) const override {
@@ -360,8 +364,7 @@ class Gun : public Shape {
       if (u > 0.12 && u < 0.25) s -= 10.0 * wave(p.x / std::max(1.6, 0.05 * w_));
       if (u > 0.90) s -= 8.0;
     } else if (v > 0.40 && u < 0.40) {  // grip: darker, checkered panel
-      const double panel = sd_polygon(p, {at(0.14, 0.45), at(0.32, 0.45), at(0.23, 0.92),
-                                          at(0.07, 0.91)});
+      const double panel = sd_polygon(p, {at(0.14, 0.45), at(0.32, 0.45), at(0.23, 0.92), at(0.07, 0.91)});
       s -= 12.0;
       if (panel < 0.0) s -= 8.0 + 7.0 * wave((p.x + p.y) / 2.2) * wave((p.x - p.y) / 2.2);
     } else {
@@ -414,7 +417,11 @@ class Elongated : public Shape {
 class Rod : public Elongated {
  public:
   using Elongated::Elongated;
-  double sd(P p) const override { return sd_rect(p, 0, 0, w_, h_, 0.45 * m_); }
+  // Inset a little across its thickness so the long sides get a soft, anti-aliased edge.
+  double sd(P p) const override {
+    const double ix = horizontal() ? 0.0 : 0.05 * w_, iy = horizontal() ? 0.05 * h_ : 0.0;
+    return sd_rect(p, ix, iy, w_ - ix, h_ - iy, 0.45 * m_);
+  }
   double shade(P p) const override {
     return cylinder(across(p), -0.35, 0.32) + rim(sd(p), 0.8, 6.0) +
            3.0 * value_noise(along(p) * length() / 5.0, 0.5, 21);
@@ -428,8 +435,8 @@ class Strip : public Elongated {
   double shade(P p) const override {
     const double c = across(p);
     // Flat: nearly even, a thin sheen along one edge and a faint ripple along the length.
-    double s = 4.0 - 10.0 * smoothstep(0.55, 1.0, c) + 12.0 * smoothstep(-0.95, -0.6, -c) *
-                                                           smoothstep(-0.95, -0.6, c + 0.3);
+    double s =
+        4.0 - 10.0 * smoothstep(0.55, 1.0, c) + 12.0 * smoothstep(-0.95, -0.6, -c) * smoothstep(-0.95, -0.6, c + 0.3);
     s += 5.0 * (along(p) - 0.5) + 3.0 * value_noise(along(p) * length() / 7.0, 3.5, 22);
     return s + rim(sd(p), 0.7, 8.0);
   }
@@ -467,7 +474,7 @@ class Plate : public Shape {
     const double d = sd(p);
     const double bw = std::max(1.2, 0.09 * m_);
     double s = 2.0 * value_noise(p.x / 9.0, p.y / 1.5, 31);  // brushed grain
-    if (-d < bw) {  // bevel lit from the top left
+    if (-d < bw) {                                           // bevel lit from the top left
       const double e = 0.25;
       const double gx = sd({p.x + e, p.y}) - sd({p.x - e, p.y});
       const double gy = sd({p.x, p.y + e}) - sd({p.x, p.y - e});
@@ -476,11 +483,12 @@ class Plate : public Shape {
       s += 18.0 * lit * (1.0 - (-d) / bw);
     }
     const double inset = std::max(2.0, 0.16 * m_), rr = std::max(0.8, 0.06 * m_);
-    for (const P& c : {P{inset, inset}, P{w_ - inset, inset}, P{inset, h_ - inset},
-                       P{w_ - inset, h_ - inset}}) {
+    for (const P& c : {P{inset, inset}, P{w_ - inset, inset}, P{inset, h_ - inset}, P{w_ - inset, h_ - inset}}) {
       const double dc = sd_circle(p, c, rr);
-      if (dc < 0.0) s += 18.0 * (1.0 + dc / rr) - 4.0;
-      else if (dc < 0.8) s -= 12.0 * (1.0 - dc / 0.8);
+      if (dc < 0.0)
+        s += 18.0 * (1.0 + dc / rr) - 4.0;
+      else if (dc < 0.8)
+        s -= 12.0 * (1.0 - dc / 0.8);
     }
     return s + rim(d, 0.6, 6.0);
   }
@@ -500,8 +508,7 @@ class Pendant : public Shape {
     const double outer = sd_ellipse(p, loop_c_, loop_rx_, loop_ry_);
     const double inner = sd_ellipse(p, loop_c_, loop_rx_ - loop_t_, loop_ry_ - loop_t_);
     const double loop = std::max(outer, -inner);
-    const double drop =
-        sd_round_cone(p, centre_, at(0.5, 0.30), big_r_, std::max(0.5, 0.08 * w_));
+    const double drop = sd_round_cone(p, centre_, at(0.5, 0.30), big_r_, std::max(0.5, 0.08 * w_));
     return std::min(loop, drop);
   }
   double shade(P p) const override {
@@ -513,7 +520,7 @@ class Pendant : public Shape {
     const double dc = sd_circle(p, centre_, big_r_);
     const double rim_w = std::max(0.8, 0.2 * big_r_);
     double s = 2.0;
-    if (-dc < rim_w) s += 14.0;                       // raised rim
+    if (-dc < rim_w) s += 14.0;  // raised rim
     const double gem = sd_circle(p, centre_, 0.42 * big_r_);
     if (gem < 0.0) s += 24.0 * (-gem / (0.42 * big_r_)) - 6.0;  // domed centre stone
     s -= 10.0 * clamp01((p.x - centre_.x + p.y - centre_.y) / (2.0 * big_r_));
@@ -548,8 +555,8 @@ class Buckle : public Shape {
     const double outer = sd_rect(p, 0, 0, w_, h_, 0.2 * m_);
     const double hole = sd_rect(p, 0.24 * w_, 0.22 * h_, 0.84 * w_, 0.78 * h_, 0.06 * m_);
     const double frame = std::max(outer, -hole);
-    const double prong = sd_round_cone(p, at(0.12, 0.5), at(0.90, 0.5), std::max(0.6, 0.05 * h_),
-                                       std::max(0.4, 0.02 * h_));
+    const double prong =
+        sd_round_cone(p, at(0.12, 0.5), at(0.90, 0.5), std::max(0.6, 0.05 * h_), std::max(0.4, 0.02 * h_));
     return std::min(frame, prong);
   }
   double shade(P p) const override {
@@ -587,8 +594,7 @@ class Slab : public Shape {
   double shade(P p) const override {
     const double sc = std::max(3.0, 0.22 * m_);
     double s = 14.0 * fbm(p.x / sc, p.y / sc, 71) + 6.0 * grain(p, 72);
-    if (hash01(static_cast<int64_t>(std::floor(p.x / 2.0)),
-               static_cast<int64_t>(std::floor(p.y / 2.0)), 73) > 0.96)
+    if (hash01(static_cast<int64_t>(std::floor(p.x / 2.0)), static_cast<int64_t>(std::floor(p.y / 2.0)), 73) > 0.96)
       s -= 18.0;  // pores
     return s + rim(sd(p), std::max(1.0, 0.1 * m_), 14.0);
   }
@@ -610,13 +616,11 @@ class Phone : public Shape {
     if (screen < 0.0) {
       // Glass: darker, with a diagonal reflection.
       const double k = (p.x / w_ + p.y / h_) * 2.2;
-      return -24.0 + 10.0 * std::max(0.0, 1.0 - std::fabs(k - 1.0) / 0.25) +
-             rim(screen, 0.8, 6.0);
+      return -24.0 + 10.0 * std::max(0.0, 1.0 - std::fabs(k - 1.0) / 0.25) + rim(screen, 0.8, 6.0);
     }
     double s = 6.0 + rim(sd(p), std::max(0.8, 0.06 * m_), 16.0);
-    if (sd_capsule(p, at(0.34, 0.055), at(0.58, 0.055), std::max(0.4, 0.012 * h_)) < 0.0)
-      s -= 28.0;  // earpiece
-    if (sd_circle(p, at(0.22, 0.055), std::max(0.4, 0.02 * h_)) < 0.0) s -= 24.0;  // camera
+    if (sd_capsule(p, at(0.34, 0.055), at(0.58, 0.055), std::max(0.4, 0.012 * h_)) < 0.0) s -= 28.0;  // earpiece
+    if (sd_circle(p, at(0.22, 0.055), std::max(0.4, 0.02 * h_)) < 0.0) s -= 24.0;                     // camera
     const double button = sd_circle(p, at(0.465, 0.92), std::max(0.6, 0.045 * h_));
     if (std::fabs(button) < std::max(0.45, 0.012 * h_)) s -= 20.0;
     return s;
@@ -654,9 +658,8 @@ struct Stop {
   int at;
   int r, g, b;
 };
-constexpr Stop kIron[] = {{0, 0, 0, 0},         {36, 22, 0, 92},      {78, 92, 0, 150},
-                          {118, 168, 6, 140},   {152, 218, 38, 64},   {186, 246, 108, 0},
-                          {222, 255, 196, 24},  {255, 255, 252, 236}};
+constexpr Stop kIron[] = {{0, 0, 0, 0},       {36, 22, 0, 92},    {78, 92, 0, 150},    {118, 168, 6, 140},
+                          {152, 218, 38, 64}, {186, 246, 108, 0}, {222, 255, 196, 24}, {255, 255, 252, 236}};
 
 }  // namespace
 
@@ -672,13 +675,18 @@ Image mmw_body(const Body& body, bool upper, int width, int height) {
   const uint64_t seed = model.seed();
   for (int y = 0; y < height; ++y) {
     const double v = (y + 0.5) * pv + (upper ? 0.0 : 200.0);
+    int next = 0;  // pixels before `next` are known to be clear of the body
     for (int x = 0; x < width; ++x) {
       const double u = (x + 0.5) * pu;
-      const double back = bg + 2.0 * value_noise(u / 9.0, v / 9.0, seed + 2) +
-                          1.5 * hash_signed(x, y, seed + 3);
-      const BodyField f = model.eval(u, v);
-      const double c = coverage(f.d, e);
+      const double back = bg + 2.0 * value_noise(u / 9.0, v / 9.0, seed + 2) + 1.5 * hash_signed(x, y, seed + 3);
       double val = back;
+      if (x < next) {
+        img.at(x, y) = to_u8(val);
+        continue;
+      }
+      const BodyField f = model.eval(u, v);
+      next = x + 1 + skip_pixels(f.d - e, pu, width);
+      const double c = coverage(f.d, e);
       if (c > 0.0) {
         const double depth = clamp01(-f.d / 26.0);
         const double s = 1.0 - (1.0 - depth) * (1.0 - depth);
@@ -702,12 +710,18 @@ Image ir_body(const Body& body, int width, int height) {
   const uint64_t seed = model.seed();
   for (int y = 0; y < height; ++y) {
     const double v = (y + 0.5) * pv;
+    int next = 0;
     for (int x = 0; x < width; ++x) {
       const double u = (x + 0.5) * pu;
       const double back = bg + 3.0 * v / 400.0 + 1.5 * value_noise(u / 12.0, v / 12.0, seed + 6);
-      const BodyField f = model.eval(u, v);
-      const double c = coverage(f.d, e);
       double val = back;
+      if (x < next) {
+        img.at(x, y) = to_u8(val);
+        continue;
+      }
+      const BodyField f = model.eval(u, v);
+      next = x + 1 + skip_pixels(f.d - e, pu, width);
+      const double c = coverage(f.d, e);
       if (c > 0.0) {
         // Each part's own temperature, blended by how close the point is to each part.
         const double sa = clamp01((v - 45.0) / 147.0), sl = clamp01((v - 240.0) / 158.0);
@@ -716,7 +730,7 @@ Image ir_body(const Body& body, int width, int height) {
         const double t_arm = limb + 0.4 * (core - limb) * (1.0 - sa) * (1.0 - sa) - 26.0 * sa * sa;
         const double t_leg = limb + 0.55 * (core - limb) * (1.0 - sl) * (1.0 - sl) - 30.0 * sl * sl;
         // Trunk and legs are one piece: a gradient down from the hips, not a seam.
-        const double t_trunk = lerp(t_core, t_leg, smoothstep(235.0, 300.0, v));
+        const double t_trunk = lerp(t_core, t_leg, smoothstep(225.0, 320.0, v));
         const double d_trunk = std::min(f.d_core, f.d_leg);
         const double dm = std::min({d_trunk, f.d_head, f.d_arm});
         auto weight = [&](double d) { return smooth(1.0 - (d - dm) / 14.0); };
@@ -742,12 +756,18 @@ Image sprite(const std::string& shape, bool vertical, int width, int height, int
   const double lv = std::clamp(level, 0, 255);
   Image img(width, height, 2);
   for (int y = 0; y < height; ++y) {
+    int next = 0;  // pixels before `next` are known to be outside
     for (int x = 0; x < width; ++x) {
+      double value = lv, alpha = 0.0;
+      if (x < next) {
+        img.at(x, y, 0) = to_u8(value);
+        continue;
+      }
       // Horizontal-frame pixel this output pixel shows.
       const int hx = vertical ? y : x, hy = vertical ? hh - 1 - x : y;
       const P centre{hx + 0.5, hy + 0.5};
       const double dc = s->sd(centre);
-      double value = lv, alpha = 0.0;
+      next = x + 1 + skip_pixels(dc - 2.0, 1.0, width);
       if (dc < -2.0) {
         value = lv + fit_shade(s->shade(centre), lv);
         alpha = 255.0;
@@ -776,8 +796,7 @@ Image sprite(const std::string& shape, bool vertical, int width, int height, int
 
 Image noise_pattern(int k, int size) {
   if (k < 0 || k >= kNoisePatterns)
-    throw std::invalid_argument("noise_pattern: k must be in 0.." +
-                                std::to_string(kNoisePatterns - 1));
+    throw std::invalid_argument("noise_pattern: k must be in 0.." + std::to_string(kNoisePatterns - 1));
   check_size(size, size, "noise_pattern");
   Image img(size, size, 1, 128);
   if (size < 3) return img;  // all border
@@ -798,8 +817,7 @@ Image noise_pattern(int k, int size) {
           break;
         }
         case 1:  // horizontal streaks: long along x, a few pixels across
-          a = 0.8 * value_noise(x / std::max(6.0, n / 5.0), y / 2.2, seed) +
-              0.3 * hash_signed(x, y, seed + 1);
+          a = 0.95 * value_noise(x / std::max(6.0, n / 4.0), y / 2.2, seed) + 0.12 * hash_signed(x, y, seed + 1);
           break;
         case 2: {  // low-frequency blotches, contrast-stretched
           const double b = fbm(x / std::max(3.0, n / 5.0), y / std::max(3.0, n / 5.0), seed);
@@ -818,7 +836,7 @@ Image noise_pattern(int k, int size) {
           a = std::clamp(1.4 * a, -1.0, 1.0);
           break;
       }
-      img.at(x, y) = to_u8(128.0 + 45.0 * env * a);
+      img.at(x, y) = to_u8(128.0 + 45.0 * env * std::clamp(a, -1.0, 1.0));
     }
   }
   return img;

@@ -8,6 +8,7 @@ namespace portalsim::cli {
 // Each registers its subcommand and returns the function that runs it (exit status).
 std::function<int()> add_simulate(CLI::App& app);
 std::function<int()> add_catalogue(CLI::App& app);
+std::function<int()> add_generate(CLI::App& app);
 
 // Parses argv and runs the chosen subcommand; prints errors, returns the exit status.
 int run(int argc, char** argv);

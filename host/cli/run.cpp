@@ -13,6 +13,7 @@ int run(int argc, char** argv) {
   std::map<std::string, std::function<int()>> commands;
   commands["simulate"] = add_simulate(app);
   commands["catalogue"] = add_catalogue(app);
+  commands["generate"] = add_generate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -7,6 +7,7 @@
 #include "scene/error.h"
 #include "scene/rules.h"
 #include "sink/scenario_folder.h"
+#include "sink/staging.h"
 
 namespace portalsim::cli {
 
@@ -56,7 +57,7 @@ int simulate(SimulateOptions& o) {
   const double run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_run).count();
 
   const auto t_write = std::chrono::steady_clock::now();
-  write_scenario_folder(folder, out, 0, scene.label == 1, s.assets.palette, FolderOptions{o.image_format});
+  write_scenario_folder([&](const std::string& f) { return folder.path(f); }, out, 0, scene.label == 1, s.assets.palette, FolderOptions{o.image_format});
   folder.commit();
   const double write_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_write).count();
 

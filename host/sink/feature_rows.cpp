@@ -1,17 +1,30 @@
 #include "sink/feature_rows.h"
 
 #include <cmath>
-#include <cstdio>
+#include <charconv>
 
 namespace portalsim {
 
 void append_number(std::string& out, float v) {
-  char buf[48];
-  int len = std::snprintf(buf, sizeof buf, "%.4f", static_cast<double>(v));
-  while (len > 0 && buf[len - 1] == '0') --len;
-  if (len > 0 && buf[len - 1] == '.') --len;
-  if (len == 2 && buf[0] == '-' && buf[1] == '0') len = 1, buf[0] = '0';  // "-0" -> "0"
-  out.append(buf, static_cast<size_t>(len));
+  // Fixed point through integers: several times faster than printf, and the same text
+  // wherever it runs.
+  long long q = std::llround(static_cast<double>(v) * 10000.0);
+  if (q < 0) {
+    out.push_back('-');
+    q = -q;
+  }
+  char buf[32];
+  auto [end, ec] = std::to_chars(buf, buf + sizeof buf, q / 10000);
+  (void)ec;
+  int frac = static_cast<int>(q % 10000);
+  if (frac != 0) {
+    *end++ = '.';
+    int digits = 4;
+    while (frac % 10 == 0) frac /= 10, --digits;
+    for (int d = digits - 1; d >= 0; --d) end[d] = static_cast<char>('0' + frac % 10), frac /= 10;
+    end += digits;
+  }
+  out.append(buf, end);
 }
 
 void append_feature_row(std::string& out, const BatchOutput& b, size_t i, bool threat) {

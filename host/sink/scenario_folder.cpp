@@ -5,6 +5,7 @@
 #include "assets/image_io.h"
 #include "scene/error.h"
 #include "sink/feature_rows.h"
+#include "sink/staging.h"
 
 namespace portalsim {
 
@@ -24,24 +25,24 @@ void write(const std::string& path, const Image& img) {
 }
 }  // namespace
 
-void write_scenario_folder(StagedFolder& folder, const BatchOutput& b, size_t i, bool threat,
+void write_scenario_folder(const PathOf& path_of, const BatchOutput& b, size_t i, bool threat,
                            const Palette& palette, const FolderOptions& opt) {
   const std::string ext = "." + opt.image_format;
   if (!b.upper.empty()) {
-    write(folder.path("upper" + ext), gray(b.upper_of(i), b.mmw_width, b.mmw_height));
-    write(folder.path("lower" + ext), gray(b.lower_of(i), b.mmw_width, b.mmw_height));
+    write(path_of("upper" + ext), gray(b.upper_of(i), b.mmw_width, b.mmw_height));
+    write(path_of("lower" + ext), gray(b.lower_of(i), b.mmw_width, b.mmw_height));
   }
-  if (!b.ir.empty()) write(folder.path("ir" + ext), colourise(gray(b.ir_of(i), b.ir_width, b.ir_height), palette));
+  if (!b.ir.empty()) write(path_of("ir" + ext), colourise(gray(b.ir_of(i), b.ir_width, b.ir_height), palette));
   if (!b.metal.empty()) {
     std::string m;
     for (int z = 0; z < kZones; ++z) m += (z ? "," : "") + std::to_string(b.metal_of(i)[z]);
-    write_text_atomic(folder.path("metal.txt"), m + "\n");
+    write_text_atomic(path_of("metal.txt"), m + "\n");
   }
-  write_text_atomic(folder.path("threat.txt"), threat ? "yes\n" : "no\n");
+  write_text_atomic(path_of("threat.txt"), threat ? "yes\n" : "no\n");
   if (!b.features.empty() && !b.metal.empty()) {
     std::string csv = feature_csv_header(b.layout);
     append_feature_row(csv, b, i, threat);
-    write_text_atomic(folder.path("features.csv"), csv);
+    write_text_atomic(path_of("features.csv"), csv);
   }
 }
 

@@ -2,11 +2,11 @@
 // upper.png, lower.png (MMW), ir.png (IR through the palette), metal.txt, threat.txt,
 // features.csv.
 #pragma once
+#include <functional>
 #include <string>
 
 #include "assets/assets.h"
 #include "backend/backend.h"
-#include "sink/staging.h"
 
 namespace portalsim {
 
@@ -14,8 +14,12 @@ struct FolderOptions {
   std::string image_format = "png";  // png or jpg
 };
 
-// Writes scenario i of `b` into `folder` (staged: nothing appears until commit).
-void write_scenario_folder(StagedFolder& folder, const BatchOutput& b, size_t i, bool threat,
+// Where each file goes: a staged folder's path(), or a plain folder being built under a
+// temporary name.
+using PathOf = std::function<std::string(const std::string& name)>;
+
+// Writes scenario i of `b`, each file at path_of(its name).
+void write_scenario_folder(const PathOf& path_of, const BatchOutput& b, size_t i, bool threat,
                            const Palette& palette, const FolderOptions& opt);
 
 }  // namespace portalsim

@@ -1,0 +1,159 @@
+// portalsim generate: labelled data sets in bulk (thesis chapter 6 at scale).
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "schedule/pipeline.h"
+#include "scene/error.h"
+
+namespace portalsim::cli {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop = true; }
+
+struct GenerateOptions {
+  CommonOptions common;
+  RunSpec spec;
+  std::string out, spec_file, objects, pool, subjects, formats, shard;
+  std::string pattern_noise;
+  size_t batch = 0;
+  unsigned threads = 0;
+  bool resume = false, quiet = false;
+  CLI::App* app = nullptr;
+};
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : s + ",")
+    if (c == ',') {
+      if (!cur.empty()) out.push_back(cur);
+      cur.clear();
+    } else if (c != ' ') {
+      cur.push_back(c);
+    }
+  return out;
+}
+
+int generate(GenerateOptions& o) {
+  CLI::App& app = *o.app;
+  RunSpec spec;
+  if (!o.spec_file.empty()) read_spec_file(o.spec_file, spec);
+  // Flags given on the command line override the spec file.
+  const auto given = [&](const char* name) { return app.get_option(name)->count() > 0; };
+  if (given("--count")) spec.count = o.spec.count;
+  if (given("--seed")) spec.seed = parse_u64(o.common.seed, "--seed");
+  if (given("--rule")) spec.rule = o.spec.rule;
+  if (given("--pool")) spec.pool = split_list(o.pool);
+  if (given("--objects")) parse_object_range(o.objects, "--objects", spec);
+  if (given("--subjects")) {
+    spec.subjects.clear();
+    for (const std::string& s : split_list(o.subjects)) {
+      if (s.empty() || s.size() > 3 || s.find_first_not_of("0123456789") != std::string::npos)
+        throw InputError("--subjects: \"" + s + "\" is not a subject number");
+      spec.subjects.push_back(std::stoi(s));
+    }
+  }
+  if (given("--balance")) spec.balance = o.spec.balance;
+  if (given("--what")) spec.what = o.spec.what;
+  if (given("--format")) spec.formats = split_list(o.formats);
+  if (given("--block")) spec.model.block = o.spec.model.block;
+  if (given("--image-format")) spec.image_format = o.spec.image_format;
+  if (given("--pattern-noise")) spec.model.pattern_noise = o.pattern_noise == "on";
+  if (given("--pixel-noise")) spec.model.pixel_sigma = o.spec.model.pixel_sigma;
+  if (given("--metal-noise")) spec.model.metal_noise = o.spec.model.metal_noise;
+  if (given("--scenarios")) spec.scenarios = o.spec.scenarios;
+  spec.validate();
+
+  PipelineOptions popt;
+  popt.batch = o.batch;
+  popt.threads = o.threads;
+  popt.resume = o.resume;
+  popt.progress = !o.quiet && ::isatty(STDERR_FILENO);
+  popt.stop = &g_stop;
+  if (!o.shard.empty()) {
+    const size_t slash = o.shard.find('/');
+    if (slash == std::string::npos) throw InputError("--shard: \"" + o.shard + "\" is not i/k");
+    popt.shard = parse_u64(o.shard.substr(0, slash), "--shard");
+    popt.shards = parse_u64(o.shard.substr(slash + 1), "--shard");
+    if (popt.shards < 1 || popt.shard >= popt.shards)
+      throw InputError("--shard: \"" + o.shard + "\" needs 0 <= i < k");
+  }
+  if (o.batch > 1000000) throw InputError("--batch: at most 1000000");
+
+  Session s;
+  open_catalogue(s, o.common);
+  {
+    // Check the generator's spec before any output exists.
+    if (spec.scenarios.empty()) Generator check(s.catalogue, generator_spec(spec, s.catalogue), spec.seed);
+    Plan plan;
+    plan.model = spec.model;
+    validate(plan, s.catalogue);
+  }
+  open_backend(s, o.common);
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  const PipelineResult r = run_pipeline(spec, s, o.out, popt);
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+
+  if (r.already_complete) {
+    std::printf("%s: already complete (manifest.json present); nothing to do\n", o.out.c_str());
+    return 0;
+  }
+  const double rate = r.seconds > 0 ? r.done / r.seconds : 0;
+  std::printf("%s: %llu scenarios [%llu, %llu) in %.2f s, %.0f scenarios/s (%s backend, batch %zu); "
+              "positive %llu, negative %llu\n",
+              o.out.c_str(), static_cast<unsigned long long>(r.done), static_cast<unsigned long long>(r.begin),
+              static_cast<unsigned long long>(r.end), r.seconds, rate, s.backend->name().c_str(), r.batch,
+              static_cast<unsigned long long>(r.positive), static_cast<unsigned long long>(r.negative));
+  if (o.common.timing)
+    std::printf("timing: compute %.3f s (%.0f scenarios/s), waiting for the writer %.3f s%s\n", r.compute_seconds,
+                r.compute_seconds > 0 ? r.done / r.compute_seconds : 0.0, r.write_wait_seconds,
+                s.runtime ? (", kernel build " + std::to_string(s.runtime->build_seconds()) + " s").c_str() : "");
+  if (r.interrupted) {
+    std::fprintf(stderr, "portalsim: interrupted; %s is consistent, continue it with --resume\n", o.out.c_str());
+    return 130;
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> add_generate(CLI::App& app) {
+  auto o = std::make_shared<GenerateOptions>();
+  CLI::App* sub = app.add_subcommand("generate", "make a labelled data set of many scenarios");
+  o->app = sub;
+  add_common_options(*sub, o->common);
+  sub->add_option("--spec", o->spec_file, "TOML spec file; command-line flags override its keys");
+  sub->add_option("--count", o->spec.count, "number of scenarios (default 1000)");
+  sub->add_option("--out", o->out, "output folder (must be new or empty, unless --resume)")->required();
+  sub->add_option("--rule", o->spec.rule, "threat rule, e.g. gun or 'iron-rod&metal-plate'");
+  sub->add_option("--pool", o->pool, "objects to draw from, comma-separated (default: all)");
+  sub->add_option("--objects", o->objects, "objects per scenario, MIN..MAX (default 0..4)");
+  sub->add_option("--subjects", o->subjects, "subjects to draw from, e.g. 1,2,5 (default: all)");
+  sub->add_flag("--balance", o->spec.balance, "equal classes: even indices threats, odd not");
+  sub->add_option("--what", o->spec.what, "features, images or both (default features)");
+  sub->add_option("--format", o->formats, "feature tables: arff,csv,npy (default arff)");
+  sub->add_option("--block", o->spec.model.block, "block side for the averaged features (default 10)");
+  sub->add_option("--image-format", o->spec.image_format, "png or jpg (default png)");
+  sub->add_option("--pattern-noise", o->pattern_noise, "the thesis's MMW noise patterns: on (default) or off")
+      ->check(CLI::IsMember({"on", "off"}));
+  sub->add_option("--pixel-noise", o->spec.model.pixel_sigma, "per-pixel Gaussian sensor noise sigma (default 0)");
+  sub->add_option("--metal-noise", o->spec.model.metal_noise, "metal detector noise half-width (default 0)");
+  sub->add_option("--scenarios", o->spec.scenarios, "explicit scenario list (CSV: subject, region1..13, label)");
+  sub->add_option("--batch", o->batch, "scenarios per kernel launch (default: about 64 MiB of outputs)");
+  sub->add_option("--threads", o->threads, "host threads for generating and writing (default: all cores)");
+  sub->add_option("--shard", o->shard, "i/k: make only part i (0-based) of k of the index range");
+  sub->add_flag("--resume", o->resume, "continue an interrupted run in --out");
+  sub->add_flag("--quiet", o->quiet, "no progress bar");
+  return [o] { return generate(*o); };
+}
+
+}  // namespace portalsim::cli

@@ -1,0 +1,307 @@
+#include "schedule/pipeline.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "schedule/parallel.h"
+#include "scene/error.h"
+#include "sink/sinks.h"
+#include "sink/staging.h"
+
+namespace portalsim {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+
+namespace {
+
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+struct Job {
+  SceneBatch scenes;
+  BatchOutput out;
+};
+
+// One-slot hand-over between the compute thread and the writer thread.
+class Handover {
+ public:
+  void put(std::unique_ptr<Job> j) {
+    std::unique_lock<std::mutex> lock(m_);
+    cv_.wait(lock, [&] { return !slot_ || failed_; });
+    if (failed_) return;
+    slot_ = std::move(j);
+    cv_.notify_all();
+  }
+  std::unique_ptr<Job> take() {
+    std::unique_lock<std::mutex> lock(m_);
+    cv_.wait(lock, [&] { return slot_ || closed_; });
+    std::unique_ptr<Job> j = std::move(slot_);
+    cv_.notify_all();
+    return j;
+  }
+  void close() {
+    std::lock_guard<std::mutex> lock(m_);
+    closed_ = true;
+    cv_.notify_all();
+  }
+  void fail() {
+    std::lock_guard<std::mutex> lock(m_);
+    failed_ = true;
+    cv_.notify_all();
+  }
+  bool failed() {
+    std::lock_guard<std::mutex> lock(m_);
+    return failed_;
+  }
+
+ private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::unique_ptr<Job> slot_;
+  bool closed_ = false, failed_ = false;
+};
+
+void draw_progress(uint64_t done, uint64_t total, double seconds) {
+  const double rate = seconds > 0 ? done / seconds : 0;
+  const double eta = rate > 0 ? (total - done) / rate : 0;
+  const int width = 30, filled = total ? static_cast<int>(width * done / total) : width;
+  std::fprintf(stderr, "\r[%s%s] %5.1f%% %llu/%llu  %.0f scenarios/s  ETA %02d:%02d:%02d ",
+               std::string(filled, '=').c_str(), std::string(width - filled, ' ').c_str(),
+               total ? 100.0 * done / total : 100.0, static_cast<unsigned long long>(done),
+               static_cast<unsigned long long>(total), rate, static_cast<int>(eta / 3600),
+               static_cast<int>(eta / 60) % 60, static_cast<int>(eta) % 60);
+  std::fflush(stderr);
+}
+
+}  // namespace
+
+size_t default_batch(const Plan& plan, const Catalogue& cat) {
+  const ImagesConfig& ic = cat.images;
+  size_t bytes = 64 + kZones;
+  if (plan.renders_mmw()) bytes += 2 * static_cast<size_t>(ic.mmw_width) * ic.mmw_height;
+  if (plan.ir_image) bytes += static_cast<size_t>(ic.ir_width) * ic.ir_height;
+  if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
+  return std::clamp<size_t>((64u << 20) / bytes, 64, 16384);
+}
+
+PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const std::string& dir,
+                            const PipelineOptions& opt) {
+  const auto t0 = Clock::now();
+  const Catalogue& cat = session.catalogue;
+  PipelineResult res;
+
+  // The scenario source.
+  std::optional<Generator> generator;
+  std::vector<Scenario> listed;
+  std::optional<ThreatRule> rule;
+  uint64_t total = spec.count;
+  if (!spec.scenarios.empty()) {
+    listed = read_scenario_file(cat, spec.scenarios);
+    total = listed.size();
+    if (!spec.rule.empty()) rule.emplace(cat, spec.rule, "--rule");
+  } else {
+    generator.emplace(cat, generator_spec(spec, cat), spec.seed);
+  }
+  if (opt.shards < 1 || opt.shard >= opt.shards) throw InputError("--shard: expected i/k with 0 <= i < k");
+  res.begin = total * opt.shard / opt.shards;
+  res.end = total * (opt.shard + 1) / opt.shards;
+
+  Plan plan;
+  plan.features = spec.wants_features();
+  plan.metal = true;
+  plan.mmw_images = spec.wants_images();
+  plan.ir_image = spec.wants_images();
+  plan.model = spec.model;
+  plan.model.seed = spec.seed;
+  validate(plan, cat);
+  res.batch = opt.batch ? opt.batch : default_batch(plan, cat);
+  const unsigned threads = opt.threads ? opt.threads : default_threads();
+
+  json identity;
+  identity["portalsim"] = PORTALSIM_VERSION;
+  identity["catalogue"] = {{"source", cat.source}, {"hash", cat.hash}};
+  identity["spec"] = spec.to_json();
+  if (!spec.scenarios.empty()) identity["spec"]["scenarios_count"] = total;
+  identity["shard"] = {{"index", opt.shard}, {"count", opt.shards}, {"begin", res.begin}, {"end", res.end}};
+
+  // The output folder: new, or an interrupted run of the same identity to resume.
+  const fs::path out(dir), state_dir = out / ".portalsim", checkpoint_path = state_dir / "checkpoint.json";
+  std::error_code ec;
+  json checkpoint;
+  bool resuming = false;
+  if (fs::exists(out, ec) && !fs::is_directory(out, ec)) throw OutputError(dir + ": exists and is not a folder");
+  if (opt.resume && fs::exists(checkpoint_path, ec)) {
+    try {
+      checkpoint = json::parse(read_file(checkpoint_path));
+    } catch (const json::exception& e) {
+      throw OutputError(checkpoint_path.string() + ": unreadable checkpoint: " + e.what());
+    }
+    if (checkpoint.value("identity", json()) != identity) {
+      std::string field = "the spec";
+      for (auto& [k, v] : identity.items())
+        if (checkpoint["identity"].value(k, json()) != v) field = k;
+      throw InputError("--resume: " + dir + " was made by a different run (its " + field +
+                       " differs); give the same spec, or another folder");
+    }
+    resuming = true;
+  } else if (opt.resume && fs::exists(out / "manifest.json", ec)) {
+    res.already_complete = true;
+    return res;
+  } else if (fs::exists(out, ec) && !fs::is_empty(out, ec)) {
+    throw OutputError(dir + ": is not empty; use --resume to continue an interrupted run there, or choose a new folder");
+  }
+  fs::create_directories(state_dir, ec);
+  if (ec) throw OutputError(dir + ": cannot create the output folder: " + ec.message());
+  if (::access(state_dir.c_str(), W_OK) != 0) throw OutputError(dir + ": the output folder is not writable");
+
+  const uint64_t start = resuming ? checkpoint["next"].get<uint64_t>() : res.begin;
+  if (resuming) {
+    res.positive = checkpoint["positive"].get<uint64_t>();
+    res.negative = checkpoint["negative"].get<uint64_t>();
+  }
+
+  // Sinks, each continuing from its checkpointed state on resume.
+  SinkContext ctx;
+  ctx.dir = dir;
+  ctx.cat = &cat;
+  ctx.assets = &session.assets;
+  ctx.layout = FeatureLayout::of(cat, plan.model.block);
+  ctx.rows = res.end - res.begin;
+  ctx.threads = threads;
+  ctx.image_format = spec.image_format;
+  std::map<std::string, FileState> saved;
+  if (resuming)
+    for (const json& f : checkpoint["files"])
+      saved[f["name"]] = FileState{f["name"], f["bytes"].get<uint64_t>(), f["crc32"].get<uint32_t>()};
+  const auto resume_state = [&](const std::string& name) -> const FileState* {
+    if (!resuming) return nullptr;
+    auto it = saved.find(name);
+    if (it == saved.end()) throw OutputError(checkpoint_path.string() + ": no state for " + name);
+    return &it->second;
+  };
+  std::vector<std::unique_ptr<Sink>> sinks;
+  sinks.push_back(make_scenario_list_sink(ctx, resume_state("scenarios.csv")));
+  if (plan.features)
+    for (const std::string& f : spec.formats) sinks.push_back(make_table_sink(f, ctx, resume_state("features." + f)));
+  if (plan.mmw_images) sinks.push_back(make_image_sink(ctx, resuming, start));
+
+  const auto save_checkpoint = [&](uint64_t next) {
+    json c;
+    c["identity"] = identity;
+    c["next"] = next;
+    c["positive"] = res.positive;
+    c["negative"] = res.negative;
+    c["files"] = json::array();
+    for (const auto& s : sinks)
+      for (const FileState& f : s->files())
+        c["files"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"crc32", f.crc32}});
+    write_text_atomic(checkpoint_path.string(), c.dump(1) + "\n");
+  };
+  if (!resuming) save_checkpoint(start);
+
+  // Writer thread: sinks, then the checkpoint, batch after batch.
+  Handover hand;
+  std::exception_ptr writer_error;
+  std::atomic<uint64_t> written{start};
+  std::thread writer([&] {
+    try {
+      while (std::unique_ptr<Job> job = hand.take()) {
+        for (auto& s : sinks) s->write(job->scenes, job->out);
+        for (uint8_t l : job->scenes.label) (l == 1 ? res.positive : res.negative)++;
+        const uint64_t next = job->scenes.first_index + job->scenes.size();
+        save_checkpoint(next);
+        written = next;
+      }
+    } catch (...) {
+      writer_error = std::current_exception();
+      hand.fail();
+    }
+  });
+
+  std::exception_ptr compute_error;
+  double last_draw = -1;
+  try {
+    for (uint64_t first = start; first < res.end; first += res.batch) {
+      if (opt.stop && *opt.stop) {
+        res.interrupted = true;
+        break;
+      }
+      if (hand.failed()) break;
+      auto job = std::make_unique<Job>();
+      const size_t n = static_cast<size_t>(std::min<uint64_t>(res.batch, res.end - first));
+      SceneBatch& b = job->scenes;
+      b.first_index = first;
+      b.subject.resize(n);
+      b.objects.resize(n * kRegions);
+      b.label.resize(n);
+      parallel_for(n, n >= 1024 ? threads : 1, [&](size_t lo, size_t hi) {
+        for (size_t i = lo; i < hi; ++i) {
+          Scenario s = generator ? (*generator)(first + i) : listed[first + i];
+          if (!generator && s.label < 0) s.label = rule && (*rule)(s) ? 1 : 0;
+          b.subject[i] = static_cast<uint8_t>(s.subject);
+          std::copy(s.objects.begin(), s.objects.end(), b.objects.begin() + i * kRegions);
+          b.label[i] = static_cast<uint8_t>(s.label);
+        }
+      });
+      const auto tc = Clock::now();
+      session.backend->run(b, plan, job->out);
+      res.compute_seconds += since(tc);
+      const auto tw = Clock::now();
+      hand.put(std::move(job));
+      res.write_wait_seconds += since(tw);
+      if (opt.progress && since(t0) - last_draw > 0.2) {
+        last_draw = since(t0);
+        draw_progress(written - res.begin, res.end - res.begin, since(t0));
+      }
+    }
+  } catch (...) {
+    compute_error = std::current_exception();
+  }
+  hand.close();
+  writer.join();
+  if (opt.progress) {
+    draw_progress(written - res.begin, res.end - res.begin, since(t0));
+    std::fprintf(stderr, "\n");
+  }
+  if (compute_error) std::rethrow_exception(compute_error);
+  if (writer_error) std::rethrow_exception(writer_error);
+  res.done = written - start;
+  res.seconds = since(t0);
+  if (res.interrupted) return res;
+
+  // Complete: final names, then the manifest, then the checkpoint goes.
+  json manifest = identity;
+  manifest["count"] = res.end - res.begin;
+  manifest["classes"] = {{"positive", res.positive}, {"negative", res.negative}};
+  manifest["outputs"] = json::array();
+  for (auto& s : sinks) {
+    for (const FileState& f : s->files()) {
+      char crc[9];
+      std::snprintf(crc, sizeof crc, "%08x", f.crc32);
+      manifest["outputs"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"crc32", crc}});
+    }
+    s->finish();
+  }
+  if (plan.mmw_images) manifest["images"] = {{"folder", "images"}, {"count", res.end - res.begin}};
+  write_text_atomic((out / "manifest.json").string(), manifest.dump(2) + "\n");
+  fs::remove_all(state_dir, ec);
+  return res;
+}
+
+}  // namespace portalsim

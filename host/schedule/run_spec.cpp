@@ -1,0 +1,185 @@
+#include "schedule/run_spec.h"
+
+#include <cmath>
+#include <filesystem>
+#include <toml++/toml.h>
+
+#include "scene/error.h"
+
+namespace portalsim {
+
+nlohmann::json RunSpec::to_json() const {
+  nlohmann::json j;
+  j["count"] = count;
+  j["seed"] = std::to_string(seed);
+  j["pool"] = pool;
+  j["objects"] = {min_objects, max_objects};
+  j["subjects"] = subjects;
+  j["rule"] = rule;
+  j["balance"] = balance;
+  j["scenarios"] = scenarios;
+  j["what"] = what;
+  j["format"] = formats;
+  j["image_format"] = image_format;
+  j["block"] = model.block;
+  j["pattern_noise"] = model.pattern_noise;
+  j["pixel_noise"] = model.pixel_sigma;
+  j["metal_noise"] = model.metal_noise;
+  return j;
+}
+
+void RunSpec::validate() const {
+  if (scenarios.empty() && (count < 1 || count > (1ull << 40)))
+    throw InputError("count: must be between 1 and 2^40");
+  if (what != "features" && what != "images" && what != "both")
+    throw InputError("what: \"" + what + "\" is not features, images or both");
+  if (wants_features() && formats.empty()) throw InputError("format: give at least one of arff, csv, npy");
+  for (size_t i = 0; i < formats.size(); ++i) {
+    if (formats[i] != "arff" && formats[i] != "csv" && formats[i] != "npy")
+      throw InputError("format: \"" + formats[i] + "\" is not arff, csv or npy");
+    for (size_t j = 0; j < i; ++j)
+      if (formats[j] == formats[i]) throw InputError("format: \"" + formats[i] + "\" given twice");
+  }
+  if (image_format != "png" && image_format != "jpg")
+    throw InputError("image_format: \"" + image_format + "\" is not png or jpg");
+  if (balance && rule.empty()) throw InputError("balance: needs a threat rule (--rule)");
+}
+
+void parse_object_range(const std::string& text, const std::string& where, RunSpec& spec) {
+  const auto number = [&](const std::string& s) {
+    if (s.empty() || s.size() > 2 || s.find_first_not_of("0123456789") != std::string::npos)
+      throw InputError(where + ": \"" + text + "\" is not MIN..MAX with 0 <= MIN <= MAX <= 13");
+    return std::stoi(s);
+  };
+  const size_t dots = text.find("..");
+  const int lo = number(dots == std::string::npos ? text : text.substr(0, dots));
+  const int hi = dots == std::string::npos ? lo : number(text.substr(dots + 2));
+  if (lo > hi || hi > 13) throw InputError(where + ": \"" + text + "\" is not MIN..MAX with 0 <= MIN <= MAX <= 13");
+  spec.min_objects = lo;
+  spec.max_objects = hi;
+}
+
+void read_spec_file(const std::string& path, RunSpec& spec) {
+  toml::table t;
+  try {
+    t = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    if (e.source().begin.line == 0) throw InputError(path + ": cannot read the spec file: " + std::string(e.description()));
+    throw InputError(path + ":" + std::to_string(e.source().begin.line) + ": syntax: " + std::string(e.description()));
+  }
+  const auto at = [&](const toml::node& n, const std::string& key) {
+    return path + ":" + std::to_string(n.source().begin.line) + ": " + key;
+  };
+  const auto integer = [&](const toml::node& n, const std::string& key, long long lo, long long hi) {
+    if (!n.is_integer()) throw InputError(at(n, key) + ": expected an integer");
+    const long long v = n.as_integer()->get();
+    if (v < lo || v > hi)
+      throw InputError(at(n, key) + ": " + std::to_string(v) + " is out of range [" + std::to_string(lo) + ", " +
+                       std::to_string(hi) + "]");
+    return v;
+  };
+  const auto string = [&](const toml::node& n, const std::string& key) {
+    if (!n.is_string()) throw InputError(at(n, key) + ": expected a string");
+    return n.as_string()->get();
+  };
+  const auto strings = [&](const toml::node& n, const std::string& key) {
+    std::vector<std::string> out;
+    if (n.is_string()) {
+      std::string s = n.as_string()->get(), cur;
+      for (char c : s + ",")
+        if (c == ',') {
+          if (!cur.empty()) out.push_back(cur);
+          cur.clear();
+        } else if (c != ' ') {
+          cur.push_back(c);
+        }
+      return out;
+    }
+    const toml::array* a = n.as_array();
+    if (!a) throw InputError(at(n, key) + ": expected an array of strings");
+    for (const toml::node& e : *a) out.push_back(string(e, key));
+    return out;
+  };
+  const auto boolean = [&](const toml::node& n, const std::string& key) {
+    if (!n.is_boolean()) throw InputError(at(n, key) + ": expected true or false");
+    return n.as_boolean()->get();
+  };
+  const std::string dir = std::filesystem::absolute(path).parent_path().string();
+  for (const auto& [k, node] : t) {
+    const std::string key(k.str());
+    if (key == "count") {
+      spec.count = static_cast<uint64_t>(integer(node, key, 1, 1ll << 40));
+    } else if (key == "seed") {
+      if (node.is_integer())
+        spec.seed = static_cast<uint64_t>(integer(node, key, 0, INT64_MAX));
+      else
+        throw InputError(at(node, key) + ": expected a non-negative integer (use --seed for values above 2^63)");
+    } else if (key == "rule") {
+      spec.rule = string(node, key);
+    } else if (key == "pool") {
+      spec.pool = strings(node, key);
+    } else if (key == "objects") {
+      if (node.is_string()) {
+        parse_object_range(string(node, key), at(node, key), spec);
+      } else if (const toml::array* a = node.as_array(); a && a->size() == 2) {
+        spec.min_objects = static_cast<int>(integer(*a->get(0), key, 0, 13));
+        spec.max_objects = static_cast<int>(integer(*a->get(1), key, 0, 13));
+        if (spec.min_objects > spec.max_objects) throw InputError(at(node, key) + ": MIN is above MAX");
+      } else {
+        throw InputError(at(node, key) + ": expected \"MIN..MAX\" or [MIN, MAX]");
+      }
+    } else if (key == "subjects") {
+      const toml::array* a = node.as_array();
+      if (!a) throw InputError(at(node, key) + ": expected an array of subject numbers");
+      spec.subjects.clear();
+      for (const toml::node& e : *a) spec.subjects.push_back(static_cast<int>(integer(e, key, 1, 255)));
+    } else if (key == "balance") {
+      spec.balance = boolean(node, key);
+    } else if (key == "what") {
+      spec.what = string(node, key);
+    } else if (key == "format") {
+      spec.formats = strings(node, key);
+    } else if (key == "image_format") {
+      spec.image_format = string(node, key);
+    } else if (key == "block") {
+      spec.model.block = static_cast<int>(integer(node, key, 1, 4096));
+    } else if (key == "pattern_noise") {
+      spec.model.pattern_noise = boolean(node, key);
+    } else if (key == "pixel_noise") {
+      double v = node.is_integer() ? static_cast<double>(node.as_integer()->get())
+                 : node.is_floating_point() ? node.as_floating_point()->get()
+                                            : throw InputError(at(node, key) + ": expected a number");
+      if (!std::isfinite(v) || v < 0 || v > 1000)
+        throw InputError(at(node, key) + ": must be a finite number between 0 and 1000");
+      spec.model.pixel_sigma = v;
+    } else if (key == "metal_noise") {
+      spec.model.metal_noise = static_cast<int>(integer(node, key, 0, 199));
+    } else if (key == "scenarios") {
+      std::filesystem::path p(string(node, key));
+      spec.scenarios = (p.is_relative() ? std::filesystem::path(dir) / p : p).string();
+    } else {
+      throw InputError(at(node, key) +
+                       ": unknown key (count, seed, rule, pool, objects, subjects, balance, what, format, "
+                       "image_format, block, pattern_noise, pixel_noise, metal_noise, scenarios)");
+    }
+  }
+}
+
+GeneratorSpec generator_spec(const RunSpec& spec, const Catalogue& cat) {
+  GeneratorSpec g;
+  for (const std::string& name : spec.pool) {
+    const int o = cat.find_object(name);
+    if (o < 0) throw InputError("pool: unknown object \"" + name + "\"");
+    for (int p : g.pool)
+      if (p == o) throw InputError("pool: \"" + name + "\" is listed twice");
+    g.pool.push_back(o);
+  }
+  g.min_objects = spec.min_objects;
+  g.max_objects = spec.max_objects;
+  for (int s : spec.subjects) g.subjects.push_back(s - 1);
+  g.rule = spec.rule;
+  g.balance = spec.balance;
+  return g;
+}
+
+}  // namespace portalsim

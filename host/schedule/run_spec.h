@@ -1,0 +1,44 @@
+// Everything that decides a data set's contents: the identity recorded in the manifest
+// and checked on --resume. Batch size, threads and backend are not part of it: they
+// never change the data.
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "plan/plan.h"
+#include "scene/generator.h"
+
+namespace portalsim {
+
+struct RunSpec {
+  uint64_t count = 1000;
+  uint64_t seed = 0;
+  std::vector<std::string> pool;  // object names as given; empty = all
+  int min_objects = 0, max_objects = 4;
+  std::vector<int> subjects;      // 1-based; empty = all
+  std::string rule;
+  bool balance = false;
+  std::string scenarios;          // explicit scenario list (CSV); replaces the generator
+  std::string what = "features";  // features | images | both
+  std::vector<std::string> formats{"arff"};
+  std::string image_format = "png";
+  ModelSettings model;            // seed is copied from `seed`
+
+  bool wants_features() const { return what != "images"; }
+  bool wants_images() const { return what != "features"; }
+  nlohmann::json to_json() const;
+  // Checks values that need no catalogue; throws InputError naming the option.
+  void validate() const;
+};
+
+// Reads a TOML spec (keys as the long options: count, seed, rule, pool, objects,
+// subjects, balance, what, format, block, image_format, pattern_noise, pixel_noise,
+// metal_noise, scenarios) over `spec`. Errors name the file, line and key.
+void read_spec_file(const std::string& path, RunSpec& spec);
+// "MIN..MAX" or "N".
+void parse_object_range(const std::string& text, const std::string& where, RunSpec& spec);
+
+GeneratorSpec generator_spec(const RunSpec& spec, const Catalogue& cat);
+
+}  // namespace portalsim

@@ -1,0 +1,206 @@
+#include "sink/sinks.h"
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "assets/image_io.h"
+#include "schedule/parallel.h"
+#include "scene/error.h"
+#include "sink/feature_rows.h"
+#include "sink/scenario_folder.h"
+#include "sink/staging.h"
+
+namespace portalsim {
+
+namespace fs = std::filesystem;
+
+std::string image_folder_name(uint64_t index) {
+  char buf[24];
+  std::snprintf(buf, sizeof buf, "%08llu", static_cast<unsigned long long>(index));
+  return buf;
+}
+
+std::string arff_header(const FeatureLayout& layout) {
+  std::string h = "% portalsim features: MMW block means, region means, metal zones (thesis 5.6)\n";
+  h += "@relation portalsim\n\n";
+  for (const std::string& n : layout.names()) h += "@attribute " + n + " numeric\n";
+  h += "@attribute class {positive,negative}\n\n@data\n";
+  return h;
+}
+
+std::string npy_header(uint64_t rows, size_t columns) {
+  std::string dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(rows) + ", " +
+                     std::to_string(columns) + "), }";
+  // Magic (6) + version (2) + length (2) + dict + padding + '\n', a multiple of 64.
+  const size_t total = (10 + dict.size() + 1 + 63) / 64 * 64;
+  dict.append(total - 10 - dict.size() - 1, ' ');
+  dict.push_back('\n');
+  std::string h("\x93NUMPY\x01\x00", 8);
+  h.push_back(static_cast<char>(dict.size() & 0xff));
+  h.push_back(static_cast<char>(dict.size() >> 8));
+  return h + dict;
+}
+
+namespace {
+
+// Rows formatted in parallel chunks, appended in order.
+class TextTableSink final : public Sink {
+ public:
+  TextTableSink(const std::string& name, const std::string& header, const SinkContext& ctx, const FileState* resume)
+      : ctx_(ctx), file_(ctx.dir, name, resume) {
+    if (!resume) file_.append(header);
+  }
+  void write(const SceneBatch& scenes, const BatchOutput& out) override {
+    const size_t n = scenes.size();
+    const unsigned parts = std::min<unsigned>(ctx_.threads, static_cast<unsigned>(std::max<size_t>(1, n / 256)));
+    std::vector<std::string> chunks(std::max(1u, parts));
+    parallel_for(chunks.size(), parts, [&](size_t b, size_t e) {
+      for (size_t c = b; c < e; ++c) {
+        std::string& s = chunks[c];
+        s.reserve((n / chunks.size() + 1) * 8 * static_cast<size_t>(out.layout.row_features()));
+        for (size_t i = n * c / chunks.size(); i < n * (c + 1) / chunks.size(); ++i)
+          append_feature_row(s, out, i, scenes.label[i] == 1);
+      }
+    });
+    for (const std::string& s : chunks) file_.append(s);
+  }
+  std::vector<FileState> files() const override { return {file_.state()}; }
+  void finish() override { file_.finish(); }
+
+ private:
+  SinkContext ctx_;
+  AppendFile file_;
+};
+
+class NpySink final : public Sink {
+ public:
+  NpySink(const SinkContext& ctx, const FileState* resume)
+      : ctx_(ctx), columns_(static_cast<size_t>(ctx.layout.row_features()) + 1), file_(ctx.dir, "features.npy", resume) {
+    if (!resume) {
+      file_.append(npy_header(ctx.rows, columns_));
+      std::string names;
+      for (const std::string& n : ctx.layout.names()) names += n + "\n";
+      write_text_atomic((fs::path(ctx.dir) / "features.columns.txt").string(), names + "class\n");
+    }
+  }
+  void write(const SceneBatch& scenes, const BatchOutput& out) override {
+    const size_t n = scenes.size(), F = static_cast<size_t>(out.layout.image_features());
+    buf_.resize(n * columns_);
+    for (size_t i = 0; i < n; ++i) {
+      float* row = buf_.data() + i * columns_;
+      std::memcpy(row, out.features_of(i), F * sizeof(float));
+      for (int z = 0; z < kZones; ++z) row[F + z] = out.metal_of(i)[z];
+      row[F + kZones] = scenes.label[i] == 1 ? 1.0f : 0.0f;
+    }
+    file_.append(buf_.data(), buf_.size() * sizeof(float));
+  }
+  std::vector<FileState> files() const override { return {file_.state()}; }
+  void finish() override { file_.finish(); }
+
+ private:
+  SinkContext ctx_;
+  size_t columns_;
+  AppendFile file_;
+  std::vector<float> buf_;
+};
+
+class ScenarioListSink final : public Sink {
+ public:
+  ScenarioListSink(const SinkContext& ctx, const FileState* resume) : ctx_(ctx), file_(ctx.dir, "scenarios.csv", resume) {
+    if (!resume) {
+      std::string h = "index,subject";
+      for (int r = 1; r <= kRegions; ++r) h += ",region" + std::to_string(r);
+      file_.append(h + ",label\n");
+    }
+    for (size_t v = 0; v < ctx.cat->variant_list.size(); ++v) names_.push_back(ctx.cat->variant_name(static_cast<int>(v)));
+  }
+  void write(const SceneBatch& scenes, const BatchOutput&) override {
+    std::string s;
+    s.reserve(scenes.size() * 96);
+    for (size_t i = 0; i < scenes.size(); ++i) {
+      s += std::to_string(scenes.first_index + i);
+      s += ',';
+      s += std::to_string(scenes.subject[i] + 1);
+      for (int r = 0; r < kRegions; ++r) {
+        s += ',';
+        const int16_t v = scenes.objects[i * kRegions + r];
+        s += v == kNoObject ? std::string("none") : names_[v];
+      }
+      s += scenes.label[i] == 1 ? ",yes\n" : ",no\n";
+    }
+    file_.append(s);
+  }
+  std::vector<FileState> files() const override { return {file_.state()}; }
+  void finish() override { file_.finish(); }
+
+ private:
+  SinkContext ctx_;
+  AppendFile file_;
+  std::vector<std::string> names_;
+};
+
+class ImageSink final : public Sink {
+ public:
+  ImageSink(const SinkContext& ctx, bool resume, uint64_t resume_from) : ctx_(ctx) {
+    root_ = (fs::path(ctx.dir) / "images").string();
+    std::error_code ec;
+    fs::create_directories(root_, ec);
+    if (ec) throw OutputError(root_ + ": cannot create: " + ec.message());
+    if (resume) {
+      // Drop what the interrupted run wrote past its checkpoint, and its staging folders.
+      for (const auto& entry : fs::directory_iterator(root_)) {
+        const std::string name = entry.path().filename().string();
+        const bool staging = name.find(".tmp") != std::string::npos;
+        bool past = false;
+        if (!staging && !name.empty() && name.find_first_not_of("0123456789") == std::string::npos)
+          past = std::stoull(name) >= resume_from;
+        if (staging || past) fs::remove_all(entry.path(), ec);
+      }
+    }
+  }
+  void write(const SceneBatch& scenes, const BatchOutput& out) override {
+    parallel_for(scenes.size(), ctx_.threads, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        const std::string name = image_folder_name(scenes.first_index + i);
+        const fs::path tmp = fs::path(root_) / (name + ".tmp");
+        std::error_code ec;
+        fs::remove_all(tmp, ec);
+        fs::create_directory(tmp, ec);
+        if (ec) throw OutputError(tmp.string() + ": cannot create: " + ec.message());
+        write_scenario_folder([&](const std::string& f) { return (tmp / f).string(); }, out, i, scenes.label[i] == 1,
+                              ctx_.assets->palette, FolderOptions{ctx_.image_format});
+        const fs::path final_path = fs::path(root_) / name;
+        fs::remove_all(final_path, ec);
+        fs::rename(tmp, final_path, ec);
+        if (ec) throw OutputError(final_path.string() + ": cannot move into place: " + ec.message());
+      }
+    });
+  }
+  std::vector<FileState> files() const override { return {}; }
+  void finish() override {}
+
+ private:
+  SinkContext ctx_;
+  std::string root_;
+};
+
+}  // namespace
+
+std::unique_ptr<Sink> make_table_sink(const std::string& format, const SinkContext& ctx, const FileState* resume) {
+  if (format == "csv")
+    return std::make_unique<TextTableSink>("features.csv", feature_csv_header(ctx.layout), ctx, resume);
+  if (format == "arff") return std::make_unique<TextTableSink>("features.arff", arff_header(ctx.layout), ctx, resume);
+  if (format == "npy") return std::make_unique<NpySink>(ctx, resume);
+  throw InputError("--format: unknown format \"" + format + "\" (arff, csv, npy)");
+}
+
+std::unique_ptr<Sink> make_scenario_list_sink(const SinkContext& ctx, const FileState* resume) {
+  return std::make_unique<ScenarioListSink>(ctx, resume);
+}
+
+std::unique_ptr<Sink> make_image_sink(const SinkContext& ctx, bool resume, uint64_t resume_from) {
+  return std::make_unique<ImageSink>(ctx, resume, resume_from);
+}
+
+}  // namespace portalsim

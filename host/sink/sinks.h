@@ -1,0 +1,46 @@
+// Data-set sinks: each takes batches in index order and appends them to its outputs.
+//   features.arff  WEKA's format (thesis 5.3, appendix D.4)
+//   features.csv   the same rows with a header
+//   features.npy   float32 matrix (features, 19 zones, class 1/0), names in features.columns.txt
+//   scenarios.csv  index, subject, region1..region13, label: re-runnable with --scenarios
+//   images/<index>/ the folder `simulate` writes, per scenario
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "backend/backend.h"
+#include "sink/append_file.h"
+
+namespace portalsim {
+
+class Sink {
+ public:
+  virtual ~Sink() = default;
+  virtual void write(const SceneBatch& scenes, const BatchOutput& out) = 0;
+  // The files as they stand (for checkpoints and the manifest).
+  virtual std::vector<FileState> files() const = 0;
+  virtual void finish() = 0;
+};
+
+struct SinkContext {
+  std::string dir;
+  const Catalogue* cat = nullptr;
+  const AssetSet* assets = nullptr;
+  FeatureLayout layout;
+  uint64_t rows = 0;  // rows the finished table will hold (the npy header needs it)
+  unsigned threads = 1;
+  std::string image_format = "png";
+};
+
+// format: arff, csv or npy. `resume` is the file's checkpointed state, or null.
+std::unique_ptr<Sink> make_table_sink(const std::string& format, const SinkContext& ctx, const FileState* resume);
+std::unique_ptr<Sink> make_scenario_list_sink(const SinkContext& ctx, const FileState* resume);
+// Writes images/<index>/ folders; on resume, folders from `resume_from` on are removed first.
+std::unique_ptr<Sink> make_image_sink(const SinkContext& ctx, bool resume, uint64_t resume_from);
+
+std::string image_folder_name(uint64_t index);
+std::string arff_header(const FeatureLayout& layout);
+std::string npy_header(uint64_t rows, size_t columns);
+
+}  // namespace portalsim
