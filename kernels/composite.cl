@@ -32,15 +32,23 @@ inline void composite_layers(Layers* L, global const short* objects, global cons
   }
 }
 
-// The composited value of pixel x over `base`: each layer v <- v + a (s - v).
+// One layer over value v: v + a (s - v), a = alpha * coverage / 255.
+inline float blend(float v, uchar value, uchar coverage, float alpha) {
+  const float a = alpha * (float)coverage * (1.0f / 255.0f);
+  return fma(a, (float)value - v, v);
+}
+
+// Rounds a model value to its 8-bit pixel.
+inline uchar to_pixel(float v) { return (uchar)clamp(floor(v + 0.5f), 0.0f, 255.0f); }
+
+// The composited value of pixel x over `base`: each layer through blend(), in region order.
 inline float composite_pixel(const Layers* L, global const uchar* atlas, float base, int x, float alpha) {
   float v = base;
   for (int k = 0; k < L->count; ++k) {
     const int sx = x - L->x0[k];
     if (sx < 0 || sx >= L->width[k]) continue;
     const int o = L->offset[k] + 2 * sx;
-    const float a = alpha * (float)atlas[o + 1] * (1.0f / 255.0f);
-    v = mad(a, (float)atlas[o] - v, v);
+    v = blend(v, atlas[o], atlas[o + 1], alpha);
   }
   return v;
 }

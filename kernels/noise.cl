@@ -2,6 +2,9 @@
 // generator, is laid over every object: a square tile centred on the object's sprite.
 // Optional per-pixel Gaussian sensor noise comes on top.
 
+#define FLAG_PATTERN_NOISE 1
+#define FLAG_PIXEL_NOISE 2
+
 typedef struct {
   int count;
   int offset[MAX_LAYERS];  // atlas offset of the tile row that meets this image row

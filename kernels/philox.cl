@@ -1,3 +1,7 @@
+// No implicit contraction of a*b+c: the dense and sparse paths must round alike, so
+// fused multiply-adds are written out as fma() where wanted.
+#pragma OPENCL FP_CONTRACT OFF
+
 // Philox4x32-10: the same generator as host/scene/philox.h (see there for the layout).
 // key = (seed lo, seed hi); counter = (element, stream, scenario lo, scenario hi).
 

@@ -1,9 +1,6 @@
 // Renders one sensor view for a batch: one work-item per (scenario, image row).
 // view: 0 MMW upper (regions 1-6), 1 MMW lower (regions 7-13), 2 IR (all regions).
 
-#define FLAG_PATTERN_NOISE 1
-#define FLAG_PIXEL_NOISE 2
-
 kernel void render_view(global const uchar* atlas, global const int* bases, global const int4* sprites,
                         global const int4* places, global const int* noise_offsets,
                         global const float* noise_gains, global const uchar* subject,
@@ -41,7 +38,7 @@ kernel void render_view(global const uchar* atlas, global const int* bases, glob
   for (int x = 0; x < W; ++x) {
     float v = composite_pixel(&L, atlas, (float)base[x], x, alpha);
     v += pattern_noise_pixel(&T, atlas, tile_size, gain, x);
-    if (flags & FLAG_PIXEL_NOISE) v = mad(sigma, pixel_noise(seed, index, view, y * W + x), v);
-    row[x] = (uchar)clamp(floor(v + 0.5f), 0.0f, 255.0f);
+    if (flags & FLAG_PIXEL_NOISE) v = fma(sigma, pixel_noise(seed, index, view, y * W + x), v);
+    row[x] = to_pixel(v);
   }
 }

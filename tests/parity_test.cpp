@@ -210,3 +210,49 @@ TEST(Determinism, ScenarioDependsOnlyOnSeedAndIndexNotOnBatch) {
 
 }  // namespace
 }  // namespace portalsim
+
+namespace portalsim {
+namespace {
+
+// The sparse features path (tables + overlap pixels) against the dense one (full images,
+// then pooling): the same numbers to the bit, for every block size and noise setting.
+TEST(SparseFeatures, EqualDenseToTheBit) {
+  std::vector<Scenario> scenes;
+  const Catalogue& c = test::catalogue();
+  for (size_t var = 0; var < c.variant_list.size(); ++var)
+    for (int r = 0; r < kRegions; ++r) {
+      Scenario s;
+      s.subject = static_cast<int>((var * 7 + r) % c.subjects.size());
+      s.objects[r] = static_cast<int16_t>(var);
+      scenes.push_back(s);
+    }
+  for (uint64_t k = 0; k < 600; ++k) scenes.push_back(test::random_scenario(c, k, k % 3 == 0 ? 13 : 4));
+  Scenario crowded;  // every region full: overlaps of three and more footprints
+  for (int r = 0; r < kRegions; ++r) crowded.objects[r] = static_cast<int16_t>(r % c.variant_list.size());
+  scenes.push_back(crowded);
+  scenes.push_back(Scenario());
+  auto cl = make_opencl_backend(c, test::assets(), test::runtime());
+  for (int block : {10, 7, 1, 20, 200}) {
+    for (bool noise : {true, false}) {
+      Plan p;
+      p.mmw_images = p.ir_image = false;
+      p.model.block = block;
+      p.model.pattern_noise = noise;
+      p.model.seed = 4242;
+      BatchOutput sparse, dense;
+      ASSERT_TRUE(p.sparse_features());
+      cl->run(test::batch_of(scenes, 3), p, sparse);
+      p.pooling = Pooling::dense;
+      ASSERT_FALSE(p.sparse_features());
+      cl->run(test::batch_of(scenes, 3), p, dense);
+      ASSERT_EQ(sparse.features.size(), dense.features.size());
+      size_t mismatches = 0;
+      for (size_t k = 0; k < dense.features.size(); ++k) mismatches += sparse.features[k] != dense.features[k];
+      EXPECT_EQ(mismatches, 0u) << "block " << block << " noise " << noise;
+      EXPECT_EQ(sparse.metal, dense.metal);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace portalsim

@@ -9,7 +9,7 @@ packages=(build-essential cmake pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
   libopenimageio-dev openimageio-tools
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
-  zlib1g-dev libgtest-dev libbenchmark-dev
+  libxxhash-dev libgtest-dev libbenchmark-dev
   weka default-jre-headless python3 python3-matplotlib)
 
 missing=()

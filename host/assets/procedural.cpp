@@ -173,7 +173,7 @@ struct BodyField {
 class BodyModel {
  public:
   explicit BodyModel(const Body& body) {
-    b_ = std::clamp(body.build, 0.5, 1.6);
+    b_ = std::isfinite(body.build) ? std::clamp(body.build, 0.5, 1.6) : 1.0;
     seed_ = mix64(static_cast<uint64_t>(static_cast<int64_t>(body.subject)) + 0x5eed);
     auto var = [&](int k) { return hash01(k, 0, seed_); };
     arm_spread_ = 4.0 * var(1);
@@ -556,7 +556,7 @@ class Buckle : public Shape {
     const double hole = sd_rect(p, 0.24 * w_, 0.22 * h_, 0.84 * w_, 0.78 * h_, 0.06 * m_);
     const double frame = std::max(outer, -hole);
     const double prong =
-        sd_round_cone(p, at(0.12, 0.5), at(0.90, 0.5), std::max(0.6, 0.05 * h_), std::max(0.4, 0.02 * h_));
+        sd_round_cone(p, at(0.12, 0.5), at(0.90, 0.5), std::max(0.6, 0.07 * h_), std::max(0.4, 0.03 * h_));
     return std::min(frame, prong);
   }
   double shade(P p) const override {

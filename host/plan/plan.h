@@ -18,13 +18,22 @@ struct ModelSettings {
   int block = 10;             // side of the averaged pixel blocks (thesis 5.6)
 };
 
+// How block and region means are computed. Both give the same numbers to the bit;
+// sparse is used for features-only runs without per-pixel noise, dense otherwise.
+enum class Pooling { sparse, dense };
+
 struct Plan {
   bool mmw_images = true;  // materialise upper/lower images
   bool ir_image = true;    // materialise the IR image
   bool metal = true;       // metal zones
   bool features = true;    // block and region means (needs the MMW views)
   ModelSettings model;
+  Pooling pooling = Pooling::sparse;
 
+  // Features straight from precomputed tables, never materialising an image.
+  bool sparse_features() const {
+    return features && !mmw_images && pooling == Pooling::sparse && model.pixel_sigma == 0;
+  }
   bool renders_mmw() const { return mmw_images || features; }
 };
 

@@ -38,9 +38,21 @@ struct Job {
   BatchOutput out;
 };
 
-// One-slot hand-over between the compute thread and the writer thread.
+// One-slot hand-over between the compute thread and the writer thread, plus the pool
+// of finished jobs whose buffers the next batch reuses (three jobs at most exist).
 class Handover {
  public:
+  std::unique_ptr<Job> recycled() {
+    std::lock_guard<std::mutex> lock(m_);
+    if (free_.empty()) return std::make_unique<Job>();
+    std::unique_ptr<Job> j = std::move(free_.back());
+    free_.pop_back();
+    return j;
+  }
+  void recycle(std::unique_ptr<Job> j) {
+    std::lock_guard<std::mutex> lock(m_);
+    free_.push_back(std::move(j));
+  }
   void put(std::unique_ptr<Job> j) {
     std::unique_lock<std::mutex> lock(m_);
     cv_.wait(lock, [&] { return !slot_ || failed_; });
@@ -74,6 +86,7 @@ class Handover {
   std::mutex m_;
   std::condition_variable cv_;
   std::unique_ptr<Job> slot_;
+  std::vector<std::unique_ptr<Job>> free_;
   bool closed_ = false, failed_ = false;
 };
 
@@ -96,6 +109,7 @@ size_t default_batch(const Plan& plan, const Catalogue& cat) {
   size_t bytes = 64 + kZones;
   if (plan.renders_mmw()) bytes += 2 * static_cast<size_t>(ic.mmw_width) * ic.mmw_height;
   if (plan.ir_image) bytes += static_cast<size_t>(ic.ir_width) * ic.ir_height;
+  if (plan.sparse_features()) bytes = 64 + kZones;  // no images, on the device either
   if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
   return std::clamp<size_t>((64u << 20) / bytes, 64, 16384);
 }
@@ -188,7 +202,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
   std::map<std::string, FileState> saved;
   if (resuming)
     for (const json& f : checkpoint["files"])
-      saved[f["name"]] = FileState{f["name"], f["bytes"].get<uint64_t>(), f["crc32"].get<uint32_t>()};
+      saved[f["name"]] = FileState{f["name"], f["bytes"].get<uint64_t>(), f["xxh3"].get<uint64_t>()};
   const auto resume_state = [&](const std::string& name) -> const FileState* {
     if (!resuming) return nullptr;
     auto it = saved.find(name);
@@ -210,7 +224,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
     c["files"] = json::array();
     for (const auto& s : sinks)
       for (const FileState& f : s->files())
-        c["files"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"crc32", f.crc32}});
+        c["files"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"xxh3", f.xxh3}});
     write_text_atomic(checkpoint_path.string(), c.dump(1) + "\n");
   };
   if (!resuming) save_checkpoint(start);
@@ -227,6 +241,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
         const uint64_t next = job->scenes.first_index + job->scenes.size();
         save_checkpoint(next);
         written = next;
+        hand.recycle(std::move(job));
       }
     } catch (...) {
       writer_error = std::current_exception();
@@ -243,7 +258,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
         break;
       }
       if (hand.failed()) break;
-      auto job = std::make_unique<Job>();
+      std::unique_ptr<Job> job = hand.recycled();
       const size_t n = static_cast<size_t>(std::min<uint64_t>(res.batch, res.end - first));
       SceneBatch& b = job->scenes;
       b.first_index = first;
@@ -292,9 +307,9 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
   manifest["outputs"] = json::array();
   for (auto& s : sinks) {
     for (const FileState& f : s->files()) {
-      char crc[9];
-      std::snprintf(crc, sizeof crc, "%08x", f.crc32);
-      manifest["outputs"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"crc32", crc}});
+      char hash[17];
+      std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(f.xxh3));
+      manifest["outputs"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"xxh3_64", hash}});
     }
     s->finish();
   }

@@ -2,7 +2,7 @@
 
 #include <fcntl.h>
 #include <unistd.h>
-#include <zlib.h>
+#include <xxhash.h>
 
 #include <cerrno>
 #include <cstring>
@@ -14,43 +14,47 @@
 namespace portalsim {
 
 namespace {
-uint32_t crc_update(uint32_t crc, const char* p, size_t n) {
-  while (n > 0) {
-    const uInt chunk = static_cast<uInt>(std::min<size_t>(n, 1u << 30));
-    crc = static_cast<uint32_t>(::crc32(crc, reinterpret_cast<const Bytef*>(p), chunk));
-    p += chunk;
-    n -= chunk;
-  }
-  return crc;
-}
+XXH3_state_t* state_of(void* p) { return static_cast<XXH3_state_t*>(p); }
 }  // namespace
 
 AppendFile::AppendFile(const std::string& dir, const std::string& name, const FileState* resume)
-    : dir_(dir),
-      partial_((std::filesystem::path(dir) / (name + ".partial")).string()),
-      final_((std::filesystem::path(dir) / name).string()) {
-  state_.name = name;
+    : partial_((std::filesystem::path(dir) / (name + ".partial")).string()),
+      final_((std::filesystem::path(dir) / name).string()),
+      name_(name) {
+  hash_ = XXH3_createState();
+  if (!hash_) throw std::bad_alloc();
+  XXH3_64bits_reset(state_of(hash_));
   if (resume) {
-    fd_ = ::open(partial_.c_str(), O_WRONLY | O_CLOEXEC);
+    fd_ = ::open(partial_.c_str(), O_RDWR | O_CLOEXEC);
     if (fd_ < 0) throw OutputError(partial_ + ": cannot resume: " + std::strerror(errno));
     const off_t size = ::lseek(fd_, 0, SEEK_END);
     if (size < 0 || static_cast<uint64_t>(size) < resume->bytes)
       throw OutputError(partial_ + ": shorter than the checkpoint says (" + std::to_string(size) + " < " +
                         std::to_string(resume->bytes) + " bytes); the run cannot be resumed, start it again");
-    if (::ftruncate(fd_, static_cast<off_t>(resume->bytes)) != 0 ||
-        ::lseek(fd_, static_cast<off_t>(resume->bytes), SEEK_SET) < 0)
+    if (::ftruncate(fd_, static_cast<off_t>(resume->bytes)) != 0)
       throw OutputError(partial_ + ": cannot truncate for resume: " + std::strerror(errno));
-    state_.bytes = resume->bytes;
-    state_.crc32 = resume->crc32;
+    // Hash the kept prefix again: it must be what the checkpoint recorded.
+    std::vector<char> buf(1 << 20);
+    uint64_t left = resume->bytes;
+    ::lseek(fd_, 0, SEEK_SET);
+    while (left > 0) {
+      const ssize_t r = ::read(fd_, buf.data(), std::min<uint64_t>(left, buf.size()));
+      if (r <= 0) throw OutputError(partial_ + ": cannot read back for resume: " + std::strerror(errno));
+      XXH3_64bits_update(state_of(hash_), buf.data(), static_cast<size_t>(r));
+      left -= static_cast<uint64_t>(r);
+    }
+    bytes_ = resume->bytes;
+    if (XXH3_64bits_digest(state_of(hash_)) != resume->xxh3)
+      throw OutputError(partial_ + ": its contents differ from the checkpoint; the run cannot be resumed");
   } else {
     fd_ = ::open(partial_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd_ < 0) throw OutputError(partial_ + ": cannot create: " + std::strerror(errno));
-    state_.crc32 = static_cast<uint32_t>(::crc32(0, nullptr, 0));
   }
 }
 
 AppendFile::~AppendFile() {
   if (fd_ >= 0) ::close(fd_);
+  XXH3_freeState(state_of(hash_));
 }
 
 void AppendFile::append(std::string_view data) {
@@ -65,26 +69,11 @@ void AppendFile::append(std::string_view data) {
     p += w;
     left -= static_cast<size_t>(w);
   }
-  state_.crc32 = crc_update(state_.crc32, data.data(), data.size());
-  state_.bytes += data.size();
+  XXH3_64bits_update(state_of(hash_), data.data(), data.size());
+  bytes_ += data.size();
 }
 
-void AppendFile::overwrite(uint64_t offset, std::string_view data) {
-  if (::pwrite(fd_, data.data(), data.size(), static_cast<off_t>(offset)) != static_cast<ssize_t>(data.size()))
-    throw OutputError(partial_ + ": write failed: " + std::strerror(errno));
-}
-
-void AppendFile::recompute_crc() {
-  const int fd = ::open(partial_.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw OutputError(partial_ + ": cannot read back: " + std::strerror(errno));
-  std::vector<char> buf(1 << 20);
-  uint32_t crc = static_cast<uint32_t>(::crc32(0, nullptr, 0));
-  ssize_t r;
-  while ((r = ::read(fd, buf.data(), buf.size())) > 0) crc = crc_update(crc, buf.data(), static_cast<size_t>(r));
-  ::close(fd);
-  if (r < 0) throw OutputError(partial_ + ": cannot read back: " + std::strerror(errno));
-  state_.crc32 = crc;
-}
+FileState AppendFile::state() const { return FileState{name_, bytes_, XXH3_64bits_digest(state_of(hash_))}; }
 
 void AppendFile::finish() {
   if (fd_ >= 0) {

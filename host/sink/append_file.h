@@ -1,5 +1,5 @@
-// A file written by appending, with its length and CRC-32 kept as it grows, so a run
-// can checkpoint where it stands and a resumed run can truncate back to that point.
+// A file written by appending, with its length and XXH3-64 hash kept as it grows, so a
+// run can checkpoint where it stands and a resumed run can truncate back to that point.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -10,13 +10,13 @@ namespace portalsim {
 struct FileState {
   std::string name;   // relative to the output folder, final name
   uint64_t bytes = 0;
-  uint32_t crc32 = 0;
+  uint64_t xxh3 = 0;  // XXH3-64 of the bytes so far
 };
 
 class AppendFile {
  public:
   // Opens dir/(name + ".partial"). With `resume`, truncates it to resume->bytes (it must
-  // be at least that long) and continues its CRC; otherwise creates it empty.
+  // be at least that long) and hashes that prefix again; otherwise creates it empty.
   AppendFile(const std::string& dir, const std::string& name, const FileState* resume = nullptr);
   AppendFile(const AppendFile&) = delete;
   AppendFile& operator=(const AppendFile&) = delete;
@@ -24,17 +24,15 @@ class AppendFile {
 
   void append(std::string_view data);
   void append(const void* data, size_t n) { append(std::string_view(static_cast<const char*>(data), n)); }
-  // Writes `data` at `offset` (an already written header being finalised); no CRC update.
-  void overwrite(uint64_t offset, std::string_view data);
-  const FileState& state() const { return state_; }
+  FileState state() const;
   // Closes and renames the partial file to its final name.
   void finish();
-  // Recomputes the CRC of the whole file (after an overwrite).
-  void recompute_crc();
 
  private:
-  std::string dir_, partial_, final_;
-  FileState state_;
+  std::string partial_, final_;
+  std::string name_;
+  uint64_t bytes_ = 0;
+  void* hash_ = nullptr;  // XXH3_state_t
   int fd_ = -1;
 };
 

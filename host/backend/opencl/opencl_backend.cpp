@@ -36,7 +36,7 @@ cl::Buffer constant(cl::Context& ctx, const std::vector<T>& v) {
 class OpenCLBackend final : public Backend {
  public:
   OpenCLBackend(const Catalogue& cat, const AssetSet& assets, std::shared_ptr<OpenCLRuntime> rt)
-      : cat_(cat), rt_(std::move(rt)) {
+      : cat_(cat), assets_(assets), rt_(std::move(rt)) {
     std::vector<uint8_t> atlas;
     auto add = [&](const Image& img) {
       const int off = static_cast<int>(atlas.size());
@@ -62,6 +62,7 @@ class OpenCLBackend final : public Backend {
     }
     std::vector<cl_int> noise_offsets;
     std::vector<cl_float> noise_gains;
+    for (const auto& sp : sprites) sprite_offsets_.push_back(sp.s[0]);
     for (size_t k = 0; k < assets.noise.size(); ++k) {
       noise_offsets.push_back(add(assets.noise[k]));
       noise_gains.push_back(static_cast<float>(cat.noise[k].gain));
@@ -92,6 +93,9 @@ class OpenCLBackend final : public Backend {
     pool_blocks_ = cl::Kernel(rt_->program(), "pool_blocks");
     pool_regions_ = cl::Kernel(rt_->program(), "pool_regions");
     metal_ = cl::Kernel(rt_->program(), "metal_zones");
+    base_features_ = cl::Kernel(rt_->program(), "base_features");
+    footprint_deltas_ = cl::Kernel(rt_->program(), "footprint_deltas");
+    features_sparse_ = cl::Kernel(rt_->program(), "features_sparse");
   }
 
   std::string name() const override { return "opencl"; }
@@ -151,7 +155,9 @@ class OpenCLBackend final : public Backend {
       q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n * H)), cl::NDRange(kLocalSize));
     };
 
-    if (plan.renders_mmw()) {
+    if (plan.sparse_features()) {
+      sparse_features(plan, n, subject, objects, seed, first, out);
+    } else if (plan.renders_mmw()) {
       cl::Buffer& upper = upper_.at_least(ctx, n * mmw_px);
       cl::Buffer& lower = lower_.at_least(ctx, n * mmw_px);
       render(0, upper, ic.mmw_width, ic.mmw_height);
@@ -216,11 +222,156 @@ class OpenCLBackend final : public Backend {
   }
 
  private:
+  // The tables of the sparse features path, built once per (block, pattern noise).
+  struct SparseTables {
+    int block = -1;
+    bool noise = false;
+    int patterns = 1;
+    cl::Buffer fps, deltas, region_deltas, base_sums, base_means;
+  };
+
+  void build_sparse_tables(const Plan& plan) {
+    const ImagesConfig& ic = cat_.images;
+    const int block = plan.model.block, W = ic.mmw_width, H = ic.mmw_height, N = ic.noise_size;
+    const bool noise = plan.model.pattern_noise;
+    if (tables_.block == block && tables_.noise == noise) return;
+    const int S = static_cast<int>(cat_.subjects.size()), V = static_cast<int>(cat_.variant_list.size());
+    const int P = noise ? static_cast<int>(cat_.noise.size()) : 1;
+    std::vector<cl_int> fps(static_cast<size_t>(V) * kRegions * 16, 0);
+    cl_int offset = 0;
+    for (int v = 0; v < V; ++v)
+      for (int r = 0; r < kRegions; ++r) {
+        const Image& sp = assets_.mmw_sprites[v];
+        const Rect& rc = cat_.regions[r].mmw;
+        cl_int* f = &fps[(static_cast<size_t>(v) * kRegions + r) * 16];
+        f[0] = rc.x + ((rc.w - sp.width) >> 1);
+        f[1] = rc.y + ((rc.h - sp.height) >> 1);
+        f[2] = sp.width;
+        f[3] = sp.height;
+        f[4] = sprite_offsets_[v * 2];
+        f[5] = f[0] + (sp.width >> 1) - (N >> 1);
+        f[6] = f[1] + (sp.height >> 1) - (N >> 1);
+        int x0 = f[0], y0 = f[1], x1 = f[0] + f[2], y1 = f[1] + f[3];
+        if (noise) {
+          x0 = std::min(x0, f[5]);
+          y0 = std::min(y0, f[6]);
+          x1 = std::max(x1, f[5] + N);
+          y1 = std::max(y1, f[6] + N);
+        }
+        x0 = std::max(x0, 0);
+        y0 = std::max(y0, 0);
+        x1 = std::min(x1, W);
+        y1 = std::min(y1, H);
+        if (x0 >= x1 || y0 >= y1) x0 = y0 = x1 = y1 = 0;  // wholly outside: touches nothing
+        f[7] = x0;
+        f[8] = y0;
+        f[9] = x1;
+        f[10] = y1;
+        f[11] = x0 / block;
+        f[12] = y0 / block;
+        f[13] = x1 > x0 ? (x1 - 1) / block - f[11] + 1 : 0;
+        f[14] = y1 > y0 ? (y1 - 1) / block - f[12] + 1 : 0;
+        f[15] = offset;
+        const int64_t next = offset + static_cast<int64_t>(S) * P * f[13] * f[14];
+        if (next > INT32_MAX) throw std::runtime_error("sparse feature tables exceed 2^31 entries; use --block larger");
+        offset = static_cast<cl_int>(next);
+      }
+    cl::Context& ctx = rt_->context();
+    cl::CommandQueue& q = rt_->queue();
+    const FeatureLayout lay = FeatureLayout::of(cat_, block);
+    const int row_len = lay.image_features(), combos = V * kRegions * S * P;
+    tables_.fps = constant(ctx, fps);
+    tables_.deltas = cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<size_t>(1, offset) * sizeof(cl_int));
+    tables_.region_deltas = cl::Buffer(ctx, CL_MEM_READ_WRITE, static_cast<size_t>(combos) * kRegions * sizeof(cl_int));
+    tables_.base_sums = cl::Buffer(ctx, CL_MEM_READ_WRITE, static_cast<size_t>(S) * row_len * sizeof(cl_int));
+    tables_.base_means = cl::Buffer(ctx, CL_MEM_READ_WRITE, static_cast<size_t>(S) * row_len * sizeof(cl_float));
+    int a = 0;
+    base_features_.setArg(a++, atlas_);
+    base_features_.setArg(a++, bases_);
+    base_features_.setArg(a++, rects_);
+    base_features_.setArg(a++, static_cast<cl_int>(S));
+    base_features_.setArg(a++, static_cast<cl_int>(W));
+    base_features_.setArg(a++, static_cast<cl_int>(H));
+    base_features_.setArg(a++, static_cast<cl_int>(block));
+    base_features_.setArg(a++, static_cast<cl_int>(lay.blocks_x));
+    base_features_.setArg(a++, static_cast<cl_int>(lay.blocks_y));
+    base_features_.setArg(a++, static_cast<cl_int>(row_len));
+    base_features_.setArg(a++, tables_.base_sums);
+    base_features_.setArg(a++, tables_.base_means);
+    q.enqueueNDRangeKernel(base_features_, cl::NullRange, cl::NDRange(padded(static_cast<size_t>(S) * row_len)),
+                           cl::NDRange(kLocalSize));
+    a = 0;
+    footprint_deltas_.setArg(a++, atlas_);
+    footprint_deltas_.setArg(a++, bases_);
+    footprint_deltas_.setArg(a++, tables_.fps);
+    footprint_deltas_.setArg(a++, noise_offsets_);
+    footprint_deltas_.setArg(a++, noise_gains_);
+    footprint_deltas_.setArg(a++, rects_);
+    footprint_deltas_.setArg(a++, static_cast<cl_int>(combos));
+    footprint_deltas_.setArg(a++, static_cast<cl_int>(S));
+    footprint_deltas_.setArg(a++, static_cast<cl_int>(P));
+    footprint_deltas_.setArg(a++, static_cast<cl_int>(W));
+    footprint_deltas_.setArg(a++, static_cast<cl_int>(block));
+    footprint_deltas_.setArg(a++, static_cast<cl_float>(ic.alpha));
+    footprint_deltas_.setArg(a++, static_cast<cl_int>(N));
+    footprint_deltas_.setArg(a++, static_cast<cl_int>(noise ? 1 : 0));
+    footprint_deltas_.setArg(a++, tables_.deltas);
+    footprint_deltas_.setArg(a++, tables_.region_deltas);
+    q.enqueueNDRangeKernel(footprint_deltas_, cl::NullRange, cl::NDRange(padded(combos)), cl::NDRange(kLocalSize));
+    q.finish();
+    tables_.block = block;
+    tables_.noise = noise;
+    tables_.patterns = P;
+  }
+
+  void sparse_features(const Plan& plan, size_t n, cl::Buffer& subject, cl::Buffer& objects, cl_uint2 seed,
+                       cl_uint2 first, BatchOutput& out) {
+    build_sparse_tables(plan);
+    const ImagesConfig& ic = cat_.images;
+    const FeatureLayout& lay = out.layout;
+    const int row_len = lay.image_features();
+    cl::Buffer& feats = features_.at_least(rt_->context(), n * row_len * sizeof(float));
+    cl::Kernel& k = features_sparse_;
+    int a = 0;
+    k.setArg(a++, atlas_);
+    k.setArg(a++, bases_);
+    k.setArg(a++, tables_.fps);
+    k.setArg(a++, tables_.deltas);
+    k.setArg(a++, tables_.region_deltas);
+    k.setArg(a++, tables_.base_sums);
+    k.setArg(a++, tables_.base_means);
+    k.setArg(a++, noise_offsets_);
+    k.setArg(a++, noise_gains_);
+    k.setArg(a++, rects_);
+    k.setArg(a++, subject);
+    k.setArg(a++, objects);
+    k.setArg(a++, static_cast<cl_uint>(n));
+    k.setArg(a++, static_cast<cl_int>(cat_.subjects.size()));
+    k.setArg(a++, static_cast<cl_int>(tables_.patterns));
+    k.setArg(a++, static_cast<cl_int>(ic.mmw_width));
+    k.setArg(a++, static_cast<cl_int>(ic.mmw_height));
+    k.setArg(a++, static_cast<cl_int>(lay.block));
+    k.setArg(a++, static_cast<cl_int>(lay.blocks_x));
+    k.setArg(a++, static_cast<cl_int>(lay.blocks_y));
+    k.setArg(a++, static_cast<cl_float>(ic.alpha));
+    k.setArg(a++, static_cast<cl_int>(ic.noise_size));
+    k.setArg(a++, static_cast<cl_int>(tables_.noise ? 1 : 0));
+    k.setArg(a++, seed);
+    k.setArg(a++, first);
+    k.setArg(a++, static_cast<cl_int>(row_len));
+    k.setArg(a++, feats);
+    rt_->queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
+    rt_->queue().enqueueReadBuffer(feats, CL_FALSE, 0, n * row_len * sizeof(float), out.features.data());
+  }
+
   const Catalogue& cat_;
+  const AssetSet& assets_;
   std::shared_ptr<OpenCLRuntime> rt_;
+  std::vector<cl_int> sprite_offsets_;
+  SparseTables tables_;
   cl::Buffer atlas_, bases_, sprites_, places_, noise_offsets_, noise_gains_, rects_, influence_, categories_,
       base_zones_;
-  cl::Kernel render_, pool_blocks_, pool_regions_, metal_;
+  cl::Kernel render_, pool_blocks_, pool_regions_, metal_, base_features_, footprint_deltas_, features_sparse_;
   Grown subject_, objects_, upper_, lower_, ir_, metal_out_, features_;
 };
 

@@ -1,0 +1,95 @@
+// Kernels and fused paths against the CPU reference, per scenario.
+//   ./build/portalsim_bench --benchmark_filter=... --benchmark_repetitions=5
+// Counters: scenarios/s ("items_per_second"). Kernel builds happen once, before timing.
+#include <benchmark/benchmark.h>
+
+#include "assets/assets.h"
+#include "backend/opencl/opencl_backend.h"
+#include "scene/generator.h"
+
+namespace portalsim {
+namespace {
+
+struct Fixture {
+  Catalogue cat = default_catalogue();
+  AssetSet assets = build_assets(cat);
+  std::shared_ptr<OpenCLRuntime> rt = std::make_shared<OpenCLRuntime>();
+};
+Fixture& fx() {
+  static Fixture f;
+  return f;
+}
+
+SceneBatch make_batch(size_t n, int max_objects = 4) {
+  GeneratorSpec spec;
+  spec.max_objects = max_objects;
+  Generator gen(fx().cat, spec, 1);
+  SceneBatch b;
+  for (size_t i = 0; i < n; ++i) b.push(gen(i));
+  return b;
+}
+
+enum Path { kFeaturesSparse, kFeaturesDense, kImages, kMetal };
+
+Plan plan_for(Path path, int block) {
+  Plan p;
+  p.model.block = block;
+  switch (path) {
+    case kFeaturesSparse:
+      p.mmw_images = p.ir_image = false;
+      break;
+    case kFeaturesDense:
+      p.mmw_images = p.ir_image = false;
+      p.pooling = Pooling::dense;
+      break;
+    case kImages:
+      p.features = false;
+      break;
+    case kMetal:
+      p.mmw_images = p.ir_image = p.features = false;
+      break;
+  }
+  return p;
+}
+
+void run(benchmark::State& state, Backend& backend, Path path) {
+  const size_t n = static_cast<size_t>(state.range(0));
+  const Plan plan = plan_for(path, static_cast<int>(state.range(1)));
+  const SceneBatch batch = make_batch(n);
+  BatchOutput out;
+  backend.run(batch, plan, out);  // warm: tables, work-group compilation
+  for (auto _ : state) {
+    backend.run(batch, plan, out);
+    benchmark::DoNotOptimize(out.metal.data());
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+}
+
+void BM_OpenCL(benchmark::State& state, Path path) {
+  auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+  run(state, *b, path);
+}
+void BM_Reference(benchmark::State& state, Path path) {
+  auto b = make_reference_backend(fx().cat, fx().assets);
+  run(state, *b, path);
+}
+
+BENCHMARK_CAPTURE(BM_OpenCL, features_sparse, kFeaturesSparse)
+    ->ArgsProduct({{1, 64, 1024, 4096, 16384, 65536}, {10}})
+    ->ArgsProduct({{16384}, {5, 20}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_OpenCL, features_dense, kFeaturesDense)
+    ->ArgsProduct({{1024}, {5, 10, 20}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_OpenCL, images, kImages)->ArgsProduct({{1, 256, 1024}, {10}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_OpenCL, metal, kMetal)->ArgsProduct({{65536}, {10}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Reference, features, kFeaturesDense)->ArgsProduct({{64}, {10}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Reference, images, kImages)->ArgsProduct({{64}, {10}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Reference, metal, kMetal)->ArgsProduct({{65536}, {10}})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace portalsim
+
+BENCHMARK_MAIN();
