@@ -1020,9 +1020,9 @@ TEST(CliCatalogueCmd, ImagesWritesEveryImage) {
       EXPECT_EQ(s.height, 200);
       EXPECT_EQ(s.channels, ir ? 3 : 1);
     } else if (n.rfind("noise", 0) == 0) {
-      ++noise;
-      EXPECT_EQ(s.width, 64);
-      EXPECT_EQ(s.height, 64);
+      ++noise;  // the catalogue's noise_size
+      EXPECT_EQ(s.width, 40);
+      EXPECT_EQ(s.height, 40);
     } else {
       ++sprites;
     }

@@ -4,7 +4,12 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cstdio>
 #include <filesystem>
+#include <mutex>
 
 #include "scene/error.h"
 
@@ -16,23 +21,82 @@ OIIO::ImageSpec spec_of(const Image& img) {
 }
 }  // namespace
 
+namespace {
+// libpng prints its complaints to stderr and OpenImageIO's PNG reader echoes them to
+// stdout; OpenImageIO's error string carries the same text, and that is what portalsim
+// reports. Both streams are held shut while decoding.
+class QuietOutput {
+ public:
+  QuietOutput() : lock_(mutex()) {
+    std::fflush(stdout);
+    std::fflush(stderr);
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    for (int i = 0; i < 2; ++i) {
+      saved_[i] = ::dup(kFds[i]);
+      if (saved_[i] >= 0 && null >= 0) ::dup2(null, kFds[i]);
+    }
+    if (null >= 0) ::close(null);
+  }
+  ~QuietOutput() {
+    std::fflush(stdout);
+    std::fflush(stderr);
+    for (int i = 0; i < 2; ++i)
+      if (saved_[i] >= 0) {
+        ::dup2(saved_[i], kFds[i]);
+        ::close(saved_[i]);
+      }
+  }
+
+ private:
+  static constexpr int kFds[2] = {STDOUT_FILENO, STDERR_FILENO};
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  int saved_[2] = {-1, -1};
+};
+}  // namespace
+
 Image read_image(const std::string& path, const std::string& origin) {
   const std::string where = origin + ": " + path;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(where + ": no such image file");
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw InputError(where + ": cannot read image: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || spec.width > 16384 || spec.height > 16384 ||
-      spec.nchannels > 16)
-    throw InputError(where + ": unsupported image dimensions " + std::to_string(spec.width) + "x" +
-                     std::to_string(spec.height) + "x" + std::to_string(spec.nchannels));
-  Image img(spec.width, spec.height, spec.nchannels);
-  const bool ok = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, img.pixels.data());
-  const std::string err = in->geterror();
-  in->close();
-  if (!ok || !err.empty())
-    throw InputError(where + ": corrupt or unreadable image" + (err.empty() ? "" : ": " + err));
+  std::string error;
+  Image img;
+  {
+    QuietOutput quiet;
+    // create() then open(), not ImageInput::open(): a failed open() inside the latter
+    // leaves an uncollected error that OpenImageIO prints at exit.
+    auto in = OIIO::ImageInput::create(path);
+    OIIO::ImageSpec opened;
+    if (!in) {
+      error = "cannot read image: " + OIIO::geterror();
+    } else if (!in->open(path, opened)) {
+      error = "cannot read image: " + in->geterror();
+    } else {
+      const OIIO::ImageSpec& spec = in->spec();
+      if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || spec.width > 16384 || spec.height > 16384 ||
+          spec.nchannels > 16) {
+        error = "unsupported image dimensions " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                "x" + std::to_string(spec.nchannels);
+      } else {
+        img = Image(spec.width, spec.height, spec.nchannels);
+        const bool ok = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, img.pixels.data());
+        const std::string err = in->geterror();
+        if (!ok || !err.empty()) error = "corrupt or unreadable image" + (err.empty() ? "" : ": " + err);
+      }
+      in->close();
+      in->geterror();
+    }
+    OIIO::geterror();  // nothing left pending to be printed later
+  }
+  if (!error.empty()) {
+    // OpenImageIO's messages may span lines; one error, one line.
+    while (!error.empty() && (error.back() == '\n' || error.back() == ' ')) error.pop_back();
+    for (size_t p; (p = error.find('\n')) != std::string::npos;) error.replace(p, 1, "; ");
+    throw InputError(where + ": " + error);
+  }
   return img;
 }
 

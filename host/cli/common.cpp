@@ -25,7 +25,8 @@ void add_common_options(CLI::App& app, CommonOptions& o) {
 
 uint64_t parse_u64(const std::string& text, const std::string& field) {
   const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
-  const std::string digits = hex ? text.substr(2) : text;
+  std::string digits = hex ? text.substr(2) : text;
+  while (digits.size() > 1 && digits[0] == '0') digits.erase(0, 1);
   const auto bad = [&]() {
     return InputError(field + ": \"" + text + "\" is not an unsigned 64-bit integer (0 to 18446744073709551615)");
   };

@@ -69,6 +69,7 @@ int generate(GenerateOptions& o) {
   if (given("--metal-noise")) spec.model.metal_noise = o.spec.model.metal_noise;
   if (given("--scenarios")) spec.scenarios = o.spec.scenarios;
   spec.validate();
+  if (o.out.empty()) throw InputError("--out: empty folder name");
 
   PipelineOptions popt;
   popt.batch = o.batch;

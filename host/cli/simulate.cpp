@@ -46,8 +46,8 @@ int simulate(SimulateOptions& o) {
   plan.model.pattern_noise = o.pattern_noise == "on";
   validate(plan, cat);
 
-  StagedFolder folder(o.out);
   open_backend(s, o.common);
+  StagedFolder folder(o.out);
 
   SceneBatch batch;
   batch.push(scene);

@@ -355,6 +355,12 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
                              t.get("ir_h") || t.get("ir_v");
     if (!procedural::is_shape(o.shape) && !file_images)
       rd.fail(t.get("shape"), f + ".shape", "unknown shape \"" + o.shape + "\" and no image files given");
+    if (codes.size() > 1)
+      for (const char* key : {"mmw", "ir"})
+        if (t.get(key))
+          rd.fail(t.get(key), f + "." + key,
+                  rd.image(t, key, f).path + ": this object has several drawings; name one file per drawing (" +
+                      key + "_h, " + key + "_v)");
     o.first_variant = static_cast<int>(cat.variant_list.size());
     for (size_t k = 0; k < codes.size(); ++k) {
       Variant v;
@@ -362,7 +368,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
       const std::string sfx = v.code.empty() ? "" : "_" + v.code;
       v.mmw = rd.image(t, "mmw" + sfx, f);
       v.ir = rd.image(t, "ir" + sfx, f);
-      if (v.code.empty() || codes.size() == 1) {
+      if (codes.size() == 1) {
         if (v.mmw.path.empty()) v.mmw = rd.image(t, "mmw", f);
         if (v.ir.path.empty()) v.ir = rd.image(t, "ir", f);
       }

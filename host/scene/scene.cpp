@@ -9,6 +9,7 @@ int16_t parse_object_token(const Catalogue& cat, const std::string& token, const
   if (const size_t colon = token.find(':'); colon != std::string::npos) {
     name = token.substr(0, colon);
     code = normalise_name(token.substr(colon + 1));
+    if (code.empty()) throw InputError(where + ": \"" + token + "\": empty orientation after ':' (use :h or :v)");
     if (code == "horizontal") code = "h";
     if (code == "vertical") code = "v";
   }

@@ -13,27 +13,38 @@ namespace portalsim {
 namespace fs = std::filesystem;
 
 StagedFolder::StagedFolder(const std::string& final_dir) : final_dir_(final_dir) {
+  if (final_dir_.empty()) throw OutputError("--out: empty folder name");
   std::error_code ec;
   if (fs::exists(final_dir_, ec) && !fs::is_directory(final_dir_, ec))
     throw OutputError(final_dir_ + ": exists and is not a folder");
-  if (!fs::exists(final_dir_, ec)) {
+  // Remember each missing ancestor, so that a failure removes all that was made.
+  for (fs::path p = fs::absolute(final_dir_, ec).lexically_normal(); !p.empty() && !fs::exists(p, ec);
+       p = p.parent_path()) {
+    created_.insert(created_.begin(), p.string());
+    if (p == p.parent_path()) break;
+  }
+  if (!created_.empty()) {
     fs::create_directories(final_dir_, ec);
-    if (ec) throw OutputError(final_dir_ + ": cannot create the output folder: " + ec.message());
-    created_final_ = true;
+    if (ec) {
+      for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
+      throw OutputError(final_dir_ + ": cannot create the output folder: " + ec.message());
+    }
   }
   staging_ = (fs::path(final_dir_) / (".portalsim-staging-" + std::to_string(::getpid()))).string();
   fs::remove_all(staging_, ec);
   fs::create_directory(staging_, ec);
   if (ec) {
-    if (created_final_) fs::remove(final_dir_, ec);
-    throw OutputError(final_dir_ + ": cannot write into the output folder: " + ec.message());
+    const std::string why = ec.message();
+    for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
+    throw OutputError(final_dir_ + ": cannot write into the output folder: " + why);
   }
 }
 
 StagedFolder::~StagedFolder() {
   std::error_code ec;
   fs::remove_all(staging_, ec);
-  if (!committed_ && created_final_) fs::remove(final_dir_, ec);  // only succeeds while empty
+  if (!committed_)  // fs::remove only takes empty folders: nothing of anyone else's goes
+    for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
 }
 
 std::string StagedFolder::path(const std::string& name) {

@@ -22,7 +22,8 @@ class StagedFolder {
  private:
   std::string final_dir_, staging_;
   std::vector<std::string> names_;
-  bool created_final_ = false, committed_ = false;
+  std::vector<std::string> created_;  // folders this object made, outermost first
+  bool committed_ = false;
 };
 
 // Writes `text` to `path` through a temporary name and a rename. Throws OutputError.
