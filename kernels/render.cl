@@ -31,14 +31,32 @@ kernel void render_view(global const uchar* atlas, global const int* bases, glob
     noise_tiles(&T, objs, sprites, places, noise_offsets[k], tile_size, r_begin, r_end, y);
   }
 
-  if (L.count == 0 && T.count == 0 && !(flags & FLAG_PIXEL_NOISE)) {
-    for (int x = 0; x < W; ++x) row[x] = base[x];
-    return;
+  // Only the span that layers and tiles cover needs per-pixel work (all of it under
+  // pixel noise); the rest of the row is the base, copied 16 bytes at a time.
+  int x0 = W, x1 = 0;
+  for (int k = 0; k < L.count; ++k) {
+    x0 = min(x0, L.x0[k]);
+    x1 = max(x1, L.x0[k] + L.width[k]);
   }
-  for (int x = 0; x < W; ++x) {
+  for (int k = 0; k < T.count; ++k) {
+    x0 = min(x0, T.x0[k]);
+    x1 = max(x1, T.x0[k] + tile_size);
+  }
+  if (flags & FLAG_PIXEL_NOISE) {
+    x0 = 0;
+    x1 = W;
+  }
+  x0 = clamp(x0, 0, W);
+  x1 = clamp(x1, x0, W);
+  int x = 0;
+  for (; x + 16 <= x0; x += 16) vstore16(vload16(0, base + x), 0, row + x);
+  for (; x < x0; ++x) row[x] = base[x];
+  for (; x < x1; ++x) {
     float v = composite_pixel(&L, atlas, (float)base[x], x, alpha);
     v += pattern_noise_pixel(&T, atlas, tile_size, gain, x);
     if (flags & FLAG_PIXEL_NOISE) v = fma(sigma, pixel_noise(seed, index, view, y * W + x), v);
     row[x] = to_pixel(v);
   }
+  for (; x + 16 <= W; x += 16) vstore16(vload16(0, base + x), 0, row + x);
+  for (; x < W; ++x) row[x] = base[x];
 }

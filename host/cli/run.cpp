@@ -14,6 +14,7 @@ int run(int argc, char** argv) {
   commands["simulate"] = add_simulate(app);
   commands["catalogue"] = add_catalogue(app);
   commands["generate"] = add_generate(app);
+  commands["features"] = add_features(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

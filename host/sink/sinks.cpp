@@ -75,13 +75,14 @@ class TextTableSink final : public Sink {
 
 class NpySink final : public Sink {
  public:
-  NpySink(const SinkContext& ctx, const FileState* resume)
-      : ctx_(ctx), columns_(static_cast<size_t>(ctx.layout.row_features()) + 1), file_(ctx.dir, "features.npy", resume) {
+  NpySink(const SinkContext& ctx, const FileState* resume, const std::string& name)
+      : ctx_(ctx), columns_(static_cast<size_t>(ctx.layout.row_features()) + 1), file_(ctx.dir, name, resume) {
     if (!resume) {
       file_.append(npy_header(ctx.rows, columns_));
       std::string names;
       for (const std::string& n : ctx.layout.names()) names += n + "\n";
-      write_text_atomic((fs::path(ctx.dir) / "features.columns.txt").string(), names + "class\n");
+      write_text_atomic((fs::path(ctx.dir) / (fs::path(name).stem().string() + ".columns.txt")).string(),
+                        names + "class\n");
     }
   }
   void write(const SceneBatch& scenes, const BatchOutput& out) override {
@@ -187,11 +188,12 @@ class ImageSink final : public Sink {
 
 }  // namespace
 
-std::unique_ptr<Sink> make_table_sink(const std::string& format, const SinkContext& ctx, const FileState* resume) {
-  if (format == "csv")
-    return std::make_unique<TextTableSink>("features.csv", feature_csv_header(ctx.layout), ctx, resume);
-  if (format == "arff") return std::make_unique<TextTableSink>("features.arff", arff_header(ctx.layout), ctx, resume);
-  if (format == "npy") return std::make_unique<NpySink>(ctx, resume);
+std::unique_ptr<Sink> make_table_sink(const std::string& format, const SinkContext& ctx, const FileState* resume,
+                                      const std::string& name) {
+  const std::string file = name.empty() ? "features." + format : name;
+  if (format == "csv") return std::make_unique<TextTableSink>(file, feature_csv_header(ctx.layout), ctx, resume);
+  if (format == "arff") return std::make_unique<TextTableSink>(file, arff_header(ctx.layout), ctx, resume);
+  if (format == "npy") return std::make_unique<NpySink>(ctx, resume, file);
   throw InputError("--format: unknown format \"" + format + "\" (arff, csv, npy)");
 }
 

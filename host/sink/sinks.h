@@ -33,8 +33,11 @@ struct SinkContext {
   std::string image_format = "png";
 };
 
-// format: arff, csv or npy. `resume` is the file's checkpointed state, or null.
-std::unique_ptr<Sink> make_table_sink(const std::string& format, const SinkContext& ctx, const FileState* resume);
+// format: arff, csv or npy; the file is ctx.dir/name (default "features.<format>"; an npy
+// table's column names go beside it in <stem>.columns.txt). `resume` is the file's
+// checkpointed state, or null.
+std::unique_ptr<Sink> make_table_sink(const std::string& format, const SinkContext& ctx, const FileState* resume,
+                                      const std::string& name = "");
 std::unique_ptr<Sink> make_scenario_list_sink(const SinkContext& ctx, const FileState* resume);
 // Writes images/<index>/ folders; on resume, folders from `resume_from` on are removed first.
 std::unique_ptr<Sink> make_image_sink(const SinkContext& ctx, bool resume, uint64_t resume_from);

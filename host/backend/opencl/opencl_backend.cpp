@@ -1,6 +1,7 @@
 #include "backend/opencl/opencl_backend.h"
 
 #include <cmath>
+#include <cstring>
 
 namespace portalsim {
 
@@ -158,8 +159,10 @@ class OpenCLBackend final : public Backend {
     if (plan.sparse_features()) {
       sparse_features(plan, n, subject, objects, seed, first, out);
     } else if (plan.renders_mmw()) {
-      cl::Buffer& upper = upper_.at_least(ctx, n * mmw_px);
-      cl::Buffer& lower = lower_.at_least(ctx, n * mmw_px);
+      // Images the caller keeps are written in place (no copy back on a CPU device);
+      // images only pooled live in device buffers.
+      cl::Buffer upper = plan.mmw_images ? wrap(out.upper) : upper_.at_least(ctx, n * mmw_px);
+      cl::Buffer lower = plan.mmw_images ? wrap(out.lower) : lower_.at_least(ctx, n * mmw_px);
       render(0, upper, ic.mmw_width, ic.mmw_height);
       render(1, lower, ic.mmw_width, ic.mmw_height);
       if (plan.features) {
@@ -193,14 +196,14 @@ class OpenCLBackend final : public Backend {
         q.enqueueReadBuffer(feats, CL_FALSE, 0, n * row_len * sizeof(float), out.features.data());
       }
       if (plan.mmw_images) {
-        q.enqueueReadBuffer(upper, CL_FALSE, 0, n * mmw_px, out.upper.data());
-        q.enqueueReadBuffer(lower, CL_FALSE, 0, n * mmw_px, out.lower.data());
+        sync(upper, out.upper);
+        sync(lower, out.lower);
       }
     }
     if (plan.ir_image) {
-      cl::Buffer& ir = ir_.at_least(ctx, n * ir_px);
+      cl::Buffer ir = wrap(out.ir);
       render(2, ir, ic.ir_width, ic.ir_height);
-      q.enqueueReadBuffer(ir, CL_FALSE, 0, n * ir_px, out.ir.data());
+      sync(ir, out.ir);
     }
     if (plan.metal) {
       cl::Buffer& metal = metal_out_.at_least(ctx, n * kZones);
@@ -222,6 +225,17 @@ class OpenCLBackend final : public Backend {
   }
 
  private:
+  // A device view of host memory: PoCL on the CPU writes there directly.
+  cl::Buffer wrap(std::vector<uint8_t>& v) {
+    return cl::Buffer(rt_->context(), CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, v.size(), v.data());
+  }
+  // Makes the kernel's writes visible in host memory (a no-op copy where shared).
+  void sync(cl::Buffer& b, std::vector<uint8_t>& v) {
+    void* p = rt_->queue().enqueueMapBuffer(b, CL_TRUE, CL_MAP_READ, 0, v.size());
+    if (p != v.data()) std::memcpy(v.data(), p, v.size());
+    rt_->queue().enqueueUnmapMemObject(b, p);
+  }
+
   // The tables of the sparse features path, built once per (block, pattern noise).
   struct SparseTables {
     int block = -1;
@@ -372,7 +386,7 @@ class OpenCLBackend final : public Backend {
   cl::Buffer atlas_, bases_, sprites_, places_, noise_offsets_, noise_gains_, rects_, influence_, categories_,
       base_zones_;
   cl::Kernel render_, pool_blocks_, pool_regions_, metal_, base_features_, footprint_deltas_, features_sparse_;
-  Grown subject_, objects_, upper_, lower_, ir_, metal_out_, features_;
+  Grown subject_, objects_, upper_, lower_, metal_out_, features_;
 };
 
 }  // namespace

@@ -1,0 +1,95 @@
+// portalsim features: scenario folders (simulated or real captures) to a feature table,
+// the thesis's generate.java (appendix D.3).
+#include <cstdio>
+#include <filesystem>
+
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "scene/error.h"
+#include "sink/folder_reader.h"
+#include "sink/sinks.h"
+
+namespace portalsim::cli {
+
+namespace {
+struct FeaturesOptions {
+  CommonOptions common;
+  std::vector<std::string> folders;
+  std::string out, format;
+  int block = 10;
+};
+
+int features(FeaturesOptions& o) {
+  namespace fs = std::filesystem;
+  Session s;
+  open_catalogue(s, o.common);
+  Plan plan;
+  plan.model.block = o.block;
+  validate(plan, s.catalogue);
+  std::string format = o.format;
+  if (format.empty()) {
+    format = fs::path(o.out).extension().string();
+    if (!format.empty()) format.erase(0, 1);
+  }
+  if (format != "arff" && format != "csv" && format != "npy")
+    throw InputError("--out: \"" + o.out + "\": name it .arff, .csv or .npy, or give --format");
+  const fs::path out(o.out);
+  if (fs::exists(out)) throw OutputError(o.out + ": already exists; choose a new file name");
+  const std::vector<std::string> folders = find_scenario_folders(o.folders);
+
+  BatchOutput rows;
+  rows.layout = FeatureLayout::of(s.catalogue, o.block);
+  SceneBatch labels;
+  const size_t chunk = 1024;
+  SinkContext ctx;
+  ctx.dir = out.parent_path().empty() ? "." : out.parent_path().string();
+  ctx.cat = &s.catalogue;
+  ctx.assets = &s.assets;
+  ctx.layout = rows.layout;
+  ctx.rows = folders.size();
+  ctx.threads = 1;
+  std::error_code ec;
+  if (!fs::is_directory(ctx.dir, ec)) throw OutputError(ctx.dir + ": no such folder for --out");
+  std::unique_ptr<Sink> sink = make_table_sink(format, ctx, nullptr, out.filename().string());
+  size_t positive = 0;
+  try {
+    for (size_t first = 0; first < folders.size(); first += chunk) {
+      const size_t n = std::min(chunk, folders.size() - first);
+      rows.n = n;
+      rows.features.assign(n * rows.layout.image_features(), 0.0f);
+      rows.metal.assign(n * kZones, 0);
+      labels.clear();
+      labels.first_index = first;
+      for (size_t i = 0; i < n; ++i) {
+        Scenario sc;
+        sc.label = read_scenario_folder(folders[first + i], s.catalogue, rows, i) ? 1 : 0;
+        positive += sc.label;
+        labels.push(sc);
+      }
+      sink->write(labels, rows);
+    }
+    sink->finish();
+  } catch (...) {
+    sink.reset();
+    fs::remove(fs::path(ctx.dir) / (out.filename().string() + ".partial"), ec);
+    if (format == "npy") fs::remove(fs::path(ctx.dir) / (out.stem().string() + ".columns.txt"), ec);
+    throw;
+  }
+  std::printf("%s: %zu rows (%zu positive, %zu negative) from %zu folders\n", o.out.c_str(), folders.size(), positive,
+              folders.size() - positive, folders.size());
+  return 0;
+}
+}  // namespace
+
+std::function<int()> add_features(CLI::App& app) {
+  auto o = std::make_shared<FeaturesOptions>();
+  CLI::App* sub = app.add_subcommand("features", "turn scenario folders (simulated or real captures) into a feature table");
+  sub->add_option("folders", o->folders, "scenario folders, or folders holding them")->required();
+  sub->add_option("--out", o->out, "output table: FILE.arff, FILE.csv or FILE.npy")->required();
+  sub->add_option("--format", o->format, "arff, csv or npy (default: from --out's extension)");
+  sub->add_option("--block", o->block, "block side for the averaged features (default 10)");
+  sub->add_option("--catalogue", o->common.catalogue, "catalogue TOML file (its region rectangles are used)");
+  return [o] { return features(*o); };
+}
+
+}  // namespace portalsim::cli

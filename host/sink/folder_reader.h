@@ -1,0 +1,21 @@
+// Reading scenario folders back (thesis 5.6.1, the conversion algorithm, and appendix
+// D.3's generate.java): upper and lower MMW images, metal.txt and threat.txt in, one
+// feature row out. Works on folders that simulate or generate wrote, and on real
+// captures laid out the same way.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "backend/backend.h"
+
+namespace portalsim {
+
+// The scenario folders under each path, in order: a path that holds upper.* itself is
+// one folder; otherwise its sub-folders are searched (sorted by name), recursively.
+std::vector<std::string> find_scenario_folders(const std::vector<std::string>& paths);
+
+// Reads folder `dir` into row i of `out` (features and metal) and returns its label.
+// Images of another size are rejected. Throws InputError naming the file and line.
+bool read_scenario_folder(const std::string& dir, const Catalogue& cat, BatchOutput& out, size_t i);
+
+}  // namespace portalsim
