@@ -1,0 +1,1304 @@
+// `portalsim generate` and `portalsim features` as a user meets them: every test runs the real
+// binary in its own temporary folder and checks its exit status, what it printed, and the data
+// set it left on disk (tables, scenario lists, image folders, manifest, checkpoints).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using Args = std::vector<std::string>;
+
+// ---------------------------------------------------------------------------------------------
+// Running the binary (the same approach as cli_test.cpp).
+
+// A fresh folder under /tmp for one test: w/ is the workspace, cap/ holds captured output.
+class GenTempDir {
+ public:
+  GenTempDir() {
+    char tmpl[] = "/tmp/portalsim-gen-XXXXXX";
+    if (!::mkdtemp(tmpl)) throw std::runtime_error(std::string("mkdtemp: ") + std::strerror(errno));
+    root_ = tmpl;
+    fs::create_directory(root_ / "w");
+    fs::create_directory(root_ / "cap");
+  }
+  GenTempDir(const GenTempDir&) = delete;
+  GenTempDir& operator=(const GenTempDir&) = delete;
+  ~GenTempDir() {
+    std::error_code ec;
+    fs::remove_all(root_, ec);
+  }
+  fs::path w() const { return root_ / "w"; }
+  fs::path cap() const { return root_ / "cap"; }
+
+ private:
+  fs::path root_;
+};
+
+struct RunResult {
+  std::string command;
+  bool exited = false;
+  int status = -1;
+  bool signaled = false;
+  int signal = 0;
+  bool timed_out = false;
+  std::string out, err;
+};
+
+std::string read_all(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_all(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+  if (!out) ADD_FAILURE() << "cannot write " << p;
+}
+
+bool has(const std::string& hay, const std::string& needle) { return hay.find(needle) != std::string::npos; }
+
+std::vector<std::string> split_on(const std::string& text, char sep) {
+  std::vector<std::string> parts;
+  std::string cur;
+  for (char c : text) {
+    if (c == sep) {
+      parts.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  parts.push_back(cur);
+  return parts;
+}
+
+std::string shell_quoted(const std::string& a) {
+  if (!a.empty() && a.find_first_of(" '\"&|;<>()$*?\\") == std::string::npos) return a;
+  std::string q = "'";
+  for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string describe_run(const RunResult& r) {
+  std::ostringstream s;
+  s << "command: " << r.command << "\n";
+  if (r.timed_out)
+    s << "timed out\n";
+  else if (r.signaled)
+    s << "killed by signal " << r.signal << "\n";
+  else
+    s << "exit status " << r.status << "\n";
+  s << "--- stdout ---\n" << r.out.substr(0, 4000) << "--- stderr ---\n" << r.err.substr(0, 4000) << "---";
+  return s.str();
+}
+
+struct Started {
+  pid_t pid = -1;
+  std::string command;
+  fs::path out_path, err_path;
+};
+
+// Starts `program ARGS` (portalsim unless told) with stdin from /dev/null and output captured.
+Started start_program(const GenTempDir& t, const std::string& program, const Args& args) {
+  static int counter = 0;
+  const int n = ++counter;
+  Started r;
+  r.out_path = t.cap() / ("run" + std::to_string(n) + ".stdout");
+  r.err_path = t.cap() / ("run" + std::to_string(n) + ".stderr");
+  std::vector<std::string> argv_s{program};
+  argv_s.insert(argv_s.end(), args.begin(), args.end());
+  r.command = program == PORTALSIM_BINARY ? "portalsim" : program;
+  for (const std::string& a : args) r.command += " " + shell_quoted(a);
+  std::vector<char*> argv;
+  for (std::string& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string out_s = r.out_path.string(), err_s = r.err_path.string();
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 1, out_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&fa, 2, err_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  const int rc = posix_spawn(&r.pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) {
+    ADD_FAILURE() << "cannot start " << program << ": " << std::strerror(rc);
+    r.pid = -1;
+  }
+  return r;
+}
+
+Started start_ps(const GenTempDir& t, const Args& args) { return start_program(t, PORTALSIM_BINARY, args); }
+
+// True once the process has ended (without reaping it).
+bool has_ended(const Started& r) {
+  siginfo_t info{};
+  if (::waitid(P_PID, static_cast<id_t>(r.pid), &info, WEXITED | WNOHANG | WNOWAIT) != 0) return true;
+  return info.si_pid != 0;
+}
+
+// Waits for a started run (at most `limit_s`, then kills it) and collects what it printed.
+RunResult wait_for(const Started& r, int limit_s = 120) {
+  RunResult res;
+  res.command = r.command;
+  if (r.pid < 0) return res;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(limit_s);
+  int ws = 0;
+  for (;;) {
+    const pid_t w = ::waitpid(r.pid, &ws, WNOHANG);
+    if (w == r.pid) break;
+    if (w < 0 && errno != EINTR) {
+      ADD_FAILURE() << "waitpid: " << std::strerror(errno);
+      return res;
+    }
+    if (std::chrono::steady_clock::now() > deadline) {
+      ::kill(r.pid, SIGKILL);
+      ::waitpid(r.pid, &ws, 0);
+      res.timed_out = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  res.exited = WIFEXITED(ws);
+  if (res.exited) res.status = WEXITSTATUS(ws);
+  res.signaled = WIFSIGNALED(ws);
+  if (res.signaled) res.signal = WTERMSIG(ws);
+  res.out = read_all(r.out_path);
+  res.err = read_all(r.err_path);
+  return res;
+}
+
+RunResult run_ps(const GenTempDir& t, const Args& args) { return wait_for(start_ps(t, args)); }
+
+std::vector<RunResult> run_ps_all(const GenTempDir& t, const std::vector<Args>& commands) {
+  std::vector<Started> running;
+  for (const Args& a : commands) running.push_back(start_ps(t, a));
+  std::vector<RunResult> results;
+  for (const Started& r : running) results.push_back(wait_for(r));
+  return results;
+}
+
+// `portalsim generate ARGS --out OUT`.
+Args gen(const Args& args, const fs::path& out) {
+  Args a{"generate"};
+  a.insert(a.end(), args.begin(), args.end());
+  a.push_back("--out");
+  a.push_back(out.string());
+  return a;
+}
+
+Args plus(Args a, const Args& more) {
+  a.insert(a.end(), more.begin(), more.end());
+  return a;
+}
+
+void ExpectOk(const RunResult& r) {
+  EXPECT_FALSE(r.timed_out) << describe_run(r);
+  EXPECT_FALSE(r.signaled) << describe_run(r);
+  EXPECT_TRUE(r.exited && r.status == 0) << describe_run(r);
+  EXPECT_FALSE(has(r.err, "error")) << describe_run(r);
+}
+
+std::vector<std::string> entries_of(const fs::path& dir) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// Every regular file under `dir`, hidden ones included, as sorted relative paths.
+std::vector<std::string> files_under(const fs::path& dir) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator();
+       it.increment(ec))
+    if (it->is_regular_file()) names.push_back(fs::relative(it->path(), dir).string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// Folder contents as path -> bytes (for "left untouched" checks on small folders).
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> m;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator();
+       it.increment(ec))
+    m[fs::relative(it->path(), dir).string()] = it->is_regular_file() ? read_all(it->path()) : std::string("<dir>");
+  return m;
+}
+
+// Two output folders hold the same files with the same bytes (large files are not printed).
+void ExpectSameTree(const fs::path& a, const fs::path& b) {
+  const std::vector<std::string> fa = files_under(a), fb = files_under(b);
+  ASSERT_EQ(fa, fb) << a << " and " << b << " hold different files";
+  ASSERT_FALSE(fa.empty()) << a << " is empty";
+  int differing = 0;
+  for (const std::string& f : fa) {
+    const std::string x = read_all(a / f), y = read_all(b / f);
+    if (x != y && ++differing <= 5)
+      ADD_FAILURE() << f << " differs between " << a << " and " << b << " (" << x.size() << " vs " << y.size()
+                    << " bytes)";
+  }
+  EXPECT_EQ(differing, 0) << "files differing between " << a << " and " << b;
+}
+
+std::vector<std::string> stderr_messages(const std::string& err) {
+  std::vector<std::string> lines;
+  for (const std::string& l : split_on(err, '\n'))
+    if (!l.empty() && l != "Run with --help for more information.") lines.push_back(l);
+  return lines;
+}
+
+// A rejected command: non-zero exit, no signal, one stderr message naming every needle, nothing
+// on stdout, and the output folder absent (or still empty when it existed before the run).
+void ExpectRefused(const RunResult& r, const fs::path& out, bool out_existed, const std::vector<std::string>& needles) {
+  SCOPED_TRACE(describe_run(r));
+  if (r.exited && r.status == 0) {
+    ADD_FAILURE() << "portalsim accepted a command it must reject";
+    return;
+  }
+  EXPECT_FALSE(r.timed_out);
+  EXPECT_FALSE(r.signaled) << "portalsim was killed by signal " << r.signal;
+  EXPECT_TRUE(r.exited);
+  EXPECT_NE(r.status, 0);
+  EXPECT_EQ(stderr_messages(r.err).size(), 1u) << "stderr should hold exactly one message";
+  for (const std::string& n : needles) EXPECT_TRUE(has(r.err, n)) << "stderr does not name \"" << n << "\"";
+  EXPECT_EQ(r.out, "") << "nothing should be printed on stdout";
+  std::error_code ec;
+  if (out_existed) {
+    EXPECT_TRUE(fs::is_directory(out, ec)) << out << " existed before and must still be there";
+    EXPECT_TRUE(entries_of(out).empty()) << out << " must stay empty, holds: " << testing::PrintToString(entries_of(out));
+  } else if (fs::exists(out, ec)) {
+    EXPECT_TRUE(fs::is_directory(out, ec) && entries_of(out).empty())
+        << out << " did not exist before and must not hold anything after a failed run; holds "
+        << testing::PrintToString(entries_of(out));
+  }
+}
+
+// One generate command that must be refused, with OUT absent and (also_existing) OUT empty.
+struct Refusal {
+  Args args;
+  std::vector<std::string> needles;
+  bool also_existing = false;
+};
+
+void ExpectAllRefused(const GenTempDir& t, const std::vector<Refusal>& cases) {
+  static int counter = 0;
+  struct Check {
+    const Refusal* c;
+    fs::path out;
+    bool existed;
+  };
+  std::vector<Check> checks;
+  for (const Refusal& c : cases) {
+    const int n = ++counter;
+    checks.push_back({&c, t.w() / ("out-fresh-" + std::to_string(n)), false});
+    if (c.also_existing) {
+      checks.push_back({&c, t.w() / ("out-existing-" + std::to_string(n)), true});
+      fs::create_directory(checks.back().out);
+    }
+  }
+  std::vector<Args> commands;
+  for (const Check& k : checks) commands.push_back(gen(k.c->args, k.out));
+  const std::vector<RunResult> r = run_ps_all(t, commands);
+  for (size_t i = 0; i < checks.size(); ++i) {
+    SCOPED_TRACE(checks[i].existed ? "output folder existed (empty) before the run"
+                                   : "output folder absent before the run");
+    ExpectRefused(r[i], checks[i].out, checks[i].existed, checks[i].c->needles);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading the outputs.
+
+// The lines of a text file without the final newline's empty string.
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> l = split_on(text, '\n');
+  if (!l.empty() && l.back().empty()) l.pop_back();
+  return l;
+}
+
+// CSV data rows (every line after the header).
+std::vector<std::string> csv_rows(const std::string& text) {
+  std::vector<std::string> l = lines_of(text);
+  if (!l.empty()) l.erase(l.begin());
+  return l;
+}
+
+// ARFF data rows (every line after @data).
+std::vector<std::string> arff_rows(const std::string& text) {
+  std::vector<std::string> l = lines_of(text), rows;
+  bool data = false;
+  for (const std::string& s : l) {
+    if (data)
+      rows.push_back(s);
+    else if (s == "@data")
+      data = true;
+  }
+  return rows;
+}
+
+json read_json(const fs::path& p) {
+  const json j = json::parse(read_all(p), nullptr, false);
+  if (j.is_discarded()) ADD_FAILURE() << p << " is not valid JSON";
+  return j;
+}
+
+struct Npy {
+  bool ok = false;
+  std::string why;
+  size_t header_bytes = 0;  // magic .. the dict's final newline
+  std::string dict;
+  uint64_t rows = 0, cols = 0;
+  std::vector<float> data;
+};
+
+// Parses an .npy file: version 1.0, little-endian float32, C order, 2-D.
+Npy parse_npy(const std::string& bytes) {
+  Npy n;
+  if (bytes.size() < 10 || bytes.compare(0, 6, "\x93NUMPY") != 0) {
+    n.why = "no \\x93NUMPY magic";
+    return n;
+  }
+  if (bytes[6] != 1 || bytes[7] != 0) {
+    n.why = "version is not 1.0";
+    return n;
+  }
+  const size_t len = static_cast<unsigned char>(bytes[8]) | (static_cast<size_t>(static_cast<unsigned char>(bytes[9])) << 8);
+  n.header_bytes = 10 + len;
+  if (bytes.size() < n.header_bytes) {
+    n.why = "shorter than its header";
+    return n;
+  }
+  n.dict = bytes.substr(10, len);
+  if (n.dict.empty() || n.dict.back() != '\n') {
+    n.why = "header does not end with a newline";
+    return n;
+  }
+  if (!has(n.dict, "'descr': '<f4'")) {
+    n.why = "descr is not '<f4': " + n.dict;
+    return n;
+  }
+  if (!has(n.dict, "'fortran_order': False")) {
+    n.why = "not C order: " + n.dict;
+    return n;
+  }
+  const size_t s = n.dict.find("'shape': (");
+  if (s == std::string::npos) {
+    n.why = "no shape: " + n.dict;
+    return n;
+  }
+  unsigned long long r = 0, c = 0;
+  if (std::sscanf(n.dict.c_str() + s, "'shape': (%llu, %llu)", &r, &c) != 2) {
+    n.why = "shape is not (N, C): " + n.dict;
+    return n;
+  }
+  n.rows = r;
+  n.cols = c;
+  const size_t payload = bytes.size() - n.header_bytes;
+  if (payload != n.rows * n.cols * sizeof(float)) {
+    n.why = "data is " + std::to_string(payload) + " bytes, shape says " + std::to_string(n.rows * n.cols * 4);
+    return n;
+  }
+  n.data.resize(static_cast<size_t>(n.rows * n.cols));
+  std::memcpy(n.data.data(), bytes.data() + n.header_bytes, payload);  // the test host is little-endian
+  n.ok = true;
+  return n;
+}
+
+const std::string kWholeRunNote = "an uninterrupted run of the same spec";
+
+// Reads DIR/.portalsim/checkpoint.json's "next" (-1 when absent or unreadable).
+long long checkpoint_next(const fs::path& dir) {
+  std::error_code ec;
+  const fs::path p = dir / ".portalsim" / "checkpoint.json";
+  if (!fs::exists(p, ec)) return -1;
+  const json j = json::parse(read_all(p), nullptr, false);
+  if (j.is_discarded() || !j.contains("next") || !j["next"].is_number_unsigned()) return -1;
+  return static_cast<long long>(j["next"].get<uint64_t>());
+}
+
+// Polls the run's checkpoint until "next" reaches `at_least` (-1: the checkpoint just exists).
+// False when the run ended first or 60 s passed.
+bool wait_for_checkpoint(const Started& r, const fs::path& dir, long long at_least) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    const long long next = checkpoint_next(dir);
+    if (next >= 0 && next >= at_least) return true;
+    if (has_ended(r)) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return false;
+}
+
+// ---------------------------------------------------------------------------------------------
+// 1. ARFF for WEKA.
+
+std::string find_on_path(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  for (const std::string& d : split_on(path ? path : "/usr/bin:/bin", ':')) {
+    if (d.empty()) continue;
+    const fs::path p = fs::path(d) / name;
+    if (::access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return "";
+}
+
+TEST(GenerateArff, HeaderRowsAndWekaLearnsTheGunRule) {
+  GenTempDir t;
+  const fs::path out = t.w() / "out";
+  const RunResult r = run_ps(t, gen({"--count", "400", "--seed", "1", "--rule", "gun", "--balance", "--format",
+                                     "arff,csv", "--quiet"},
+                                    out));
+  ExpectOk(r);
+  EXPECT_EQ(entries_of(out),
+            (std::vector<std::string>{"features.arff", "features.csv", "manifest.json", "scenarios.csv"}));
+  const std::string arff = read_all(out / "features.arff");
+  const std::vector<std::string> lines = lines_of(arff);
+  ASSERT_FALSE(lines.empty());
+  std::vector<std::string> attributes;
+  bool relation = false, data = false, class_attr = false;
+  size_t data_rows = 0;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const std::string& l = lines[i];
+    if (data) {
+      ++data_rows;
+      const std::vector<std::string> f = split_on(l, ',');
+      ASSERT_EQ(f.size(), attributes.size()) << "data row " << data_rows << " has a wrong field count";
+      EXPECT_TRUE(f.back() == "positive" || f.back() == "negative") << "row " << data_rows << ": " << f.back();
+      continue;
+    }
+    if (l.rfind("@relation ", 0) == 0) {
+      relation = true;
+    } else if (l == "@attribute class {positive,negative}") {
+      class_attr = true;
+      attributes.push_back("class");
+    } else if (l.rfind("@attribute ", 0) == 0) {
+      EXPECT_FALSE(class_attr) << "line " << i + 1 << ": attributes after the class";
+      const std::vector<std::string> f = split_on(l, ' ');
+      ASSERT_EQ(f.size(), 3u) << "line " << i + 1 << ": " << l;
+      EXPECT_EQ(f[2], "numeric") << "line " << i + 1 << ": " << l;
+      attributes.push_back(f[1]);
+    } else if (l == "@data") {
+      data = true;
+    } else {
+      EXPECT_TRUE(l.empty() || l[0] == '%') << "line " << i + 1 << " is not ARFF: " << l;
+    }
+  }
+  EXPECT_TRUE(relation) << "no @relation line";
+  EXPECT_TRUE(class_attr) << "no @attribute class {positive,negative}";
+  EXPECT_TRUE(data) << "no @data line";
+  EXPECT_EQ(attributes.size(), 2u * 20 * 20 + 13 + 19 + 1);
+  EXPECT_EQ(std::set<std::string>(attributes.begin(), attributes.end()).size(), attributes.size())
+      << "attribute names must be distinct";
+  EXPECT_EQ(data_rows, 400u);
+  // The CSV has the same names and the same rows.
+  const std::string csv = read_all(out / "features.csv");
+  const std::vector<std::string> csv_lines = lines_of(csv);
+  ASSERT_FALSE(csv_lines.empty());
+  EXPECT_EQ(split_on(csv_lines[0], ','), attributes) << "the CSV header names the ARFF attributes";
+  EXPECT_TRUE(csv_rows(csv) == arff_rows(arff)) << "the CSV and ARFF data rows differ";
+
+  const fs::path jar = "/usr/share/java/weka.jar";
+  const std::string java = find_on_path("java");
+  if (java.empty() || !fs::exists(jar)) GTEST_SKIP() << "java or " << jar << " is not installed: WEKA part skipped";
+  const RunResult w =
+      wait_for(start_program(t, java, {"-cp", jar.string(), "weka.classifiers.trees.J48", "-t", (out / "features.arff").string()}));
+  ASSERT_TRUE(w.exited && w.status == 0) << describe_run(w);
+  ASSERT_TRUE(has(w.out, "Correctly Classified Instances")) << describe_run(w);
+  // With -t alone WEKA prints the training-set figures, then the 10-fold cross-validation's.
+  const size_t cv = w.out.find("=== Stratified cross-validation ===");
+  ASSERT_NE(cv, std::string::npos) << describe_run(w);
+  const size_t at = w.out.find("Correctly Classified Instances", cv);
+  ASSERT_NE(at, std::string::npos) << describe_run(w);
+  std::istringstream s(w.out.substr(at + std::strlen("Correctly Classified Instances")));
+  long long correct = -1;
+  double percent = -1;
+  s >> correct >> percent;
+  ASSERT_TRUE(s) << describe_run(w);
+  EXPECT_GT(percent, 80.0) << "J48 should learn 'gun' from the metal zones; cross-validated accuracy " << percent
+                           << "%";
+}
+
+// ---------------------------------------------------------------------------------------------
+// 2. CSV header and NPY.
+
+TEST(GenerateTables, NpyParsesAndEqualsTheCsv) {
+  GenTempDir t;
+  const fs::path out = t.w() / "out";
+  ExpectOk(run_ps(t, gen({"--count", "300", "--seed", "5", "--rule", "gun|iron-rod", "--metal-noise", "3", "--format",
+                          "csv,npy", "--quiet"},
+                         out)));
+  EXPECT_EQ(entries_of(out), (std::vector<std::string>{"features.columns.txt", "features.csv", "features.npy",
+                                                       "manifest.json", "scenarios.csv"}));
+  const std::vector<std::string> csv = lines_of(read_all(out / "features.csv"));
+  ASSERT_EQ(csv.size(), 301u);
+  const std::vector<std::string> header = split_on(csv[0], ',');
+  const size_t C = header.size();
+  EXPECT_EQ(C, 2u * 20 * 20 + 13 + 19 + 1);
+  EXPECT_EQ(header.back(), "class");
+  EXPECT_EQ(lines_of(read_all(out / "features.columns.txt")), header)
+      << "features.columns.txt names the npy columns, one per line, as the CSV header does";
+
+  const std::string bytes = read_all(out / "features.npy");
+  const Npy npy = parse_npy(bytes);
+  ASSERT_TRUE(npy.ok) << npy.why;
+  EXPECT_EQ(npy.header_bytes % 64, 0u) << "the npy header should be padded to 64 bytes";
+  EXPECT_EQ(npy.rows, 300u);
+  EXPECT_EQ(npy.cols, C);
+  const size_t F = C - 1 - 19;  // image features, then 19 zones, then the class
+  int mismatches = 0;
+  for (size_t i = 0; i < 300 && mismatches < 10; ++i) {
+    const std::vector<std::string> f = split_on(csv[i + 1], ',');
+    ASSERT_EQ(f.size(), C) << "CSV row " << i;
+    const float* row = npy.data.data() + i * C;
+    for (size_t k = 0; k < C; ++k) {
+      if (k < F) {
+        char* end = nullptr;
+        const double v = std::strtod(f[k].c_str(), &end);
+        ASSERT_TRUE(end && *end == '\0' && !f[k].empty()) << "row " << i << " column " << header[k] << ": " << f[k];
+        if (std::fabs(v - static_cast<double>(row[k])) > 5e-5 + 1e-9)
+          ++mismatches, ADD_FAILURE() << "row " << i << " column " << header[k] << ": csv " << f[k] << ", npy "
+                                      << row[k];
+      } else if (k < C - 1) {
+        if (std::to_string(static_cast<int>(row[k])) != f[k] || row[k] != std::floor(row[k]))
+          ++mismatches, ADD_FAILURE() << "row " << i << " zone " << header[k] << ": csv " << f[k] << ", npy " << row[k];
+      } else {
+        const float want = f[k] == "positive" ? 1.0f : f[k] == "negative" ? 0.0f : -1.0f;
+        if (row[k] != want)
+          ++mismatches, ADD_FAILURE() << "row " << i << " class: csv " << f[k] << ", npy " << row[k];
+      }
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  // The rule mixes classes here; both must show up.
+  const json m = read_json(out / "manifest.json");
+  EXPECT_EQ(m["count"], 300);
+  EXPECT_GT(m["classes"]["positive"].get<int>(), 0);
+  EXPECT_GT(m["classes"]["negative"].get<int>(), 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// 3. Determinism.
+
+TEST(GenerateDeterminism, FeaturesDoNotDependOnBatchOrThreads) {
+  GenTempDir t;
+  const Args spec{"--count", "1500", "--seed", "7", "--rule", "gun", "--balance", "--metal-noise", "3",
+                  "--format", "arff,csv,npy", "--quiet"};
+  const std::vector<Args> variants{{"--batch", "1", "--threads", "1"},    {"--batch", "7", "--threads", "2"},
+                                   {"--batch", "1000", "--threads", "2"}, {"--batch", "1000", "--threads", "1"},
+                                   {"--threads", "2"},                    {"--backend", "opencl"}};
+  std::vector<Args> commands;
+  for (size_t i = 0; i < variants.size(); ++i)
+    commands.push_back(gen(plus(spec, variants[i]), t.w() / ("v" + std::to_string(i))));
+  Args other = spec;
+  other[3] = "8";
+  commands.push_back(gen(other, t.w() / "seed8"));
+  const std::vector<RunResult> r = run_ps_all(t, commands);
+  for (const RunResult& x : r) ExpectOk(x);
+  ASSERT_EQ(entries_of(t.w() / "v0"),
+            (std::vector<std::string>{"features.arff", "features.columns.txt", "features.csv", "features.npy",
+                                      "manifest.json", "scenarios.csv"}));
+  const std::string manifest = read_all(t.w() / "v0" / "manifest.json");
+  EXPECT_FALSE(has(manifest, "second")) << "the manifest must not hold timings:\n" << manifest;
+  for (size_t i = 1; i < variants.size(); ++i) {
+    SCOPED_TRACE(r[i].command);
+    ExpectSameTree(t.w() / "v0", t.w() / ("v" + std::to_string(i)));
+  }
+  // Another seed: other scenarios, other features (rows compared without the class).
+  const std::vector<std::string> a = csv_rows(read_all(t.w() / "v0" / "features.csv")),
+                                 b = csv_rows(read_all(t.w() / "seed8" / "features.csv"));
+  ASSERT_EQ(a.size(), 1500u);
+  ASSERT_EQ(b.size(), 1500u);
+  size_t same = 0;
+  for (size_t i = 0; i < a.size(); ++i) same += a[i] == b[i];
+  EXPECT_LT(same, 750u) << "seeds 7 and 8 gave the same feature row for " << same << " of 1500 scenarios";
+  EXPECT_NE(read_all(t.w() / "v0" / "scenarios.csv"), read_all(t.w() / "seed8" / "scenarios.csv"));
+  // Balanced: even indices are threats.
+  const std::vector<std::string> sc = csv_rows(read_all(t.w() / "v0" / "scenarios.csv"));
+  ASSERT_EQ(sc.size(), 1500u);
+  for (size_t i = 0; i < sc.size(); ++i) {
+    const std::vector<std::string> f = split_on(sc[i], ',');
+    ASSERT_EQ(f.size(), 16u) << sc[i];
+    EXPECT_EQ(f[0], std::to_string(i));
+    ASSERT_EQ(f[15], i % 2 == 0 ? "yes" : "no") << "row " << i << ": " << sc[i];
+  }
+}
+
+TEST(GenerateDeterminism, ImagesAndNoisyFeaturesDoNotDependOnBatchOrThreads) {
+  GenTempDir t;
+  const Args spec{"--count", "20", "--seed", "11", "--what", "both", "--rule", "gun", "--pixel-noise", "2",
+                  "--metal-noise", "3", "--format", "csv,npy", "--quiet"};
+  const std::vector<Args> variants{
+      {"--batch", "1", "--threads", "1"}, {"--batch", "7", "--threads", "2"}, {"--batch", "1000", "--threads", "2"}};
+  std::vector<Args> commands;
+  for (size_t i = 0; i < variants.size(); ++i)
+    commands.push_back(gen(plus(spec, variants[i]), t.w() / ("v" + std::to_string(i))));
+  const std::vector<RunResult> r = run_ps_all(t, commands);
+  for (const RunResult& x : r) ExpectOk(x);
+  const fs::path v0 = t.w() / "v0";
+  std::vector<std::string> folders;
+  for (int i = 0; i < 20; ++i) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%08d", i);
+    folders.push_back(name);
+  }
+  EXPECT_EQ(entries_of(v0 / "images"), folders);
+  EXPECT_EQ(entries_of(v0 / "images" / "00000013"),
+            (std::vector<std::string>{"features.csv", "ir.png", "lower.png", "metal.txt", "threat.txt", "upper.png"}));
+  for (size_t i = 1; i < variants.size(); ++i) {
+    SCOPED_TRACE(r[i].command);
+    ExpectSameTree(v0, t.w() / ("v" + std::to_string(i)));
+  }
+  // Each scenario folder's features.csv row is that scenario's row of the table.
+  const std::vector<std::string> rows = csv_rows(read_all(v0 / "features.csv"));
+  ASSERT_EQ(rows.size(), 20u);
+  for (size_t i = 0; i < 20; ++i)
+    EXPECT_EQ(csv_rows(read_all(v0 / "images" / folders[i] / "features.csv")), std::vector<std::string>{rows[i]})
+        << folders[i];
+  const json m = read_json(v0 / "manifest.json");
+  EXPECT_EQ(m["images"]["count"], 20);
+}
+
+// ---------------------------------------------------------------------------------------------
+// 4. Shards.
+
+TEST(GenerateShards, RowsConcatenateToTheWholeRun) {
+  GenTempDir t;
+  const Args spec{"--count", "1000", "--seed", "3", "--rule", "gun", "--balance", "--format", "csv,npy,arff", "--quiet"};
+  std::vector<Args> commands{gen(spec, t.w() / "whole")};
+  for (int i = 0; i < 3; ++i)
+    commands.push_back(gen(plus(spec, {"--shard", std::to_string(i) + "/3"}), t.w() / ("s" + std::to_string(i))));
+  const std::vector<RunResult> r = run_ps_all(t, commands);
+  for (const RunResult& x : r) ExpectOk(x);
+  const fs::path whole = t.w() / "whole";
+  const uint64_t bounds[4] = {0, 333, 666, 1000};
+
+  std::vector<std::string> csv, arff, scen;
+  std::string npy_data;
+  uint64_t positive = 0, negative = 0;
+  for (int i = 0; i < 3; ++i) {
+    SCOPED_TRACE("shard " + std::to_string(i) + "/3");
+    const fs::path s = t.w() / ("s" + std::to_string(i));
+    const std::string c = read_all(s / "features.csv"), a = read_all(s / "features.arff"),
+                      sc = read_all(s / "scenarios.csv");
+    EXPECT_EQ(lines_of(c).at(0), lines_of(read_all(whole / "features.csv")).at(0)) << "every shard has the header";
+    EXPECT_EQ(lines_of(sc).at(0), lines_of(read_all(whole / "scenarios.csv")).at(0));
+    for (const std::string& l : csv_rows(c)) csv.push_back(l);
+    for (const std::string& l : arff_rows(a)) arff.push_back(l);
+    for (const std::string& l : csv_rows(sc)) scen.push_back(l);
+    const std::string nb = read_all(s / "features.npy");
+    const Npy n = parse_npy(nb);
+    ASSERT_TRUE(n.ok) << n.why;
+    EXPECT_EQ(n.rows, bounds[i + 1] - bounds[i]) << "the shard's npy shape counts its own rows";
+    npy_data += nb.substr(n.header_bytes);
+    EXPECT_EQ(read_all(s / "features.columns.txt"), read_all(whole / "features.columns.txt"));
+    const json m = read_json(s / "manifest.json");
+    EXPECT_EQ(m["shard"]["index"], i);
+    EXPECT_EQ(m["shard"]["count"], 3);
+    EXPECT_EQ(m["shard"]["begin"], bounds[i]) << m.dump(1);
+    EXPECT_EQ(m["shard"]["end"], bounds[i + 1]) << m.dump(1);
+    EXPECT_EQ(m["count"], bounds[i + 1] - bounds[i]);
+    positive += m["classes"]["positive"].get<uint64_t>();
+    negative += m["classes"]["negative"].get<uint64_t>();
+    EXPECT_TRUE(has(r[i + 1].out, "[" + std::to_string(bounds[i]) + ", " + std::to_string(bounds[i + 1]) + ")"))
+        << describe_run(r[i + 1]);
+  }
+  EXPECT_TRUE(csv == csv_rows(read_all(whole / "features.csv"))) << "shard CSV rows differ from the whole run's";
+  EXPECT_TRUE(arff == arff_rows(read_all(whole / "features.arff"))) << "shard ARFF rows differ from the whole run's";
+  EXPECT_EQ(scen, csv_rows(read_all(whole / "scenarios.csv")));
+  const std::string wb = read_all(whole / "features.npy");
+  const Npy wn = parse_npy(wb);
+  ASSERT_TRUE(wn.ok) << wn.why;
+  EXPECT_EQ(wn.rows, 1000u);
+  EXPECT_TRUE(npy_data == wb.substr(wn.header_bytes)) << "shard npy data differ from the whole run's";
+  const json wm = read_json(whole / "manifest.json");
+  EXPECT_EQ(wm["shard"]["begin"], 0);
+  EXPECT_EQ(wm["shard"]["end"], 1000);
+  EXPECT_EQ(positive, wm["classes"]["positive"].get<uint64_t>());
+  EXPECT_EQ(negative, wm["classes"]["negative"].get<uint64_t>());
+  EXPECT_EQ(positive, 500u);
+}
+
+TEST(GenerateShards, ImageFoldersSplitByIndex) {
+  GenTempDir t;
+  const Args spec{"--count", "10", "--seed", "4", "--what", "both", "--format", "csv", "--quiet"};
+  std::vector<Args> commands{gen(spec, t.w() / "whole")};
+  for (int i = 0; i < 3; ++i)
+    commands.push_back(gen(plus(spec, {"--shard", std::to_string(i) + "/3"}), t.w() / ("s" + std::to_string(i))));
+  const std::vector<RunResult> r = run_ps_all(t, commands);
+  for (const RunResult& x : r) ExpectOk(x);
+  const std::vector<std::vector<std::string>> want{
+      {"00000000", "00000001", "00000002"}, {"00000003", "00000004", "00000005"}, {"00000006", "00000007", "00000008", "00000009"}};
+  for (int i = 0; i < 3; ++i) {
+    const fs::path s = t.w() / ("s" + std::to_string(i));
+    EXPECT_EQ(entries_of(s / "images"), want[i]) << "shard " << i;
+    for (const std::string& folder : want[i]) {
+      SCOPED_TRACE("shard " + std::to_string(i) + " images/" + folder);
+      ExpectSameTree(s / "images" / folder, t.w() / "whole" / "images" / folder);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// 5. Interrupting and resuming.
+
+// A features run that takes a couple of seconds (small batches: a checkpoint every 8 scenarios).
+const Args kLongSpec{"--count", "30000", "--seed", "21", "--rule", "gun", "--block", "40",
+                     "--format", "csv,npy", "--batch", "8", "--quiet"};
+
+void ExpectInterruptedState(const fs::path& dir, const std::vector<std::string>& data_files) {
+  std::error_code ec;
+  EXPECT_FALSE(fs::exists(dir / "manifest.json", ec)) << "no manifest before the run is complete";
+  EXPECT_TRUE(fs::exists(dir / ".portalsim" / "checkpoint.json", ec)) << "the checkpoint must be kept";
+  for (const std::string& f : data_files) {
+    EXPECT_FALSE(fs::exists(dir / f, ec)) << f << " must not have its final name before the run is complete";
+    EXPECT_TRUE(fs::exists(dir / (f + ".partial"), ec)) << f << ".partial must exist";
+  }
+}
+
+TEST(GenerateResume, KillNineThenResumeMatchesAnUninterruptedRun) {
+  GenTempDir t;
+  const fs::path dir = t.w() / "killed", ref = t.w() / "ref";
+  const Started reference = start_ps(t, gen(kLongSpec, ref));
+  const Started victim = start_ps(t, gen(kLongSpec, dir));
+  const bool progressed = wait_for_checkpoint(victim, dir, 1);
+  ::kill(victim.pid, SIGKILL);
+  const RunResult k = wait_for(victim);
+  ExpectOk(wait_for(reference));
+  ASSERT_TRUE(progressed) << "the run never checkpointed progress\n" << describe_run(k);
+  ASSERT_TRUE(k.signaled && k.signal == SIGKILL) << "the run ended before it could be killed; make kLongSpec longer\n"
+                                                 << describe_run(k);
+  const long long next = checkpoint_next(dir);
+  EXPECT_GT(next, 0);
+  EXPECT_LT(next, 30000);
+  ExpectInterruptedState(dir, {"features.csv", "features.npy", "scenarios.csv"});
+
+  // Resume with other batch and thread counts: they are not part of the spec.
+  Args resume = plus(kLongSpec, {"--resume"});
+  resume[resume.size() - 3] = "1000";  // --batch 8 -> --batch 1000 (before --quiet --resume)
+  ASSERT_EQ(resume[resume.size() - 4], "--batch");
+  const RunResult r = run_ps(t, gen(plus(resume, {"--threads", "1"}), dir));
+  ExpectOk(r);
+  ExpectSameTree(dir, ref);
+  EXPECT_FALSE(fs::exists(dir / ".portalsim")) << "the checkpoint folder goes once the run is complete";
+
+  // A complete folder: --resume has nothing to do, says so, and changes nothing.
+  const auto before = files_under(dir);
+  const std::string manifest = read_all(dir / "manifest.json");
+  const RunResult again = run_ps(t, gen(plus(kLongSpec, {"--resume"}), dir));
+  ExpectOk(again);
+  EXPECT_TRUE(has(again.out + again.err, "already complete")) << describe_run(again);
+  EXPECT_EQ(files_under(dir), before);
+  EXPECT_EQ(read_all(dir / "manifest.json"), manifest);
+}
+
+TEST(GenerateResume, CtrlCStopsConsistentlyAndResumes) {
+  GenTempDir t;
+  const fs::path dir = t.w() / "stopped", ref = t.w() / "ref";
+  const Started reference = start_ps(t, gen(kLongSpec, ref));
+  const Started victim = start_ps(t, gen(kLongSpec, dir));
+  const bool progressed = wait_for_checkpoint(victim, dir, 1);
+  ::kill(victim.pid, SIGINT);
+  const RunResult k = wait_for(victim);
+  ExpectOk(wait_for(reference));
+  ASSERT_TRUE(progressed) << describe_run(k);
+  SCOPED_TRACE(describe_run(k));
+  ASSERT_FALSE(k.signaled) << "SIGINT must stop the run cleanly, not kill it";
+  EXPECT_TRUE(k.exited);
+  EXPECT_EQ(k.status, 130) << "an interrupted run exits with 130";
+  EXPECT_TRUE(has(k.err, "--resume")) << "the message must say how to continue";
+  EXPECT_EQ(stderr_messages(k.err).size(), 1u);
+  const long long next = checkpoint_next(dir);
+  EXPECT_GT(next, 0);
+  EXPECT_LT(next, 30000);
+  ExpectInterruptedState(dir, {"features.csv", "features.npy", "scenarios.csv"});
+  // What is there is consistent: the partial CSV holds exactly the checkpointed rows.
+  EXPECT_EQ(static_cast<long long>(csv_rows(read_all(dir / "features.csv.partial")).size()), next);
+  EXPECT_EQ(static_cast<long long>(csv_rows(read_all(dir / "scenarios.csv.partial")).size()), next);
+
+  const RunResult r = run_ps(t, gen(plus(kLongSpec, {"--resume"}), dir));
+  ExpectOk(r);
+  ExpectSameTree(dir, ref);
+}
+
+TEST(GenerateResume, ImagesKillNineThenResumeMatchesAnUninterruptedRun) {
+  GenTempDir t;
+  const Args spec{"--count", "160", "--seed", "9", "--what", "both", "--rule", "gun", "--format", "csv", "--batch", "2",
+                  "--quiet"};
+  const fs::path dir = t.w() / "killed", ref = t.w() / "ref";
+  const Started reference = start_ps(t, gen(spec, ref));
+  const Started victim = start_ps(t, gen(spec, dir));
+  const bool progressed = wait_for_checkpoint(victim, dir, 1);
+  ::kill(victim.pid, SIGKILL);
+  const RunResult k = wait_for(victim);
+  ExpectOk(wait_for(reference));
+  ASSERT_TRUE(progressed) << describe_run(k);
+  ASSERT_TRUE(k.signaled) << "the run ended before it could be killed\n" << describe_run(k);
+  ExpectInterruptedState(dir, {"features.csv", "scenarios.csv"});
+  const RunResult r = run_ps(t, gen(plus(spec, {"--resume"}), dir));
+  ExpectOk(r);
+  ExpectSameTree(dir, ref);
+  EXPECT_EQ(entries_of(dir / "images").size(), 160u) << "no staging folders may be left";
+}
+
+// Makes DIR an interrupted run: starts kLongSpec and stops it with SIGINT as soon as its
+// checkpoint exists.
+void make_interrupted(const GenTempDir& t, const fs::path& dir) {
+  const Started s = start_ps(t, gen(kLongSpec, dir));
+  wait_for_checkpoint(s, dir, -1);
+  ::kill(s.pid, SIGINT);
+  const RunResult r = wait_for(s);
+  ASSERT_TRUE(r.exited && r.status == 130) << describe_run(r);
+}
+
+TEST(GenerateResume, DifferentSpecIsRefusedNamingWhatDiffers) {
+  GenTempDir t;
+  const fs::path dir = t.w() / "run";
+  ASSERT_NO_FATAL_FAILURE(make_interrupted(t, dir));
+  const auto before = snapshot(dir);
+  ASSERT_FALSE(before.empty());
+  struct Case {
+    Args change;
+    std::string names;
+  };
+  const std::vector<Case> cases{{{"--seed", "22"}, "seed"},
+                                {{"--count", "30001"}, "count"},
+                                {{"--block", "20"}, "block"},
+                                {{"--shard", "1/2"}, "shard"}};
+  for (const Case& c : cases) {
+    Args args = kLongSpec;
+    for (size_t i = 0; i + 1 < args.size(); ++i)
+      if (args[i] == c.change[0]) args.erase(args.begin() + static_cast<std::ptrdiff_t>(i), args.begin() + static_cast<std::ptrdiff_t>(i) + 2);
+    const RunResult r = run_ps(t, gen(plus(plus(args, c.change), {"--resume"}), dir));
+    SCOPED_TRACE(describe_run(r));
+    EXPECT_TRUE(r.exited && r.status != 0) << "resuming with a different spec must be refused";
+    EXPECT_EQ(stderr_messages(r.err).size(), 1u);
+    EXPECT_TRUE(has(r.err, "--resume"));
+    EXPECT_TRUE(has(r.err, c.names)) << "the message must name what differs: " << c.names;
+    EXPECT_TRUE(snapshot(dir) == before) << "a refused resume must leave the folder as it was";
+  }
+  // The folder is still good for the right spec.
+  ExpectOk(run_ps(t, gen(plus(kLongSpec, {"--resume"}), dir)));
+  EXPECT_TRUE(fs::exists(dir / "manifest.json"));
+}
+
+// A crash while a finished run renames its files into place (AppendFile::finish fsyncs each
+// file first, which can take seconds for a large table) leaves some final names, some .partial
+// files and the checkpoint. This builds exactly that state from a complete run: the checkpoint
+// the last batch wrote (next = end, every file's full size and hash), features.npy not yet
+// renamed, no manifest. --resume must finish the job.
+TEST(GenerateResume, CrashWhileFinishingIsResumable) {
+  GenTempDir t;
+  const Args spec{"--count", "50", "--seed", "6", "--format", "csv,npy", "--quiet"};
+  const fs::path ref = t.w() / "ref", dir = t.w() / "crashed", late = t.w() / "late";
+  ExpectOk(run_ps(t, gen(spec, ref)));
+  const json m = read_json(ref / "manifest.json");
+  ASSERT_TRUE(m.contains("outputs") && m.contains("classes")) << m.dump(1);
+  json checkpoint;
+  checkpoint["identity"] = {{"portalsim", m["portalsim"]}, {"catalogue", m["catalogue"]}, {"spec", m["spec"]},
+                            {"shard", m["shard"]}};
+  checkpoint["next"] = m["shard"]["end"];
+  checkpoint["positive"] = m["classes"]["positive"];
+  checkpoint["negative"] = m["classes"]["negative"];
+  checkpoint["files"] = json::array();
+  for (const json& o : m["outputs"])
+    checkpoint["files"].push_back({{"name", o["name"]},
+                                   {"bytes", o["bytes"]},
+                                   {"xxh3", std::stoull(o["xxh3_64"].get<std::string>(), nullptr, 16)}});
+  for (const fs::path& d : {dir, late}) {
+    fs::copy(ref, d, fs::copy_options::recursive);
+    fs::create_directory(d / ".portalsim");
+    write_all(d / ".portalsim" / "checkpoint.json", checkpoint.dump(1) + "\n");
+  }
+  // Crashed between renaming scenarios.csv and features.csv and renaming features.npy.
+  fs::rename(dir / "features.npy", dir / "features.npy.partial");
+  fs::remove(dir / "manifest.json");
+  // Crashed after writing the manifest, before removing the checkpoint.
+  for (const fs::path& d : {dir, late}) {
+    SCOPED_TRACE(d.filename().string());
+    const RunResult r = run_ps(t, gen(plus(spec, {"--resume"}), d));
+    ExpectOk(r);
+    fs::remove_all(d / ".portalsim");  // compare the data, whatever became of the checkpoint
+    ExpectSameTree(d, ref);
+  }
+}
+
+TEST(GenerateResume, ResumeIntoAFolderWithoutACheckpointSaysSo) {
+  GenTempDir t;
+  const fs::path dir = t.w() / "notes";
+  fs::create_directory(dir);
+  write_all(dir / "notes.txt", "mine\n");
+  const RunResult r = run_ps(t, gen({"--count", "5", "--resume", "--quiet"}, dir));
+  SCOPED_TRACE(describe_run(r));
+  EXPECT_TRUE(r.exited && r.status != 0);
+  EXPECT_EQ(stderr_messages(r.err).size(), 1u);
+  EXPECT_TRUE(has(r.err, dir.string()));
+  EXPECT_FALSE(has(r.err, "use --resume")) << "--resume was given; telling the user to use it does not help";
+  EXPECT_EQ(entries_of(dir), std::vector<std::string>{"notes.txt"});
+  EXPECT_EQ(read_all(dir / "notes.txt"), "mine\n");
+}
+
+// ---------------------------------------------------------------------------------------------
+// 6. Refusals: the output folder.
+
+TEST(GenerateOutput, NonEmptyFolderIsRefused) {
+  GenTempDir t;
+  const fs::path mine = t.w() / "mine", done = t.w() / "done";
+  fs::create_directory(mine);
+  write_all(mine / "notes.txt", "keep me\n");
+  ExpectOk(run_ps(t, gen({"--count", "5", "--quiet"}, done)));
+  for (const fs::path& d : {mine, done}) {
+    const auto before = snapshot(d);
+    const RunResult r = run_ps(t, gen({"--count", "5", "--quiet"}, d));
+    SCOPED_TRACE(describe_run(r));
+    EXPECT_TRUE(r.exited && r.status != 0);
+    EXPECT_EQ(stderr_messages(r.err).size(), 1u);
+    EXPECT_TRUE(has(r.err, d.string()));
+    EXPECT_TRUE(has(r.err, "not empty"));
+    EXPECT_TRUE(has(r.err, "--resume"));
+    EXPECT_EQ(r.out, "");
+    EXPECT_TRUE(snapshot(d) == before) << d << " must be left untouched";
+  }
+  // An existing empty folder is fine.
+  const fs::path empty = t.w() / "empty";
+  fs::create_directory(empty);
+  ExpectOk(run_ps(t, gen({"--count", "5", "--quiet"}, empty)));
+  EXPECT_TRUE(fs::exists(empty / "manifest.json"));
+}
+
+TEST(GenerateOutput, OutIsARegularFile) {
+  GenTempDir t;
+  const fs::path file = t.w() / "afile";
+  write_all(file, "keep me\n");
+  const RunResult r = run_ps(t, gen({"--count", "5", "--quiet"}, file));
+  SCOPED_TRACE(describe_run(r));
+  EXPECT_TRUE(r.exited && r.status != 0);
+  EXPECT_EQ(stderr_messages(r.err).size(), 1u);
+  EXPECT_TRUE(has(r.err, file.string()));
+  EXPECT_EQ(read_all(file), "keep me\n");
+  EXPECT_EQ(entries_of(t.w()), std::vector<std::string>{"afile"});
+}
+
+TEST(GenerateOutput, UnwritableLocationUnderARegularFile) {
+  GenTempDir t;
+  const fs::path file = t.w() / "afile";
+  write_all(file, "keep me\n");
+  const fs::path out = file / "sub" / "out";
+  const RunResult r = run_ps(t, gen({"--count", "5", "--quiet"}, out));
+  ExpectRefused(r, out, false, {out.string()});
+  EXPECT_EQ(read_all(file), "keep me\n");
+  EXPECT_EQ(entries_of(t.w()), std::vector<std::string>{"afile"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// 7. Bad specs.
+
+std::string at_line(const fs::path& file, int line) { return file.string() + ":" + std::to_string(line) + ":"; }
+
+TEST(GenerateBadSpec, SpecFileErrorsNameFileLineAndKey) {
+  GenTempDir t;
+  struct SpecCase {
+    std::string text;
+    int line;
+    std::vector<std::string> more;
+  };
+  const std::vector<SpecCase> specs{
+      {"count = 10\nseed = [1\n", 2, {"syntax"}},
+      {"count = 10\ncolour = \"red\"\n", 2, {"colour", "unknown key"}},
+      {"seed = 1\ncount = -5\n", 2, {"count", "-5"}},
+      {"count = \"x\"\n", 1, {"count"}},
+      {"count = 10\n\npixel_noise = nan\n", 3, {"pixel_noise"}},
+      {"count = 10\nobjects = \"5..2\"\n", 2, {"objects", "5..2"}},
+  };
+  std::vector<Refusal> cases;
+  for (size_t i = 0; i < specs.size(); ++i) {
+    const fs::path p = t.w() / ("spec" + std::to_string(i) + ".toml");
+    write_all(p, specs[i].text);
+    std::vector<std::string> needles{at_line(p, specs[i].line)};
+    needles.insert(needles.end(), specs[i].more.begin(), specs[i].more.end());
+    cases.push_back({{"--spec", p.string(), "--quiet"}, needles, i == 0});
+  }
+  cases.push_back({{"--spec", (t.w() / "missing.toml").string()}, {(t.w() / "missing.toml").string()}});
+  ExpectAllRefused(t, cases);
+}
+
+TEST(GenerateBadSpec, OptionErrorsNameTheOption) {
+  GenTempDir t;
+  ExpectAllRefused(
+      t, {
+             {{"--count", "5", "--objects", "3..20"}, {"--objects", "3..20"}, true},
+             {{"--count", "5", "--pool", "gun,laser"}, {"pool", "\"laser\""}},
+             {{"--count", "5", "--balance"}, {"balance", "--rule"}},
+             {{"--count", "5", "--balance", "--rule", "gun", "--pool", "iron-rod,metal-plate"}, {"balance", "gun"}, true},
+             {{"--count", "5", "--format", "xls"}, {"format", "xls"}},
+             {{"--count", "5", "--what", "pictures"}, {"what", "pictures"}},
+             {{"--count", "5", "--shard", "3/3"}, {"--shard", "3/3"}},
+             {{"--count", "5", "--shard", "x"}, {"--shard", "\"x\""}},
+             {{"--count", "5", "--subjects", "0"}, {"subjects", "0"}},
+             {{"--count", "0"}, {"count"}},
+             {{"--count", "5", "--rule", "gun|laser"}, {"rule", "laser"}},
+         });
+}
+
+// Values that are only checked after the spec file is read (the object pool, what, format,
+// subjects) must still point at the spec file's line, as the other spec errors do.
+TEST(GenerateBadSpec, SpecValuesCheckedLaterStillNameFileAndLine) {
+  GenTempDir t;
+  struct SpecCase {
+    std::string text;
+    int line;
+    std::vector<std::string> more;
+  };
+  const std::vector<SpecCase> specs{
+      {"count = 10\npool = [\"gun\", \"laser\"]\n", 2, {"pool", "laser"}},
+      {"count = 10\nwhat = \"pictures\"\n", 2, {"what", "pictures"}},
+      {"count = 10\nformat = \"xls\"\n", 2, {"format", "xls"}},
+      {"count = 10\nsubjects = [9]\n", 2, {"subjects", "9"}},
+  };
+  std::vector<Refusal> cases;
+  for (size_t i = 0; i < specs.size(); ++i) {
+    const fs::path p = t.w() / ("spec" + std::to_string(i) + ".toml");
+    write_all(p, specs[i].text);
+    std::vector<std::string> needles{at_line(p, specs[i].line)};
+    needles.insert(needles.end(), specs[i].more.begin(), specs[i].more.end());
+    cases.push_back({{"--spec", p.string(), "--quiet"}, needles});
+  }
+  ExpectAllRefused(t, cases);
+}
+
+const char* kScenarioHeader =
+    "subject,region1,region2,region3,region4,region5,region6,region7,region8,region9,region10,region11,region12,"
+    "region13,label\n";
+const char* kGunRow = "1,gun,none,none,none,none,none,none,none,none,none,none,none,none,yes\n";
+
+TEST(GenerateBadSpec, ScenarioFileErrorsNameFileLineAndColumn) {
+  GenTempDir t;
+  struct ListCase {
+    std::string text;
+    int line;
+    std::vector<std::string> more;
+  };
+  const std::vector<ListCase> lists{
+      {std::string(kScenarioHeader) + kGunRow + "2,none,laser,none,none,none,none,none,none,none,none,none,none,none,no\n",
+       3,
+       {"region2", "laser"}},
+      {"subject,region1,region2,region3,region4,region5,region6,region7,region8,region9,region10,region11,region12,"
+       "label\n" +
+           std::string(kGunRow),
+       1,
+       {"region13"}},
+      {std::string(kScenarioHeader) + kGunRow + "2,none,none,none,none,none,none,none,none,none,none,none,none,no\n",
+       3,
+       {"15", "14"}},
+      {std::string(kScenarioHeader) + kGunRow + "9,none,none,none,none,none,none,none,none,none,none,none,none,none,no\n",
+       3,
+       {"subject", "9"}},
+  };
+  std::vector<Refusal> cases;
+  for (size_t i = 0; i < lists.size(); ++i) {
+    const fs::path p = t.w() / ("list" + std::to_string(i) + ".csv");
+    write_all(p, lists[i].text);
+    std::vector<std::string> needles{at_line(p, lists[i].line)};
+    needles.insert(needles.end(), lists[i].more.begin(), lists[i].more.end());
+    cases.push_back({{"--scenarios", p.string(), "--quiet"}, needles, i == 0});
+  }
+  ExpectAllRefused(t, cases);
+
+  // The well-formed list runs, one row per scenario, the labels as given.
+  const fs::path good = t.w() / "good.csv";
+  write_all(good, std::string(kScenarioHeader) + kGunRow +
+                      "2,none,rod:v,none,none,none,none,none,none,none,none,none,none,plate,no\n");
+  const fs::path out = t.w() / "good-out";
+  ExpectOk(run_ps(t, gen({"--scenarios", good.string(), "--format", "csv", "--quiet"}, out)));
+  const std::vector<std::string> sc = csv_rows(read_all(out / "scenarios.csv"));
+  ASSERT_EQ(sc.size(), 2u);
+  EXPECT_EQ(sc[0], "0,1,gun:h,none,none,none,none,none,none,none,none,none,none,none,none,yes");
+  EXPECT_EQ(sc[1], "1,2,none,iron-rod:v,none,none,none,none,none,none,none,none,none,none,metal-plate,no");
+}
+
+// A balanced rule that the up-front check finds possible but that is too rare to draw for an
+// index: the run fails when it reaches that index. The failure must leave no half-written
+// data set behind (the folder was new), or the next attempt is refused as "not empty".
+TEST(GenerateBadSpec, TooRareBalancedRuleLeavesNoHalfWrittenFolder) {
+  GenTempDir t;
+  const fs::path out = t.w() / "rare";
+  const RunResult r = run_ps(t, gen({"--count", "10", "--seed", "1", "--balance", "--rule",
+                                     "gun:h&gun:v&iron-rod:h&iron-rod:v&pendant&belt-buckle", "--objects", "6..6",
+                                     "--quiet"},
+                                    out));
+  if (r.exited && r.status == 0) GTEST_SKIP() << "the rule was drawn after all; nothing to check";
+  ExpectRefused(r, out, false, {"balance"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// 8. `portalsim features` gives the same rows as generate.
+
+TEST(FeaturesCmd, RowsEqualGenerate) {
+  GenTempDir t;
+  const fs::path g = t.w() / "gen";
+  ExpectOk(run_ps(t, gen({"--count", "120", "--seed", "12", "--what", "both", "--format", "csv,arff,npy", "--rule",
+                          "gun", "--quiet"},
+                         g)));
+  const fs::path x = t.w() / "x";
+  fs::create_directory(x);
+  const std::vector<RunResult> r =
+      run_ps_all(t, {{"features", (g / "images").string(), "--out", (x / "X.csv").string()},
+                     {"features", (g / "images").string(), "--out", (x / "X.arff").string()},
+                     {"features", (g / "images").string(), "--out", (x / "X.npy").string()}});
+  for (const RunResult& y : r) ExpectOk(y);
+  EXPECT_TRUE(has(r[0].out, "120 rows")) << describe_run(r[0]);
+  const std::string gcsv = read_all(g / "features.csv");
+  const std::vector<std::string> rows = csv_rows(gcsv);
+  ASSERT_EQ(rows.size(), 120u);
+  EXPECT_EQ(lines_of(read_all(x / "X.csv")).at(0), lines_of(gcsv).at(0)) << "the CSV headers differ";
+  EXPECT_TRUE(csv_rows(read_all(x / "X.csv")) == rows) << "features X.csv rows differ from generate's";
+  EXPECT_TRUE(arff_rows(read_all(x / "X.arff")) == arff_rows(read_all(g / "features.arff")))
+      << "features X.arff rows differ from generate's";
+  EXPECT_TRUE(read_all(x / "X.npy") == read_all(g / "features.npy")) << "features X.npy differs from generate's";
+  EXPECT_EQ(read_all(x / "X.columns.txt"), read_all(g / "features.columns.txt"));
+  EXPECT_EQ(entries_of(x), (std::vector<std::string>{"X.arff", "X.columns.txt", "X.csv", "X.npy"}));
+  // Labels: scenarios.csv's yes/no, each folder's threat.txt and the table's class agree.
+  const std::vector<std::string> sc = csv_rows(read_all(g / "scenarios.csv"));
+  ASSERT_EQ(sc.size(), 120u);
+  int positives = 0;
+  for (size_t i = 0; i < 120; ++i) {
+    const bool yes = sc[i].size() > 4 && sc[i].compare(sc[i].size() - 4, 4, ",yes") == 0;
+    positives += yes;
+    const std::string cls = rows[i].substr(rows[i].rfind(',') + 1);
+    EXPECT_EQ(cls, yes ? "positive" : "negative") << "row " << i;
+    char name[16];
+    std::snprintf(name, sizeof name, "%08zu", i);
+    EXPECT_EQ(read_all(g / "images" / name / "threat.txt"), yes ? "yes\n" : "no\n") << name;
+  }
+  EXPECT_GT(positives, 0);
+}
+
+TEST(FeaturesCmd, SimulateFolderGivesItsOwnRow) {
+  GenTempDir t;
+  const fs::path sim = t.w() / "sim", out = t.w() / "row.csv";
+  ExpectOk(run_ps(t, {"simulate", "gun", "rod:v", "none", "plate", "--seed", "3", "--rule", "gun", "--out",
+                      sim.string()}));
+  ExpectOk(run_ps(t, {"features", sim.string(), "--out", out.string()}));
+  EXPECT_EQ(read_all(out), read_all(sim / "features.csv"));
+  EXPECT_EQ(csv_rows(read_all(out)).size(), 1u);
+}
+
+TEST(FeaturesCmd, BadInput) {
+  GenTempDir t;
+  const fs::path sim = t.w() / "sim";
+  ExpectOk(run_ps(t, {"simulate", "gun", "--out", sim.string()}));
+  const fs::path empty = t.w() / "empty", bad = t.w() / "bad", outs = t.w() / "outs";
+  fs::create_directory(empty);
+  fs::create_directory(empty / "sub");
+  write_all(empty / "sub" / "metal.txt", "200\n");
+  fs::copy(sim, bad / "a", fs::copy_options::recursive);
+  fs::copy(sim, bad / "b", fs::copy_options::recursive);
+  write_all(bad / "b" / "metal.txt", "200,200,200,200,200,200,200,200,200,200,200,200,200,200,200,200,200,200\n");
+  fs::create_directory(outs);
+  write_all(outs / "taken.csv", "keep me\n");
+  const std::vector<RunResult> r =
+      run_ps_all(t, {{"features", empty.string(), "--out", (outs / "e.csv").string()},
+                     {"features", bad.string(), "--out", (outs / "m.csv").string()},
+                     {"features", bad.string(), "--out", (outs / "m.npy").string()},
+                     {"features", sim.string(), "--out", (outs / "taken.csv").string()}});
+  const auto one_message = [](const RunResult& x, const std::vector<std::string>& needles) {
+    SCOPED_TRACE(describe_run(x));
+    EXPECT_TRUE(x.exited && x.status != 0);
+    EXPECT_FALSE(x.signaled);
+    EXPECT_EQ(stderr_messages(x.err).size(), 1u);
+    for (const std::string& n : needles) EXPECT_TRUE(has(x.err, n)) << "stderr does not name \"" << n << "\"";
+  };
+  one_message(r[0], {empty.string(), "no scenario folders"});
+  one_message(r[1], {(bad / "b" / "metal.txt").string() + ":1", "19"});
+  one_message(r[2], {(bad / "b" / "metal.txt").string() + ":1", "19"});
+  one_message(r[3], {(outs / "taken.csv").string(), "exists"});
+  EXPECT_EQ(read_all(outs / "taken.csv"), "keep me\n");
+  EXPECT_EQ(entries_of(outs), std::vector<std::string>{"taken.csv"}) << "no output, partial or columns file is left";
+}
+
+// ---------------------------------------------------------------------------------------------
+// 9. The thesis's experimental cases.
+
+fs::path case_spec(const std::string& name) { return fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / name; }
+
+TEST(GenerateThesisCases, Case1GunIsBalanced) {
+  const fs::path spec = case_spec("case1-gun.toml");
+  if (!fs::exists(spec)) GTEST_SKIP() << spec << " does not exist yet";
+  GenTempDir t;
+  const fs::path out = t.w() / "case1";
+  ExpectOk(run_ps(t, gen({"--spec", spec.string(), "--count", "200", "--quiet"}, out)));
+  const json m = read_json(out / "manifest.json");
+  EXPECT_EQ(m["count"], 200);
+  EXPECT_EQ(m["classes"]["positive"], m["classes"]["negative"]) << m.dump(1);
+  const std::vector<std::string> sc = csv_rows(read_all(out / "scenarios.csv"));
+  ASSERT_EQ(sc.size(), 200u);
+  for (const std::string& row : sc) {
+    const bool gun = has(row, ",gun");
+    EXPECT_EQ(row.substr(row.rfind(',') + 1), gun ? "yes" : "no") << row;
+  }
+}
+
+TEST(GenerateThesisCases, Case2RodAndPlateUsesItsPoolAndIsBalanced) {
+  const fs::path spec = case_spec("case2-rod-plate.toml");
+  if (!fs::exists(spec)) GTEST_SKIP() << spec << " does not exist yet";
+  GenTempDir t;
+  const fs::path out = t.w() / "case2";
+  ExpectOk(run_ps(t, gen({"--spec", spec.string(), "--count", "200", "--quiet"}, out)));
+  const json m = read_json(out / "manifest.json");
+  EXPECT_EQ(m["count"], 200);
+  EXPECT_EQ(m["classes"]["positive"], m["classes"]["negative"]) << m.dump(1);
+  const std::set<std::string> allowed{"metal-plate", "iron-rod:h",    "iron-rod:v",   "iron-rod", "compact-disk",
+                                      "cement-tile", "ceramic-plate", "mobile-phone", "none"};
+  const std::vector<std::string> sc = csv_rows(read_all(out / "scenarios.csv"));
+  ASSERT_EQ(sc.size(), 200u);
+  int positives = 0;
+  for (const std::string& row : sc) {
+    const std::vector<std::string> f = split_on(row, ',');
+    ASSERT_EQ(f.size(), 16u) << row;
+    bool rod = false, plate = false;
+    for (int k = 2; k < 15; ++k) {
+      EXPECT_TRUE(allowed.count(f[k])) << "object \"" << f[k] << "\" is not in case 2's set: " << row;
+      rod = rod || f[k].rfind("iron-rod", 0) == 0;
+      plate = plate || f[k] == "metal-plate";
+    }
+    if (f[15] == "yes") {
+      ++positives;
+      EXPECT_TRUE(rod && plate) << "a positive must hold both an iron rod and a metal plate: " << row;
+    } else {
+      EXPECT_EQ(f[15], "no") << row;
+      EXPECT_FALSE(rod && plate) << "a negative must not hold both: " << row;
+    }
+  }
+  EXPECT_EQ(positives, 100);
+}
+
+}  // namespace
