@@ -40,7 +40,7 @@ Plan plan_for(Path path, int block) {
       break;
     case kFeaturesDense:
       p.mmw_images = p.ir_image = false;
-      p.pooling = Pooling::dense;
+      p.fidelity.pooling = Pooling::dense;
       break;
     case kImages:
       p.features = false;

@@ -32,18 +32,9 @@ inline void composite_layers(Layers* L, global const short* objects, global cons
   }
 }
 
-// One layer over value v: v + a (s - v), a = alpha * coverage / 255.
-inline float blend(float v, uchar value, uchar coverage, float alpha) {
-  const float a = alpha * (float)coverage * (1.0f / 255.0f);
-  return fma(a, (float)value - v, v);
-}
-
-// Rounds a model value to its 8-bit pixel.
-inline uchar to_pixel(float v) { return (uchar)clamp(floor(v + 0.5f), 0.0f, 255.0f); }
-
 // The composited value of pixel x over `base`: each layer through blend(), in region order.
-inline float composite_pixel(const Layers* L, global const uchar* atlas, float base, int x, float alpha) {
-  float v = base;
+inline real composite_pixel(const Layers* L, global const uchar* atlas, real base, int x, float alpha) {
+  real v = base;
   for (int k = 0; k < L->count; ++k) {
     const int sx = x - L->x0[k];
     if (sx < 0 || sx >= L->width[k]) continue;

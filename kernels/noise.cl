@@ -30,19 +30,34 @@ inline void noise_tiles(Tiles* T, global const short* objects, global const int4
   }
 }
 
-inline float pattern_noise_pixel(const Tiles* T, global const uchar* atlas, int tile_size, float gain, int x) {
-  float n = 0.0f;
+// v with the pattern noise of every tile over pixel x added (tile values summed first).
+inline real pattern_noise(const Tiles* T, global const uchar* atlas, int tile_size, float gain, real v, int x) {
+  real n = real_zero();
   for (int k = 0; k < T->count; ++k) {
     const int tx = x - T->x0[k];
     if (tx < 0 || tx >= tile_size) continue;
-    n += (float)atlas[T->offset[k] + tx] - 128.0f;
+    n = noise_acc(n, atlas[T->offset[k] + tx]);
   }
-  return gain * n;
+  return add_noise(v, gain, n);
 }
 
-// Per-pixel sensor noise: one Philox draw feeds a Box-Muller pair (pixels 2k, 2k+1).
-inline float pixel_noise(uint2 seed, ulong index, int view, int p) {
-  const uint4 r = draw(seed, index, STREAM_PIXEL_NOISE, ((uint)view << 28) | ((uint)p >> 1));
-  const float2 g = gauss2(r.x, r.y);
-  return (p & 1) ? g.y : g.x;
+// Per-pixel sensor noise: one Philox draw feeds a Box-Muller pair (pixels 2k, 2k+1),
+// computed at the build's Gaussian precision.
+typedef struct {
+  int pair;  // pixel index / 2 of the cached pair, -1 for none
+  greal g[2];
+} GaussPair;
+
+inline greal pixel_noise(GaussPair* c, uint2 seed, ulong index, int view, int p) {
+  if (c->pair != (p >> 1)) {
+    c->pair = p >> 1;
+    const uint4 r = draw(seed, index, STREAM_PIXEL_NOISE, ((uint)view << 28) | ((uint)p >> 1));
+    const greal u1 = (greal)1 - (greal)(r.x >> 8) * ((greal)1 / (greal)16777216);
+    const greal u2 = (greal)(r.y >> 8) * ((greal)1 / (greal)16777216);
+    const greal rad = sqrt((greal)-2 * log(u1));
+    const greal th = (greal)6.283185307179586 * u2;
+    c->g[0] = rad * cos(th);
+    c->g[1] = rad * sin(th);
+  }
+  return c->g[p & 1];
 }

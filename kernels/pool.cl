@@ -88,17 +88,17 @@ kernel void base_features(global const uchar* atlas, global const int* bases, gl
 // wherever no other object reaches.
 inline uchar single_pixel(global const uchar* atlas, global const int* fp, uchar base, int x, int y, int W,
                           float alpha, int tile, int tile_offset, float gain, int use_noise) {
-  float v = (float)base;
+  real v = from_pixel(base);
   const int sx = x - fp[0], sy = y - fp[1];
   if (sx >= 0 && sy >= 0 && sx < fp[2] && sy < fp[3]) {
     const int o = fp[4] + (sy * fp[2] + sx) * 2;
     v = blend(v, atlas[o], atlas[o + 1], alpha);
   }
   if (use_noise) {
-    float n = 0.0f;
+    real n = real_zero();
     const int tx = x - fp[5], ty = y - fp[6];
-    if (tx >= 0 && ty >= 0 && tx < tile && ty < tile) n += (float)atlas[tile_offset + ty * tile + tx] - 128.0f;
-    v += gain * n;
+    if (tx >= 0 && ty >= 0 && tx < tile && ty < tile) n = noise_acc(n, atlas[tile_offset + ty * tile + tx]);
+    v = add_noise(v, gain, n);
   }
   return to_pixel(v);
 }
@@ -214,7 +214,7 @@ kernel void features_sparse(global const uchar* atlas, global const int* bases, 
                 earlier = in_rect(x, y, fp[a2]) && in_rect(x, y, fp[b2]);
             if (earlier) continue;
             const uchar bp = base[y * W + x];
-            float v = (float)bp, nsum = 0.0f;
+            real v = from_pixel(bp), nsum = real_zero();
             int singles = 0;
             for (int k = 0; k < cnt; ++k) {
               if (!in_rect(x, y, fp[k])) continue;
@@ -228,9 +228,9 @@ kernel void features_sparse(global const uchar* atlas, global const int* bases, 
             if (use_noise) {
               for (int k = 0; k < cnt; ++k) {
                 const int tx = x - fp[k][5], ty = y - fp[k][6];
-                if (tx >= 0 && ty >= 0 && tx < tile && ty < tile) nsum += (float)atlas[toff + ty * tile + tx] - 128.0f;
+                if (tx >= 0 && ty >= 0 && tx < tile && ty < tile) nsum = noise_acc(nsum, atlas[toff + ty * tile + tx]);
               }
-              v += gain * nsum;
+              v = add_noise(v, gain, nsum);
             }
             const int corr = (int)to_pixel(v) - (int)bp - singles;
             if (corr == 0) continue;
@@ -254,4 +254,35 @@ kernel void features_sparse(global const uchar* atlas, global const int* bases, 
       const int4 rc = rects[r];
       row[2 * per_view + r] = (float)(uint)reg[r] / (float)(rc.z * rc.w);
     }
+}
+
+#define STREAM_BLOCK_NOISE 4u
+
+// The block-mean noise model (tier "fast", features-only runs with pixel noise): rather
+// than drawing sigma * N(0,1) for every pixel, each mean over c pixels gets one draw of
+// N(0, sigma^2 / c), clipped to the pixel range. Rounding and clipping of single pixels
+// are not modelled; tradeoff measures what that costs. One work-item per scenario.
+kernel void analytic_noise(global float* features, global const int4* rects, uint n, int W, int H, int block,
+                           int bx_count, int by_count, int row_len, float sigma, uint2 seed, uint2 first) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= n) return;
+  const ulong index = upsample(first.y, first.x) + i;
+  const int per_view = bx_count * by_count;
+  global float* row = features + (size_t)i * row_len;
+  for (int f = 0; f < row_len; f += 2) {
+    const uint4 r = draw(seed, index, STREAM_BLOCK_NOISE, (uint)f);
+    const float2 g = gauss2(r.x, r.y);
+    for (int k = 0; k < 2 && f + k < row_len; ++k) {
+      const int q = f + k;
+      int count;
+      if (q < 2 * per_view) {
+        const int b = q % per_view;
+        count = block_count(b % bx_count, b / bx_count, block, W, H);
+      } else {
+        const int4 rc = rects[q - 2 * per_view];
+        count = rc.z * rc.w;
+      }
+      row[q] = clamp(row[q] + sigma * rsqrt((float)count) * (k ? g.y : g.x), 0.0f, 255.0f);
+    }
+  }
 }

@@ -51,10 +51,12 @@ kernel void render_view(global const uchar* atlas, global const int* bases, glob
   int x = 0;
   for (; x + 16 <= x0; x += 16) vstore16(vload16(0, base + x), 0, row + x);
   for (; x < x0; ++x) row[x] = base[x];
+  GaussPair gp;
+  gp.pair = -1;
   for (; x < x1; ++x) {
-    float v = composite_pixel(&L, atlas, (float)base[x], x, alpha);
-    v += pattern_noise_pixel(&T, atlas, tile_size, gain, x);
-    if (flags & FLAG_PIXEL_NOISE) v = fma(sigma, pixel_noise(seed, index, view, y * W + x), v);
+    real v = composite_pixel(&L, atlas, from_pixel(base[x]), x, alpha);
+    v = pattern_noise(&T, atlas, tile_size, gain, v, x);
+    if (flags & FLAG_PIXEL_NOISE) v = add_gauss(v, sigma, pixel_noise(&gp, seed, index, view, y * W + x));
     row[x] = to_pixel(v);
   }
   for (; x + 16 <= W; x += 16) vstore16(vload16(0, base + x), 0, row + x);

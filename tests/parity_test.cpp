@@ -242,7 +242,7 @@ TEST(SparseFeatures, EqualDenseToTheBit) {
       BatchOutput sparse, dense;
       ASSERT_TRUE(p.sparse_features());
       cl->run(test::batch_of(scenes, 3), p, sparse);
-      p.pooling = Pooling::dense;
+      p.fidelity.pooling = Pooling::dense;
       ASSERT_FALSE(p.sparse_features());
       cl->run(test::batch_of(scenes, 3), p, dense);
       ASSERT_EQ(sparse.features.size(), dense.features.size());

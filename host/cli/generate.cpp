@@ -21,7 +21,7 @@ struct GenerateOptions {
   RunSpec spec;
   std::string out, spec_file, objects, pool, subjects, formats, shard;
   std::string pattern_noise;
-  size_t batch = 0;
+  long long batch = 0;
   unsigned threads = 0;
   bool resume = false, quiet = false;
   CLI::App* app = nullptr;
@@ -45,11 +45,24 @@ int generate(GenerateOptions& o) {
   RunSpec spec;
   if (!o.spec_file.empty()) read_spec_file(o.spec_file, spec);
   // Flags given on the command line override the spec file.
-  const auto given = [&](const char* name) { return app.get_option(name)->count() > 0; };
+  const auto given = [&](const char* name) {
+    const bool g = app.get_option(name)->count() > 0;
+    if (g) {  // the flag overrides the spec file: errors name the flag
+      std::string key = std::string(name).substr(2);
+      for (char& c : key)
+        if (c == '-') c = '_';
+      spec.origin.erase(key);
+      if (key == "image_format") spec.origin.erase("image_format");
+    }
+    return g;
+  };
   if (given("--count")) spec.count = o.spec.count;
   if (given("--seed")) spec.seed = parse_u64(o.common.seed, "--seed");
   if (given("--rule")) spec.rule = o.spec.rule;
-  if (given("--pool")) spec.pool = split_list(o.pool);
+  if (given("--pool")) {
+    spec.pool = split_list(o.pool);
+    if (spec.pool.empty()) throw InputError("--pool: no object names given");
+  }
   if (given("--objects")) parse_object_range(o.objects, "--objects", spec);
   if (given("--subjects")) {
     spec.subjects.clear();
@@ -72,7 +85,7 @@ int generate(GenerateOptions& o) {
   if (o.out.empty()) throw InputError("--out: empty folder name");
 
   PipelineOptions popt;
-  popt.batch = o.batch;
+  popt.batch = static_cast<size_t>(std::max(0ll, o.batch));
   popt.threads = o.threads;
   popt.resume = o.resume;
   popt.progress = !o.quiet && ::isatty(STDERR_FILENO);
@@ -85,7 +98,8 @@ int generate(GenerateOptions& o) {
     if (popt.shards < 1 || popt.shard >= popt.shards)
       throw InputError("--shard: \"" + o.shard + "\" needs 0 <= i < k");
   }
-  if (o.batch > 1000000) throw InputError("--batch: at most 1000000");
+  if (app.get_option("--batch")->count() > 0 && (o.batch < 1 || o.batch > 1000000))
+    throw InputError("--batch: " + std::to_string(o.batch) + " is not between 1 and 1000000");
 
   Session s;
   open_catalogue(s, o.common);

@@ -15,6 +15,7 @@ int run(int argc, char** argv) {
   commands["catalogue"] = add_catalogue(app);
   commands["generate"] = add_generate(app);
   commands["features"] = add_features(app);
+  commands["tradeoff"] = add_tradeoff(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -25,12 +25,41 @@ std::vector<std::string> FeatureLayout::names() const {
   return n;
 }
 
+Fidelity tier_fidelity(Tier t) {
+  Fidelity f;
+  switch (t) {
+    case Tier::exact:
+      f.precision = Precision::fp64;
+      f.pooling = Pooling::dense;
+      break;
+    case Tier::standard:
+      break;
+    case Tier::fast:
+      f.precision = Precision::fixed16;
+      f.fast_math = true;
+      f.noise = NoiseModel::block_mean;
+      break;
+  }
+  return f;
+}
+
+Tier parse_tier(const std::string& name, const std::string& where) {
+  if (name == "fast") return Tier::fast;
+  if (name == "standard") return Tier::standard;
+  if (name == "exact") return Tier::exact;
+  throw InputError(where + ": \"" + name + "\" is not a tier (fast, standard, exact)");
+}
+
+const char* tier_name(Tier t) { return t == Tier::fast ? "fast" : t == Tier::exact ? "exact" : "standard"; }
+const char* precision_name(Precision p) {
+  return p == Precision::fp64 ? "fp64" : p == Precision::fixed16 ? "fixed16" : "fp32";
+}
+
 void validate(const Plan& plan, const Catalogue& cat) {
   const ModelSettings& m = plan.model;
-  const int side = std::max(cat.images.mmw_width, cat.images.mmw_height);
-  if (m.block < 1 || m.block > side)
-    throw InputError("--block: " + std::to_string(m.block) + " must be between 1 and the image side (" +
-                     std::to_string(side) + ")");
+  (void)cat;
+  if (m.block < 1 || m.block > 65536)
+    throw InputError("--block: " + std::to_string(m.block) + " must be between 1 and 65536 pixels");
   if (!std::isfinite(m.pixel_sigma) || m.pixel_sigma < 0 || m.pixel_sigma > 1000)
     throw InputError("--pixel-noise: must be a finite number between 0 and 1000 gray levels");
   if (m.metal_noise < 0 || m.metal_noise > 199)

@@ -21,6 +21,27 @@ struct ModelSettings {
 // How block and region means are computed. Both give the same numbers to the bit;
 // sparse is used for features-only runs without per-pixel noise, dense otherwise.
 enum class Pooling { sparse, dense };
+// The arithmetic of the kernels' pixel values.
+enum class Precision { fp32, fp64, fixed16 };
+// Per-pixel sensor noise, or (features-only runs) its effect on each mean drawn
+// directly: N(0, sigma^2 / pixels), ignoring rounding and clipping.
+enum class NoiseModel { per_pixel, block_mean };
+
+// The speed/accuracy knobs of the OpenCL backend (README, "Fidelity tiers"). None of
+// them changes what is modelled; each changes how closely the kernels follow the fp64
+// reference, and how fast.
+struct Fidelity {
+  Precision precision = Precision::fp32;
+  Pooling pooling = Pooling::sparse;
+  bool fast_math = false;  // -cl-fast-relaxed-math
+  NoiseModel noise = NoiseModel::per_pixel;
+};
+
+enum class Tier { fast, standard, exact };
+Fidelity tier_fidelity(Tier t);
+Tier parse_tier(const std::string& name, const std::string& where);
+const char* tier_name(Tier t);
+const char* precision_name(Precision p);
 
 struct Plan {
   bool mmw_images = true;  // materialise upper/lower images
@@ -28,11 +49,17 @@ struct Plan {
   bool metal = true;       // metal zones
   bool features = true;    // block and region means (needs the MMW views)
   ModelSettings model;
-  Pooling pooling = Pooling::sparse;
+  Fidelity fidelity;
 
-  // Features straight from precomputed tables, never materialising an image.
+  // Per-pixel noise drawn pixel by pixel (otherwise none, or the block-mean model).
+  bool pixel_noise_per_pixel() const {
+    return model.pixel_sigma > 0 && (mmw_images || ir_image || fidelity.noise == NoiseModel::per_pixel);
+  }
+  // Features straight from precomputed tables, never materialising an image. Block sums
+  // must stay exact in fp32 (255 * 256^2 < 2^24).
   bool sparse_features() const {
-    return features && !mmw_images && pooling == Pooling::sparse && model.pixel_sigma == 0;
+    return features && !mmw_images && fidelity.pooling == Pooling::sparse && !pixel_noise_per_pixel() &&
+           model.block <= 256;
   }
   bool renders_mmw() const { return mmw_images || features; }
 };

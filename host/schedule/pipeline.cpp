@@ -160,6 +160,12 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
   json checkpoint;
   bool resuming = false;
   if (fs::exists(out, ec) && !fs::is_directory(out, ec)) throw OutputError(dir + ": exists and is not a folder");
+  if (opt.resume && fs::exists(out / "manifest.json", ec)) {
+    // Complete; a crash after the manifest was written may have left the state folder.
+    fs::remove_all(state_dir, ec);
+    res.already_complete = true;
+    return res;
+  }
   if (opt.resume && fs::exists(checkpoint_path, ec)) {
     try {
       checkpoint = json::parse(read_file(checkpoint_path));
@@ -167,21 +173,49 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
       throw OutputError(checkpoint_path.string() + ": unreadable checkpoint: " + e.what());
     }
     if (checkpoint.value("identity", json()) != identity) {
-      std::string field = "the spec";
-      for (auto& [k, v] : identity.items())
-        if (checkpoint["identity"].value(k, json()) != v) field = k;
-      throw InputError("--resume: " + dir + " was made by a different run (its " + field +
-                       " differs); give the same spec, or another folder");
+      // Name the first differing entry, with both values.
+      std::string what = "identity";
+      const json was = checkpoint.value("identity", json::object());
+      for (const std::string k : {"spec", "catalogue", "shard", "portalsim"}) {  // the likeliest cause first
+        const json& v = identity[k];
+        const json old = was.value(k, json());
+        if (old == v) continue;
+        what = k + " (" + old.dump() + " there, " + v.dump() + " now)";
+        if (v.is_object() && old.is_object())
+          for (auto& [k2, v2] : v.items())
+            if (old.value(k2, json()) != v2) {
+              what = k + "." + k2 + " (" + old.value(k2, json()).dump() + " there, " + v2.dump() + " now)";
+              break;
+            }
+        break;
+      }
+      throw InputError("--resume: " + dir + " was made by a different run: " + what +
+                       "; give the same spec, or another folder");
     }
     resuming = true;
-  } else if (opt.resume && fs::exists(out / "manifest.json", ec)) {
-    res.already_complete = true;
-    return res;
+  } else if (opt.resume && fs::exists(out, ec) && !fs::is_empty(out, ec)) {
+    throw OutputError(dir + ": holds no interrupted run to resume (no .portalsim/checkpoint.json); "
+                      "choose a new folder");
   } else if (fs::exists(out, ec) && !fs::is_empty(out, ec)) {
     throw OutputError(dir + ": is not empty; use --resume to continue an interrupted run there, or choose a new folder");
   }
+  const bool created_dir = !fs::exists(out, ec);
   fs::create_directories(state_dir, ec);
   if (ec) throw OutputError(dir + ": cannot create the output folder: " + ec.message());
+  // A fresh run that fails before any batch is written leaves nothing behind.
+  struct Cleanup {
+    fs::path dir;
+    bool created, armed;
+    ~Cleanup() {
+      if (!armed) return;
+      std::error_code e;
+      if (created) {
+        fs::remove_all(dir, e);
+      } else {
+        for (const auto& entry : fs::directory_iterator(dir, e)) fs::remove_all(entry.path(), e);
+      }
+    }
+  } cleanup{out, created_dir, !resuming};
   if (::access(state_dir.c_str(), W_OK) != 0) throw OutputError(dir + ": the output folder is not writable");
 
   const uint64_t start = resuming ? checkpoint["next"].get<uint64_t>() : res.begin;
@@ -294,6 +328,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
     draw_progress(written - res.begin, res.end - res.begin, since(t0));
     std::fprintf(stderr, "\n");
   }
+  if (written > start || res.end == start) cleanup.armed = false;  // progress worth resuming
   if (compute_error) std::rethrow_exception(compute_error);
   if (writer_error) std::rethrow_exception(writer_error);
   res.done = written - start;

@@ -30,19 +30,19 @@ nlohmann::json RunSpec::to_json() const {
 
 void RunSpec::validate() const {
   if (scenarios.empty() && (count < 1 || count > (1ull << 40)))
-    throw InputError("count: must be between 1 and 2^40");
+    throw InputError(where("count") + ": " + std::to_string(count) + " is not between 1 and 2^40");
   if (what != "features" && what != "images" && what != "both")
-    throw InputError("what: \"" + what + "\" is not features, images or both");
-  if (wants_features() && formats.empty()) throw InputError("format: give at least one of arff, csv, npy");
+    throw InputError(where("what") + ": \"" + what + "\" is not features, images or both");
+  if (wants_features() && formats.empty()) throw InputError(where("format") + ": give at least one of arff, csv, npy");
   for (size_t i = 0; i < formats.size(); ++i) {
     if (formats[i] != "arff" && formats[i] != "csv" && formats[i] != "npy")
-      throw InputError("format: \"" + formats[i] + "\" is not arff, csv or npy");
+      throw InputError(where("format") + ": \"" + formats[i] + "\" is not arff, csv or npy");
     for (size_t j = 0; j < i; ++j)
-      if (formats[j] == formats[i]) throw InputError("format: \"" + formats[i] + "\" given twice");
+      if (formats[j] == formats[i]) throw InputError(where("format") + ": \"" + formats[i] + "\" given twice");
   }
   if (image_format != "png" && image_format != "jpg")
-    throw InputError("image_format: \"" + image_format + "\" is not png or jpg");
-  if (balance && rule.empty()) throw InputError("balance: needs a threat rule (--rule)");
+    throw InputError(where("image_format") + ": \"" + image_format + "\" is not png or jpg");
+  if (balance && rule.empty()) throw InputError(where("balance") + ": needs a threat rule (--rule)");
 }
 
 void parse_object_range(const std::string& text, const std::string& where, RunSpec& spec) {
@@ -107,6 +107,7 @@ void read_spec_file(const std::string& path, RunSpec& spec) {
   const std::string dir = std::filesystem::absolute(path).parent_path().string();
   for (const auto& [k, node] : t) {
     const std::string key(k.str());
+    spec.origin[key] = at(node, key);
     if (key == "count") {
       spec.count = static_cast<uint64_t>(integer(node, key, 1, 1ll << 40));
     } else if (key == "seed") {
@@ -169,14 +170,19 @@ GeneratorSpec generator_spec(const RunSpec& spec, const Catalogue& cat) {
   GeneratorSpec g;
   for (const std::string& name : spec.pool) {
     const int o = cat.find_object(name);
-    if (o < 0) throw InputError("pool: unknown object \"" + name + "\"");
+    if (o < 0) throw InputError(spec.where("pool") + ": unknown object \"" + name + "\"");
     for (int p : g.pool)
-      if (p == o) throw InputError("pool: \"" + name + "\" is listed twice");
+      if (p == o) throw InputError(spec.where("pool") + ": \"" + name + "\" is listed twice");
     g.pool.push_back(o);
   }
   g.min_objects = spec.min_objects;
   g.max_objects = spec.max_objects;
-  for (int s : spec.subjects) g.subjects.push_back(s - 1);
+  for (int s : spec.subjects) {
+    if (s < 1 || s > static_cast<int>(cat.subjects.size()))
+      throw InputError(spec.where("subjects") + ": " + std::to_string(s) + " is out of range (1 to " +
+                       std::to_string(cat.subjects.size()) + ")");
+    g.subjects.push_back(s - 1);
+  }
   g.rule = spec.rule;
   g.balance = spec.balance;
   return g;

@@ -3,6 +3,7 @@
 // never change the data.
 #pragma once
 #include <nlohmann/json.hpp>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,13 @@ struct RunSpec {
   std::vector<std::string> formats{"arff"};
   std::string image_format = "png";
   ModelSettings model;            // seed is copied from `seed`
+  // Where each key came from in a spec file ("spec.toml:3: pool"); keys given on the
+  // command line are named by their flag instead.
+  std::map<std::string, std::string> origin;
+  std::string where(const std::string& key) const {
+    auto it = origin.find(key);
+    return it != origin.end() ? it->second : "--" + key;
+  }
 
   bool wants_features() const { return what != "images"; }
   bool wants_images() const { return what != "features"; }

@@ -25,6 +25,10 @@ AppendFile::AppendFile(const std::string& dir, const std::string& name, const Fi
   if (!hash_) throw std::bad_alloc();
   XXH3_64bits_reset(state_of(hash_));
   if (resume) {
+    // A run that died while renaming its finished files: take the file back.
+    std::error_code ec;
+    if (!std::filesystem::exists(partial_, ec) && std::filesystem::exists(final_, ec))
+      std::filesystem::rename(final_, partial_, ec);
     fd_ = ::open(partial_.c_str(), O_RDWR | O_CLOEXEC);
     if (fd_ < 0) throw OutputError(partial_ + ": cannot resume: " + std::strerror(errno));
     const off_t size = ::lseek(fd_, 0, SEEK_END);

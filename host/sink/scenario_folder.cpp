@@ -35,7 +35,10 @@ void write_scenario_folder(const PathOf& path_of, const BatchOutput& b, size_t i
   if (!b.ir.empty()) write(path_of("ir" + ext), colourise(gray(b.ir_of(i), b.ir_width, b.ir_height), palette));
   if (!b.metal.empty()) {
     std::string m;
-    for (int z = 0; z < kZones; ++z) m += (z ? "," : "") + std::to_string(b.metal_of(i)[z]);
+    for (int z = 0; z < kZones; ++z) {
+      if (z) m.push_back(',');
+      m += std::to_string(b.metal_of(i)[z]);
+    }
     write_text_atomic(path_of("metal.txt"), m + "\n");
   }
   write_text_atomic(path_of("threat.txt"), threat ? "yes\n" : "no\n");

@@ -17,6 +17,8 @@ class StagedFolder {
 
   // Where to write `name` now; it reaches final_dir/name at commit().
   std::string path(const std::string& name);
+  // The staging folder itself (files written there without path() are dropped).
+  const std::string& dir() const { return staging_; }
   void commit();
 
  private:

@@ -90,13 +90,6 @@ class OpenCLBackend final : public Backend {
     influence_ = constant(ctx, influence);
     categories_ = constant(ctx, categories);
     base_zones_ = constant(ctx, base_zones);
-    render_ = cl::Kernel(rt_->program(), "render_view");
-    pool_blocks_ = cl::Kernel(rt_->program(), "pool_blocks");
-    pool_regions_ = cl::Kernel(rt_->program(), "pool_regions");
-    metal_ = cl::Kernel(rt_->program(), "metal_zones");
-    base_features_ = cl::Kernel(rt_->program(), "base_features");
-    footprint_deltas_ = cl::Kernel(rt_->program(), "footprint_deltas");
-    features_sparse_ = cl::Kernel(rt_->program(), "features_sparse");
   }
 
   std::string name() const override { return "opencl"; }
@@ -122,16 +115,17 @@ class OpenCLBackend final : public Backend {
 
     cl::Context& ctx = rt_->context();
     cl::CommandQueue& q = rt_->queue();
+    Kernels& K = kernels_for(plan.fidelity);
     cl::Buffer& subject = subject_.at_least(ctx, n);
     cl::Buffer& objects = objects_.at_least(ctx, n * kRegions * sizeof(int16_t));
     q.enqueueWriteBuffer(subject, CL_FALSE, 0, n, batch.subject.data());
     q.enqueueWriteBuffer(objects, CL_FALSE, 0, n * kRegions * sizeof(int16_t), batch.objects.data());
     const cl_uint2 seed = split(plan.model.seed), first = split(batch.first_index);
     const cl_uint count = static_cast<cl_uint>(n);
-    const cl_int flags = (plan.model.pattern_noise ? 1 : 0) | (plan.model.pixel_sigma > 0 ? 2 : 0);
+    const cl_int flags = (plan.model.pattern_noise ? 1 : 0) | (plan.pixel_noise_per_pixel() ? 2 : 0);
 
     auto render = [&](int view, cl::Buffer& dst, int W, int H) {
-      cl::Kernel& k = render_;
+      cl::Kernel& k = K.render;
       int a = 0;
       k.setArg(a++, atlas_);
       k.setArg(a++, bases_);
@@ -156,8 +150,9 @@ class OpenCLBackend final : public Backend {
       q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n * H)), cl::NDRange(kLocalSize));
     };
 
+    cl::Buffer& feats = features_.at_least(ctx, std::max<size_t>(1, n * row_len * sizeof(float)));
     if (plan.sparse_features()) {
-      sparse_features(plan, n, subject, objects, seed, first, out);
+      sparse_features(K, plan, n, subject, objects, seed, first, feats);
     } else if (plan.renders_mmw()) {
       // Images the caller keeps are written in place (no copy back on a CPU device);
       // images only pooled live in device buffers.
@@ -166,39 +161,41 @@ class OpenCLBackend final : public Backend {
       render(0, upper, ic.mmw_width, ic.mmw_height);
       render(1, lower, ic.mmw_width, ic.mmw_height);
       if (plan.features) {
-        cl::Buffer& feats = features_.at_least(ctx, n * row_len * sizeof(float));
         const FeatureLayout& f = out.layout;
         int a = 0;
-        pool_blocks_.setArg(a++, upper);
-        pool_blocks_.setArg(a++, lower);
-        pool_blocks_.setArg(a++, count);
-        pool_blocks_.setArg(a++, static_cast<cl_int>(ic.mmw_width));
-        pool_blocks_.setArg(a++, static_cast<cl_int>(ic.mmw_height));
-        pool_blocks_.setArg(a++, static_cast<cl_int>(f.block));
-        pool_blocks_.setArg(a++, static_cast<cl_int>(f.blocks_x));
-        pool_blocks_.setArg(a++, static_cast<cl_int>(f.blocks_y));
-        pool_blocks_.setArg(a++, static_cast<cl_int>(row_len));
-        pool_blocks_.setArg(a++, feats);
-        q.enqueueNDRangeKernel(pool_blocks_, cl::NullRange, cl::NDRange(padded(n * 2 * f.blocks_x * f.blocks_y)),
+        K.pool_blocks.setArg(a++, upper);
+        K.pool_blocks.setArg(a++, lower);
+        K.pool_blocks.setArg(a++, count);
+        K.pool_blocks.setArg(a++, static_cast<cl_int>(ic.mmw_width));
+        K.pool_blocks.setArg(a++, static_cast<cl_int>(ic.mmw_height));
+        K.pool_blocks.setArg(a++, static_cast<cl_int>(f.block));
+        K.pool_blocks.setArg(a++, static_cast<cl_int>(f.blocks_x));
+        K.pool_blocks.setArg(a++, static_cast<cl_int>(f.blocks_y));
+        K.pool_blocks.setArg(a++, static_cast<cl_int>(row_len));
+        K.pool_blocks.setArg(a++, feats);
+        q.enqueueNDRangeKernel(K.pool_blocks, cl::NullRange, cl::NDRange(padded(n * 2 * f.blocks_x * f.blocks_y)),
                                cl::NDRange(kLocalSize));
         a = 0;
-        pool_regions_.setArg(a++, upper);
-        pool_regions_.setArg(a++, lower);
-        pool_regions_.setArg(a++, count);
-        pool_regions_.setArg(a++, static_cast<cl_int>(ic.mmw_width));
-        pool_regions_.setArg(a++, static_cast<cl_int>(ic.mmw_height));
-        pool_regions_.setArg(a++, rects_);
-        pool_regions_.setArg(a++, static_cast<cl_int>(2 * f.blocks_x * f.blocks_y));
-        pool_regions_.setArg(a++, static_cast<cl_int>(row_len));
-        pool_regions_.setArg(a++, feats);
-        q.enqueueNDRangeKernel(pool_regions_, cl::NullRange, cl::NDRange(padded(n * kRegions)),
+        K.pool_regions.setArg(a++, upper);
+        K.pool_regions.setArg(a++, lower);
+        K.pool_regions.setArg(a++, count);
+        K.pool_regions.setArg(a++, static_cast<cl_int>(ic.mmw_width));
+        K.pool_regions.setArg(a++, static_cast<cl_int>(ic.mmw_height));
+        K.pool_regions.setArg(a++, rects_);
+        K.pool_regions.setArg(a++, static_cast<cl_int>(2 * f.blocks_x * f.blocks_y));
+        K.pool_regions.setArg(a++, static_cast<cl_int>(row_len));
+        K.pool_regions.setArg(a++, feats);
+        q.enqueueNDRangeKernel(K.pool_regions, cl::NullRange, cl::NDRange(padded(n * kRegions)),
                                cl::NDRange(kLocalSize));
-        q.enqueueReadBuffer(feats, CL_FALSE, 0, n * row_len * sizeof(float), out.features.data());
       }
       if (plan.mmw_images) {
         sync(upper, out.upper);
         sync(lower, out.lower);
       }
+    }
+    if (plan.features) {
+      if (plan.model.pixel_sigma > 0 && !plan.pixel_noise_per_pixel()) analytic_noise(K, plan, n, seed, first, feats);
+      q.enqueueReadBuffer(feats, CL_FALSE, 0, n * row_len * sizeof(float), out.features.data());
     }
     if (plan.ir_image) {
       cl::Buffer ir = wrap(out.ir);
@@ -208,17 +205,17 @@ class OpenCLBackend final : public Backend {
     if (plan.metal) {
       cl::Buffer& metal = metal_out_.at_least(ctx, n * kZones);
       int a = 0;
-      metal_.setArg(a++, influence_);
-      metal_.setArg(a++, categories_);
-      metal_.setArg(a++, base_zones_);
-      metal_.setArg(a++, subject);
-      metal_.setArg(a++, objects);
-      metal_.setArg(a++, count);
-      metal_.setArg(a++, seed);
-      metal_.setArg(a++, first);
-      metal_.setArg(a++, static_cast<cl_int>(plan.model.metal_noise));
-      metal_.setArg(a++, metal);
-      q.enqueueNDRangeKernel(metal_, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
+      K.metal.setArg(a++, influence_);
+      K.metal.setArg(a++, categories_);
+      K.metal.setArg(a++, base_zones_);
+      K.metal.setArg(a++, subject);
+      K.metal.setArg(a++, objects);
+      K.metal.setArg(a++, count);
+      K.metal.setArg(a++, seed);
+      K.metal.setArg(a++, first);
+      K.metal.setArg(a++, static_cast<cl_int>(plan.model.metal_noise));
+      K.metal.setArg(a++, metal);
+      q.enqueueNDRangeKernel(K.metal, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
       q.enqueueReadBuffer(metal, CL_FALSE, 0, n * kZones, out.metal.data());
     }
     q.finish();
@@ -236,15 +233,71 @@ class OpenCLBackend final : public Backend {
     rt_->queue().enqueueUnmapMemObject(b, p);
   }
 
-  // The tables of the sparse features path, built once per (block, pattern noise).
+  // The tables of the sparse features path, built once per (block, pattern noise) for
+  // each program variant.
   struct SparseTables {
     int block = -1;
     bool noise = false;
     int patterns = 1;
     cl::Buffer fps, deltas, region_deltas, base_sums, base_means;
   };
+  // The kernels of one program variant (precision, fast math).
+  struct Kernels {
+    cl::Kernel render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, features_sparse,
+        analytic_noise;
+    SparseTables tables;
+  };
 
-  void build_sparse_tables(const Plan& plan) {
+  static std::string build_options(const Fidelity& f) {
+    std::string o = f.precision == Precision::fp64      ? "-DPRECISION_FP64"
+                    : f.precision == Precision::fixed16 ? "-DPRECISION_FIXED"
+                                                        : "";
+    if (f.fast_math) o += " -cl-fast-relaxed-math";
+    return o;
+  }
+
+  Kernels& kernels_for(const Fidelity& f) {
+    const std::string options = build_options(f);
+    auto it = variants_.find(options);
+    if (it != variants_.end()) return it->second;
+    cl::Program& p = rt_->program(options);
+    Kernels k;
+    k.render = cl::Kernel(p, "render_view");
+    k.pool_blocks = cl::Kernel(p, "pool_blocks");
+    k.pool_regions = cl::Kernel(p, "pool_regions");
+    k.metal = cl::Kernel(p, "metal_zones");
+    k.base_features = cl::Kernel(p, "base_features");
+    k.footprint_deltas = cl::Kernel(p, "footprint_deltas");
+    k.features_sparse = cl::Kernel(p, "features_sparse");
+    k.analytic_noise = cl::Kernel(p, "analytic_noise");
+    return variants_.emplace(options, std::move(k)).first->second;
+  }
+
+  // Block-mean noise model: each mean gets N(0, sigma^2 / pixels) from the generator.
+  void analytic_noise(Kernels& K, const Plan& plan, size_t n, cl_uint2 seed, cl_uint2 first, cl::Buffer& feats) {
+    const ImagesConfig& ic = cat_.images;
+    const FeatureLayout lay = FeatureLayout::of(cat_, plan.model.block);
+    cl::Kernel& k = K.analytic_noise;
+    int a = 0;
+    k.setArg(a++, feats);
+    k.setArg(a++, rects_);
+    k.setArg(a++, static_cast<cl_uint>(n));
+    k.setArg(a++, static_cast<cl_int>(ic.mmw_width));
+    k.setArg(a++, static_cast<cl_int>(ic.mmw_height));
+    k.setArg(a++, static_cast<cl_int>(lay.block));
+    k.setArg(a++, static_cast<cl_int>(lay.blocks_x));
+    k.setArg(a++, static_cast<cl_int>(lay.blocks_y));
+    k.setArg(a++, static_cast<cl_int>(lay.image_features()));
+    k.setArg(a++, static_cast<cl_float>(plan.model.pixel_sigma));
+    k.setArg(a++, seed);
+    k.setArg(a++, first);
+    rt_->queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
+  }
+
+  void build_sparse_tables(Kernels& K, const Plan& plan) {
+    SparseTables& tables_ = K.tables;
+    cl::Kernel& base_features_ = K.base_features;
+    cl::Kernel& footprint_deltas_ = K.footprint_deltas;
     const ImagesConfig& ic = cat_.images;
     const int block = plan.model.block, W = ic.mmw_width, H = ic.mmw_height, N = ic.noise_size;
     const bool noise = plan.model.pattern_noise;
@@ -338,14 +391,14 @@ class OpenCLBackend final : public Backend {
     tables_.patterns = P;
   }
 
-  void sparse_features(const Plan& plan, size_t n, cl::Buffer& subject, cl::Buffer& objects, cl_uint2 seed,
-                       cl_uint2 first, BatchOutput& out) {
-    build_sparse_tables(plan);
+  void sparse_features(Kernels& K, const Plan& plan, size_t n, cl::Buffer& subject, cl::Buffer& objects,
+                       cl_uint2 seed, cl_uint2 first, cl::Buffer& feats) {
+    build_sparse_tables(K, plan);
+    const SparseTables& tables_ = K.tables;
     const ImagesConfig& ic = cat_.images;
-    const FeatureLayout& lay = out.layout;
+    const FeatureLayout lay = FeatureLayout::of(cat_, plan.model.block);
     const int row_len = lay.image_features();
-    cl::Buffer& feats = features_.at_least(rt_->context(), n * row_len * sizeof(float));
-    cl::Kernel& k = features_sparse_;
+    cl::Kernel& k = K.features_sparse;
     int a = 0;
     k.setArg(a++, atlas_);
     k.setArg(a++, bases_);
@@ -375,17 +428,15 @@ class OpenCLBackend final : public Backend {
     k.setArg(a++, static_cast<cl_int>(row_len));
     k.setArg(a++, feats);
     rt_->queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
-    rt_->queue().enqueueReadBuffer(feats, CL_FALSE, 0, n * row_len * sizeof(float), out.features.data());
   }
 
   const Catalogue& cat_;
   const AssetSet& assets_;
   std::shared_ptr<OpenCLRuntime> rt_;
   std::vector<cl_int> sprite_offsets_;
-  SparseTables tables_;
+  std::map<std::string, Kernels> variants_;
   cl::Buffer atlas_, bases_, sprites_, places_, noise_offsets_, noise_gains_, rects_, influence_, categories_,
       base_zones_;
-  cl::Kernel render_, pool_blocks_, pool_regions_, metal_, base_features_, footprint_deltas_, features_sparse_;
   Grown subject_, objects_, upper_, lower_, metal_out_, features_;
 };
 

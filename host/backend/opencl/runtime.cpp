@@ -7,13 +7,13 @@
 namespace portalsim {
 
 namespace embedded {
-extern const std::string_view kernel_philox, kernel_composite, kernel_noise, kernel_pool, kernel_metal,
+extern const std::string_view kernel_philox, kernel_precision, kernel_composite, kernel_noise, kernel_pool, kernel_metal,
     kernel_render;
 }
 
 std::string OpenCLRuntime::source() {
   std::string s;
-  for (std::string_view part : {embedded::kernel_philox, embedded::kernel_composite, embedded::kernel_noise,
+  for (std::string_view part : {embedded::kernel_philox, embedded::kernel_precision, embedded::kernel_composite, embedded::kernel_noise,
                                 embedded::kernel_pool, embedded::kernel_metal, embedded::kernel_render}) {
     s += part;
     s += "\n";
@@ -59,6 +59,24 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
     throw std::runtime_error("OpenCL program build failed:\n" + program_.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_));
   }
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  variants_[""] = program_;
+  base_options_ = options.build_options;
+}
+
+cl::Program& OpenCLRuntime::program(const std::string& options) {
+  auto it = variants_.find(options);
+  if (it != variants_.end()) return it->second;
+  if (options.find("PRECISION_FP64") != std::string::npos &&
+      device_.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") == std::string::npos)
+    throw std::runtime_error("the exact tier needs fp64, and " + device_name_ + " has no cl_khr_fp64");
+  cl::Program p(context_, source());
+  try {
+    p.build({device_}, ("-cl-std=CL1.2 " + base_options_ + " " + options).c_str());
+  } catch (const cl::Error&) {
+    throw std::runtime_error("OpenCL program build failed (" + options + "):\n" +
+                             p.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_));
+  }
+  return variants_.emplace(options, p).first->second;
 }
 
 }  // namespace portalsim

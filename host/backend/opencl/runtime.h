@@ -1,6 +1,7 @@
 // The OpenCL runtime: one device, context, queue and the built portalsim program.
 #pragma once
 #include <CL/opencl.hpp>
+#include <map>
 #include <string>
 
 namespace portalsim {
@@ -16,6 +17,9 @@ class OpenCLRuntime {
   cl::Context& context() { return context_; }
   cl::CommandQueue& queue() { return queue_; }
   cl::Program& program() { return program_; }
+  // The program built with extra options (e.g. "-DPRECISION_FP64 -cl-fast-relaxed-math"),
+  // built once and kept.
+  cl::Program& program(const std::string& options);
   const std::string& device_name() const { return device_name_; }
   double build_seconds() const { return build_seconds_; }
   static std::string source();  // the kernels/ files, concatenated in build order
@@ -25,7 +29,8 @@ class OpenCLRuntime {
   cl::Device device_;
   cl::CommandQueue queue_;
   cl::Program program_;
-  std::string device_name_;
+  std::map<std::string, cl::Program> variants_;
+  std::string device_name_, base_options_;
   double build_seconds_ = 0;
 };
 

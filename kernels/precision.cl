@@ -1,0 +1,52 @@
+// The arithmetic of a pixel value, chosen at build time (the fidelity tiers):
+//   default          fp32
+//   PRECISION_FP64   fp64, the reference's formulas (tier "exact")
+//   PRECISION_FIXED  8.8 fixed point in integers (tier "fast")
+// Every stage works through these helpers, so the dense and sparse paths of one build
+// round alike.
+
+#if defined(PRECISION_FP64)
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+typedef double real;
+typedef double greal;  // Gaussian draws
+inline real from_pixel(uchar b) { return (real)b; }
+// The reference's form: a s + (1 - a) v, a = alpha coverage / 255.
+inline real blend(real v, uchar value, uchar coverage, float alpha) {
+  const real a = (real)alpha * (real)coverage / 255.0;
+  return a * (real)value + (1.0 - a) * v;
+}
+inline real noise_acc(real n, uchar t) { return n + ((real)t - 128.0); }
+inline real add_noise(real v, float gain, real n) { return v + (real)gain * n; }
+inline real add_gauss(real v, float sigma, greal g) { return v + (real)sigma * g; }
+inline uchar to_pixel(real v) { return (uchar)clamp(floor(v + 0.5), 0.0, 255.0); }
+inline real real_zero(void) { return 0.0; }
+
+#elif defined(PRECISION_FIXED)
+typedef int real;  // value * 256
+typedef float greal;
+inline real from_pixel(uchar b) { return (int)b << 8; }
+inline real blend(real v, uchar value, uchar coverage, float alpha) {
+  const int a = (int)(alpha * (float)coverage * (256.0f / 255.0f) + 0.5f);  // 0..256
+  return v + ((a * (((int)value << 8) - v)) >> 8);
+}
+inline real noise_acc(real n, uchar t) { return n + ((int)t - 128); }
+inline real add_noise(real v, float gain, real n) { return v + (int)rint(gain * 256.0f) * n; }
+inline real add_gauss(real v, float sigma, float g) { return v + (int)rint(sigma * g * 256.0f); }
+inline uchar to_pixel(real v) { return (uchar)clamp((v + 128) >> 8, 0, 255); }
+inline real real_zero(void) { return 0; }
+
+#else
+typedef float real;
+typedef float greal;
+inline real from_pixel(uchar b) { return (float)b; }
+// v + a (s - v), a = alpha coverage / 255, one rounding in the fused multiply-add.
+inline real blend(real v, uchar value, uchar coverage, float alpha) {
+  const float a = alpha * (float)coverage * (1.0f / 255.0f);
+  return fma(a, (float)value - v, v);
+}
+inline real noise_acc(real n, uchar t) { return n + ((float)t - 128.0f); }
+inline real add_noise(real v, float gain, real n) { return v + gain * n; }
+inline real add_gauss(real v, float sigma, float g) { return fma(sigma, g, v); }
+inline uchar to_pixel(real v) { return (uchar)clamp(floor(v + 0.5f), 0.0f, 255.0f); }
+inline real real_zero(void) { return 0.0f; }
+#endif
