@@ -14,6 +14,8 @@ struct Fixture {
   Catalogue cat = default_catalogue();
   AssetSet assets = build_assets(cat);
   std::shared_ptr<OpenCLRuntime> rt = std::make_shared<OpenCLRuntime>();
+  // One compute unit: PoCL runs the kernels on a single thread.
+  std::shared_ptr<OpenCLRuntime> rt1 = std::make_shared<OpenCLRuntime>(OpenCLOptions{"", "", 1});
 };
 Fixture& fx() {
   static Fixture f;
@@ -52,9 +54,12 @@ Plan plan_for(Path path, int block) {
   return p;
 }
 
-void run(benchmark::State& state, Backend& backend, Path path) {
+void run(benchmark::State& state, Backend& backend, Path path, Tier tier = Tier::standard) {
   const size_t n = static_cast<size_t>(state.range(0));
-  const Plan plan = plan_for(path, static_cast<int>(state.range(1)));
+  Plan plan = plan_for(path, static_cast<int>(state.range(1)));
+  const Pooling pooling = plan.fidelity.pooling;
+  plan.fidelity = tier_fidelity(tier);
+  if (path == kFeaturesDense) plan.fidelity.pooling = pooling;
   const SceneBatch batch = make_batch(n);
   BatchOutput out;
   backend.run(batch, plan, out);  // warm: tables, work-group compilation
@@ -65,9 +70,17 @@ void run(benchmark::State& state, Backend& backend, Path path) {
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
 }
 
+// Args: batch size, block size, threads (PoCL compute units: 1 or all).
 void BM_OpenCL(benchmark::State& state, Path path) {
-  auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+  auto b = make_opencl_backend(fx().cat, fx().assets, state.range(2) == 1 ? fx().rt1 : fx().rt);
   run(state, *b, path);
+}
+// Args: batch size, block size, tier (0 fast, 1 standard, 2 exact).
+void BM_Tier(benchmark::State& state, Path path) {
+  auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+  const Tier t = state.range(2) == 0 ? Tier::fast : state.range(2) == 2 ? Tier::exact : Tier::standard;
+  state.SetLabel(tier_name(t));
+  run(state, *b, path, t);
 }
 void BM_Reference(benchmark::State& state, Path path) {
   auto b = make_reference_backend(fx().cat, fx().assets);
@@ -75,19 +88,30 @@ void BM_Reference(benchmark::State& state, Path path) {
 }
 
 BENCHMARK_CAPTURE(BM_OpenCL, features_sparse, kFeaturesSparse)
-    ->ArgsProduct({{1, 64, 1024, 4096, 16384, 65536}, {10}})
-    ->ArgsProduct({{16384}, {5, 20}})
+    ->ArgsProduct({{1, 64, 1024, 4096, 16384, 65536}, {10}, {2}})
+    ->ArgsProduct({{16384}, {5, 20}, {2}})
+    ->ArgsProduct({{16384}, {10}, {1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_OpenCL, features_dense, kFeaturesDense)
-    ->ArgsProduct({{1024}, {5, 10, 20}})
+    ->ArgsProduct({{1024}, {5, 10, 20}, {2}})
+    ->ArgsProduct({{1024}, {10}, {1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_OpenCL, images, kImages)->ArgsProduct({{1, 256, 1024}, {10}})->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_OpenCL, metal, kMetal)->ArgsProduct({{65536}, {10}})->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Reference, features, kFeaturesDense)->ArgsProduct({{64}, {10}})->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Reference, images, kImages)->ArgsProduct({{64}, {10}})->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Reference, metal, kMetal)->ArgsProduct({{65536}, {10}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_OpenCL, images, kImages)
+    ->ArgsProduct({{1, 256, 1024}, {10}, {2}})
+    ->ArgsProduct({{1024}, {10}, {1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_OpenCL, metal, kMetal)->ArgsProduct({{65536}, {10}, {1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Tier, features, kFeaturesSparse)
+    ->ArgsProduct({{16384}, {10}, {0, 1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Tier, images, kImages)->ArgsProduct({{1024}, {10}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Reference, features, kFeaturesDense)->ArgsProduct({{64}, {10}, {1}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Reference, images, kImages)->ArgsProduct({{64}, {10}, {1}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Reference, metal, kMetal)->ArgsProduct({{65536}, {10}, {1}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace portalsim

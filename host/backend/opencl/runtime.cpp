@@ -49,6 +49,20 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
     throw std::runtime_error(options.device.empty()
                                  ? "no OpenCL CPU device found (is pocl-opencl-icd installed?)"
                                  : "no OpenCL device matches \"" + options.device + "\"");
+  if (options.compute_units > 0) {
+    // Device fission: PoCL runs a sub-device's work on that many threads.
+    const cl_uint max_units = device_.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
+    if (options.compute_units < max_units) {
+      const cl_device_partition_property props[] = {CL_DEVICE_PARTITION_EQUALLY,
+                                                    static_cast<cl_device_partition_property>(options.compute_units), 0};
+      std::vector<cl::Device> subs;
+      if (device_.createSubDevices(props, &subs) != CL_SUCCESS || subs.empty())
+        throw std::runtime_error("cannot make a sub-device of " + std::to_string(options.compute_units) +
+                                 " compute units on " + device_name_);
+      device_ = subs[0];
+      device_name_ += " (" + std::to_string(options.compute_units) + " of " + std::to_string(max_units) + " units)";
+    }
+  }
   context_ = cl::Context(device_);
   queue_ = cl::CommandQueue(context_, device_);
   program_ = cl::Program(context_, source());
