@@ -23,6 +23,20 @@ void add_common_options(CLI::App& app, CommonOptions& o) {
   app.add_flag("--timing", o.timing, "print where the time went");
 }
 
+void add_fidelity_options(CLI::App& app, std::string& tier, std::map<std::string, std::string>& knobs) {
+  app.add_option("--tier", tier, "fidelity tier: fast, standard (default) or exact")
+      ->check(CLI::IsMember({"fast", "standard", "exact"}));
+  app.add_option("--precision", knobs["precision"], "kernel arithmetic: fp32, fp64 or fixed16 (overrides the tier)")
+      ->check(CLI::IsMember({"fp32", "fp64", "fixed16"}));
+  app.add_option("--pooling", knobs["pooling"], "features: sparse or dense (overrides the tier)")
+      ->check(CLI::IsMember({"sparse", "dense"}));
+  app.add_option("--fast-math", knobs["fast_math"], "-cl-fast-relaxed-math: on or off (overrides the tier)")
+      ->check(CLI::IsMember({"on", "off"}));
+  app.add_option("--noise-model", knobs["noise_model"],
+                 "pixel noise in features-only runs: per-pixel or block-mean (overrides the tier)")
+      ->check(CLI::IsMember({"per-pixel", "block-mean"}));
+}
+
 uint64_t parse_u64(const std::string& text, const std::string& field) {
   const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
   std::string digits = hex ? text.substr(2) : text;

@@ -21,6 +21,7 @@ struct GenerateOptions {
   RunSpec spec;
   std::string out, spec_file, objects, pool, subjects, formats, shard;
   std::string pattern_noise;
+  std::map<std::string, std::string> knobs;
   long long batch = 0;
   unsigned threads = 0;
   bool resume = false, quiet = false;
@@ -81,6 +82,14 @@ int generate(GenerateOptions& o) {
   if (given("--pixel-noise")) spec.model.pixel_sigma = o.spec.model.pixel_sigma;
   if (given("--metal-noise")) spec.model.metal_noise = o.spec.model.metal_noise;
   if (given("--scenarios")) spec.scenarios = o.spec.scenarios;
+  if (given("--tier")) spec.tier = o.spec.tier;
+  for (const char* knob : {"--precision", "--pooling", "--fast-math", "--noise-model"})
+    if (given(knob)) {
+      std::string key = knob + 2;
+      for (char& c : key)
+        if (c == '-') c = '_';
+      spec.knobs[key] = o.knobs[key];
+    }
   spec.validate();
   if (o.out.empty()) throw InputError("--out: empty folder name");
 
@@ -163,6 +172,7 @@ std::function<int()> add_generate(CLI::App& app) {
   sub->add_option("--pixel-noise", o->spec.model.pixel_sigma, "per-pixel Gaussian sensor noise sigma (default 0)");
   sub->add_option("--metal-noise", o->spec.model.metal_noise, "metal detector noise half-width (default 0)");
   sub->add_option("--scenarios", o->spec.scenarios, "explicit scenario list (CSV: subject, region1..13, label)");
+  add_fidelity_options(*sub, o->spec.tier, o->knobs);
   sub->add_option("--batch", o->batch, "scenarios per kernel launch (default: about 64 MiB of outputs)");
   sub->add_option("--threads", o->threads, "host threads for generating and writing (default: all cores)");
   sub->add_option("--shard", o->shard, "i/k: make only part i (0-based) of k of the index range");

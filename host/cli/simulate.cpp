@@ -19,6 +19,9 @@ struct SimulateOptions {
   std::vector<std::string> objects;
   ModelSettings model;
   std::string pattern_noise = "on";
+  std::string tier = "standard";
+  std::map<std::string, std::string> knobs;
+  CLI::App* app = nullptr;
 };
 
 int simulate(SimulateOptions& o) {
@@ -44,6 +47,13 @@ int simulate(SimulateOptions& o) {
   plan.model = o.model;
   plan.model.seed = parse_u64(o.common.seed, "--seed");
   plan.model.pattern_noise = o.pattern_noise == "on";
+  plan.fidelity = tier_fidelity(parse_tier(o.tier, "--tier"));
+  for (const auto& [k, v] : o.knobs) {
+    std::string flag = "--" + k;
+    for (char& c : flag)
+      if (c == '_') c = '-';
+    if (o.app->get_option(flag)->count() > 0) set_fidelity_knob(plan.fidelity, k, v, flag);
+  }
   validate(plan, cat);
 
   open_backend(s, o.common);
@@ -91,6 +101,8 @@ std::function<int()> add_simulate(CLI::App& app) {
       ->check(CLI::IsMember({"on", "off"}));
   sub->add_option("--pixel-noise", o->model.pixel_sigma, "per-pixel Gaussian sensor noise sigma, gray levels (default 0)");
   sub->add_option("--metal-noise", o->model.metal_noise, "metal detector noise half-width in counts (default 0: off)");
+  add_fidelity_options(*sub, o->tier, o->knobs);
+  o->app = sub;
   return [o] { return simulate(*o); };
 }
 

@@ -143,6 +143,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
   plan.ir_image = spec.wants_images();
   plan.model = spec.model;
   plan.model.seed = spec.seed;
+  plan.fidelity = spec.fidelity();
   validate(plan, cat);
   res.batch = opt.batch ? opt.batch : default_batch(plan, cat);
   const unsigned threads = opt.threads ? opt.threads : default_threads();

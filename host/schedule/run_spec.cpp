@@ -25,7 +25,20 @@ nlohmann::json RunSpec::to_json() const {
   j["pattern_noise"] = model.pattern_noise;
   j["pixel_noise"] = model.pixel_sigma;
   j["metal_noise"] = model.metal_noise;
+  // The fidelity changes the numbers (within its tier's tolerance), so it is part of
+  // the identity; pooling is not (sparse and dense agree to the bit).
+  const Fidelity f = fidelity();
+  j["tier"] = tier;
+  j["precision"] = precision_name(f.precision);
+  j["fast_math"] = f.fast_math;
+  j["noise_model"] = f.noise == NoiseModel::block_mean ? "block-mean" : "per-pixel";
   return j;
+}
+
+Fidelity RunSpec::fidelity() const {
+  Fidelity f = tier_fidelity(parse_tier(tier, where("tier")));
+  for (const auto& [k, v] : knobs) set_fidelity_knob(f, k, v, where(k));
+  return f;
 }
 
 void RunSpec::validate() const {
@@ -43,6 +56,7 @@ void RunSpec::validate() const {
   if (image_format != "png" && image_format != "jpg")
     throw InputError(where("image_format") + ": \"" + image_format + "\" is not png or jpg");
   if (balance && rule.empty()) throw InputError(where("balance") + ": needs a threat rule (--rule)");
+  (void)fidelity();  // checks the tier and knobs
 }
 
 void parse_object_range(const std::string& text, const std::string& where, RunSpec& spec) {
@@ -155,13 +169,20 @@ void read_spec_file(const std::string& path, RunSpec& spec) {
       spec.model.pixel_sigma = v;
     } else if (key == "metal_noise") {
       spec.model.metal_noise = static_cast<int>(integer(node, key, 0, 199));
+    } else if (key == "tier") {
+      spec.tier = string(node, key);
+    } else if (key == "precision" || key == "pooling" || key == "noise_model") {
+      spec.knobs[key] = string(node, key);
+    } else if (key == "fast_math") {
+      spec.knobs[key] = boolean(node, key) ? "on" : "off";
     } else if (key == "scenarios") {
       std::filesystem::path p(string(node, key));
       spec.scenarios = (p.is_relative() ? std::filesystem::path(dir) / p : p).string();
     } else {
       throw InputError(at(node, key) +
                        ": unknown key (count, seed, rule, pool, objects, subjects, balance, what, format, "
-                       "image_format, block, pattern_noise, pixel_noise, metal_noise, scenarios)");
+                       "image_format, block, pattern_noise, pixel_noise, metal_noise, scenarios, tier, precision, pooling, "
+                       "fast_math, noise_model)");
     }
   }
 }

@@ -25,6 +25,9 @@ struct RunSpec {
   std::vector<std::string> formats{"arff"};
   std::string image_format = "png";
   ModelSettings model;            // seed is copied from `seed`
+  std::string tier = "standard";  // fast | standard | exact; the knobs below override it
+  std::map<std::string, std::string> knobs;  // precision, pooling, fast_math, noise_model
+  Fidelity fidelity() const;
   // Where each key came from in a spec file ("spec.toml:3: pool"); keys given on the
   // command line are named by their flag instead.
   std::map<std::string, std::string> origin;
