@@ -15,6 +15,10 @@ inline real blend(real v, uchar value, uchar coverage, float alpha) {
   const real a = (real)alpha * (real)coverage / 255.0;
   return a * (real)value + (1.0 - a) * v;
 }
+// A sub-pixel layer: premultiplied value pv and coverage c (0..1) from bilinear sampling.
+inline real blend_frac(real v, greal pv, greal c, float alpha) {
+  return (1.0 - (real)alpha * c) * v + (real)alpha * pv;
+}
 inline real noise_acc(real n, uchar t) { return n + ((real)t - 128.0); }
 inline real add_noise(real v, float gain, real n) { return v + (real)gain * n; }
 inline real add_gauss(real v, float sigma, greal g) { return v + (real)sigma * g; }
@@ -28,6 +32,9 @@ inline real from_pixel(uchar b) { return (int)b << 8; }
 inline real blend(real v, uchar value, uchar coverage, float alpha) {
   const int a = (int)(alpha * (float)coverage * (256.0f / 255.0f) + 0.5f);  // 0..256
   return v + ((a * (((int)value << 8) - v)) >> 8);
+}
+inline real blend_frac(real v, greal pv, greal c, float alpha) {
+  return (int)rint((1.0f - alpha * c) * (float)v + alpha * pv * 256.0f);
 }
 inline real noise_acc(real n, uchar t) { return n + ((int)t - 128); }
 inline real add_noise(real v, float gain, real n) { return v + (int)rint(gain * 256.0f) * n; }
@@ -44,6 +51,7 @@ inline real blend(real v, uchar value, uchar coverage, float alpha) {
   const float a = alpha * (float)coverage * (1.0f / 255.0f);
   return fma(a, (float)value - v, v);
 }
+inline real blend_frac(real v, greal pv, greal c, float alpha) { return (1.0f - alpha * c) * v + alpha * pv; }
 inline real noise_acc(real n, uchar t) { return n + ((float)t - 128.0f); }
 inline real add_noise(real v, float gain, real n) { return v + gain * n; }
 inline real add_gauss(real v, float sigma, float g) { return fma(sigma, g, v); }

@@ -6,7 +6,7 @@ kernel void render_view(global const uchar* atlas, global const int* bases, glob
                         global const float* noise_gains, global const uchar* subject,
                         global const short* objects, uint n, int view, int W, int H, float alpha,
                         uint2 seed, uint2 first, int patterns, int tile_size, float sigma, int flags,
-                        global uchar* out) {
+                        int placement, float jx, float jy, global uchar* out) {
   const size_t gid = get_global_id(0);
   const uint i = (uint)(gid / (size_t)H);
   const int y = (int)(gid % (size_t)H);
@@ -20,7 +20,7 @@ kernel void render_view(global const uchar* atlas, global const int* bases, glob
   global uchar* row = out + ((size_t)i * H + y) * W;
 
   Layers L;
-  composite_layers(&L, objs, sprites, places, sensor, r_begin, r_end, y);
+  composite_layers(&L, objs, sprites, places, sensor, r_begin, r_end, y, placement, jx, jy, seed, index);
 
   Tiles T;
   T.count = 0;

@@ -10,6 +10,8 @@
 
 #include <cmath>
 
+#include "backend/compare.h"
+#include "plan/tolerance.h"
 #include "support.h"
 
 namespace portalsim {
@@ -252,6 +254,44 @@ TEST(SparseFeatures, EqualDenseToTheBit) {
       EXPECT_EQ(sparse.metal, dense.metal);
     }
   }
+}
+
+}  // namespace
+}  // namespace portalsim
+
+namespace portalsim {
+namespace {
+
+// Sprite placement with jitter, whole-pixel and sub-pixel (bilinear): kernels within the
+// standard tier's tolerance of the reference, and the sprites really move.
+TEST(Parity, PlacementJitterIntegerAndBilinear) {
+  std::vector<Scenario> scenes;
+  for (uint64_t k = 0; k < 150; ++k) scenes.push_back(test::random_scenario(test::catalogue(), k, 6));
+  auto cl = make_opencl_backend(test::catalogue(), test::assets(), test::runtime());
+  auto ref = make_reference_backend(test::catalogue(), test::assets());
+  BatchOutput still;
+  Plan p;
+  p.model.seed = 31;
+  cl->run(test::batch_of(scenes), p, still);
+  for (bool bilinear : {false, true}) {
+    p.model.bilinear = bilinear;
+    p.model.jitter = 4.5;
+    ASSERT_FALSE(p.sparse_features());
+    BatchOutput a, b;
+    cl->run(test::batch_of(scenes), p, a);
+    ref->run(test::batch_of(scenes), p, b);
+    const OutputDiff d = compare_outputs(a, b);
+    EXPECT_EQ(check_tolerance(d, tier_tolerance(Tier::standard)), "") << "bilinear " << bilinear;
+    EXPECT_NE(a.upper, still.upper) << "jitter must move the sprites";
+    EXPECT_EQ(a.metal, still.metal) << "placement does not touch the metal detector";
+  }
+  // Bilinear placement without jitter still samples between texels only at whole pixels:
+  // it equals integer placement to within a level.
+  p.model.jitter = 0;
+  p.model.bilinear = true;
+  BatchOutput c;
+  cl->run(test::batch_of(scenes), p, c);
+  EXPECT_LE(compare_outputs(c, still).mmw.max_abs, 1);
 }
 
 }  // namespace

@@ -22,6 +22,7 @@ struct GenerateOptions {
   std::string out, spec_file, objects, pool, subjects, formats, shard;
   std::string pattern_noise;
   std::map<std::string, std::string> knobs;
+  std::string placement = "integer";
   long long batch = 0;
   unsigned threads = 0;
   bool resume = false, quiet = false;
@@ -83,6 +84,8 @@ int generate(GenerateOptions& o) {
   if (given("--metal-noise")) spec.model.metal_noise = o.spec.model.metal_noise;
   if (given("--scenarios")) spec.scenarios = o.spec.scenarios;
   if (given("--tier")) spec.tier = o.spec.tier;
+  if (given("--placement")) spec.model.bilinear = o.placement == "bilinear";
+  if (given("--jitter")) spec.model.jitter = o.spec.model.jitter;
   for (const char* knob : {"--precision", "--pooling", "--fast-math", "--noise-model"})
     if (given(knob)) {
       std::string key = knob + 2;
@@ -173,6 +176,9 @@ std::function<int()> add_generate(CLI::App& app) {
   sub->add_option("--metal-noise", o->spec.model.metal_noise, "metal detector noise half-width (default 0)");
   sub->add_option("--scenarios", o->spec.scenarios, "explicit scenario list (CSV: subject, region1..13, label)");
   add_fidelity_options(*sub, o->spec.tier, o->knobs);
+  sub->add_option("--placement", o->placement, "sprite placement: integer (default) or bilinear (sub-pixel)")
+      ->check(CLI::IsMember({"integer", "bilinear"}));
+  sub->add_option("--jitter", o->spec.model.jitter, "move each object by up to this many pixels (default 0)");
   sub->add_option("--batch", o->batch, "scenarios per kernel launch (default: about 64 MiB of outputs)");
   sub->add_option("--threads", o->threads, "host threads for generating and writing (default: all cores)");
   sub->add_option("--shard", o->shard, "i/k: make only part i (0-based) of k of the index range");

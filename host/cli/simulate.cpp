@@ -21,6 +21,7 @@ struct SimulateOptions {
   std::string pattern_noise = "on";
   std::string tier = "standard";
   std::map<std::string, std::string> knobs;
+  std::string placement = "integer";
   CLI::App* app = nullptr;
 };
 
@@ -47,6 +48,7 @@ int simulate(SimulateOptions& o) {
   plan.model = o.model;
   plan.model.seed = parse_u64(o.common.seed, "--seed");
   plan.model.pattern_noise = o.pattern_noise == "on";
+  plan.model.bilinear = o.placement == "bilinear";
   plan.fidelity = tier_fidelity(parse_tier(o.tier, "--tier"));
   for (const auto& [k, v] : o.knobs) {
     std::string flag = "--" + k;
@@ -102,6 +104,9 @@ std::function<int()> add_simulate(CLI::App& app) {
   sub->add_option("--pixel-noise", o->model.pixel_sigma, "per-pixel Gaussian sensor noise sigma, gray levels (default 0)");
   sub->add_option("--metal-noise", o->model.metal_noise, "metal detector noise half-width in counts (default 0: off)");
   add_fidelity_options(*sub, o->tier, o->knobs);
+  sub->add_option("--placement", o->placement, "sprite placement: integer (default) or bilinear (sub-pixel)")
+      ->check(CLI::IsMember({"integer", "bilinear"}));
+  sub->add_option("--jitter", o->model.jitter, "move each object by up to this many pixels (default 0)");
   o->app = sub;
   return [o] { return simulate(*o); };
 }

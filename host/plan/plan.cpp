@@ -88,6 +88,8 @@ void validate(const Plan& plan, const Catalogue& cat) {
     throw InputError("--block: " + std::to_string(m.block) + " must be between 1 and 65536 pixels");
   if (!std::isfinite(m.pixel_sigma) || m.pixel_sigma < 0 || m.pixel_sigma > 1000)
     throw InputError("--pixel-noise: must be a finite number between 0 and 1000 gray levels");
+  if (!std::isfinite(m.jitter) || m.jitter < 0 || m.jitter > 1000)
+    throw InputError("--jitter: must be a finite number of pixels between 0 and 1000");
   if (m.metal_noise < 0 || m.metal_noise > 199)
     throw InputError("--metal-noise: must be between 0 and 199");
 }

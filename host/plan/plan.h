@@ -16,6 +16,12 @@ struct ModelSettings {
   double pixel_sigma = 0.0;   // per-pixel Gaussian sensor noise, gray levels (MMW and IR)
   int metal_noise = 0;        // detector noise: triangular integer noise, half-width in counts
   int block = 10;             // side of the averaged pixel blocks (thesis 5.6)
+  // Sprite placement: each object moves by jitter * (2u - 1) pixels in x and y (u from
+  // the counter generator), rounded to whole pixels, or kept sub-pixel with bilinear
+  // sampling. The noise tiles stay where the unmoved sprite would be.
+  bool bilinear = false;
+  double jitter = 0.0;
+  bool moves_sprites() const { return bilinear || jitter > 0; }
 };
 
 // How block and region means are computed. Both give the same numbers to the bit;
@@ -62,7 +68,7 @@ struct Plan {
   // must stay exact in fp32 (255 * 256^2 < 2^24).
   bool sparse_features() const {
     return features && !mmw_images && fidelity.pooling == Pooling::sparse && !pixel_noise_per_pixel() &&
-           model.block <= 256;
+           model.block <= 256 && !model.moves_sprites();
   }
   bool renders_mmw() const { return mmw_images || features; }
 };

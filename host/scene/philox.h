@@ -31,6 +31,8 @@ enum Stream : uint32_t {
   kStreamNoisePattern = 1,  // which MMW noise pattern a scenario gets
   kStreamMetalNoise = 2,    // metal detector noise, element = zone
   kStreamPixelNoise = 3,    // per-pixel sensor noise; element = view << 28 | pixel / 2
+  kStreamBlockNoise = 4,    // block-mean noise model (kernels only), element = feature
+  kStreamJitter = 5,        // sprite placement jitter, element = region
   kStreamGenerate = 16,     // scenario generators (generate command)
 };
 

@@ -25,6 +25,8 @@ nlohmann::json RunSpec::to_json() const {
   j["pattern_noise"] = model.pattern_noise;
   j["pixel_noise"] = model.pixel_sigma;
   j["metal_noise"] = model.metal_noise;
+  j["placement"] = model.bilinear ? "bilinear" : "integer";
+  j["jitter"] = model.jitter;
   // The fidelity changes the numbers (within its tier's tolerance), so it is part of
   // the identity; pooling is not (sparse and dense agree to the bit).
   const Fidelity f = fidelity();
@@ -169,6 +171,17 @@ void read_spec_file(const std::string& path, RunSpec& spec) {
       spec.model.pixel_sigma = v;
     } else if (key == "metal_noise") {
       spec.model.metal_noise = static_cast<int>(integer(node, key, 0, 199));
+    } else if (key == "placement") {
+      const std::string v = string(node, key);
+      if (v != "integer" && v != "bilinear") throw InputError(at(node, key) + ": \"" + v + "\" is not integer or bilinear");
+      spec.model.bilinear = v == "bilinear";
+    } else if (key == "jitter") {
+      double v = node.is_integer() ? static_cast<double>(node.as_integer()->get())
+                 : node.is_floating_point() ? node.as_floating_point()->get()
+                                            : throw InputError(at(node, key) + ": expected a number");
+      if (!std::isfinite(v) || v < 0 || v > 1000)
+        throw InputError(at(node, key) + ": must be a finite number of pixels between 0 and 1000");
+      spec.model.jitter = v;
     } else if (key == "tier") {
       spec.tier = string(node, key);
     } else if (key == "precision" || key == "pooling" || key == "noise_model") {
@@ -181,7 +194,7 @@ void read_spec_file(const std::string& path, RunSpec& spec) {
     } else {
       throw InputError(at(node, key) +
                        ": unknown key (count, seed, rule, pool, objects, subjects, balance, what, format, "
-                       "image_format, block, pattern_noise, pixel_noise, metal_noise, scenarios, tier, precision, pooling, "
+                       "image_format, block, pattern_noise, pixel_noise, metal_noise, scenarios, placement, jitter, tier, precision, pooling, "
                        "fast_math, noise_model)");
     }
   }

@@ -146,6 +146,12 @@ class OpenCLBackend final : public Backend {
       k.setArg(a++, static_cast<cl_int>(ic.noise_size));
       k.setArg(a++, static_cast<cl_float>(plan.model.pixel_sigma));
       k.setArg(a++, flags);
+      // Jitter in this view's pixels: the IR view is at its own scale.
+      const double sx = view == 2 ? double(ic.ir_width) / ic.mmw_width : 1.0;
+      const double sy = view == 2 ? double(ic.ir_height) / (2.0 * ic.mmw_height) : 1.0;
+      k.setArg(a++, static_cast<cl_int>(plan.model.bilinear ? 1 : 0));
+      k.setArg(a++, static_cast<cl_float>(plan.model.jitter * sx));
+      k.setArg(a++, static_cast<cl_float>(plan.model.jitter * sy));
       k.setArg(a++, dst);
       q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n * H)), cl::NDRange(kLocalSize));
     };

@@ -68,9 +68,12 @@ class ReferenceBackend final : public Backend {
 
     struct Placed {
       const Image* sprite;
-      int x0, y0;
+      int x0, y0;        // centred in the region: where the noise tile goes
+      double dx, dy;     // the placement jitter
     };
     std::vector<Placed> placed;
+    const double scale_x = view < 2 ? 1.0 : double(ic.ir_width) / ic.mmw_width;
+    const double scale_y = view < 2 ? 1.0 : double(ic.ir_height) / (2.0 * ic.mmw_height);
     for (int r = 0; r < kRegions; ++r) {
       const int16_t v = s.objects[r];
       if (v == kNoObject) continue;
@@ -80,19 +83,58 @@ class ReferenceBackend final : public Backend {
       const Rect& rect = view < 2 ? reg.mmw : reg.ir;
       const int x0 = rect.x + static_cast<int>(std::floor((rect.w - sp.width) / 2.0));
       const int y0 = rect.y + static_cast<int>(std::floor((rect.h - sp.height) / 2.0));
-      placed.push_back({&sp, x0, y0});
+      double dx = 0, dy = 0;
+      if (m.jitter > 0) {
+        const Philox4 q = draw(m.seed, index, kStreamJitter, static_cast<uint32_t>(r));
+        dx = m.jitter * scale_x * (2.0 * uniform24(q[0]) - 1.0);
+        dy = m.jitter * scale_y * (2.0 * uniform24(q[1]) - 1.0);
+      }
+      placed.push_back({&sp, x0, y0, dx, dy});
     }
 
     // Composite (thesis algorithm step 8): objects in region order over the base.
-    for (const Placed& p : placed)
-      for (int sy = 0; sy < p.sprite->height; ++sy)
-        for (int sx = 0; sx < p.sprite->width; ++sx) {
-          const int x = p.x0 + sx, y = p.y0 + sy;
-          if (x < 0 || y < 0 || x >= W || y >= H) continue;
-          const double a = ic.alpha * p.sprite->at(sx, sy, 1) / 255.0;
+    for (const Placed& p : placed) {
+      const Image& sp = *p.sprite;
+      if (!m.bilinear) {
+        const int ox = p.x0 + static_cast<int>(std::floor(p.dx + 0.5));
+        const int oy = p.y0 + static_cast<int>(std::floor(p.dy + 0.5));
+        for (int sy = 0; sy < sp.height; ++sy)
+          for (int sx = 0; sx < sp.width; ++sx) {
+            const int x = ox + sx, y = oy + sy;
+            if (x < 0 || y < 0 || x >= W || y >= H) continue;
+            const double a = ic.alpha * sp.at(sx, sy, 1) / 255.0;
+            double& v = value[y * W + x];
+            v = a * sp.at(sx, sy, 0) + (1.0 - a) * v;
+          }
+        continue;
+      }
+      // Sub-pixel: the sprite's premultiplied value and coverage, sampled bilinearly.
+      const double fx = p.x0 + p.dx, fy = p.y0 + p.dy;
+      const auto texel = [&](int i, int j, double& pv, double& c) {
+        if (i < 0 || j < 0 || i >= sp.width || j >= sp.height) return;
+        const double cov = sp.at(i, j, 1) / 255.0;
+        pv = cov * sp.at(i, j, 0);
+        c = cov;
+      };
+      for (int y = std::max(0, static_cast<int>(std::floor(fy)) - 1); y < std::min(H, static_cast<int>(fy) + sp.height + 2); ++y)
+        for (int x = std::max(0, static_cast<int>(std::floor(fx)) - 1); x < std::min(W, static_cast<int>(fx) + sp.width + 2); ++x) {
+          const double sx = x - fx, sy = y - fy;
+          const int i0 = static_cast<int>(std::floor(sx)), j0 = static_cast<int>(std::floor(sy));
+          const double tx = sx - i0, ty = sy - j0;
+          double pv = 0, c = 0;
+          for (int j = 0; j < 2; ++j)
+            for (int i = 0; i < 2; ++i) {
+              double tpv = 0, tc = 0;
+              texel(i0 + i, j0 + j, tpv, tc);
+              const double w = (i ? tx : 1 - tx) * (j ? ty : 1 - ty);
+              pv += w * tpv;
+              c += w * tc;
+            }
+          if (c == 0) continue;
           double& v = value[y * W + x];
-          v = a * p.sprite->at(sx, sy, 0) + (1.0 - a) * v;
+          v = (1.0 - ic.alpha * c) * v + ic.alpha * pv;
         }
+    }
 
     // Noise (thesis 4.2): the scenario's pattern, centred on every object in MMW views.
     if (view < 2 && m.pattern_noise && !placed.empty()) {
