@@ -28,6 +28,10 @@ struct BatchOutput {
   const float* features_of(size_t i) const { return features.data() + i * layout.image_features(); }
 };
 
+// Sizes `out` for n scenarios of `plan` (buffers kept for reuse): what each backend
+// fills in run().
+void prepare_output(BatchOutput& out, const Catalogue& cat, const Plan& plan, size_t n);
+
 class Backend {
  public:
   virtual ~Backend() = default;

@@ -29,19 +29,6 @@ struct GenerateOptions {
   CLI::App* app = nullptr;
 };
 
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : s + ",")
-    if (c == ',') {
-      if (!cur.empty()) out.push_back(cur);
-      cur.clear();
-    } else if (c != ' ') {
-      cur.push_back(c);
-    }
-  return out;
-}
-
 int generate(GenerateOptions& o) {
   CLI::App& app = *o.app;
   RunSpec spec;

@@ -61,6 +61,19 @@ void RunSpec::validate() const {
   (void)fidelity();  // checks the tier and knobs
 }
 
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : text + ",")
+    if (c == ',') {
+      if (!cur.empty()) out.push_back(cur);
+      cur.clear();
+    } else if (c != ' ') {
+      cur.push_back(c);
+    }
+  return out;
+}
+
 void parse_object_range(const std::string& text, const std::string& where, RunSpec& spec) {
   const auto number = [&](const std::string& s) {
     if (s.empty() || s.size() > 2 || s.find_first_not_of("0123456789") != std::string::npos)
@@ -100,17 +113,7 @@ void read_spec_file(const std::string& path, RunSpec& spec) {
   };
   const auto strings = [&](const toml::node& n, const std::string& key) {
     std::vector<std::string> out;
-    if (n.is_string()) {
-      std::string s = n.as_string()->get(), cur;
-      for (char c : s + ",")
-        if (c == ',') {
-          if (!cur.empty()) out.push_back(cur);
-          cur.clear();
-        } else if (c != ' ') {
-          cur.push_back(c);
-        }
-      return out;
-    }
+    if (n.is_string()) return split_list(n.as_string()->get());
     const toml::array* a = n.as_array();
     if (!a) throw InputError(at(n, key) + ": expected an array of strings");
     for (const toml::node& e : *a) out.push_back(string(e, key));

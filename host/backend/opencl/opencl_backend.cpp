@@ -97,20 +97,9 @@ class OpenCLBackend final : public Backend {
   void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) override {
     const ImagesConfig& ic = cat_.images;
     const size_t n = batch.size();
-    out.n = n;
-    out.mmw_width = ic.mmw_width;
-    out.mmw_height = ic.mmw_height;
-    out.ir_width = ic.ir_width;
-    out.ir_height = ic.ir_height;
-    out.layout = FeatureLayout::of(cat_, plan.model.block);
+    prepare_output(out, cat_, plan, n);
     const size_t mmw_px = static_cast<size_t>(ic.mmw_width) * ic.mmw_height;
-    const size_t ir_px = static_cast<size_t>(ic.ir_width) * ic.ir_height;
     const int row_len = out.layout.image_features();
-    out.upper.resize(plan.mmw_images ? n * mmw_px : 0);
-    out.lower.resize(plan.mmw_images ? n * mmw_px : 0);
-    out.ir.resize(plan.ir_image ? n * ir_px : 0);
-    out.metal.resize(plan.metal ? n * kZones : 0);
-    out.features.resize(plan.features ? n * row_len : 0);
     if (n == 0) return;
 
     cl::Context& ctx = rt_->context();
