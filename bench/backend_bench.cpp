@@ -103,15 +103,30 @@ BENCHMARK_CAPTURE(BM_OpenCL, images, kImages)
     ->ArgsProduct({{1024}, {10}, {1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_OpenCL, metal, kMetal)->ArgsProduct({{65536}, {10}, {1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_OpenCL, metal, kMetal)
+    ->ArgsProduct({{65536}, {10}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Tier, features, kFeaturesSparse)
     ->ArgsProduct({{16384}, {10}, {0, 1, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_Tier, images, kImages)->ArgsProduct({{1024}, {10}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Reference, features, kFeaturesDense)->ArgsProduct({{64}, {10}, {1}})->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Reference, images, kImages)->ArgsProduct({{64}, {10}, {1}})->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Reference, metal, kMetal)->ArgsProduct({{65536}, {10}, {1}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Tier, images, kImages)
+    ->ArgsProduct({{1024}, {10}, {0, 1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Reference, features, kFeaturesDense)
+    ->ArgsProduct({{64}, {10}, {1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Reference, images, kImages)
+    ->ArgsProduct({{64}, {10}, {1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Reference, metal, kMetal)
+    ->ArgsProduct({{65536}, {10}, {1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace portalsim

@@ -19,8 +19,8 @@ void BM_KernelBuild(benchmark::State& state) {
   cl::Program(rt.context(), OpenCLRuntime::source()).build(warm_options.c_str());  // fill the cache once
   for (auto _ : state) {
     // A fresh define changes the cache key: PoCL must compile.
-    const std::string options = cold ? "-DPORTALSIM_BENCH_NONCE=" + std::to_string(rd()) + std::to_string(rd())
-                                     : warm_options;
+    const std::string options =
+        cold ? "-DPORTALSIM_BENCH_NONCE=" + std::to_string(rd()) + std::to_string(rd()) : warm_options;
     cl::Program p(rt.context(), OpenCLRuntime::source());
     p.build(options.c_str());
     cl::Kernel k(p, "render_view");  // kernels exist: the build really finished

@@ -5,8 +5,8 @@
 
 #include <filesystem>
 
-#include "schedule/pipeline.h"
 #include "scene/generator.h"
+#include "schedule/pipeline.h"
 
 namespace portalsim {
 namespace {
@@ -27,7 +27,8 @@ void BM_Pipeline_features(benchmark::State& state) {
   const char* formats[] = {"npy", "csv", "arff"};
   spec.formats = {formats[state.range(1)]};
   state.SetLabel(spec.formats[0]);
-  const std::string dir = (std::filesystem::temp_directory_path() / ("portalsim-bench-" + std::to_string(::getpid()))).string();
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / ("portalsim-bench-" + std::to_string(::getpid()))).string();
   for (auto _ : state) {
     std::filesystem::remove_all(dir);
     PipelineOptions opt;
@@ -37,7 +38,12 @@ void BM_Pipeline_features(benchmark::State& state) {
   std::filesystem::remove_all(dir);
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * spec.count));
 }
-BENCHMARK(BM_Pipeline_features)->Args({200000, 0})->Args({50000, 1})->Args({50000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Pipeline_features)
+    ->Args({200000, 0})
+    ->Args({50000, 1})
+    ->Args({50000, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_Generator(benchmark::State& state) {
   GeneratorSpec gs;

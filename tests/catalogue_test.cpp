@@ -23,7 +23,7 @@ TEST(Catalogue, DefaultHoldsTheThesisInventory) {
   EXPECT_EQ(c.regions[2].name, "left-chest");
   EXPECT_EQ(c.regions[3].name, "right-abdomen");
   EXPECT_EQ(c.subjects[0].base_zones, (std::array<int, kZones>{200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200,
-                                                                200, 200, 200, 200, 200, 200, 200, 200}));
+                                                               200, 200, 200, 200, 200, 200, 200, 200}));
   // Gun and rod have horizontal and vertical drawings; the rest one.
   for (const Object& o : c.objects) {
     const bool two = o.name == "gun" || o.name == "iron-rod";

@@ -44,9 +44,9 @@ TEST_P(MetalBothBackends, ThesisIronPipeInLeftChest) {
 
 TEST_P(MetalBothBackends, ThesisMobileInLeftChestAndDiskInRightThigh) {
   auto b = backend();
-  EXPECT_EQ(
-      zones(*b, {"none", "none", "Mobile", "none", "none", "none", "compact-disk"}),
-      (std::vector<int>{200, 183, 165, 136, 137, 142, 193, 200, 200, 198, 199, 185, 185, 195, 176, 175, 190, 200, 200}));
+  EXPECT_EQ(zones(*b, {"none", "none", "Mobile", "none", "none", "none", "compact-disk"}),
+            (std::vector<int>{200, 183, 165, 136, 137, 142, 193, 200, 200, 198, 199, 185, 185, 195, 176, 175, 190, 200,
+                              200}));
 }
 
 TEST_P(MetalBothBackends, EmptyScenarioGivesTheSubjectsBase) {

@@ -75,8 +75,8 @@ Plan images_only(bool pattern, double sigma) {
 }
 
 void expect_images_within_one(const Outputs& o, const char* stage) {
-  for (auto [name, a, b] : {std::tuple{"upper", &o.ref.upper, &o.cl.upper}, std::tuple{"lower", &o.ref.lower, &o.cl.lower},
-                            std::tuple{"ir", &o.ref.ir, &o.cl.ir}}) {
+  for (auto [name, a, b] : {std::tuple{"upper", &o.ref.upper, &o.cl.upper},
+                            std::tuple{"lower", &o.ref.lower, &o.cl.lower}, std::tuple{"ir", &o.ref.ir, &o.cl.ir}}) {
     const Diff d = compare(*a, *b);
     EXPECT_LE(d.max_abs, 1) << stage << " " << name;
     // Ties are rare: fewer than 1 pixel in 1000 may round the other way.

@@ -1,12 +1,13 @@
 // The counter generator: published known-answer vectors, and the kernel copy
 // (kernels/philox.cl) bit-identical to the host copy (scene/philox.h).
+#include "scene/philox.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string_view>
 
 #include "backend/opencl/runtime.h"
-#include "scene/philox.h"
 
 namespace portalsim {
 namespace embedded {

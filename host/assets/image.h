@@ -18,9 +18,7 @@ struct Image {
 
   bool empty() const { return pixels.empty(); }
   uint8_t& at(int x, int y, int c = 0) { return pixels[(static_cast<std::size_t>(y) * width + x) * channels + c]; }
-  uint8_t at(int x, int y, int c = 0) const {
-    return pixels[(static_cast<std::size_t>(y) * width + x) * channels + c];
-  }
+  uint8_t at(int x, int y, int c = 0) const { return pixels[(static_cast<std::size_t>(y) * width + x) * channels + c]; }
 };
 
 }  // namespace portalsim

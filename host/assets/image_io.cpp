@@ -3,7 +3,6 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
-
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -78,8 +77,8 @@ Image read_image(const std::string& path, const std::string& origin) {
       const OIIO::ImageSpec& spec = in->spec();
       if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || spec.width > 16384 || spec.height > 16384 ||
           spec.nchannels > 16) {
-        error = "unsupported image dimensions " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                "x" + std::to_string(spec.nchannels);
+        error = "unsupported image dimensions " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + "x" +
+                std::to_string(spec.nchannels);
       } else {
         img = Image(spec.width, spec.height, spec.nchannels);
         const bool ok = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, img.pixels.data());

@@ -19,8 +19,8 @@ struct Body {
   double build = 1.0;   // torso/leg width scale, 0.8..1.2
   int mmw_level = 150;  // gray of the body in MMW (passive emission of skin)
   int mmw_background = 25;
-  int ir_core = 215;    // IR temperature index of the torso (warmest)
-  int ir_limb = 175;    // IR temperature index of the limbs and head edges
+  int ir_core = 215;  // IR temperature index of the torso (warmest)
+  int ir_limb = 175;  // IR temperature index of the limbs and head edges
   int ir_background = 35;
 };
 

@@ -19,7 +19,7 @@ struct BatchOutput {
   std::vector<uint8_t> ir;            // n * ir_height * ir_width, temperature index
   std::vector<uint8_t> metal;         // n * 19
   FeatureLayout layout;
-  std::vector<float> features;        // n * layout.image_features()
+  std::vector<float> features;  // n * layout.image_features()
 
   const uint8_t* upper_of(size_t i) const { return upper.data() + i * mmw_width * mmw_height; }
   const uint8_t* lower_of(size_t i) const { return lower.data() + i * mmw_width * mmw_height; }

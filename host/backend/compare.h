@@ -8,10 +8,10 @@
 namespace portalsim {
 
 struct ImageDiff {
-  int max_abs = 0;              // gray levels (IR: temperature index)
-  double rmse_mean = 0;         // mean over images of each image's RMSE
-  double rmse_max = 0;          // worst image's RMSE
-  double psnr = 0;              // over all pixels, dB (infinite when identical: reported as 999)
+  int max_abs = 0;       // gray levels (IR: temperature index)
+  double rmse_mean = 0;  // mean over images of each image's RMSE
+  double rmse_max = 0;   // worst image's RMSE
+  double psnr = 0;       // over all pixels, dB (infinite when identical: reported as 999)
   double share_off_by_more_than_1 = 0;
   double share_differing = 0;
   size_t pixels = 0;

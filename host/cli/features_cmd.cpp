@@ -83,7 +83,8 @@ int features(FeaturesOptions& o) {
 
 std::function<int()> add_features(CLI::App& app) {
   auto o = std::make_shared<FeaturesOptions>();
-  CLI::App* sub = app.add_subcommand("features", "turn scenario folders (simulated or real captures) into a feature table");
+  CLI::App* sub =
+      app.add_subcommand("features", "turn scenario folders (simulated or real captures) into a feature table");
   sub->add_option("folders", o->folders, "scenario folders, or folders holding them")->required();
   sub->add_option("--out", o->out, "output table: FILE.arff, FILE.csv or FILE.npy")->required();
   sub->add_option("--format", o->format, "arff, csv or npy (default: from --out's extension)");

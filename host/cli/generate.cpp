@@ -6,8 +6,8 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "schedule/pipeline.h"
 #include "scene/error.h"
+#include "schedule/pipeline.h"
 
 namespace portalsim::cli {
 
@@ -94,8 +94,7 @@ int generate(GenerateOptions& o) {
     if (slash == std::string::npos) throw InputError("--shard: \"" + o.shard + "\" is not i/k");
     popt.shard = parse_u64(o.shard.substr(0, slash), "--shard");
     popt.shards = parse_u64(o.shard.substr(slash + 1), "--shard");
-    if (popt.shards < 1 || popt.shard >= popt.shards)
-      throw InputError("--shard: \"" + o.shard + "\" needs 0 <= i < k");
+    if (popt.shards < 1 || popt.shard >= popt.shards) throw InputError("--shard: \"" + o.shard + "\" needs 0 <= i < k");
   }
   if (app.get_option("--batch")->count() > 0 && (o.batch < 1 || o.batch > 1000000))
     throw InputError("--batch: " + std::to_string(o.batch) + " is not between 1 and 1000000");
@@ -122,11 +121,12 @@ int generate(GenerateOptions& o) {
     return 0;
   }
   const double rate = r.seconds > 0 ? r.done / r.seconds : 0;
-  std::printf("%s: %llu scenarios [%llu, %llu) in %.2f s, %.0f scenarios/s (%s backend, batch %zu); "
-              "positive %llu, negative %llu\n",
-              o.out.c_str(), static_cast<unsigned long long>(r.done), static_cast<unsigned long long>(r.begin),
-              static_cast<unsigned long long>(r.end), r.seconds, rate, s.backend->name().c_str(), r.batch,
-              static_cast<unsigned long long>(r.positive), static_cast<unsigned long long>(r.negative));
+  std::printf(
+      "%s: %llu scenarios [%llu, %llu) in %.2f s, %.0f scenarios/s (%s backend, batch %zu); "
+      "positive %llu, negative %llu\n",
+      o.out.c_str(), static_cast<unsigned long long>(r.done), static_cast<unsigned long long>(r.begin),
+      static_cast<unsigned long long>(r.end), r.seconds, rate, s.backend->name().c_str(), r.batch,
+      static_cast<unsigned long long>(r.positive), static_cast<unsigned long long>(r.negative));
   if (o.common.timing)
     std::printf("timing: compute %.3f s (%.0f scenarios/s), waiting for the writer %.3f s%s\n", r.compute_seconds,
                 r.compute_seconds > 0 ? r.done / r.compute_seconds : 0.0, r.write_wait_seconds,

@@ -35,8 +35,8 @@ int simulate(SimulateOptions& o) {
   Scenario scene = parse_object_list(cat, o.objects);
   const int subjects = static_cast<int>(cat.subjects.size());
   if (o.subject < 1 || o.subject > subjects)
-    throw InputError("--subject: " + std::to_string(o.subject) + " is out of range (1 to " +
-                     std::to_string(subjects) + ")");
+    throw InputError("--subject: " + std::to_string(o.subject) + " is out of range (1 to " + std::to_string(subjects) +
+                     ")");
   scene.subject = o.subject - 1;
   if (!o.rule.empty() && !o.threat.empty()) throw InputError("--rule and --threat: give one or the other");
   if (!o.rule.empty())
@@ -69,7 +69,8 @@ int simulate(SimulateOptions& o) {
   const double run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_run).count();
 
   const auto t_write = std::chrono::steady_clock::now();
-  write_scenario_folder([&](const std::string& f) { return folder.path(f); }, out, 0, scene.label == 1, s.assets.palette, FolderOptions{o.image_format});
+  write_scenario_folder([&](const std::string& f) { return folder.path(f); }, out, 0, scene.label == 1,
+                        s.assets.palette, FolderOptions{o.image_format});
   folder.commit();
   const double write_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_write).count();
 
@@ -78,9 +79,10 @@ int simulate(SimulateOptions& o) {
   std::printf("\n");
   if (o.common.timing) {
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("timing: catalogue %.4f s, assets %.4f s, backend setup %.4f s", s.catalogue_seconds,
-                s.assets_seconds, s.backend_seconds);
-    if (s.runtime) std::printf(" (kernel build %.4f s on %s)", s.runtime->build_seconds(), s.runtime->device_name().c_str());
+    std::printf("timing: catalogue %.4f s, assets %.4f s, backend setup %.4f s", s.catalogue_seconds, s.assets_seconds,
+                s.backend_seconds);
+    if (s.runtime)
+      std::printf(" (kernel build %.4f s on %s)", s.runtime->build_seconds(), s.runtime->device_name().c_str());
     std::printf(", run %.4f s, write %.4f s, total %.4f s\n", run_seconds, write_seconds, total);
   }
   return 0;
@@ -101,7 +103,8 @@ std::function<int()> add_simulate(CLI::App& app) {
   sub->add_option("--block", o->model.block, "block side for the averaged features (default 10)");
   sub->add_option("--pattern-noise", o->pattern_noise, "the thesis's MMW noise patterns: on (default) or off")
       ->check(CLI::IsMember({"on", "off"}));
-  sub->add_option("--pixel-noise", o->model.pixel_sigma, "per-pixel Gaussian sensor noise sigma, gray levels (default 0)");
+  sub->add_option("--pixel-noise", o->model.pixel_sigma,
+                  "per-pixel Gaussian sensor noise sigma, gray levels (default 0)");
   sub->add_option("--metal-noise", o->model.metal_noise, "metal detector noise half-width in counts (default 0: off)");
   add_fidelity_options(*sub, o->tier, o->knobs);
   sub->add_option("--placement", o->placement, "sprite placement: integer (default) or bilinear (sub-pixel)")

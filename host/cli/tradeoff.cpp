@@ -191,10 +191,11 @@ int tradeoff(TradeoffOptions& o) {
       folder.path(arff);  // keep it
     }
     rows.push_back(r);
-    std::printf("  %-9s features %10.0f/s  images %8.0f/s  MMW max %d rmse %.4f  feature max %.4g  metal %.4f%s\n",
-                name.c_str(), feat_rate, img_rate, img_err.mmw.max_abs, img_err.mmw.rmse_mean,
-                feat_err.feature_max_abs, feat_err.metal_exact,
-                r["j48_accuracy"].is_null() ? "" : ("  J48 " + std::to_string(r["j48_accuracy"].get<double>())).c_str());
+    std::printf(
+        "  %-9s features %10.0f/s  images %8.0f/s  MMW max %d rmse %.4f  feature max %.4g  metal %.4f%s\n",
+        name.c_str(), feat_rate, img_rate, img_err.mmw.max_abs, img_err.mmw.rmse_mean, feat_err.feature_max_abs,
+        feat_err.metal_exact,
+        r["j48_accuracy"].is_null() ? "" : ("  J48 " + std::to_string(r["j48_accuracy"].get<double>())).c_str());
     std::fflush(stdout);
   };
   add_row("reference", nullptr, ref.rate, ref.rate, OutputDiff{}, OutputDiff{}, ref.out);

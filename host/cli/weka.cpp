@@ -18,8 +18,8 @@ std::optional<double> j48_cv_accuracy(const std::string& arff, std::string& why)
   std::string quoted = "'";
   for (char c : arff) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
   quoted += "'";
-  const std::string cmd = "java -Xmx4g -cp " + std::string(jar) + " weka.classifiers.trees.J48 -x 10 -o -t " +
-                          quoted + " 2>&1";
+  const std::string cmd =
+      "java -Xmx4g -cp " + std::string(jar) + " weka.classifiers.trees.J48 -x 10 -o -t " + quoted + " 2>&1";
   FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) {
     why = "cannot run java";

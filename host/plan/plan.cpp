@@ -55,22 +55,35 @@ void set_fidelity_knob(Fidelity& f, const std::string& knob, const std::string& 
     return InputError(where + ": \"" + value + "\" is not one of " + allowed);
   };
   if (knob == "precision") {
-    if (value == "fp32") f.precision = Precision::fp32;
-    else if (value == "fp64") f.precision = Precision::fp64;
-    else if (value == "fixed16") f.precision = Precision::fixed16;
-    else throw bad("fp32, fp64, fixed16");
+    if (value == "fp32")
+      f.precision = Precision::fp32;
+    else if (value == "fp64")
+      f.precision = Precision::fp64;
+    else if (value == "fixed16")
+      f.precision = Precision::fixed16;
+    else
+      throw bad("fp32, fp64, fixed16");
   } else if (knob == "pooling") {
-    if (value == "sparse") f.pooling = Pooling::sparse;
-    else if (value == "dense") f.pooling = Pooling::dense;
-    else throw bad("sparse, dense");
+    if (value == "sparse")
+      f.pooling = Pooling::sparse;
+    else if (value == "dense")
+      f.pooling = Pooling::dense;
+    else
+      throw bad("sparse, dense");
   } else if (knob == "fast_math") {
-    if (value == "on" || value == "true") f.fast_math = true;
-    else if (value == "off" || value == "false") f.fast_math = false;
-    else throw bad("on, off");
+    if (value == "on" || value == "true")
+      f.fast_math = true;
+    else if (value == "off" || value == "false")
+      f.fast_math = false;
+    else
+      throw bad("on, off");
   } else if (knob == "noise_model") {
-    if (value == "per-pixel") f.noise = NoiseModel::per_pixel;
-    else if (value == "block-mean") f.noise = NoiseModel::block_mean;
-    else throw bad("per-pixel, block-mean");
+    if (value == "per-pixel")
+      f.noise = NoiseModel::per_pixel;
+    else if (value == "block-mean")
+      f.noise = NoiseModel::block_mean;
+    else
+      throw bad("per-pixel, block-mean");
   } else {
     throw InputError(where + ": unknown fidelity knob \"" + knob + "\"");
   }
@@ -90,8 +103,7 @@ void validate(const Plan& plan, const Catalogue& cat) {
     throw InputError("--pixel-noise: must be a finite number between 0 and 1000 gray levels");
   if (!std::isfinite(m.jitter) || m.jitter < 0 || m.jitter > 1000)
     throw InputError("--jitter: must be a finite number of pixels between 0 and 1000");
-  if (m.metal_noise < 0 || m.metal_noise > 199)
-    throw InputError("--metal-noise: must be between 0 and 199");
+  if (m.metal_noise < 0 || m.metal_noise > 199) throw InputError("--metal-noise: must be between 0 and 199");
 }
 
 }  // namespace portalsim

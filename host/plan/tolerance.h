@@ -9,9 +9,9 @@
 namespace portalsim {
 
 struct Tolerance {
-  int pixel_max_abs;            // gray levels (MMW) and temperature index (IR)
-  double pixel_share_differing; // share of pixels that may differ at all
-  double feature_max_abs;       // without the block-mean noise model
+  int pixel_max_abs;             // gray levels (MMW) and temperature index (IR)
+  double pixel_share_differing;  // share of pixels that may differ at all
+  double feature_max_abs;        // without the block-mean noise model
   double feature_mean_abs;
   // Metal zones and labels are integers and match exactly in every tier.
 };
@@ -33,7 +33,8 @@ inline std::string check_tolerance(const OutputDiff& d, const Tolerance& t) {
   std::string why;
   for (auto [name, img] : {std::pair{"MMW", &d.mmw}, std::pair{"IR", &d.ir}}) {
     if (img->max_abs > t.pixel_max_abs)
-      why += std::string(name) + " max abs " + std::to_string(img->max_abs) + " > " + std::to_string(t.pixel_max_abs) + "; ";
+      why += std::string(name) + " max abs " + std::to_string(img->max_abs) + " > " + std::to_string(t.pixel_max_abs) +
+             "; ";
     if (img->share_differing > t.pixel_share_differing)
       why += std::string(name) + " share differing " + std::to_string(img->share_differing) + " > " +
              std::to_string(t.pixel_share_differing) + "; ";

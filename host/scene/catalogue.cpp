@@ -1,11 +1,12 @@
 #include "scene/catalogue.h"
 
+#include <toml++/toml.h>
+
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "assets/procedural.h"
 #include "scene/error.h"
@@ -41,8 +42,8 @@ struct Reader {
     if (!n->is_integer()) fail(n, field, "expected an integer");
     const long long v = n->as_integer()->get();
     if (v < lo || v > hi)
-      fail(n, field, "value " + std::to_string(v) + " is out of range [" + std::to_string(lo) + ", " +
-                         std::to_string(hi) + "]");
+      fail(n, field,
+           "value " + std::to_string(v) + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return v;
   }
   int integer(const toml::table& t, const std::string& key, const std::string& field, long long lo, long long hi,
@@ -90,8 +91,7 @@ struct Reader {
     return n->as_string()->get();
   }
 
-  std::vector<int> ints(const toml::node* n, const std::string& field, size_t count, long long lo,
-                        long long hi) const {
+  std::vector<int> ints(const toml::node* n, const std::string& field, size_t count, long long lo, long long hi) const {
     const toml::array* a = n->as_array();
     if (!a) fail(n, field, "expected an array of " + std::to_string(count) + " integers");
     if (a->size() != count)
@@ -109,8 +109,7 @@ struct Reader {
     const Rect r{v[0], v[1], v[2], v[3]};
     if (r.w < 1 || r.h < 1) fail(n, f, "width and height must be at least 1");
     if (r.x < 0 || r.y < 0 || r.x + r.w > view_w || r.y + r.h > view_h)
-      fail(n, f,
-           "rectangle lies outside the " + std::to_string(view_w) + "x" + std::to_string(view_h) + " view");
+      fail(n, f, "rectangle lies outside the " + std::to_string(view_w) + "x" + std::to_string(view_h) + " view");
     return r;
   }
 
@@ -227,8 +226,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     for (const auto& [key, node] : *inf) {
       bool known = false;
       for (const std::string& c : cat.metal_categories) known |= (c == key.str());
-      if (!known)
-        rd.fail(&node, "metal.influence." + std::string(key.str()), "not one of metal.categories");
+      if (!known) rd.fail(&node, "metal.influence." + std::string(key.str()), "not one of metal.categories");
     }
     for (const std::string& c : cat.metal_categories) {
       const std::string f = "metal.influence." + c;
@@ -238,8 +236,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
         rd.fail(rows_node, f, "expected " + std::to_string(kRegions) + " rows, one per region");
       std::array<std::array<int, kZones>, kRegions> table{};
       for (int r = 0; r < kRegions; ++r) {
-        const std::vector<int> v =
-            rd.ints(rows->get(r), f + "[region " + std::to_string(r + 1) + "]", kZones, 0, 199);
+        const std::vector<int> v = rd.ints(rows->get(r), f + "[region " + std::to_string(r + 1) + "]", kZones, 0, 199);
         std::copy(v.begin(), v.end(), table[r].begin());
       }
       cat.influence.push_back(table);
@@ -289,8 +286,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
       rd.fail(t.get("view"), f + ".view", "expected \"upper\" or \"lower\", got \"" + view + "\"");
     const bool must_upper = id <= kUpperRegions;
     if ((r.view == View::upper) != must_upper)
-      rd.fail(t.get("view"), f + ".view",
-              "regions 1-6 are in the upper view and 7-13 in the lower view (thesis 4.2)");
+      rd.fail(t.get("view"), f + ".view", "regions 1-6 are in the upper view and 7-13 in the lower view (thesis 4.2)");
     r.mmw = rd.rect(t, "mmw", f, ic.mmw_width, ic.mmw_height);
     r.ir = rd.rect(t, "ir", f, ic.ir_width, ic.ir_height);
   }
@@ -309,8 +305,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
       const toml::array* a = an->as_array();
       if (!a) rd.fail(an, f + ".aliases", "expected an array of strings");
       for (size_t k = 0; k < a->size(); ++k) {
-        if (!a->get(k)->is_string())
-          rd.fail(a->get(k), f + ".aliases[" + std::to_string(k) + "]", "expected a string");
+        if (!a->get(k)->is_string()) rd.fail(a->get(k), f + ".aliases[" + std::to_string(k) + "]", "expected a string");
         o.aliases.push_back(a->get(k)->as_string()->get());
       }
     }
@@ -351,16 +346,16 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     } else {
       codes.push_back("");
     }
-    const bool file_images = t.get("mmw") || t.get("ir") || t.get("mmw_h") || t.get("mmw_v") ||
-                             t.get("ir_h") || t.get("ir_v");
+    const bool file_images =
+        t.get("mmw") || t.get("ir") || t.get("mmw_h") || t.get("mmw_v") || t.get("ir_h") || t.get("ir_v");
     if (!procedural::is_shape(o.shape) && !file_images)
       rd.fail(t.get("shape"), f + ".shape", "unknown shape \"" + o.shape + "\" and no image files given");
     if (codes.size() > 1)
       for (const char* key : {"mmw", "ir"})
         if (t.get(key))
           rd.fail(t.get(key), f + "." + key,
-                  rd.image(t, key, f).path + ": this object has several drawings; name one file per drawing (" +
-                      key + "_h, " + key + "_v)");
+                  rd.image(t, key, f).path + ": this object has several drawings; name one file per drawing (" + key +
+                      "_h, " + key + "_v)");
     o.first_variant = static_cast<int>(cat.variant_list.size());
     for (size_t k = 0; k < codes.size(); ++k) {
       Variant v;

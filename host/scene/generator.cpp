@@ -123,9 +123,11 @@ std::vector<Scenario> read_scenario_file(const Catalogue& cat, const std::string
     else if (h.rfind("region", 0) == 0 && h.size() > 6 && h.size() <= 8 &&
              h.find_first_not_of("0123456789", 6) == std::string::npos) {
       const int r = std::stoi(h.substr(6));
-      if (r >= 1 && r <= kRegions) col_region[r - 1] = static_cast<int>(c);
-      else throw InputError(path + ":" + std::to_string(lineno) + ": column " + std::to_string(c + 1) + " \"" +
-                            header[c] + "\": there are regions 1 to 13 only");
+      if (r >= 1 && r <= kRegions)
+        col_region[r - 1] = static_cast<int>(c);
+      else
+        throw InputError(path + ":" + std::to_string(lineno) + ": column " + std::to_string(c + 1) + " \"" + header[c] +
+                         "\": there are regions 1 to 13 only");
     } else if (h == "index") {
     } else {
       throw InputError(path + ":" + std::to_string(lineno) + ": column " + std::to_string(c + 1) + " \"" + header[c] +

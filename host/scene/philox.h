@@ -44,8 +44,6 @@ inline Philox4 draw(uint64_t seed, uint64_t index, uint32_t stream, uint32_t ele
 // Uniform in [0, 1) with 24 bits: exact in float and in double, so both backends agree.
 inline double uniform24(uint32_t r) { return static_cast<double>(r >> 8) * (1.0 / 16777216.0); }
 // Uniform integer in [0, n) without division: the high word of r * n.
-inline uint32_t below(uint32_t r, uint32_t n) {
-  return static_cast<uint32_t>((static_cast<uint64_t>(r) * n) >> 32);
-}
+inline uint32_t below(uint32_t r, uint32_t n) { return static_cast<uint32_t>((static_cast<uint64_t>(r) * n) >> 32); }
 
 }  // namespace portalsim

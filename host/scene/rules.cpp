@@ -82,8 +82,8 @@ ThreatRule::ThreatRule(const Catalogue& cat, const std::string& text, const std:
     }
     p.skip();
     const size_t start = p.pos;
-    while (p.pos < text.size() && (std::isalnum(static_cast<unsigned char>(text[p.pos])) ||
-                                   text[p.pos] == '-' || text[p.pos] == '_' || text[p.pos] == ':'))
+    while (p.pos < text.size() && (std::isalnum(static_cast<unsigned char>(text[p.pos])) || text[p.pos] == '-' ||
+                                   text[p.pos] == '_' || text[p.pos] == ':'))
       ++p.pos;
     if (p.pos == start) p.fail("expected an object name");
     const std::string token = text.substr(start, p.pos - start);

@@ -30,8 +30,8 @@ int16_t parse_object_token(const Catalogue& cat, const std::string& token, const
   std::string known;
   for (const Variant& v : o.variants)
     if (!v.code.empty()) known += (known.empty() ? "" : ", ") + v.code;
-  throw InputError(where + ": object " + o.name + " has no orientation \"" + token.substr(token.find(':') + 1) +
-                   "\"" + (known.empty() ? " (it has a single drawing)" : " (it has: " + known + ")"));
+  throw InputError(where + ": object " + o.name + " has no orientation \"" + token.substr(token.find(':') + 1) + "\"" +
+                   (known.empty() ? " (it has a single drawing)" : " (it has: " + known + ")"));
 }
 
 Scenario parse_object_list(const Catalogue& cat, const std::vector<std::string>& tokens) {
@@ -40,8 +40,8 @@ Scenario parse_object_list(const Catalogue& cat, const std::vector<std::string>&
                      std::to_string(kRegions) + " regions (one object per region, \"none\" for empty)");
   Scenario s;
   for (size_t i = 0; i < tokens.size(); ++i)
-    s.objects[i] = parse_object_token(cat, tokens[i], "object " + std::to_string(i + 1) + " (region " +
-                                                          std::to_string(i + 1) + ")");
+    s.objects[i] = parse_object_token(cat, tokens[i],
+                                      "object " + std::to_string(i + 1) + " (region " + std::to_string(i + 1) + ")");
   return s;
 }
 

@@ -12,9 +12,9 @@ namespace portalsim {
 constexpr int16_t kNoObject = -1;
 
 struct Scenario {
-  int subject = 0;                         // 0-based
-  std::array<int16_t, kRegions> objects;   // variant id per region, kNoObject for none
-  int label = 0;                           // 1 threat, 0 not
+  int subject = 0;                        // 0-based
+  std::array<int16_t, kRegions> objects;  // variant id per region, kNoObject for none
+  int label = 0;                          // 1 threat, 0 not
   Scenario() { objects.fill(kNoObject); }
 };
 
@@ -22,9 +22,9 @@ struct Scenario {
 // position in the batch, feeds the random generator, so results never depend on batching.
 struct SceneBatch {
   uint64_t first_index = 0;
-  std::vector<uint8_t> subject;   // n
-  std::vector<int16_t> objects;   // n * 13, region-major within a scenario
-  std::vector<uint8_t> label;     // n
+  std::vector<uint8_t> subject;  // n
+  std::vector<int16_t> objects;  // n * 13, region-major within a scenario
+  std::vector<uint8_t> label;    // n
 
   size_t size() const { return subject.size(); }
   void clear() {

@@ -11,8 +11,8 @@
 #include <optional>
 #include <thread>
 
-#include "schedule/parallel.h"
 #include "scene/error.h"
+#include "schedule/parallel.h"
 #include "sink/sinks.h"
 #include "sink/staging.h"
 
@@ -195,10 +195,12 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
     }
     resuming = true;
   } else if (opt.resume && fs::exists(out, ec) && !fs::is_empty(out, ec)) {
-    throw OutputError(dir + ": holds no interrupted run to resume (no .portalsim/checkpoint.json); "
+    throw OutputError(dir +
+                      ": holds no interrupted run to resume (no .portalsim/checkpoint.json); "
                       "choose a new folder");
   } else if (fs::exists(out, ec) && !fs::is_empty(out, ec)) {
-    throw OutputError(dir + ": is not empty; use --resume to continue an interrupted run there, or choose a new folder");
+    throw OutputError(dir +
+                      ": is not empty; use --resume to continue an interrupted run there, or choose a new folder");
   }
   const bool created_dir = !fs::exists(out, ec);
   fs::create_directories(state_dir, ec);

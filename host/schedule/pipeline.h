@@ -12,11 +12,11 @@
 namespace portalsim {
 
 struct PipelineOptions {
-  size_t batch = 0;        // 0 = sized from the outputs (about 64 MiB per batch)
-  unsigned threads = 0;    // host threads for generating and writing; 0 = all cores
+  size_t batch = 0;      // 0 = sized from the outputs (about 64 MiB per batch)
+  unsigned threads = 0;  // host threads for generating and writing; 0 = all cores
   uint64_t shard = 0, shards = 1;
   bool resume = false;
-  bool progress = false;   // draw a progress bar on stderr
+  bool progress = false;                    // draw a progress bar on stderr
   const std::atomic<bool>* stop = nullptr;  // set by a signal: finish the batch, checkpoint, stop
 };
 

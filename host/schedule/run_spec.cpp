@@ -1,8 +1,9 @@
 #include "schedule/run_spec.h"
 
+#include <toml++/toml.h>
+
 #include <cmath>
 #include <filesystem>
-#include <toml++/toml.h>
 
 #include "scene/error.h"
 
@@ -93,7 +94,8 @@ void read_spec_file(const std::string& path, RunSpec& spec) {
   try {
     t = toml::parse_file(path);
   } catch (const toml::parse_error& e) {
-    if (e.source().begin.line == 0) throw InputError(path + ": cannot read the spec file: " + std::string(e.description()));
+    if (e.source().begin.line == 0)
+      throw InputError(path + ": cannot read the spec file: " + std::string(e.description()));
     throw InputError(path + ":" + std::to_string(e.source().begin.line) + ": syntax: " + std::string(e.description()));
   }
   const auto at = [&](const toml::node& n, const std::string& key) {
@@ -166,7 +168,7 @@ void read_spec_file(const std::string& path, RunSpec& spec) {
     } else if (key == "pattern_noise") {
       spec.model.pattern_noise = boolean(node, key);
     } else if (key == "pixel_noise") {
-      double v = node.is_integer() ? static_cast<double>(node.as_integer()->get())
+      double v = node.is_integer()          ? static_cast<double>(node.as_integer()->get())
                  : node.is_floating_point() ? node.as_floating_point()->get()
                                             : throw InputError(at(node, key) + ": expected a number");
       if (!std::isfinite(v) || v < 0 || v > 1000)
@@ -176,10 +178,11 @@ void read_spec_file(const std::string& path, RunSpec& spec) {
       spec.model.metal_noise = static_cast<int>(integer(node, key, 0, 199));
     } else if (key == "placement") {
       const std::string v = string(node, key);
-      if (v != "integer" && v != "bilinear") throw InputError(at(node, key) + ": \"" + v + "\" is not integer or bilinear");
+      if (v != "integer" && v != "bilinear")
+        throw InputError(at(node, key) + ": \"" + v + "\" is not integer or bilinear");
       spec.model.bilinear = v == "bilinear";
     } else if (key == "jitter") {
-      double v = node.is_integer() ? static_cast<double>(node.as_integer()->get())
+      double v = node.is_integer()          ? static_cast<double>(node.as_integer()->get())
                  : node.is_floating_point() ? node.as_floating_point()->get()
                                             : throw InputError(at(node, key) + ": expected a number");
       if (!std::isfinite(v) || v < 0 || v > 1000)
@@ -197,7 +200,8 @@ void read_spec_file(const std::string& path, RunSpec& spec) {
     } else {
       throw InputError(at(node, key) +
                        ": unknown key (count, seed, rule, pool, objects, subjects, balance, what, format, "
-                       "image_format, block, pattern_noise, pixel_noise, metal_noise, scenarios, placement, jitter, tier, precision, pooling, "
+                       "image_format, block, pattern_noise, pixel_noise, metal_noise, scenarios, placement, jitter, "
+                       "tier, precision, pooling, "
                        "fast_math, noise_model)");
     }
   }

@@ -2,8 +2,8 @@
 // and checked on --resume. Batch size, threads and backend are not part of it: they
 // never change the data.
 #pragma once
-#include <nlohmann/json.hpp>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -17,15 +17,15 @@ struct RunSpec {
   uint64_t seed = 0;
   std::vector<std::string> pool;  // object names as given; empty = all
   int min_objects = 0, max_objects = 4;
-  std::vector<int> subjects;      // 1-based; empty = all
+  std::vector<int> subjects;  // 1-based; empty = all
   std::string rule;
   bool balance = false;
   std::string scenarios;          // explicit scenario list (CSV); replaces the generator
   std::string what = "features";  // features | images | both
   std::vector<std::string> formats{"arff"};
   std::string image_format = "png";
-  ModelSettings model;            // seed is copied from `seed`
-  std::string tier = "standard";  // fast | standard | exact; the knobs below override it
+  ModelSettings model;                       // seed is copied from `seed`
+  std::string tier = "standard";             // fast | standard | exact; the knobs below override it
   std::map<std::string, std::string> knobs;  // precision, pooling, fast_math, noise_model
   Fidelity fidelity() const;
   // Where each key came from in a spec file ("spec.toml:3: pool"); keys given on the

@@ -8,7 +8,7 @@
 namespace portalsim {
 
 struct FileState {
-  std::string name;   // relative to the output folder, final name
+  std::string name;  // relative to the output folder, final name
   uint64_t bytes = 0;
   uint64_t xxh3 = 0;  // XXH3-64 of the bytes so far
 };

@@ -1,7 +1,7 @@
 #include "sink/feature_rows.h"
 
-#include <cmath>
 #include <charconv>
+#include <cmath>
 
 namespace portalsim {
 

@@ -25,8 +25,8 @@ void write(const std::string& path, const Image& img) {
 }
 }  // namespace
 
-void write_scenario_folder(const PathOf& path_of, const BatchOutput& b, size_t i, bool threat,
-                           const Palette& palette, const FolderOptions& opt) {
+void write_scenario_folder(const PathOf& path_of, const BatchOutput& b, size_t i, bool threat, const Palette& palette,
+                           const FolderOptions& opt) {
   const std::string ext = "." + opt.image_format;
   if (!b.upper.empty()) {
     write(path_of("upper" + ext), gray(b.upper_of(i), b.mmw_width, b.mmw_height));

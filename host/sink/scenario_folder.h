@@ -19,7 +19,7 @@ struct FolderOptions {
 using PathOf = std::function<std::string(const std::string& name)>;
 
 // Writes scenario i of `b`, each file at path_of(its name).
-void write_scenario_folder(const PathOf& path_of, const BatchOutput& b, size_t i, bool threat,
-                           const Palette& palette, const FolderOptions& opt);
+void write_scenario_folder(const PathOf& path_of, const BatchOutput& b, size_t i, bool threat, const Palette& palette,
+                           const FolderOptions& opt);
 
 }  // namespace portalsim

@@ -5,8 +5,8 @@
 #include <filesystem>
 
 #include "assets/image_io.h"
-#include "schedule/parallel.h"
 #include "scene/error.h"
+#include "schedule/parallel.h"
 #include "sink/feature_rows.h"
 #include "sink/scenario_folder.h"
 #include "sink/staging.h"
@@ -108,13 +108,15 @@ class NpySink final : public Sink {
 
 class ScenarioListSink final : public Sink {
  public:
-  ScenarioListSink(const SinkContext& ctx, const FileState* resume) : ctx_(ctx), file_(ctx.dir, "scenarios.csv", resume) {
+  ScenarioListSink(const SinkContext& ctx, const FileState* resume)
+      : ctx_(ctx), file_(ctx.dir, "scenarios.csv", resume) {
     if (!resume) {
       std::string h = "index,subject";
       for (int r = 1; r <= kRegions; ++r) h += ",region" + std::to_string(r);
       file_.append(h + ",label\n");
     }
-    for (size_t v = 0; v < ctx.cat->variant_list.size(); ++v) names_.push_back(ctx.cat->variant_name(static_cast<int>(v)));
+    for (size_t v = 0; v < ctx.cat->variant_list.size(); ++v)
+      names_.push_back(ctx.cat->variant_name(static_cast<int>(v)));
   }
   void write(const SceneBatch& scenes, const BatchOutput&) override {
     std::string s;

@@ -55,10 +55,9 @@ class OpenCLBackend final : public Backend {
       for (int r = 0; r < kRegions; ++r) {
         const Region& reg = cat.regions[r];
         // Sprite centred in the region; >> 1 floors negative differences too.
-        places[v * kRegions + r] = {{reg.mmw.x + ((reg.mmw.w - sp[0]->width) >> 1),
-                                     reg.mmw.y + ((reg.mmw.h - sp[0]->height) >> 1),
-                                     reg.ir.x + ((reg.ir.w - sp[1]->width) >> 1),
-                                     reg.ir.y + ((reg.ir.h - sp[1]->height) >> 1)}};
+        places[v * kRegions + r] = {
+            {reg.mmw.x + ((reg.mmw.w - sp[0]->width) >> 1), reg.mmw.y + ((reg.mmw.h - sp[0]->height) >> 1),
+             reg.ir.x + ((reg.ir.w - sp[1]->width) >> 1), reg.ir.y + ((reg.ir.h - sp[1]->height) >> 1)}};
       }
     }
     std::vector<cl_int> noise_offsets;
@@ -386,8 +385,8 @@ class OpenCLBackend final : public Backend {
     tables_.patterns = P;
   }
 
-  void sparse_features(Kernels& K, const Plan& plan, size_t n, cl::Buffer& subject, cl::Buffer& objects,
-                       cl_uint2 seed, cl_uint2 first, cl::Buffer& feats) {
+  void sparse_features(Kernels& K, const Plan& plan, size_t n, cl::Buffer& subject, cl::Buffer& objects, cl_uint2 seed,
+                       cl_uint2 first, cl::Buffer& feats) {
     build_sparse_tables(K, plan);
     const SparseTables& tables_ = K.tables;
     const ImagesConfig& ic = cat_.images;

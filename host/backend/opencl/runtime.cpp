@@ -7,14 +7,15 @@
 namespace portalsim {
 
 namespace embedded {
-extern const std::string_view kernel_philox, kernel_precision, kernel_composite, kernel_noise, kernel_pool, kernel_metal,
-    kernel_render;
+extern const std::string_view kernel_philox, kernel_precision, kernel_composite, kernel_noise, kernel_pool,
+    kernel_metal, kernel_render;
 }
 
 std::string OpenCLRuntime::source() {
   std::string s;
-  for (std::string_view part : {embedded::kernel_philox, embedded::kernel_precision, embedded::kernel_composite, embedded::kernel_noise,
-                                embedded::kernel_pool, embedded::kernel_metal, embedded::kernel_render}) {
+  for (std::string_view part :
+       {embedded::kernel_philox, embedded::kernel_precision, embedded::kernel_composite, embedded::kernel_noise,
+        embedded::kernel_pool, embedded::kernel_metal, embedded::kernel_render}) {
     s += part;
     s += "\n";
   }
@@ -46,15 +47,14 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
     if (found) break;
   }
   if (!found)
-    throw std::runtime_error(options.device.empty()
-                                 ? "no OpenCL CPU device found (is pocl-opencl-icd installed?)"
-                                 : "no OpenCL device matches \"" + options.device + "\"");
+    throw std::runtime_error(options.device.empty() ? "no OpenCL CPU device found (is pocl-opencl-icd installed?)"
+                                                    : "no OpenCL device matches \"" + options.device + "\"");
   if (options.compute_units > 0) {
     // Device fission: PoCL runs a sub-device's work on that many threads.
     const cl_uint max_units = device_.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
     if (options.compute_units < max_units) {
-      const cl_device_partition_property props[] = {CL_DEVICE_PARTITION_EQUALLY,
-                                                    static_cast<cl_device_partition_property>(options.compute_units), 0};
+      const cl_device_partition_property props[] = {
+          CL_DEVICE_PARTITION_EQUALLY, static_cast<cl_device_partition_property>(options.compute_units), 0};
       std::vector<cl::Device> subs;
       if (device_.createSubDevices(props, &subs) != CL_SUCCESS || subs.empty())
         throw std::runtime_error("cannot make a sub-device of " + std::to_string(options.compute_units) +

@@ -7,9 +7,9 @@
 namespace portalsim {
 
 struct OpenCLOptions {
-  std::string device;        // substring of the platform or device name; empty = first CPU device
-  std::string build_options; // extra options for clBuildProgram
-  unsigned compute_units = 0; // > 0: a sub-device of this many compute units (threads on PoCL)
+  std::string device;          // substring of the platform or device name; empty = first CPU device
+  std::string build_options;   // extra options for clBuildProgram
+  unsigned compute_units = 0;  // > 0: a sub-device of this many compute units (threads on PoCL)
 };
 
 class OpenCLRuntime {

@@ -58,8 +58,8 @@ class ReferenceBackend final : public Backend {
 
     struct Placed {
       const Image* sprite;
-      int x0, y0;        // centred in the region: where the noise tile goes
-      double dx, dy;     // the placement jitter
+      int x0, y0;     // centred in the region: where the noise tile goes
+      double dx, dy;  // the placement jitter
     };
     std::vector<Placed> placed;
     const double scale_x = view < 2 ? 1.0 : double(ic.ir_width) / ic.mmw_width;
@@ -106,8 +106,10 @@ class ReferenceBackend final : public Backend {
         pv = cov * sp.at(i, j, 0);
         c = cov;
       };
-      for (int y = std::max(0, static_cast<int>(std::floor(fy)) - 1); y < std::min(H, static_cast<int>(fy) + sp.height + 2); ++y)
-        for (int x = std::max(0, static_cast<int>(std::floor(fx)) - 1); x < std::min(W, static_cast<int>(fx) + sp.width + 2); ++x) {
+      for (int y = std::max(0, static_cast<int>(std::floor(fy)) - 1);
+           y < std::min(H, static_cast<int>(fy) + sp.height + 2); ++y)
+        for (int x = std::max(0, static_cast<int>(std::floor(fx)) - 1);
+             x < std::min(W, static_cast<int>(fx) + sp.width + 2); ++x) {
           const double sx = x - fx, sy = y - fy;
           const int i0 = static_cast<int>(std::floor(sx)), j0 = static_cast<int>(std::floor(sy));
           const double tx = sx - i0, ty = sy - j0;
@@ -128,13 +130,13 @@ class ReferenceBackend final : public Backend {
 
     // Noise (thesis 4.2): the scenario's pattern, centred on every object in MMW views.
     if (view < 2 && m.pattern_noise && !placed.empty()) {
-      const uint32_t k = below(draw(m.seed, index, kStreamNoisePattern, 0)[0],
-                               static_cast<uint32_t>(assets_.noise.size()));
+      const uint32_t k =
+          below(draw(m.seed, index, kStreamNoisePattern, 0)[0], static_cast<uint32_t>(assets_.noise.size()));
       const Image& tile = assets_.noise[k];
       const double gain = cat_.noise[k].gain;
       for (const Placed& p : placed) {
-        const int tx0 = p.x0 + static_cast<int>(std::floor(p.sprite->width / 2.0)) -
-                        static_cast<int>(std::floor(tile.width / 2.0));
+        const int tx0 =
+            p.x0 + static_cast<int>(std::floor(p.sprite->width / 2.0)) - static_cast<int>(std::floor(tile.width / 2.0));
         const int ty0 = p.y0 + static_cast<int>(std::floor(p.sprite->height / 2.0)) -
                         static_cast<int>(std::floor(tile.height / 2.0));
         for (int ty = 0; ty < tile.height; ++ty)
@@ -149,8 +151,8 @@ class ReferenceBackend final : public Backend {
     // Per-pixel sensor noise: Box-Muller over the counter generator, a pair per draw.
     if (m.pixel_sigma > 0) {
       for (int p = 0; p < W * H; ++p) {
-        const Philox4 r = draw(m.seed, index, kStreamPixelNoise,
-                               (static_cast<uint32_t>(view) << 28) | static_cast<uint32_t>(p / 2));
+        const Philox4 r =
+            draw(m.seed, index, kStreamPixelNoise, (static_cast<uint32_t>(view) << 28) | static_cast<uint32_t>(p / 2));
         const double u1 = 1.0 - uniform24(r[0]), u2 = uniform24(r[1]);
         const double rad = std::sqrt(-2.0 * std::log(u1));
         const double g = (p % 2 == 0) ? rad * std::cos(kTwoPi * u2) : rad * std::sin(kTwoPi * u2);

@@ -1,0 +1,1186 @@
+// The model at its extremes: alpha 0 and 1, all-black and all-white images, every region
+// holding the heaviest metal, no objects at all, block sizes from 1 to beyond the image,
+// images of 1x1 and 4096x4096, sprites hanging off the image, huge noise, the largest
+// seeds and scenario indices, batches of one and a million, and NaN, infinity and
+// negative numbers wherever a user can type one.
+//
+// Unless a case is about rejection, every fidelity tier (exact, standard, fast) is held to
+// its stated tolerance (plan/tolerance.h) against the fp64 reference, once with images
+// materialised and once as a features-only run (the sparse path where the plan allows).
+// Per-pixel noise in a features-only run is drawn by the fast tier's block-mean model,
+// which does not draw the reference's pixels: there the fast tier's features are compared
+// only statistically (mean signed error near 0) or, where clipping at 0 or 255 biases the
+// per-pixel model, only for their range.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "assets/image_io.h"
+#include "backend/compare.h"
+#include "plan/plan.h"
+#include "plan/tolerance.h"
+#include "scene/error.h"
+#include "support.h"
+
+extern char** environ;
+
+namespace portalsim::embedded {
+extern const std::string_view default_catalogue;
+}
+
+namespace portalsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::array<Tier, 3> kTiers{Tier::exact, Tier::standard, Tier::fast};
+constexpr uint64_t kMaxU64 = std::numeric_limits<uint64_t>::max();
+
+// ---------------------------------------------------------------------------------------------
+// Catalogue text edits.
+
+std::string default_text() { return std::string(embedded::default_catalogue); }
+
+std::string replace_once(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  if (at == std::string::npos) {
+    ADD_FAILURE() << "the default catalogue no longer contains \"" << from << "\"; update the test";
+    return text;
+  }
+  return text.replace(at, from.size(), to);
+}
+
+// 1-based line of the first occurrence of `needle` (0 when absent).
+int line_of(const std::string& text, const std::string& needle) {
+  const size_t at = text.find(needle);
+  if (at == std::string::npos) return 0;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+}
+
+// Rewrites the text line by line: `f` gets each line and returns its replacement, or nothing
+// to keep it.
+std::string edit_lines(const std::string& text,
+                       const std::function<std::optional<std::string>(const std::string&)>& f) {
+  std::istringstream in(text);
+  std::string line, out;
+  while (std::getline(in, line)) {
+    const std::optional<std::string> r = f(line);
+    out += r ? *r : line;
+    out += '\n';
+  }
+  return out;
+}
+
+std::vector<int> numbers_in(const std::string& line) {
+  std::vector<int> v;
+  const size_t open = line.find('['), close = line.find(']');
+  if (open == std::string::npos || close == std::string::npos) return v;
+  std::istringstream s(line.substr(open + 1, close - open - 1));
+  std::string part;
+  while (std::getline(s, part, ',')) v.push_back(std::stoi(part));
+  return v;
+}
+
+std::string rect_line(const char* key, const Rect& r) {
+  return std::string(key) + " = [" + std::to_string(r.x) + ", " + std::to_string(r.y) + ", " + std::to_string(r.w) +
+         ", " + std::to_string(r.h) + "]";
+}
+
+// Every region rectangle through `f(region id 1..13, is_mmw, rect)`.
+std::string map_rects(const std::string& text, const std::function<Rect(int, bool, Rect)>& f) {
+  int region = 0;
+  return edit_lines(text, [&](const std::string& line) -> std::optional<std::string> {
+    if (line.rfind("[[", 0) == 0) region = line == "[[regions]]" ? region + 1 : (region > 0 ? 100 : 0);
+    if (region < 1 || region > kRegions) return std::nullopt;
+    for (const char* key : {"mmw", "ir"}) {
+      if (line.rfind(std::string(key) + " = [", 0) != 0) continue;
+      const std::vector<int> v = numbers_in(line);
+      if (v.size() != 4) return std::nullopt;
+      return rect_line(key, f(region, key[0] == 'm', Rect{v[0], v[1], v[2], v[3]}));
+    }
+    return std::nullopt;
+  });
+}
+
+// Every object's `size = [w, h]` through `f`.
+std::string map_sizes(const std::string& text, const std::function<std::pair<int, int>(int, int)>& f) {
+  return edit_lines(text, [&](const std::string& line) -> std::optional<std::string> {
+    if (line.rfind("size = [", 0) != 0) return std::nullopt;
+    const std::vector<int> v = numbers_in(line);
+    if (v.size() != 2) return std::nullopt;
+    const auto [w, h] = f(v[0], v[1]);
+    return "size = [" + std::to_string(w) + ", " + std::to_string(h) + "]";
+  });
+}
+
+// Sets one [images] key (a line "key = value ...").
+std::string set_image_key(const std::string& text, const std::string& key, const std::string& value) {
+  bool done = false;
+  std::string out = edit_lines(text, [&](const std::string& line) -> std::optional<std::string> {
+    if (done || line.rfind(key + " = ", 0) != 0) return std::nullopt;
+    done = true;
+    return key + " = " + value;
+  });
+  if (!done) ADD_FAILURE() << "no \"" << key << " = \" line in the catalogue";
+  return out;
+}
+
+// Inserts `lines` after the line `name = "<name>"` (a subject's or an object's table).
+std::string add_after_name(const std::string& text, const std::string& name, const std::string& lines) {
+  return replace_once(text, "name = \"" + name + "\"\n", "name = \"" + name + "\"\n" + lines);
+}
+
+// Keeps only the first [[subjects]] table.
+std::string first_subject_only(const std::string& text) {
+  const size_t first = text.find("[[subjects]]");
+  const size_t second = text.find("[[subjects]]", first + 1);
+  const size_t regions = text.find("# --- Regions");
+  if (first == std::string::npos || second == std::string::npos || regions == std::string::npos || regions < second) {
+    ADD_FAILURE() << "the default catalogue's subjects moved; update the test";
+    return text;
+  }
+  return text.substr(0, second) + text.substr(regions);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Temporary folders and test images.
+
+class TempDir {
+ public:
+  TempDir() {
+    char tmpl[] = "/tmp/portalsim-extremes-XXXXXX";
+    if (!::mkdtemp(tmpl)) throw std::runtime_error(std::string("mkdtemp: ") + std::strerror(errno));
+    root_ = tmpl;
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(root_, ec);
+  }
+  const fs::path& path() const { return root_; }
+  std::string str() const { return root_.string(); }
+
+ private:
+  fs::path root_;
+};
+
+std::string write_gray(const fs::path& dir, const std::string& name, int w, int h, uint8_t value) {
+  const fs::path p = dir / name;
+  write_image(p.string(), Image(w, h, 1, value));
+  return p.string();
+}
+
+// ---------------------------------------------------------------------------------------------
+// A catalogue, its assets and both backends.
+
+struct World {
+  Catalogue cat;
+  AssetSet assets;
+  std::unique_ptr<Backend> ref, cl;
+};
+
+std::unique_ptr<World> make_world(const std::string& text, const std::string& dir = "") {
+  auto w = std::make_unique<World>();
+  w->cat = parse_catalogue(text, "test.toml", dir, "");
+  w->assets = build_assets(w->cat);
+  w->ref = make_reference_backend(w->cat, w->assets);
+  w->cl = make_opencl_backend(w->cat, w->assets, test::runtime());
+  return w;
+}
+
+World& default_world() {
+  static std::unique_ptr<World> w = make_world(default_text());
+  return *w;
+}
+
+// Every variant in every region (one object per scenario, rotating subjects), then random
+// crowds of up to `max_objects`.
+std::vector<Scenario> coverage(const Catalogue& c, size_t n, int max_objects, bool singles = true) {
+  std::vector<Scenario> v;
+  if (singles)
+    for (size_t var = 0; var < c.variant_list.size(); ++var)
+      for (int r = 0; r < kRegions; ++r) {
+        Scenario s;
+        s.subject = static_cast<int>((var + r) % c.subjects.size());
+        s.objects[r] = static_cast<int16_t>(var);
+        v.push_back(s);
+      }
+  for (uint64_t k = 0; v.size() < n; ++k) v.push_back(test::random_scenario(c, k, max_objects));
+  return v;
+}
+
+// Every region holding an object: variants rotate from `first`.
+Scenario crowded(const Catalogue& c, int subject, size_t first = 0) {
+  Scenario s;
+  s.subject = subject;
+  for (int r = 0; r < kRegions; ++r) s.objects[r] = static_cast<int16_t>((first + r) % c.variant_list.size());
+  return s;
+}
+
+Plan images_plan(const ModelSettings& m, Tier t) {
+  Plan p;
+  p.model = m;
+  p.fidelity = tier_fidelity(t);
+  return p;
+}
+
+Plan features_plan(const ModelSettings& m, Tier t) {
+  Plan p = images_plan(m, t);
+  p.mmw_images = p.ir_image = false;
+  return p;
+}
+
+ModelSettings model(uint64_t seed, bool pattern, double sigma = 0, int block = 10, int metal_noise = 0) {
+  ModelSettings m;
+  m.seed = seed;
+  m.pattern_noise = pattern;
+  m.pixel_sigma = sigma;
+  m.block = block;
+  m.metal_noise = metal_noise;
+  return m;
+}
+
+std::string describe(const ModelSettings& m) {
+  std::ostringstream s;
+  s << "seed " << m.seed << ", pattern noise " << (m.pattern_noise ? "on" : "off") << ", pixel sigma " << m.pixel_sigma
+    << ", block " << m.block << ", metal noise " << m.metal_noise;
+  return s.str();
+}
+
+// The same shape as the reference: any difference here would make compare_outputs skip a part.
+void expect_same_shape(const BatchOutput& a, const BatchOutput& ref) {
+  EXPECT_EQ(a.n, ref.n);
+  EXPECT_EQ(a.mmw_width, ref.mmw_width);
+  EXPECT_EQ(a.mmw_height, ref.mmw_height);
+  EXPECT_EQ(a.ir_width, ref.ir_width);
+  EXPECT_EQ(a.ir_height, ref.ir_height);
+  EXPECT_EQ(a.upper.size(), ref.upper.size());
+  EXPECT_EQ(a.lower.size(), ref.lower.size());
+  EXPECT_EQ(a.ir.size(), ref.ir.size());
+  EXPECT_EQ(a.metal.size(), ref.metal.size());
+  EXPECT_EQ(a.features.size(), ref.features.size());
+  EXPECT_EQ(a.layout.block, ref.layout.block);
+  EXPECT_EQ(a.layout.blocks_x, ref.layout.blocks_x);
+  EXPECT_EQ(a.layout.blocks_y, ref.layout.blocks_y);
+}
+
+// Features are finite gray levels and metal zones lie in [1, 200]. (compare_outputs would let
+// a NaN feature through: max() with NaN keeps the old value.)
+void expect_in_range(const BatchOutput& o) {
+  size_t bad = 0;
+  float worst = 0;
+  for (float f : o.features)
+    if (!std::isfinite(f) || f < 0.0f || f > 255.0f) {
+      if (bad++ == 0) worst = f;
+    }
+  EXPECT_EQ(bad, 0u) << "features outside [0, 255] or not finite, e.g. " << worst;
+  size_t bad_metal = 0;
+  for (uint8_t z : o.metal) bad_metal += z < 1 || z > 200;
+  EXPECT_EQ(bad_metal, 0u) << "metal zones outside [1, 200]";
+}
+
+// How the fast tier's features are held in a features-only plan with per-pixel noise.
+enum class FastNoisy { statistical, range_only };
+
+struct Parity {
+  BatchOutput ref_images, ref_features;
+  std::array<BatchOutput, 3> images, features;  // in kTiers order
+};
+
+// Every tier against the reference, images plan and features-only plan.
+std::unique_ptr<Parity> expect_parity(World& w, const SceneBatch& batch, const ModelSettings& m,
+                                      const std::string& what, FastNoisy fast_noisy = FastNoisy::statistical) {
+  SCOPED_TRACE(what + " (" + describe(m) + ", " + std::to_string(batch.size()) + " scenarios)");
+  auto p = std::make_unique<Parity>();
+  const auto T0 = std::chrono::steady_clock::now();
+  auto lap = [&](const char* what) { fprintf(stderr, "TIMING %s %.3f\n", what, std::chrono::duration<double>(std::chrono::steady_clock::now() - T0).count()); };
+  w.ref->run(batch, images_plan(m, Tier::exact), p->ref_images);
+  w.ref->run(batch, features_plan(m, Tier::exact), p->ref_features);
+  expect_in_range(p->ref_images);
+  expect_in_range(p->ref_features);
+  for (size_t t = 0; t < kTiers.size(); ++t) {
+    const Tier tier = kTiers[t];
+    const Tolerance tol = tier_tolerance(tier);
+    SCOPED_TRACE(std::string("tier ") + tier_name(tier));
+    {
+      SCOPED_TRACE("images plan");
+      BatchOutput& o = p->images[t];
+      w.cl->run(batch, images_plan(m, tier), o);
+      expect_same_shape(o, p->ref_images);
+      expect_in_range(o);
+      EXPECT_EQ(check_tolerance(compare_outputs(o, p->ref_images), tol), "");
+      EXPECT_EQ(o.metal, p->ref_images.metal);
+      lap("images");
+    }
+    {
+      SCOPED_TRACE("features-only plan");
+      BatchOutput& o = p->features[t];
+      const Plan plan = features_plan(m, tier);
+      w.cl->run(batch, plan, o);
+      expect_same_shape(o, p->ref_features);
+      expect_in_range(o);
+      EXPECT_EQ(o.metal, p->ref_features.metal);
+      if (tier == Tier::fast && m.pixel_sigma > 0) {
+        // Block-mean noise model: other draws than the reference's pixels.
+        EXPECT_EQ(plan.fidelity.noise, NoiseModel::block_mean);
+        if (fast_noisy == FastNoisy::statistical && !o.features.empty() &&
+            o.features.size() == p->ref_features.features.size()) {
+          double signed_sum = 0;
+          for (size_t k = 0; k < o.features.size(); ++k)
+            signed_sum += double(o.features[k]) - double(p->ref_features.features[k]);
+          EXPECT_NEAR(signed_sum / o.features.size(), 0.0, 0.25) << "mean signed feature error of the block-mean model";
+        }
+      } else {
+        EXPECT_EQ(check_tolerance(compare_outputs(o, p->ref_features), tol), "");
+      }
+    }
+  }
+  lap("all");
+  return p;
+}
+
+size_t count_differing(const uint8_t* a, const uint8_t* b, size_t n) {
+  size_t d = 0;
+  for (size_t i = 0; i < n; ++i) d += a[i] != b[i];
+  return d;
+}
+
+// The features row of a subject with no objects: block and region means of its bases.
+std::vector<double> base_features(const World& w, int subject, int block) {
+  const FeatureLayout f = FeatureLayout::of(w.cat, block);
+  const int W = w.cat.images.mmw_width, H = w.cat.images.mmw_height;
+  std::vector<double> row;
+  for (int view = 0; view < 2; ++view) {
+    const Image& img = w.assets.bases[subject][view];
+    for (int by = 0; by < f.blocks_y; ++by)
+      for (int bx = 0; bx < f.blocks_x; ++bx) {
+        double sum = 0;
+        int count = 0;
+        for (int y = by * block; y < std::min(H, (by + 1) * block); ++y)
+          for (int x = bx * block; x < std::min(W, (bx + 1) * block); ++x, ++count) sum += img.at(x, y);
+        row.push_back(sum / count);
+      }
+  }
+  for (const Region& r : w.cat.regions) {
+    const Image& img = w.assets.bases[subject][r.view == View::upper ? 0 : 1];
+    double sum = 0;
+    for (int y = r.mmw.y; y < r.mmw.y + r.mmw.h; ++y)
+      for (int x = r.mmw.x; x < r.mmw.x + r.mmw.w; ++x) sum += img.at(x, y);
+    row.push_back(sum / (double(r.mmw.w) * r.mmw.h));
+  }
+  return row;
+}
+
+// Each scenario's images equal its subject's bases, in the images plan's output `o`.
+void expect_images_are_bases(const World& w, const SceneBatch& batch, const BatchOutput& o, const std::string& who) {
+  const size_t mmw = size_t(o.mmw_width) * o.mmw_height, ir = size_t(o.ir_width) * o.ir_height;
+  ASSERT_EQ(o.upper.size(), batch.size() * mmw) << who;
+  ASSERT_EQ(o.ir.size(), batch.size() * ir) << who;
+  size_t upper = 0, lower = 0, irs = 0;
+  for (size_t i = 0; i < batch.size(); ++i) {
+    const auto& b = w.assets.bases[batch.subject[i]];
+    upper += count_differing(o.upper_of(i), b[0].pixels.data(), mmw);
+    lower += count_differing(o.lower_of(i), b[1].pixels.data(), mmw);
+    irs += count_differing(o.ir_of(i), b[2].pixels.data(), ir);
+  }
+  EXPECT_EQ(upper, 0u) << who << ": upper pixels differing from the base";
+  EXPECT_EQ(lower, 0u) << who << ": lower pixels differing from the base";
+  EXPECT_EQ(irs, 0u) << who << ": IR pixels differing from the base";
+}
+
+// Each scenario's features equal its subject's base means (within `tol`).
+void expect_features_are_base_means(const World& w, const SceneBatch& batch, const BatchOutput& o, int block,
+                                    double tol, const std::string& who) {
+  const size_t F = o.layout.image_features();
+  ASSERT_EQ(o.features.size(), batch.size() * F) << who;
+  double worst = 0;
+  size_t worst_at = 0;
+  std::vector<std::vector<double>> rows(w.cat.subjects.size());
+  for (size_t i = 0; i < batch.size(); ++i) {
+    std::vector<double>& expect = rows[batch.subject[i]];
+    if (expect.empty()) expect = base_features(w, batch.subject[i], block);
+    ASSERT_EQ(expect.size(), F);
+    for (size_t k = 0; k < F; ++k) {
+      const double e = std::abs(double(o.features_of(i)[k]) - expect[k]);
+      if (!(e <= worst)) worst = e, worst_at = k;
+    }
+  }
+  EXPECT_LE(worst, tol) << who << ": feature " << worst_at << " is off the base mean by " << worst;
+}
+
+// Where sprite `v` (placed in region `r`) has full coverage, the image shows the sprite's value.
+// Counts pixels of full coverage (checked) and mismatches.
+struct OpaqueCheck {
+  size_t checked = 0, wrong = 0, clear_checked = 0, clear_wrong = 0;
+};
+void check_opaque(const Image& sprite, const Rect& rect, const uint8_t* img, const Image& base, OpaqueCheck& c) {
+  const int W = base.width, H = base.height;
+  const int x0 = rect.x + static_cast<int>(std::floor((rect.w - sprite.width) / 2.0));
+  const int y0 = rect.y + static_cast<int>(std::floor((rect.h - sprite.height) / 2.0));
+  for (int sy = 0; sy < sprite.height; ++sy)
+    for (int sx = 0; sx < sprite.width; ++sx) {
+      const int x = x0 + sx, y = y0 + sy;
+      if (x < 0 || y < 0 || x >= W || y >= H) continue;
+      const uint8_t got = img[size_t(y) * W + x];
+      if (sprite.at(sx, sy, 1) == 255) {
+        ++c.checked;
+        c.wrong += got != sprite.at(sx, sy, 0);
+      } else if (sprite.at(sx, sy, 1) == 0) {
+        ++c.clear_checked;
+        c.clear_wrong += got != base.at(x, y);
+      }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Running the binary (as tests/cli_test.cpp does).
+
+struct Result {
+  std::string command;
+  bool exited = false, signaled = false, timed_out = false;
+  int status = -1, signal = 0;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void spit(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+  if (!out) ADD_FAILURE() << "cannot write " << p;
+}
+
+std::string describe(const Result& r) {
+  std::ostringstream s;
+  s << "command: " << r.command << "\n";
+  if (r.timed_out)
+    s << "timed out\n";
+  else if (r.signaled)
+    s << "killed by signal " << r.signal << "\n";
+  else
+    s << "exit status " << r.status << "\n";
+  s << "--- stdout ---\n" << r.out << "--- stderr ---\n" << r.err << "---";
+  return s.str();
+}
+
+struct Running {
+  pid_t pid = -1;
+  std::string command;
+  fs::path out_path, err_path;
+};
+
+Running start(const fs::path& cap, const std::vector<std::string>& args) {
+  static int counter = 0;
+  const int n = ++counter;
+  Running r;
+  r.out_path = cap / ("run" + std::to_string(n) + ".stdout");
+  r.err_path = cap / ("run" + std::to_string(n) + ".stderr");
+  std::vector<std::string> argv_s{PORTALSIM_BINARY};
+  argv_s.insert(argv_s.end(), args.begin(), args.end());
+  r.command = "portalsim";
+  for (const std::string& a : args) r.command += " " + a;
+  std::vector<char*> argv;
+  for (std::string& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string out_s = r.out_path.string(), err_s = r.err_path.string();
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 1, out_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&fa, 2, err_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0 || pid <= 0) {
+    ADD_FAILURE() << "cannot start " << PORTALSIM_BINARY << ": " << std::strerror(rc);
+    pid = -1;
+  }
+  r.pid = pid;
+  return r;
+}
+
+// Waits (at most 60 s, then kills that one child) and collects what it printed.
+Result finish(const Running& r) {
+  Result res;
+  res.command = r.command;
+  if (r.pid <= 0) return res;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  int ws = 0;
+  for (;;) {
+    const pid_t w = ::waitpid(r.pid, &ws, WNOHANG);
+    if (w == r.pid) break;
+    if (w < 0 && errno != EINTR) {
+      ADD_FAILURE() << "waitpid: " << std::strerror(errno);
+      return res;
+    }
+    if (std::chrono::steady_clock::now() > deadline) {
+      if (r.pid > 0) ::kill(r.pid, SIGKILL);
+      ::waitpid(r.pid, &ws, 0);
+      res.timed_out = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  res.exited = WIFEXITED(ws);
+  if (res.exited) res.status = WEXITSTATUS(ws);
+  res.signaled = WIFSIGNALED(ws);
+  if (res.signaled) res.signal = WTERMSIG(ws);
+  res.out = slurp(r.out_path);
+  res.err = slurp(r.err_path);
+  return res;
+}
+
+bool contains(const std::string& hay, const std::string& needle) { return hay.find(needle) != std::string::npos; }
+
+struct Rejection {
+  std::vector<std::string> args;  // without --out
+  std::vector<std::string> needles;
+};
+
+// Runs every command at once (each with its own absent --out folder); each must fail cleanly:
+// non-zero exit, no signal, stderr naming every needle, nothing on stdout, no output folder.
+void expect_all_rejected(const std::vector<Rejection>& cases) {
+  TempDir t;
+  fs::create_directory(t.path() / "cap");
+  std::vector<Running> running;
+  std::vector<fs::path> outs;
+  for (size_t i = 0; i < cases.size(); ++i) {
+    outs.push_back(t.path() / ("out" + std::to_string(i)));
+    std::vector<std::string> args = cases[i].args;
+    args.push_back("--out");
+    args.push_back(outs.back().string());
+    running.push_back(start(t.path() / "cap", args));
+  }
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const Result r = finish(running[i]);
+    SCOPED_TRACE(describe(r));
+    EXPECT_FALSE(r.timed_out);
+    EXPECT_FALSE(r.signaled) << "killed by signal " << r.signal;
+    EXPECT_TRUE(r.exited && r.status != 0) << "a command with a bad number must be rejected";
+    for (const std::string& n : cases[i].needles)
+      EXPECT_TRUE(contains(r.err, n)) << "stderr does not name \"" << n << "\"";
+    EXPECT_EQ(r.out, "") << "nothing should be printed on stdout";
+    std::error_code ec;
+    EXPECT_FALSE(fs::exists(outs[i], ec)) << outs[i] << " must not be left behind";
+  }
+}
+
+// =============================================================================================
+// 1. Alpha 0 and 1.
+
+TEST(ExtremeAlpha, ZeroMakesObjectsInvisible) {
+  const std::string text = replace_once(default_text(), "alpha = 0.9", "alpha = 0.0");
+  auto w = make_world(text);
+  ASSERT_EQ(w->cat.images.alpha, 0.0);
+  const SceneBatch batch = test::batch_of(coverage(w->cat, 240, 13), 5);
+  {
+    // No pattern noise: nothing but the objects could change a pixel, and they are invisible.
+    const auto p = expect_parity(*w, batch, model(11, false), "alpha 0");
+    expect_images_are_bases(*w, batch, p->ref_images, "reference");
+    for (size_t t = 0; t < kTiers.size(); ++t) {
+      expect_images_are_bases(*w, batch, p->images[t], tier_name(kTiers[t]));
+      expect_features_are_base_means(*w, batch, p->features[t], 10, 1e-3,
+                                     std::string(tier_name(kTiers[t])) + " features-only");
+    }
+  }
+  // The pattern noise is still laid over the (invisible) objects.
+  expect_parity(*w, batch, model(12, true), "alpha 0 with pattern noise");
+}
+
+TEST(ExtremeAlpha, OneMakesSpritesOpaque) {
+  const std::string text = replace_once(default_text(), "alpha = 0.9", "alpha = 1");
+  auto w = make_world(text);
+  ASSERT_EQ(w->cat.images.alpha, 1.0);
+  const std::vector<Scenario> singles = coverage(w->cat, 0, 13);  // one object per scenario
+  const SceneBatch batch = test::batch_of(singles, 0);
+  const auto p = expect_parity(*w, batch, model(21, false), "alpha 1, one object");
+  auto check = [&](const BatchOutput& o, const std::string& who) {
+    OpaqueCheck mmw, ir;
+    for (size_t i = 0; i < singles.size(); ++i) {
+      const Scenario& s = singles[i];
+      for (int r = 0; r < kRegions; ++r) {
+        const int v = s.objects[r];
+        if (v < 0) continue;
+        const Region& reg = w->cat.regions[r];
+        const int view = reg.view == View::upper ? 0 : 1;
+        check_opaque(w->assets.mmw_sprites[v], reg.mmw, view == 0 ? o.upper_of(i) : o.lower_of(i),
+                     w->assets.bases[s.subject][view], mmw);
+        check_opaque(w->assets.ir_sprites[v], reg.ir, o.ir_of(i), w->assets.bases[s.subject][2], ir);
+      }
+    }
+    EXPECT_GT(mmw.checked, 10000u) << who;
+    EXPECT_EQ(mmw.wrong, 0u) << who << ": MMW pixels under full coverage that are not the sprite's, of " << mmw.checked;
+    EXPECT_EQ(mmw.clear_wrong, 0u) << who << ": MMW pixels under zero coverage that are not the base's";
+    EXPECT_GT(ir.checked, 1000u) << who;
+    EXPECT_EQ(ir.wrong, 0u) << who << ": IR pixels under full coverage that are not the sprite's, of " << ir.checked;
+    EXPECT_EQ(ir.clear_wrong, 0u) << who << ": IR pixels under zero coverage that are not the base's";
+  };
+  check(p->ref_images, "reference");
+  for (size_t t = 0; t < kTiers.size(); ++t) check(p->images[t], tier_name(kTiers[t]));
+  // Crowds, with both kinds of noise.
+  const SceneBatch crowds = test::batch_of(coverage(w->cat, 120, 13, false), 77);
+  expect_parity(*w, crowds, model(22, true), "alpha 1, crowds");
+  expect_parity(*w, crowds, model(23, true, 4.0), "alpha 1, crowds, pixel noise");
+}
+
+// =============================================================================================
+// 2. All-black and all-white bases and sprites (user image files).
+
+void black_and_white(uint8_t base, uint8_t sprite) {
+  TempDir t;
+  const std::string b = std::to_string(base), s = std::to_string(sprite);
+  const std::string up = write_gray(t.path(), "base-" + b + ".png", 200, 200, base);
+  const std::string ir = write_gray(t.path(), "base-ir-" + b + ".png", 100, 200, base);
+  const std::string sh = write_gray(t.path(), "sprite-h-" + s + ".png", 40, 30, sprite);
+  const std::string sv = write_gray(t.path(), "sprite-v-" + s + ".png", 30, 40, sprite);
+  const std::string ih = write_gray(t.path(), "sprite-ir-h-" + s + ".png", 20, 15, sprite);
+  const std::string iv = write_gray(t.path(), "sprite-ir-v-" + s + ".png", 15, 20, sprite);
+  std::string text = default_text();
+  for (int k = 1; k <= 5; ++k)
+    text = add_after_name(text, "subject-" + std::to_string(k),
+                          "mmw_upper = \"" + up + "\"\nmmw_lower = \"" + up + "\"\nir = \"" + ir + "\"\n");
+  for (const char* o : {"gun", "iron-rod"})
+    text = add_after_name(
+        text, o, "mmw_h = \"" + sh + "\"\nmmw_v = \"" + sv + "\"\nir_h = \"" + ih + "\"\nir_v = \"" + iv + "\"\n");
+  for (const char* o : {"iron-handle", "compact-disk", "metal-strip", "metal-plate", "pendant", "iron-pipe",
+                        "belt-buckle", "ceramic-plate", "cement-tile", "mobile-phone"})
+    text = add_after_name(text, o, "mmw = \"" + sh + "\"\nir = \"" + ih + "\"\n");
+  auto w = make_world(text, t.str());
+  for (const auto& views : w->assets.bases)
+    for (const Image& img : views)
+      ASSERT_TRUE(std::all_of(img.pixels.begin(), img.pixels.end(), [&](uint8_t v) { return v == base; }));
+  for (const Image& sp : w->assets.mmw_sprites) ASSERT_EQ(sp.at(0, 0, 0), sprite);
+
+  std::vector<Scenario> scenes = coverage(w->cat, 200, 13);
+  for (int subject = 0; subject < 5; ++subject) scenes.push_back(crowded(w->cat, subject, subject));
+  const SceneBatch batch = test::batch_of(scenes, 1000);
+
+  // Pattern noise pushes past both ends: the kernels must clamp as the reference does.
+  expect_parity(*w, batch, model(31, true, 0.0, 10, 3), "pattern noise");
+  {
+    // Neither noise: every pixel is the base or the blend of base and sprite.
+    const auto p = expect_parity(*w, batch, model(32, false), "no noise");
+    if (base == sprite) {
+      for (size_t t = 0; t < kTiers.size(); ++t) {
+        const BatchOutput& o = p->images[t];
+        for (const std::vector<uint8_t>* v : {&o.upper, &o.lower, &o.ir})
+          EXPECT_TRUE(std::all_of(v->begin(), v->end(), [&](uint8_t x) { return x == base; }))
+              << tier_name(kTiers[t]) << ": a flat scene must stay flat";
+      }
+    }
+  }
+  {
+    // Per-pixel noise of sigma 8 (at most 5.8 sigma from the 24-bit Box-Muller): black stays
+    // within [0, 47], white within [208, 255] where no sprite of the other colour lies, and
+    // nothing wraps around. The block-mean model ignores clipping, so the fast tier's
+    // features-only run is checked for range only.
+    const auto p = expect_parity(*w, batch, model(33, false, 8.0), "pixel noise", FastNoisy::range_only);
+    if (base == sprite) {
+      for (size_t t = 0; t < kTiers.size(); ++t) {
+        const BatchOutput& o = p->images[t];
+        for (const std::vector<uint8_t>* v : {&o.upper, &o.lower, &o.ir}) {
+          const auto [lo, hi] = std::minmax_element(v->begin(), v->end());
+          if (base == 0)
+            EXPECT_LE(*hi, 47) << tier_name(kTiers[t]) << ": black image with sigma 8";
+          else
+            EXPECT_GE(*lo, 208) << tier_name(kTiers[t]) << ": white image with sigma 8 (a wrap past 255?)";
+          EXPECT_GT(*hi, *lo) << "the noise did something";
+        }
+      }
+    }
+  }
+}
+
+TEST(ExtremeBlackWhite, BlackBaseWhiteSprites) { black_and_white(0, 255); }
+TEST(ExtremeBlackWhite, WhiteBaseBlackSprites) { black_and_white(255, 0); }
+TEST(ExtremeBlackWhite, AllBlack) { black_and_white(0, 0); }
+TEST(ExtremeBlackWhite, AllWhite) { black_and_white(255, 255); }
+
+// =============================================================================================
+// 3. The heaviest metal in every region: zones clamp at 1.
+
+TEST(ExtremeMetal, HeaviestMetalInEveryRegionClampsAtOne) {
+  World& w = default_world();
+  const int gun = w.cat.find_object("gun");
+  ASSERT_GE(gun, 0);
+  ASSERT_EQ(w.cat.metal_categories[w.cat.objects[gun].metal], "heavy");
+  const int first = w.cat.objects[gun].first_variant;
+  std::vector<Scenario> scenes;
+  for (int s = 0; s < static_cast<int>(w.cat.subjects.size()); ++s)
+    for (int mix = 0; mix < 2; ++mix) {
+      Scenario sc;
+      sc.subject = s;
+      for (int r = 0; r < kRegions; ++r) sc.objects[r] = static_cast<int16_t>(first + (mix ? r % 2 : 0));
+      scenes.push_back(sc);
+    }
+  // Influence sums per zone (the same for every scenario: all 13 regions hold heavy metal).
+  std::array<int, kZones> sum{};
+  for (int r = 0; r < kRegions; ++r)
+    for (int z = 0; z < kZones; ++z) sum[z] += w.cat.influence[w.cat.objects[gun].metal][r][z];
+  int clamped = 0;
+  for (int z = 0; z < kZones; ++z) clamped += sum[z] >= 200 + 199;
+  ASSERT_GT(clamped, 5) << "the test needs zones far below 1";
+
+  struct Case {
+    uint64_t seed, first;
+    int noise;
+  };
+  for (const Case c : {Case{0, 0, 0}, Case{0, 0, 199}, Case{kMaxU64, 0, 199}, Case{kMaxU64, kMaxU64 - 9, 199},
+                       Case{0, kMaxU64 - 9, 199}}) {
+    const SceneBatch batch = test::batch_of(scenes, c.first);
+    const ModelSettings m = model(c.seed, true, 0.0, 10, c.noise);
+    const auto p = expect_parity(w, batch, m, "gun in all 13 regions");
+    SCOPED_TRACE(describe(m) + ", first index " + std::to_string(c.first));
+    for (size_t t = 0; t < kTiers.size(); ++t) {
+      EXPECT_EQ(p->images[t].metal, p->ref_images.metal) << tier_name(kTiers[t]);
+      EXPECT_EQ(p->features[t].metal, p->ref_images.metal) << tier_name(kTiers[t]);
+    }
+    const BatchOutput& o = p->ref_images;
+    ASSERT_EQ(o.metal.size(), scenes.size() * kZones);
+    for (size_t i = 0; i < scenes.size(); ++i) {
+      const auto& base = w.cat.subjects[scenes[i].subject].base_zones;
+      for (int z = 0; z < kZones; ++z) {
+        const int got = o.metal_of(i)[z], exact = base[z] - sum[z];
+        EXPECT_GE(got, 1) << "zone " << z + 1;
+        EXPECT_LE(got, 200) << "zone " << z + 1;
+        if (c.noise == 0)
+          EXPECT_EQ(got, std::clamp(exact, 1, 200)) << "zone " << z + 1;
+        else if (sum[z] == 0)
+          EXPECT_EQ(got, base[z]) << "zone " << z + 1 << ": no influence, no noise";
+        else if (exact + c.noise < 1)
+          EXPECT_EQ(got, 1) << "zone " << z + 1 << ": base - influence = " << exact;
+        else
+          EXPECT_LE(std::abs(got - std::clamp(exact, 1, 200)), c.noise) << "zone " << z + 1;
+      }
+    }
+  }
+}
+
+// =============================================================================================
+// 4. No objects: the subject's base images, base means and base zones.
+
+TEST(ExtremeEmpty, NoObjectsGiveTheBase) {
+  World& w = default_world();
+  std::vector<Scenario> scenes;
+  for (int k = 0; k < 3; ++k)
+    for (int s = 0; s < static_cast<int>(w.cat.subjects.size()); ++s) {
+      Scenario sc;
+      sc.subject = s;
+      scenes.push_back(sc);
+    }
+  for (const auto& [seed, first, block] :
+       {std::tuple{uint64_t{0}, uint64_t{0}, 10}, std::tuple{kMaxU64, kMaxU64 - 14, 7}}) {
+    const SceneBatch batch = test::batch_of(scenes, first);
+    const ModelSettings m = model(seed, true, 0.0, block, 50);
+    const auto p = expect_parity(w, batch, m, "no objects");
+    SCOPED_TRACE(describe(m));
+    expect_images_are_bases(w, batch, p->ref_images, "reference");
+    expect_features_are_base_means(w, batch, p->ref_features, block, 1e-4, "reference");
+    for (size_t t = 0; t < kTiers.size(); ++t) {
+      const std::string who = tier_name(kTiers[t]);
+      expect_images_are_bases(w, batch, p->images[t], who);
+      expect_features_are_base_means(w, batch, p->images[t], block, 1e-4, who + " images plan");
+      expect_features_are_base_means(w, batch, p->features[t], block, 1e-4, who + " features-only");
+      for (const BatchOutput* o : {&p->images[t], &p->features[t]}) {
+        ASSERT_EQ(o->metal.size(), scenes.size() * kZones);
+        for (size_t i = 0; i < scenes.size(); ++i) {
+          const auto& base = w.cat.subjects[scenes[i].subject].base_zones;
+          EXPECT_TRUE(std::equal(base.begin(), base.end(), o->metal_of(i))) << who << " scenario " << i;
+        }
+      }
+    }
+  }
+}
+
+// =============================================================================================
+// 5. Block sizes 1, 7, the image, and beyond it.
+
+TEST(ExtremeBlock, SizesFromOnePixelToBeyondTheImage) {
+  World& w = default_world();
+  for (int block : {1, 7, 200, 256, 257, 500, 65536}) {
+    SCOPED_TRACE("block " + std::to_string(block));
+    const FeatureLayout lay = FeatureLayout::of(w.cat, block);
+    EXPECT_EQ(lay.blocks_x, (200 + block - 1) / block);
+    EXPECT_EQ(lay.blocks_y, (200 + block - 1) / block);
+    EXPECT_EQ(lay.image_features(), 2 * lay.blocks_x * lay.blocks_y + kRegions);
+    EXPECT_EQ(lay.names().size(), static_cast<size_t>(lay.row_features()));
+    Plan check = features_plan(model(0, true, 0.0, block), Tier::standard);
+    EXPECT_NO_THROW(validate(check, w.cat));
+    const SceneBatch batch = test::batch_of(coverage(w.cat, block == 1 ? 40 : 120, 13, false), 300);
+    const auto p = expect_parity(w, batch, model(41, true, 0.0, block), "block");
+    if (block >= 200) {
+      // One block per view: its mean is the whole view's, in every output with images.
+      EXPECT_EQ(lay.blocks_x, 1);
+      EXPECT_EQ(lay.blocks_y, 1);
+      for (const BatchOutput* o : {&p->ref_images, &p->images[0], &p->images[1], &p->images[2]}) {
+        ASSERT_EQ(o->features.size(), batch.size() * (2 + kRegions));
+        for (size_t i = 0; i < batch.size(); ++i) {
+          const size_t px = size_t(o->mmw_width) * o->mmw_height;
+          double up = 0, lo = 0;
+          for (size_t q = 0; q < px; ++q) up += o->upper_of(i)[q], lo += o->lower_of(i)[q];
+          EXPECT_NEAR(o->features_of(i)[0], up / px, 1e-3) << "scenario " << i;
+          EXPECT_NEAR(o->features_of(i)[1], lo / px, 1e-3) << "scenario " << i;
+        }
+      }
+    }
+  }
+  // Per-pixel noise (the dense path everywhere but the fast tier's block-mean model).
+  for (int block : {7, 500}) {
+    const SceneBatch batch = test::batch_of(coverage(w.cat, 60, 6, false), 900);
+    expect_parity(w, batch, model(42, true, 5.0, block), "block with pixel noise");
+  }
+  Plan too_big = features_plan(model(0, true, 0.0, 65537), Tier::standard);
+  EXPECT_THROW(validate(too_big, w.cat), InputError);
+}
+
+// =============================================================================================
+// 6. Images of 1x1 and 4096x4096.
+
+TEST(ExtremeImageSize, OneByOne) {
+  std::string text = default_text();
+  for (const char* key : {"mmw_width", "mmw_height", "ir_width", "ir_height"}) text = set_image_key(text, key, "1");
+  text = map_rects(text, [](int, bool, Rect) { return Rect{0, 0, 1, 1}; });
+  for (const std::string noise : {"40", "1"}) {
+    SCOPED_TRACE("noise_size " + noise);
+    auto w = make_world(set_image_key(text, "noise_size", noise));
+    ASSERT_EQ(w->cat.images.mmw_width, 1);
+    ASSERT_EQ(w->cat.regions[12].ir.w, 1);
+    const SceneBatch batch = test::batch_of(coverage(w->cat, 300, 13), 42);
+    for (int block : {1, 10}) expect_parity(*w, batch, model(61, true, 0.0, block), "1x1 images");
+    expect_parity(*w, batch, model(62, true, 3.0, 1), "1x1 images with pixel noise", FastNoisy::range_only);
+    const FeatureLayout lay = FeatureLayout::of(w->cat, 10);
+    EXPECT_EQ(lay.image_features(), 2 + kRegions);
+  }
+}
+
+// A 4096x4096 catalogue: the default's rectangles, object sizes and noise tile scaled by 20
+// (IR 2048x4096), one subject to keep the procedural images quick.
+World& world_4096() {
+  static std::unique_ptr<World> w = [] {
+    std::string text = first_subject_only(default_text());
+    text = set_image_key(text, "mmw_width", "4096");
+    text = set_image_key(text, "mmw_height", "4096");
+    text = set_image_key(text, "ir_width", "2048");
+    text = set_image_key(text, "ir_height", "4096");
+    text = set_image_key(text, "noise_size", "800");
+    text = map_rects(text, [](int, bool, Rect r) { return Rect{r.x * 20, r.y * 20, r.w * 20, r.h * 20}; });
+    text = map_sizes(text, [](int a, int b) { return std::pair{a * 20, b * 20}; });
+    return make_world(text);
+  }();
+  return *w;
+}
+
+std::vector<Scenario> three_scenes_4096(const Catalogue& c) {
+  std::vector<Scenario> v(3);
+  for (int r : {0, 4, 8, 12}) v[1].objects[r] = static_cast<int16_t>((r * 3) % c.variant_list.size());
+  v[2] = crowded(c, 0, 5);
+  return v;
+}
+
+TEST(ExtremeImageSize, FourThousandNinetySix) {
+  World& w = world_4096();
+  ASSERT_EQ(w.cat.images.mmw_width, 4096);
+  ASSERT_EQ(w.assets.bases[0][0].width, 4096);
+  ASSERT_EQ(w.assets.bases[0][2].width, 2048);
+  const SceneBatch batch = test::batch_of(three_scenes_4096(w.cat), 7);
+  expect_parity(w, batch, model(71, true, 0.0, 512), "4096x4096");
+}
+
+// =============================================================================================
+// 7. Sprites partly outside the image.
+
+TEST(ExtremeSprites, PartlyOutsideTheImage) {
+  const std::string big = map_sizes(default_text(), [](int, int) { return std::pair{400, 400}; });
+  // Regions at the corners of both views.
+  const std::string corners = map_rects(big, [](int region, bool mmw, Rect) {
+    switch (region % 4) {
+      case 0:
+        return mmw ? Rect{0, 0, 1, 1} : Rect{0, 0, 1, 1};
+      case 1:
+        return mmw ? Rect{199, 199, 1, 1} : Rect{99, 199, 1, 1};
+      case 2:
+        return mmw ? Rect{199, 0, 1, 1} : Rect{99, 0, 1, 1};
+      default:
+        return mmw ? Rect{0, 199, 1, 1} : Rect{0, 199, 1, 1};
+    }
+  });
+  for (const auto& [name, text] :
+       {std::pair{"400x400 sprites at the corners", corners},
+        std::pair{"400x400 sprites, 600x600 noise tile, default regions", set_image_key(big, "noise_size", "600")}}) {
+    SCOPED_TRACE(name);
+    auto w = make_world(text);
+    ASSERT_EQ(w->assets.mmw_sprites[0].width, 400);
+    std::vector<Scenario> scenes = coverage(w->cat, 40, 4, false);
+    scenes.push_back(crowded(w->cat, 0, 0));
+    scenes.push_back(crowded(w->cat, 3, 7));
+    const SceneBatch batch = test::batch_of(scenes, 123);
+    expect_parity(*w, batch, model(81, true), name);
+    expect_parity(*w, batch, model(82, false, 2.0), name);
+  }
+}
+
+// =============================================================================================
+// 8. Huge per-pixel noise.
+
+TEST(ExtremeNoise, SigmaOfAThousand) {
+  World& w = default_world();
+  const SceneBatch batch = test::batch_of(coverage(w.cat, 50, 6, false), 31);
+  // The block-mean model ignores clipping, which dominates at this sigma: the fast tier's
+  // features-only run is held to [0, 255] only.
+  const auto p = expect_parity(w, batch, model(91, true, 1000.0), "sigma 1000", FastNoisy::range_only);
+  auto share_at_ends = [](const BatchOutput& o) {
+    size_t ends = 0, all = 0;
+    for (const std::vector<uint8_t>* v : {&o.upper, &o.lower, &o.ir}) {
+      for (uint8_t x : *v) ends += x == 0 || x == 255;
+      all += v->size();
+    }
+    return all ? double(ends) / all : 0.0;
+  };
+  EXPECT_GT(share_at_ends(p->ref_images), 0.85);
+  for (size_t t = 0; t < kTiers.size(); ++t) EXPECT_GT(share_at_ends(p->images[t]), 0.85) << tier_name(kTiers[t]);
+}
+
+// =============================================================================================
+// 9. The largest seeds and scenario indices.
+
+TEST(ExtremeSeeds, ZeroAndMaxSeedsAndIndicesNearTheEnd) {
+  World& w = default_world();
+  std::vector<Scenario> scenes;
+  for (uint64_t k = 0; k < 10; ++k) scenes.push_back(test::random_scenario(w.cat, k + 500, 6));
+  for (const uint64_t seed : {uint64_t{0}, kMaxU64})
+    for (const uint64_t first : {uint64_t{0}, kMaxU64 - 9}) {
+      const SceneBatch batch = test::batch_of(scenes, first);
+      const ModelSettings m = model(seed, true, 5.0, 10, 7);
+      SCOPED_TRACE(describe(m) + ", first index " + std::to_string(first));
+      const auto p = expect_parity(w, batch, m, "extreme seed and index");
+      for (size_t t = 0; t < kTiers.size(); ++t) {
+        const std::string who = tier_name(kTiers[t]);
+        // Same inputs, same bytes.
+        BatchOutput again;
+        w.cl->run(batch, images_plan(m, kTiers[t]), again);
+        EXPECT_TRUE(again.upper == p->images[t].upper && again.lower == p->images[t].lower &&
+                    again.ir == p->images[t].ir)
+            << who << ": images differ between two identical runs";
+        EXPECT_TRUE(again.features == p->images[t].features) << who;
+        EXPECT_TRUE(again.metal == p->images[t].metal) << who;
+        w.cl->run(batch, features_plan(m, kTiers[t]), again);
+        EXPECT_TRUE(again.features == p->features[t].features) << who << ": features-only run not repeatable";
+        // The last scenario alone, as the first of its own batch.
+        BatchOutput one;
+        w.cl->run(test::batch_of({scenes[9]}, first + 9), images_plan(m, kTiers[t]), one);
+        const size_t px = size_t(one.mmw_width) * one.mmw_height;
+        ASSERT_EQ(one.upper.size(), px);
+        EXPECT_TRUE(std::equal(one.upper.begin(), one.upper.end(), p->images[t].upper_of(9))) << who;
+        EXPECT_TRUE(std::equal(one.metal.begin(), one.metal.end(), p->images[t].metal_of(9))) << who;
+      }
+    }
+  // The seed matters at the top of its range too.
+  BatchOutput a, b;
+  const SceneBatch batch = test::batch_of(scenes, kMaxU64 - 9);
+  w.cl->run(batch, images_plan(model(0, true, 5.0), Tier::standard), a);
+  w.cl->run(batch, images_plan(model(kMaxU64, true, 5.0), Tier::standard), b);
+  EXPECT_NE(a.upper, b.upper);
+}
+
+// =============================================================================================
+// 10. Batches of one and of a million.
+
+TEST(ExtremeBatch, OneAndAMillion) {
+  World& w = default_world();
+  const ModelSettings m = model(1234, true, 0.0, 100, 5);
+  const Plan plan = features_plan(m, Tier::standard);
+  ASSERT_TRUE(plan.sparse_features());
+  constexpr size_t kMillion = 1000000;
+  SceneBatch big;
+  big.first_index = 0;
+  big.subject.reserve(kMillion);
+  big.objects.reserve(kMillion * kRegions);
+  big.label.reserve(kMillion);
+  for (uint64_t k = 0; k < kMillion; ++k) big.push(test::random_scenario(w.cat, k, 4));
+  BatchOutput out;
+  w.cl->run(big, plan, out);
+  const size_t F = out.layout.image_features();
+  ASSERT_EQ(F, size_t(2 * 2 * 2 + kRegions));
+  ASSERT_EQ(out.features.size(), kMillion * F);
+  ASSERT_EQ(out.metal.size(), kMillion * kZones);
+  expect_in_range(out);
+  for (const uint64_t index : {uint64_t{0}, uint64_t{1}, uint64_t{500000}, uint64_t{999999}}) {
+    SCOPED_TRACE("index " + std::to_string(index));
+    const SceneBatch one = test::batch_of({big.at(index)}, index);
+    BatchOutput alone, ref;
+    w.cl->run(one, plan, alone);
+    ASSERT_EQ(alone.features.size(), F);
+    EXPECT_TRUE(std::equal(alone.features.begin(), alone.features.end(), out.features_of(index)))
+        << "features of the scenario alone differ from its row in the million";
+    EXPECT_TRUE(std::equal(alone.metal.begin(), alone.metal.end(), out.metal_of(index)));
+    w.ref->run(one, plan, ref);
+    EXPECT_EQ(check_tolerance(compare_outputs(alone, ref), tier_tolerance(Tier::standard)), "");
+  }
+}
+
+// =============================================================================================
+// 11. Sums over large blocks: fp32 against fp64.
+
+TEST(ExtremeLargeSums, BlockOf4096OverA4096Image) {
+  {
+    // Per-scenario content (procedural body, objects, pattern noise): within tolerance.
+    World& w = world_4096();
+    const SceneBatch batch = test::batch_of(three_scenes_4096(w.cat), 3);
+    const auto p = expect_parity(w, batch, model(111, true, 0.0, 4096), "4096 image, block 4096");
+    EXPECT_EQ(p->ref_features.layout.blocks_x, 1);
+  }
+  // All white, with regions 1 and 7 the whole view: every mean is exactly 255, though the sum
+  // (255 * 4096^2) is above 2^31 and far above 2^24. Block 256 takes the sparse path.
+  TempDir t;
+  const std::string white = write_gray(t.path(), "white.png", 4096, 4096, 255);
+  const std::string white_ir = write_gray(t.path(), "white-ir.png", 2048, 4096, 255);
+  std::string text = first_subject_only(default_text());
+  text = set_image_key(text, "mmw_width", "4096");
+  text = set_image_key(text, "mmw_height", "4096");
+  text = set_image_key(text, "ir_width", "2048");
+  text = set_image_key(text, "ir_height", "4096");
+  text = map_rects(text, [](int region, bool mmw, Rect r) {
+    if (region == 1 || region == 7) return mmw ? Rect{0, 0, 4096, 4096} : Rect{0, 0, 2048, 4096};
+    return Rect{r.x * 20, r.y * 20, r.w * 20, r.h * 20};
+  });
+  text = add_after_name(text, "subject-1",
+                        "mmw_upper = \"" + white + "\"\nmmw_lower = \"" + white + "\"\nir = \"" + white_ir + "\"\n");
+  auto w = make_world(text, t.str());
+  std::vector<Scenario> scenes(2);  // empty, then objects over the white
+  for (int r : {0, 3, 6, 9, 12}) scenes[1].objects[r] = static_cast<int16_t>(r % w->cat.variant_list.size());
+  const SceneBatch batch = test::batch_of(scenes, 0);
+  for (int block : {4096, 256}) {
+    const auto p = expect_parity(*w, batch, model(112, true, 0.0, block), "white 4096 image");
+    SCOPED_TRACE("block " + std::to_string(block));
+    for (const BatchOutput* o : {&p->ref_images, &p->ref_features, &p->images[0], &p->images[1], &p->images[2],
+                                 &p->features[0], &p->features[1], &p->features[2]}) {
+      ASSERT_EQ(o->features.size(), 2 * size_t(o->layout.image_features()));
+      size_t not_white = 0;
+      for (int k = 0; k < o->layout.image_features(); ++k) not_white += o->features_of(0)[k] != 255.0f;
+      EXPECT_EQ(not_white, 0u) << "means of an all-white scenario that are not exactly 255";
+      EXPECT_LT(o->features_of(1)[2 * o->layout.blocks_x * o->layout.blocks_y], 255.0f) << "objects show";
+    }
+  }
+}
+
+// =============================================================================================
+// 12. NaN, infinity and negative numbers are rejected, naming file, line and field.
+
+TEST(ExtremeRejection, CatalogueNumbers) {
+  const std::string zones =
+      "base_zones = [200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200]";
+  struct Case {
+    std::string from, to, field;
+    std::vector<std::string> extra;
+  };
+  const std::vector<Case> cases = {
+      {"alpha = 0.9", "alpha = nan", "images.alpha", {"NaN"}},
+      {"alpha = 0.9", "alpha = inf", "images.alpha", {"infinity"}},
+      {"alpha = 0.9", "alpha = -inf", "images.alpha", {"infinity"}},
+      {"alpha = 0.9", "alpha = -0.1", "images.alpha", {"-0.1"}},
+      {"build = 1.0", "build = nan", "subjects[1].build", {"NaN"}},
+      {"build = 1.0", "build = -inf", "subjects[1].build", {"infinity"}},
+      {"build = 1.0", "build = -1.0", "subjects[1].build", {"-1"}},
+      {zones, replace_once(zones, "[200, 200", "[200, -5"), "subjects[1].base_zones[1]", {"-5"}},
+      {"size = [44, 30]", "size = [-3, 4]", "objects[1].size[0]", {"-3"}},
+      {"size = [44, 30]", "size = [44, -30]", "objects[1].size[1]", {"-30"}},
+      {"gain = 1.0", "gain = -1", "noise[1].gain", {"-1"}},
+      {"gain = 1.0", "gain = inf", "noise[1].gain", {"infinity"}},
+      {"gain = 1.0", "gain = nan", "noise[1].gain", {"NaN"}},
+      {"mmw_width = 200", "mmw_width = -200", "images.mmw_width", {"-200"}},
+      {"noise_size = 40", "noise_size = -40", "images.noise_size", {"-40"}},
+      {"mmw_level = 238", "mmw_level = -1", "objects[1].mmw_level", {"-1"}},
+      {"mmw = [49, 40, 34, 70]", "mmw = [-1, 40, 34, 70]", "regions[1].mmw", {}},
+  };
+  for (const Case& c : cases) {
+    const std::string text = replace_once(default_text(), c.from, c.to);
+    const int line = line_of(text, c.to);
+    ASSERT_GT(line, 0);
+    SCOPED_TRACE(c.to);
+    try {
+      parse_catalogue(text, "test.toml", "", "");
+      ADD_FAILURE() << "accepted: " << c.to;
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_TRUE(contains(msg, "test.toml:" + std::to_string(line) + ":")) << msg;
+      EXPECT_TRUE(contains(msg, c.field)) << msg;
+      for (const std::string& x : c.extra) EXPECT_TRUE(contains(msg, x)) << msg;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "not an InputError: " << e.what();
+    }
+  }
+}
+
+TEST(ExtremeRejection, SpecFileNumbers) {
+  TempDir t;
+  struct Case {
+    std::string line, key;
+  };
+  const std::vector<Case> cases = {
+      {"pixel_noise = nan", "pixel_noise"},
+      {"pixel_noise = -1", "pixel_noise"},
+      {"pixel_noise = inf", "pixel_noise"},
+      {"pixel_noise = -inf", "pixel_noise"},
+      {"pixel_noise = -0.5", "pixel_noise"},
+      {"count = -1", "count"},
+      {"metal_noise = -2", "metal_noise"},
+      {"block = -5", "block"},
+      {"seed = -1", "seed"},
+  };
+  std::vector<Rejection> rejections;
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const fs::path spec = t.path() / ("spec" + std::to_string(i) + ".toml");
+    // The bad value on line 3; a harmless key before it.
+    spit(spec, std::string("# extreme value\n") + (cases[i].key == "count" ? "what = \"features\"\n" : "count = 10\n") +
+                   cases[i].line + "\n");
+    rejections.push_back({{"generate", "--spec", spec.string()}, {spec.string() + ":3: " + cases[i].key}});
+  }
+  expect_all_rejected(rejections);
+}
+
+TEST(ExtremeRejection, CommandLineNumbers) {
+  std::vector<Rejection> cases;
+  for (const auto& [flag, value] : std::vector<std::pair<std::string, std::string>>{{"--pixel-noise", "nan"},
+                                                                                    {"--pixel-noise", "-1"},
+                                                                                    {"--pixel-noise", "inf"},
+                                                                                    {"--pixel-noise", "-inf"},
+                                                                                    {"--block", "-5"},
+                                                                                    {"--block", "0"},
+                                                                                    {"--metal-noise", "-1"}}) {
+    cases.push_back({{"simulate", "gun", flag, value}, {flag}});
+    cases.push_back({{"generate", "--count", "5", flag, value}, {flag}});
+  }
+  cases.push_back({{"generate", "--count", "-1"}, {"--count"}});
+  expect_all_rejected(cases);
+}
+
+}  // namespace
+}  // namespace portalsim
