@@ -92,7 +92,7 @@ inline void bilinear_sample(const Layers* L, int k, global const uchar* atlas, i
 }
 
 // The composited value of pixel x over `base`: each layer in region order.
-inline real composite_pixel(const Layers* L, global const uchar* atlas, real base, int x, float alpha) {
+inline real composite_pixel(const Layers* L, global const uchar* atlas, real base, int x, param alpha) {
   real v = base;
   for (int k = 0; k < L->count; ++k) {
     const int sx = x - L->x0[k];

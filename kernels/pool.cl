@@ -2,6 +2,14 @@
 // region's rectangle. Sums are exact integers; partial edge blocks average the pixels
 // they hold.
 
+// A mean of 8-bit pixels: whole part by integer division, remainder in float, so a flat
+// area's mean is exact even when -cl-fast-relaxed-math makes float division approximate
+// (host/sink/folder_reader.cpp computes the same expression). Clamped to the pixel range.
+inline float mean_of(uint sum, int count) {
+  const uint q = sum / (uint)count, r = sum % (uint)count;
+  return clamp((float)q + (float)r / (float)count, 0.0f, 255.0f);
+}
+
 // One work-item per (scenario, view, block). Features row: upper blocks, lower blocks,
 // region means.
 kernel void pool_blocks(global const uchar* upper, global const uchar* lower, uint n, int W, int H, int block,
@@ -18,7 +26,7 @@ kernel void pool_blocks(global const uchar* upper, global const uchar* lower, ui
   uint sum = 0;
   for (int y = y0; y < y1; ++y)
     for (int x = x0; x < x1; ++x) sum += img[y * W + x];
-  features[(size_t)i * row_len + rem] = (float)sum / (float)((x1 - x0) * (y1 - y0));
+  features[(size_t)i * row_len + rem] = mean_of(sum, (x1 - x0) * (y1 - y0));
 }
 
 // One work-item per (scenario, region). rects: int4 (x, y, w, h) in the region's MMW view.
@@ -33,7 +41,7 @@ kernel void pool_regions(global const uchar* upper, global const uchar* lower, u
   uint sum = 0;
   for (int y = rc.y; y < rc.y + rc.w; ++y)
     for (int x = rc.x; x < rc.x + rc.z; ++x) sum += img[y * W + x];
-  features[(size_t)i * row_len + offset + r] = (float)sum / (float)(rc.z * rc.w);
+  features[(size_t)i * row_len + offset + r] = mean_of(sum, rc.z * rc.w);
 }
 
 // ---------------------------------------------------------------------------------
@@ -81,13 +89,13 @@ kernel void base_features(global const uchar* atlas, global const int* bases, gl
     count = rc.z * rc.w;
   }
   sums[g] = (int)sum;
-  means[g] = (float)sum / (float)count;
+  means[g] = mean_of(sum, count);
 }
 
 // The pixel at (x, y) with one object alone over the base: what the dense kernel gives
 // wherever no other object reaches.
 inline uchar single_pixel(global const uchar* atlas, global const int* fp, uchar base, int x, int y, int W,
-                          float alpha, int tile, int tile_offset, float gain, int use_noise) {
+                          param alpha, int tile, int tile_offset, float gain, int use_noise) {
   real v = from_pixel(base);
   const int sx = x - fp[0], sy = y - fp[1];
   if (sx >= 0 && sy >= 0 && sx < fp[2] && sy < fp[3]) {
@@ -107,7 +115,7 @@ inline uchar single_pixel(global const uchar* atlas, global const int* fp, uchar
 // over each block of the footprint and over each region.
 kernel void footprint_deltas(global const uchar* atlas, global const int* bases, global const int* fps,
                              global const int* noise_offsets, global const float* noise_gains,
-                             global const int4* rects, int combos, int S, int P, int W, int block, float alpha,
+                             global const int4* rects, int combos, int S, int P, int W, int block, param alpha,
                              int tile, int use_noise, global int* deltas, global int* region_deltas) {
   const int g = (int)get_global_id(0);
   if (g >= combos) return;
@@ -149,7 +157,7 @@ kernel void features_sparse(global const uchar* atlas, global const int* bases, 
                             global const float* base_means, global const int* noise_offsets,
                             global const float* noise_gains, global const int4* rects, global const uchar* subject,
                             global const short* objects, uint n, int S, int P, int W, int H, int block,
-                            int bx_count, int by_count, float alpha, int tile, int use_noise, uint2 seed,
+                            int bx_count, int by_count, param alpha, int tile, int use_noise, uint2 seed,
                             uint2 first, int row_len, global float* features) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
@@ -246,13 +254,13 @@ kernel void features_sparse(global const uchar* atlas, global const int* bases, 
         for (int bx = fp[k][11]; bx < fp[k][11] + fp[k][13]; ++bx) {
           int seen = 0;
           for (int j = 0; j < k; ++j) seen |= in_blocks(bx, by, fp[j]);
-          if (!seen) vrow[by * bx_count + bx] = vrow[by * bx_count + bx] / (float)block_count(bx, by, block, W, H);
+          if (!seen) vrow[by * bx_count + bx] = mean_of((uint)vrow[by * bx_count + bx], block_count(bx, by, block, W, H));
         }
   }
   if (touched_regions)
     for (int r = 0; r < 13; ++r) {
       const int4 rc = rects[r];
-      row[2 * per_view + r] = (float)(uint)reg[r] / (float)(rc.z * rc.w);
+      row[2 * per_view + r] = mean_of((uint)reg[r], rc.z * rc.w);
     }
 }
 

@@ -9,52 +9,55 @@
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 typedef double real;
 typedef double greal;  // Gaussian draws
+typedef double param;  // alpha and sigma as the catalogue and command line give them
 inline real from_pixel(uchar b) { return (real)b; }
 // The reference's form: a s + (1 - a) v, a = alpha coverage / 255.
-inline real blend(real v, uchar value, uchar coverage, float alpha) {
+inline real blend(real v, uchar value, uchar coverage, param alpha) {
   const real a = (real)alpha * (real)coverage / 255.0;
   return a * (real)value + (1.0 - a) * v;
 }
 // A sub-pixel layer: premultiplied value pv and coverage c (0..1) from bilinear sampling.
-inline real blend_frac(real v, greal pv, greal c, float alpha) {
+inline real blend_frac(real v, greal pv, greal c, param alpha) {
   return (1.0 - (real)alpha * c) * v + (real)alpha * pv;
 }
 inline real noise_acc(real n, uchar t) { return n + ((real)t - 128.0); }
 inline real add_noise(real v, float gain, real n) { return v + (real)gain * n; }
-inline real add_gauss(real v, float sigma, greal g) { return v + (real)sigma * g; }
+inline real add_gauss(real v, param sigma, greal g) { return v + (real)sigma * g; }
 inline uchar to_pixel(real v) { return (uchar)clamp(floor(v + 0.5), 0.0, 255.0); }
 inline real real_zero(void) { return 0.0; }
 
 #elif defined(PRECISION_FIXED)
 typedef int real;  // value * 256
 typedef float greal;
+typedef float param;
 inline real from_pixel(uchar b) { return (int)b << 8; }
-inline real blend(real v, uchar value, uchar coverage, float alpha) {
+inline real blend(real v, uchar value, uchar coverage, param alpha) {
   const int a = (int)(alpha * (float)coverage * (256.0f / 255.0f) + 0.5f);  // 0..256
   return v + ((a * (((int)value << 8) - v)) >> 8);
 }
-inline real blend_frac(real v, greal pv, greal c, float alpha) {
+inline real blend_frac(real v, greal pv, greal c, param alpha) {
   return (int)rint((1.0f - alpha * c) * (float)v + alpha * pv * 256.0f);
 }
 inline real noise_acc(real n, uchar t) { return n + ((int)t - 128); }
 inline real add_noise(real v, float gain, real n) { return v + (int)rint(gain * 256.0f) * n; }
-inline real add_gauss(real v, float sigma, float g) { return v + (int)rint(sigma * g * 256.0f); }
+inline real add_gauss(real v, param sigma, float g) { return v + (int)rint(sigma * g * 256.0f); }
 inline uchar to_pixel(real v) { return (uchar)clamp((v + 128) >> 8, 0, 255); }
 inline real real_zero(void) { return 0; }
 
 #else
 typedef float real;
 typedef float greal;
+typedef float param;
 inline real from_pixel(uchar b) { return (float)b; }
 // v + a (s - v), a = alpha coverage / 255, one rounding in the fused multiply-add.
-inline real blend(real v, uchar value, uchar coverage, float alpha) {
-  const float a = alpha * (float)coverage * (1.0f / 255.0f);
+inline real blend(real v, uchar value, uchar coverage, param alpha) {
+  const float a = alpha * (float)coverage / 255.0f;
   return fma(a, (float)value - v, v);
 }
-inline real blend_frac(real v, greal pv, greal c, float alpha) { return (1.0f - alpha * c) * v + alpha * pv; }
+inline real blend_frac(real v, greal pv, greal c, param alpha) { return (1.0f - alpha * c) * v + alpha * pv; }
 inline real noise_acc(real n, uchar t) { return n + ((float)t - 128.0f); }
 inline real add_noise(real v, float gain, real n) { return v + gain * n; }
-inline real add_gauss(real v, float sigma, float g) { return fma(sigma, g, v); }
+inline real add_gauss(real v, param sigma, float g) { return fma(sigma, g, v); }
 inline uchar to_pixel(real v) { return (uchar)clamp(floor(v + 0.5f), 0.0f, 255.0f); }
 inline real real_zero(void) { return 0.0f; }
 #endif

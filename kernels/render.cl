@@ -4,8 +4,8 @@
 kernel void render_view(global const uchar* atlas, global const int* bases, global const int4* sprites,
                         global const int4* places, global const int* noise_offsets,
                         global const float* noise_gains, global const uchar* subject,
-                        global const short* objects, uint n, int view, int W, int H, float alpha,
-                        uint2 seed, uint2 first, int patterns, int tile_size, float sigma, int flags,
+                        global const short* objects, uint n, int view, int W, int H, param alpha,
+                        uint2 seed, uint2 first, int patterns, int tile_size, param sigma, int flags,
                         int placement, float jx, float jy, global uchar* out) {
   const size_t gid = get_global_id(0);
   const uint i = (uint)(gid / (size_t)H);

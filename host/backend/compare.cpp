@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <limits>
+#include <tuple>
 
 namespace portalsim {
 
@@ -45,14 +47,22 @@ OutputDiff compare_outputs(const BatchOutput& test, const BatchOutput& ref) {
     e.mmw = compare_images(a, b, mmw_px);
   }
   e.ir = compare_images(test.ir, ref.ir, size_t(ref.ir_width) * ref.ir_height);
-  if (!ref.features.empty() && test.features.size() == ref.features.size()) {
+  for (auto [a, b, d] : {std::tuple{&test.upper, &ref.upper, &e.mmw}, std::tuple{&test.ir, &ref.ir, &e.ir}})
+    if (a->size() != b->size()) d->max_abs = 256;  // one side has images the other lacks
+  constexpr double kBroken = std::numeric_limits<double>::infinity();
+  if (test.features.size() != ref.features.size()) {
+    e.feature_max_abs = e.feature_mean_abs = kBroken;  // a missing or misshapen table is no match
+  } else if (!ref.features.empty()) {
     for (size_t k = 0; k < ref.features.size(); ++k) {
-      const double d = std::abs(double(test.features[k]) - double(ref.features[k]));
+      double d = std::abs(double(test.features[k]) - double(ref.features[k]));
+      if (std::isnan(d)) d = kBroken;
       e.feature_max_abs = std::max(e.feature_max_abs, d);
       e.feature_mean_abs += d / ref.features.size();
     }
   }
-  if (!ref.metal.empty() && test.metal.size() == ref.metal.size()) {
+  if (test.metal.size() != ref.metal.size()) {
+    e.metal_exact = 0;
+  } else if (!ref.metal.empty()) {
     size_t same = 0;
     for (size_t i = 0; i < ref.n; ++i)
       same += std::equal(test.metal.begin() + i * 19, test.metal.begin() + (i + 1) * 19, ref.metal.begin() + i * 19);

@@ -19,7 +19,7 @@ extern "C" void on_signal(int) { g_stop = true; }
 struct GenerateOptions {
   CommonOptions common;
   RunSpec spec;
-  std::string out, spec_file, objects, pool, subjects, formats, shard;
+  std::string count, out, spec_file, objects, pool, subjects, formats, shard;
   std::string pattern_noise;
   std::map<std::string, std::string> knobs;
   std::string placement = "integer";
@@ -45,7 +45,10 @@ int generate(GenerateOptions& o) {
     }
     return g;
   };
-  if (given("--count")) spec.count = o.spec.count;
+  if (given("--count")) {
+    spec.count = parse_u64(o.count, "--count");
+    if (spec.count < 1 || spec.count > (1ull << 40)) throw InputError("--count: \"" + o.count + "\" is not between 1 and 2^40");
+  }
   if (given("--seed")) spec.seed = parse_u64(o.common.seed, "--seed");
   if (given("--rule")) spec.rule = o.spec.rule;
   if (given("--pool")) {
@@ -146,7 +149,7 @@ std::function<int()> add_generate(CLI::App& app) {
   o->app = sub;
   add_common_options(*sub, o->common);
   sub->add_option("--spec", o->spec_file, "TOML spec file; command-line flags override its keys");
-  sub->add_option("--count", o->spec.count, "number of scenarios (default 1000)");
+  sub->add_option("--count", o->count, "number of scenarios (default 1000)");
   sub->add_option("--out", o->out, "output folder (must be new or empty, unless --resume)")->required();
   sub->add_option("--rule", o->spec.rule, "threat rule, e.g. gun or 'iron-rod&metal-plate'");
   sub->add_option("--pool", o->pool, "objects to draw from, comma-separated (default: all)");

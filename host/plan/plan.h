@@ -24,8 +24,9 @@ struct ModelSettings {
   bool moves_sprites() const { return bilinear || jitter > 0; }
 };
 
-// How block and region means are computed. Both give the same numbers to the bit;
-// sparse is used for features-only runs without per-pixel noise, dense otherwise.
+// How block and region means are computed. Both give the same numbers to the bit
+// (under -cl-fast-relaxed-math, to the division's approximation); sparse is used for
+// features-only runs without per-pixel noise, dense otherwise.
 enum class Pooling { sparse, dense };
 // The arithmetic of the kernels' pixel values.
 enum class Precision { fp32, fp64, fixed16 };

@@ -33,6 +33,12 @@ std::string read_line(const fs::path& p) {
   return line;
 }
 
+// The kernels' mean_of (kernels/pool.cl), so rows from folders equal generate's rows.
+float mean_of(uint32_t sum, int count) {
+  const uint32_t q = sum / static_cast<uint32_t>(count), r = sum % static_cast<uint32_t>(count);
+  return std::clamp(static_cast<float>(q) + static_cast<float>(r) / static_cast<float>(count), 0.0f, 255.0f);
+}
+
 }  // namespace
 
 std::vector<std::string> find_scenario_folders(const std::vector<std::string>& paths) {
@@ -85,14 +91,14 @@ bool read_scenario_folder(const std::string& dir, const Catalogue& cat, BatchOut
         uint32_t sum = 0;
         for (int y = y0; y < y1; ++y)
           for (int x = x0; x < x1; ++x) sum += img.at(x, y);
-        row[k++] = static_cast<float>(sum) / static_cast<float>((x1 - x0) * (y1 - y0));
+        row[k++] = mean_of(sum, (x1 - x0) * (y1 - y0));
       }
   for (const Region& r : cat.regions) {
     const Image& img = views[r.view == View::upper ? 0 : 1];
     uint32_t sum = 0;
     for (int y = r.mmw.y; y < r.mmw.y + r.mmw.h; ++y)
       for (int x = r.mmw.x; x < r.mmw.x + r.mmw.w; ++x) sum += img.at(x, y);
-    row[k++] = static_cast<float>(sum) / static_cast<float>(r.mmw.w * r.mmw.h);
+    row[k++] = mean_of(sum, r.mmw.w * r.mmw.h);
   }
   // metal.txt: 19 integers 1..200, separated by commas and/or spaces.
   const fs::path metal = d / "metal.txt";

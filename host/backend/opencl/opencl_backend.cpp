@@ -127,12 +127,12 @@ class OpenCLBackend final : public Backend {
       k.setArg(a++, static_cast<cl_int>(view));
       k.setArg(a++, static_cast<cl_int>(W));
       k.setArg(a++, static_cast<cl_int>(H));
-      k.setArg(a++, static_cast<cl_float>(ic.alpha));
+      set(k, a++, param(K, ic.alpha));
       k.setArg(a++, seed);
       k.setArg(a++, first);
       k.setArg(a++, static_cast<cl_int>(cat_.noise.size()));
       k.setArg(a++, static_cast<cl_int>(ic.noise_size));
-      k.setArg(a++, static_cast<cl_float>(plan.model.pixel_sigma));
+      set(k, a++, param(K, plan.model.pixel_sigma));
       k.setArg(a++, flags);
       // Jitter in this view's pixels: the IR view is at its own scale.
       const double sx = view == 2 ? double(ic.ir_width) / ic.mmw_width : 1.0;
@@ -240,7 +240,21 @@ class OpenCLBackend final : public Backend {
     cl::Kernel render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, features_sparse,
         analytic_noise;
     SparseTables tables;
+    bool fp64 = false;  // alpha and sigma are passed as double
   };
+
+  // A model parameter at the kernels' parameter precision (see kernels/precision.cl).
+  struct ParamArg {
+    bool fp64;
+    double v;
+  };
+  static ParamArg param(const Kernels& k, double v) { return {k.fp64, v}; }
+  static void set(cl::Kernel& k, int index, ParamArg p) {
+    if (p.fp64)
+      k.setArg(index, static_cast<cl_double>(p.v));
+    else
+      k.setArg(index, static_cast<cl_float>(p.v));
+  }
 
   static std::string build_options(const Fidelity& f) {
     std::string o = f.precision == Precision::fp64      ? "-DPRECISION_FP64"
@@ -264,6 +278,7 @@ class OpenCLBackend final : public Backend {
     k.footprint_deltas = cl::Kernel(p, "footprint_deltas");
     k.features_sparse = cl::Kernel(p, "features_sparse");
     k.analytic_noise = cl::Kernel(p, "analytic_noise");
+    k.fp64 = f.precision == Precision::fp64;
     return variants_.emplace(options, std::move(k)).first->second;
   }
 
@@ -373,7 +388,7 @@ class OpenCLBackend final : public Backend {
     footprint_deltas_.setArg(a++, static_cast<cl_int>(P));
     footprint_deltas_.setArg(a++, static_cast<cl_int>(W));
     footprint_deltas_.setArg(a++, static_cast<cl_int>(block));
-    footprint_deltas_.setArg(a++, static_cast<cl_float>(ic.alpha));
+    set(footprint_deltas_, a++, param(K, ic.alpha));
     footprint_deltas_.setArg(a++, static_cast<cl_int>(N));
     footprint_deltas_.setArg(a++, static_cast<cl_int>(noise ? 1 : 0));
     footprint_deltas_.setArg(a++, tables_.deltas);
@@ -414,7 +429,7 @@ class OpenCLBackend final : public Backend {
     k.setArg(a++, static_cast<cl_int>(lay.block));
     k.setArg(a++, static_cast<cl_int>(lay.blocks_x));
     k.setArg(a++, static_cast<cl_int>(lay.blocks_y));
-    k.setArg(a++, static_cast<cl_float>(ic.alpha));
+    set(k, a++, param(K, ic.alpha));
     k.setArg(a++, static_cast<cl_int>(ic.noise_size));
     k.setArg(a++, static_cast<cl_int>(tables_.noise ? 1 : 0));
     k.setArg(a++, seed);
