@@ -40,7 +40,9 @@ def main():
             label = r["name"] + ("" if acc is None else "\nJ48 %.1f%%" % acc)
             ax.annotate(label, pts[i], textcoords="offset points", xytext=(6, 6), fontsize=8)
         ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "--", color="C3", label="Pareto front")
-        ax.set_xscale("log")
+        xs = [p[0] for p in pts]
+        if max(xs) > 10 * min(xs):  # a log axis only where the range calls for one
+            ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel(xl)
         ax.set_ylabel(yl)
