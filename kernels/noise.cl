@@ -43,21 +43,11 @@ inline real pattern_noise(const Tiles* T, global const uchar* atlas, int tile_si
 
 // Per-pixel sensor noise: one Philox draw feeds a Box-Muller pair (pixels 2k, 2k+1),
 // computed at the build's Gaussian precision.
-typedef struct {
-  int pair;  // pixel index / 2 of the cached pair, -1 for none
-  greal g[2];
-} GaussPair;
-
-inline greal pixel_noise(GaussPair* c, uint2 seed, ulong index, int view, int p) {
-  if (c->pair != (p >> 1)) {
-    c->pair = p >> 1;
-    const uint4 r = draw(seed, index, STREAM_PIXEL_NOISE, ((uint)view << 28) | ((uint)p >> 1));
-    const greal u1 = (greal)1 - (greal)(r.x >> 8) * ((greal)1 / (greal)16777216);
-    const greal u2 = (greal)(r.y >> 8) * ((greal)1 / (greal)16777216);
-    const greal rad = sqrt((greal)-2 * log(u1));
-    const greal th = (greal)6.283185307179586 * u2;
-    c->g[0] = rad * cos(th);
-    c->g[1] = rad * sin(th);
-  }
-  return c->g[p & 1];
+inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {
+  const uint4 r = draw(seed, index, STREAM_PIXEL_NOISE, ((uint)view << 28) | (uint)pair);
+  const greal u1 = (greal)1 - (greal)(r.x >> 8) * ((greal)1 / (greal)16777216);
+  const greal u2 = (greal)(r.y >> 8) * ((greal)1 / (greal)16777216);
+  const greal rad = sqrt((greal)-2 * log(u1));
+  const greal th = (greal)6.283185307179586 * u2;
+  return (greal2)(rad * cos(th), rad * sin(th));
 }

@@ -9,6 +9,7 @@
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 typedef double real;
 typedef double greal;  // Gaussian draws
+typedef double2 greal2;
 typedef double param;  // alpha and sigma as the catalogue and command line give them
 inline real from_pixel(uchar b) { return (real)b; }
 // The reference's form: a s + (1 - a) v, a = alpha coverage / 255.
@@ -29,6 +30,7 @@ inline real real_zero(void) { return 0.0; }
 #elif defined(PRECISION_FIXED)
 typedef int real;  // value * 256
 typedef float greal;
+typedef float2 greal2;
 typedef float param;
 inline real from_pixel(uchar b) { return (int)b << 8; }
 inline real blend(real v, uchar value, uchar coverage, param alpha) {
@@ -47,6 +49,7 @@ inline real real_zero(void) { return 0; }
 #else
 typedef float real;
 typedef float greal;
+typedef float2 greal2;
 typedef float param;
 inline real from_pixel(uchar b) { return (float)b; }
 // v + a (s - v), a = alpha coverage / 255, one rounding in the fused multiply-add.

@@ -51,13 +51,28 @@ kernel void render_view(global const uchar* atlas, global const int* bases, glob
   int x = 0;
   for (; x + 16 <= x0; x += 16) vstore16(vload16(0, base + x), 0, row + x);
   for (; x < x0; ++x) row[x] = base[x];
-  GaussPair gp;
-  gp.pair = -1;
+  if (flags & FLAG_PIXEL_NOISE) {
+    // The whole row, a Box-Muller pair (one Philox draw) per two pixels, no branch per
+    // pixel. Pairs follow the pixel index y*W + x, so an odd W starts rows mid-pair.
+    const int p0 = y * W;
+    for (; x < W; ++x) {
+      const int p = p0 + x;
+      const greal2 g = gauss_pair(seed, index, view, p >> 1);
+      real v = composite_pixel(&L, atlas, from_pixel(base[x]), x, alpha);
+      v = pattern_noise(&T, atlas, tile_size, gain, v, x);
+      row[x] = to_pixel(add_gauss(v, sigma, (p & 1) ? g.y : g.x));
+      if ((p & 1) == 0 && x + 1 < W) {
+        ++x;
+        real v1 = composite_pixel(&L, atlas, from_pixel(base[x]), x, alpha);
+        v1 = pattern_noise(&T, atlas, tile_size, gain, v1, x);
+        row[x] = to_pixel(add_gauss(v1, sigma, g.y));
+      }
+    }
+    return;
+  }
   for (; x < x1; ++x) {
     real v = composite_pixel(&L, atlas, from_pixel(base[x]), x, alpha);
-    v = pattern_noise(&T, atlas, tile_size, gain, v, x);
-    if (flags & FLAG_PIXEL_NOISE) v = add_gauss(v, sigma, pixel_noise(&gp, seed, index, view, y * W + x));
-    row[x] = to_pixel(v);
+    row[x] = to_pixel(pattern_noise(&T, atlas, tile_size, gain, v, x));
   }
   for (; x + 16 <= W; x += 16) vstore16(vload16(0, base + x), 0, row + x);
   for (; x < W; ++x) row[x] = base[x];
