@@ -10,7 +10,7 @@ packages=(build-essential cmake pkg-config
   libopenimageio-dev openimageio-tools
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libxxhash-dev libgtest-dev libbenchmark-dev
-  weka default-jre-headless python3 python3-matplotlib)
+  weka default-jre-headless python3 python3-matplotlib clang-format)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -47,7 +47,8 @@ int generate(GenerateOptions& o) {
   };
   if (given("--count")) {
     spec.count = parse_u64(o.count, "--count");
-    if (spec.count < 1 || spec.count > (1ull << 40)) throw InputError("--count: \"" + o.count + "\" is not between 1 and 2^40");
+    if (spec.count < 1 || spec.count > (1ull << 40))
+      throw InputError("--count: \"" + o.count + "\" is not between 1 and 2^40");
   }
   if (given("--seed")) spec.seed = parse_u64(o.common.seed, "--seed");
   if (given("--rule")) spec.rule = o.spec.rule;

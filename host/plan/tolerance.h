@@ -25,9 +25,9 @@ inline Tolerance tier_tolerance(Tier t) {
   switch (t) {
     case Tier::exact:  // fp64, the reference's formulas: ties and libm's last bits
       return {1, 1e-3, 0.05, 1e-3};
-    case Tier::standard:  // fp32: ties, also carried through overlapping blends
+    case Tier::standard:                   // fp32: ties, also carried through overlapping blends
       return {1, 0.05, 1.0 + 1e-4, 0.05};  // a mean of pixels within 1, plus its float rounding
-    case Tier::fast:  // 8.8 fixed point: alpha and noise gain quantised to 1/256
+    case Tier::fast:                       // 8.8 fixed point: alpha and noise gain quantised to 1/256
       return {2, 0.5, 2.0, 0.5};
   }
   return {0, 0, 0, 0};
