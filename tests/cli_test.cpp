@@ -22,7 +22,7 @@
 #include <thread>
 #include <vector>
 
-extern char** environ;
+#include "run_binary.h"
 
 namespace {
 
@@ -68,118 +68,15 @@ class TempDir {
   fs::path root_;
 };
 
-struct Result {
-  std::string command;
-  bool exited = false;
-  int status = -1;
-  bool signaled = false;
-  int signal = 0;
-  bool timed_out = false;
-  std::string out, err;
-};
+using portalsim::test::describe;
+using portalsim::test::finish;
+using portalsim::test::quoted;
+using portalsim::test::Result;
+using portalsim::test::Running;
+using portalsim::test::slurp;
+using portalsim::test::spit;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void spit(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-  if (!out) ADD_FAILURE() << "cannot write " << p;
-}
-
-std::string quoted(const std::string& a) {
-  if (!a.empty() && a.find_first_of(" '\"&|;<>()$*?\\") == std::string::npos) return a;
-  std::string q = "'";
-  for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string describe(const Result& r) {
-  std::ostringstream s;
-  s << "command: " << r.command << "\n";
-  if (r.timed_out)
-    s << "timed out\n";
-  else if (r.signaled)
-    s << "killed by signal " << r.signal << "\n";
-  else
-    s << "exit status " << r.status << "\n";
-  s << "--- stdout ---\n" << r.out << "--- stderr ---\n" << r.err << "---";
-  return s.str();
-}
-
-struct Running {
-  pid_t pid = -1;
-  std::string command;
-  fs::path out_path, err_path;
-};
-
-// Starts `portalsim ARGS` with stdin from /dev/null and stdout/stderr captured in files.
-Running start(const TempDir& t, const Args& args) {
-  static int counter = 0;
-  const int n = ++counter;
-  Running r;
-  r.out_path = t.cap() / (std::string("run") + std::to_string(n) + ".stdout");
-  r.err_path = t.cap() / (std::string("run") + std::to_string(n) + ".stderr");
-  std::vector<std::string> argv_s{PORTALSIM_BINARY};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
-  r.command = "portalsim";
-  for (const std::string& a : args) {
-    r.command += ' ';
-    r.command += quoted(a);
-  }
-  std::vector<char*> argv;
-  for (std::string& a : argv_s) argv.push_back(a.data());
-  argv.push_back(nullptr);
-
-  const std::string out_s = r.out_path.string(), err_s = r.err_path.string();
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, 1, out_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&fa, 2, err_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  const int rc = posix_spawn(&r.pid, argv[0], &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0) {
-    ADD_FAILURE() << "cannot start " << PORTALSIM_BINARY << ": " << std::strerror(rc);
-    r.pid = -1;
-  }
-  return r;
-}
-
-// Waits for a started run (at most 120 s, then kills it) and collects what it printed.
-Result finish(const Running& r) {
-  Result res;
-  res.command = r.command;
-  if (r.pid < 0) return res;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  int ws = 0;
-  for (;;) {
-    const pid_t w = ::waitpid(r.pid, &ws, WNOHANG);
-    if (w == r.pid) break;
-    if (w < 0 && errno != EINTR) {
-      ADD_FAILURE() << "waitpid: " << std::strerror(errno);
-      return res;
-    }
-    if (std::chrono::steady_clock::now() > deadline) {
-      ::kill(r.pid, SIGKILL);
-      ::waitpid(r.pid, &ws, 0);
-      res.timed_out = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  res.exited = WIFEXITED(ws);
-  if (res.exited) res.status = WEXITSTATUS(ws);
-  res.signaled = WIFSIGNALED(ws);
-  if (res.signaled) res.signal = WTERMSIG(ws);
-  res.out = slurp(r.out_path);
-  res.err = slurp(r.err_path);
-  return res;
-}
+Running start(const TempDir& t, const Args& args) { return portalsim::test::start(t.cap(), args); }
 
 Result run(const TempDir& t, const Args& args) { return finish(start(t, args)); }
 

@@ -41,10 +41,9 @@
 #include "backend/compare.h"
 #include "plan/plan.h"
 #include "plan/tolerance.h"
+#include "run_binary.h"
 #include "scene/error.h"
 #include "support.h"
-
-extern char** environ;
 
 namespace portalsim::embedded {
 extern const std::string_view default_catalogue;
@@ -477,105 +476,12 @@ void check_opaque(const Image& sprite, const Rect& rect, const uint8_t* img, con
 // ---------------------------------------------------------------------------------------------
 // Running the binary (as tests/cli_test.cpp does).
 
-struct Result {
-  std::string command;
-  bool exited = false, signaled = false, timed_out = false;
-  int status = -1, signal = 0;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void spit(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-  if (!out) ADD_FAILURE() << "cannot write " << p;
-}
-
-std::string describe(const Result& r) {
-  std::ostringstream s;
-  s << "command: " << r.command << "\n";
-  if (r.timed_out)
-    s << "timed out\n";
-  else if (r.signaled)
-    s << "killed by signal " << r.signal << "\n";
-  else
-    s << "exit status " << r.status << "\n";
-  s << "--- stdout ---\n" << r.out << "--- stderr ---\n" << r.err << "---";
-  return s.str();
-}
-
-struct Running {
-  pid_t pid = -1;
-  std::string command;
-  fs::path out_path, err_path;
-};
-
-Running start(const fs::path& cap, const std::vector<std::string>& args) {
-  static int counter = 0;
-  const int n = ++counter;
-  Running r;
-  r.out_path = cap / ("run" + std::to_string(n) + ".stdout");
-  r.err_path = cap / ("run" + std::to_string(n) + ".stderr");
-  std::vector<std::string> argv_s{PORTALSIM_BINARY};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
-  r.command = "portalsim";
-  for (const std::string& a : args) r.command += " " + a;
-  std::vector<char*> argv;
-  for (std::string& a : argv_s) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const std::string out_s = r.out_path.string(), err_s = r.err_path.string();
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, 1, out_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&fa, 2, err_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0 || pid <= 0) {
-    ADD_FAILURE() << "cannot start " << PORTALSIM_BINARY << ": " << std::strerror(rc);
-    pid = -1;
-  }
-  r.pid = pid;
-  return r;
-}
-
-// Waits (at most 60 s, then kills that one child) and collects what it printed.
-Result finish(const Running& r) {
-  Result res;
-  res.command = r.command;
-  if (r.pid <= 0) return res;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  int ws = 0;
-  for (;;) {
-    const pid_t w = ::waitpid(r.pid, &ws, WNOHANG);
-    if (w == r.pid) break;
-    if (w < 0 && errno != EINTR) {
-      ADD_FAILURE() << "waitpid: " << std::strerror(errno);
-      return res;
-    }
-    if (std::chrono::steady_clock::now() > deadline) {
-      if (r.pid > 0) ::kill(r.pid, SIGKILL);
-      ::waitpid(r.pid, &ws, 0);
-      res.timed_out = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  res.exited = WIFEXITED(ws);
-  if (res.exited) res.status = WEXITSTATUS(ws);
-  res.signaled = WIFSIGNALED(ws);
-  if (res.signaled) res.signal = WTERMSIG(ws);
-  res.out = slurp(r.out_path);
-  res.err = slurp(r.err_path);
-  return res;
-}
+using portalsim::test::describe;
+using portalsim::test::Result;
+using portalsim::test::Running;
+using portalsim::test::slurp;
+using portalsim::test::spit;
+using portalsim::test::start;
 
 bool contains(const std::string& hay, const std::string& needle) { return hay.find(needle) != std::string::npos; }
 
@@ -599,7 +505,7 @@ void expect_all_rejected(const std::vector<Rejection>& cases) {
     running.push_back(start(t.path() / "cap", args));
   }
   for (size_t i = 0; i < cases.size(); ++i) {
-    const Result r = finish(running[i]);
+    const Result r = finish(running[i], 60);  // this suite's runs are short
     SCOPED_TRACE(describe(r));
     EXPECT_FALSE(r.timed_out);
     EXPECT_FALSE(r.signaled) << "killed by signal " << r.signal;

@@ -26,13 +26,17 @@
 #include <thread>
 #include <vector>
 
-extern char** environ;
+#include "run_binary.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 using Args = std::vector<std::string>;
+using RunResult = portalsim::test::Result;
+using Started = portalsim::test::Running;
+const auto& read_all = portalsim::test::slurp;
+const auto& write_all = portalsim::test::spit;
 
 // ---------------------------------------------------------------------------------------------
 // Running the binary (the same approach as cli_test.cpp).
@@ -60,29 +64,6 @@ class GenTempDir {
   fs::path root_;
 };
 
-struct RunResult {
-  std::string command;
-  bool exited = false;
-  int status = -1;
-  bool signaled = false;
-  int signal = 0;
-  bool timed_out = false;
-  std::string out, err;
-};
-
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write_all(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-  if (!out) ADD_FAILURE() << "cannot write " << p;
-}
-
 bool has(const std::string& hay, const std::string& needle) { return hay.find(needle) != std::string::npos; }
 
 std::vector<std::string> split_on(const std::string& text, char sep) {
@@ -100,13 +81,6 @@ std::vector<std::string> split_on(const std::string& text, char sep) {
   return parts;
 }
 
-std::string shell_quoted(const std::string& a) {
-  if (!a.empty() && a.find_first_of(" '\"&|;<>()$*?\\") == std::string::npos) return a;
-  std::string q = "'";
-  for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
 std::string describe_run(const RunResult& r) {
   std::ostringstream s;
   s << "command: " << r.command << "\n";
@@ -120,42 +94,8 @@ std::string describe_run(const RunResult& r) {
   return s.str();
 }
 
-struct Started {
-  pid_t pid = -1;
-  std::string command;
-  fs::path out_path, err_path;
-};
-
-// Starts `program ARGS` (portalsim unless told) with stdin from /dev/null and output captured.
 Started start_program(const GenTempDir& t, const std::string& program, const Args& args) {
-  static int counter = 0;
-  const int n = ++counter;
-  Started r;
-  r.out_path = t.cap() / (std::string("run") + std::to_string(n) + ".stdout");
-  r.err_path = t.cap() / (std::string("run") + std::to_string(n) + ".stderr");
-  std::vector<std::string> argv_s{program};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
-  r.command = program == PORTALSIM_BINARY ? "portalsim" : program;
-  for (const std::string& a : args) {
-    r.command += ' ';
-    r.command += shell_quoted(a);
-  }
-  std::vector<char*> argv;
-  for (std::string& a : argv_s) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const std::string out_s = r.out_path.string(), err_s = r.err_path.string();
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, 1, out_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&fa, 2, err_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  const int rc = posix_spawn(&r.pid, argv[0], &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0) {
-    ADD_FAILURE() << "cannot start " << program << ": " << std::strerror(rc);
-    r.pid = -1;
-  }
-  return r;
+  return portalsim::test::start_program(t.cap(), program, args);
 }
 
 Started start_ps(const GenTempDir& t, const Args& args) { return start_program(t, PORTALSIM_BINARY, args); }
@@ -173,36 +113,7 @@ bool has_ended(const Started& r) {
   return info.si_pid != 0;
 }
 
-// Waits for a started run (at most `limit_s`, then kills it) and collects what it printed.
-RunResult wait_for(const Started& r, int limit_s = 120) {
-  RunResult res;
-  res.command = r.command;
-  if (r.pid < 0) return res;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(limit_s);
-  int ws = 0;
-  for (;;) {
-    const pid_t w = ::waitpid(r.pid, &ws, WNOHANG);
-    if (w == r.pid) break;
-    if (w < 0 && errno != EINTR) {
-      ADD_FAILURE() << "waitpid: " << std::strerror(errno);
-      return res;
-    }
-    if (std::chrono::steady_clock::now() > deadline) {
-      ::kill(r.pid, SIGKILL);
-      ::waitpid(r.pid, &ws, 0);
-      res.timed_out = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  res.exited = WIFEXITED(ws);
-  if (res.exited) res.status = WEXITSTATUS(ws);
-  res.signaled = WIFSIGNALED(ws);
-  if (res.signaled) res.signal = WTERMSIG(ws);
-  res.out = read_all(r.out_path);
-  res.err = read_all(r.err_path);
-  return res;
-}
+RunResult wait_for(const Started& r, int limit_s = 120) { return portalsim::test::finish(r, limit_s); }
 
 RunResult run_ps(const GenTempDir& t, const Args& args) { return wait_for(start_ps(t, args)); }
 

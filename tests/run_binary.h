@@ -1,0 +1,146 @@
+// Running the real portalsim binary from a test: stdin from /dev/null, stdout and
+// stderr captured in files, the exit status read back. Shared by the suites that test
+// the command line as a user meets it.
+#pragma once
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace portalsim::test {
+
+struct Result {
+  std::string command;
+  bool exited = false;
+  int status = -1;
+  bool signaled = false;
+  int signal = 0;
+  bool timed_out = false;
+  std::string out, err;
+};
+
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+inline void spit(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+  if (!out) ADD_FAILURE() << "cannot write " << p;
+}
+
+inline std::string quoted(const std::string& a) {
+  if (!a.empty() && a.find_first_of(" '\"&|;<>()$*?\\") == std::string::npos) return a;
+  std::string q = "'";
+  for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+inline std::string describe(const Result& r) {
+  std::ostringstream s;
+  s << "command: " << r.command << "\n";
+  if (r.timed_out)
+    s << "timed out\n";
+  else if (r.signaled)
+    s << "killed by signal " << r.signal << "\n";
+  else
+    s << "exit status " << r.status << "\n";
+  s << "--- stdout ---\n" << r.out << "--- stderr ---\n" << r.err << "---";
+  return s.str();
+}
+
+struct Running {
+  pid_t pid = -1;
+  std::string command;
+  std::filesystem::path out_path, err_path;
+};
+
+// Starts `program ARGS` with stdin from /dev/null and stdout/stderr captured in files
+// under `cap`.
+inline Running start_program(const std::filesystem::path& cap, const std::string& program,
+                             const std::vector<std::string>& args) {
+  static int counter = 0;
+  const int n = ++counter;
+  Running r;
+  r.out_path = cap / (std::string("run") + std::to_string(n) + ".stdout");
+  r.err_path = cap / (std::string("run") + std::to_string(n) + ".stderr");
+  std::vector<std::string> argv_s{program};
+  argv_s.insert(argv_s.end(), args.begin(), args.end());
+  r.command = program == PORTALSIM_BINARY ? "portalsim" : program;
+  for (const std::string& a : args) {
+    r.command += ' ';
+    r.command += quoted(a);
+  }
+  std::vector<char*> argv;
+  for (std::string& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+
+  const std::string out_s = r.out_path.string(), err_s = r.err_path.string();
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 1, out_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&fa, 2, err_s.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  const int rc = posix_spawn(&r.pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0 || r.pid <= 0) {
+    ADD_FAILURE() << "cannot start " << program << ": " << std::strerror(rc);
+    r.pid = -1;
+  }
+  return r;
+}
+
+// The same for portalsim itself.
+inline Running start(const std::filesystem::path& cap, const std::vector<std::string>& args) {
+  return start_program(cap, PORTALSIM_BINARY, args);
+}
+
+// Waits for a started run (at most limit_s, then kills that one child) and collects what it printed.
+inline Result finish(const Running& r, int limit_s = 120) {
+  Result res;
+  res.command = r.command;
+  if (r.pid <= 0) return res;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(limit_s);
+  int ws = 0;
+  for (;;) {
+    const pid_t w = ::waitpid(r.pid, &ws, WNOHANG);
+    if (w == r.pid) break;
+    if (w < 0 && errno != EINTR) {
+      ADD_FAILURE() << "waitpid: " << std::strerror(errno);
+      return res;
+    }
+    if (std::chrono::steady_clock::now() > deadline) {
+      ::kill(r.pid, SIGKILL);
+      ::waitpid(r.pid, &ws, 0);
+      res.timed_out = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  res.exited = WIFEXITED(ws);
+  if (res.exited) res.status = WEXITSTATUS(ws);
+  res.signaled = WIFSIGNALED(ws);
+  if (res.signaled) res.signal = WTERMSIG(ws);
+  res.out = slurp(r.out_path);
+  res.err = slurp(r.err_path);
+  return res;
+}
+
+}  // namespace portalsim::test
