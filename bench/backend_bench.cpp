@@ -3,33 +3,12 @@
 // Counters: scenarios/s ("items_per_second"). Kernel builds happen once, before timing.
 #include <benchmark/benchmark.h>
 
-#include "assets/assets.h"
-#include "backend/opencl/opencl_backend.h"
-#include "scene/generator.h"
+#include "fixture.h"
 
 namespace portalsim {
 namespace {
-
-struct Fixture {
-  Catalogue cat = default_catalogue();
-  AssetSet assets = build_assets(cat);
-  std::shared_ptr<OpenCLRuntime> rt = std::make_shared<OpenCLRuntime>();
-  // One compute unit: PoCL runs the kernels on a single thread.
-  std::shared_ptr<OpenCLRuntime> rt1 = std::make_shared<OpenCLRuntime>(OpenCLOptions{"", "", 1});
-};
-Fixture& fx() {
-  static Fixture f;
-  return f;
-}
-
-SceneBatch make_batch(size_t n, int max_objects = 4) {
-  GeneratorSpec spec;
-  spec.max_objects = max_objects;
-  Generator gen(fx().cat, spec, 1);
-  SceneBatch b;
-  for (size_t i = 0; i < n; ++i) b.push(gen(i));
-  return b;
-}
+using bench::fx;
+using bench::make_batch;
 
 enum Path { kFeaturesSparse, kFeaturesDense, kImages, kMetal };
 
@@ -38,17 +17,18 @@ Plan plan_for(Path path, int block) {
   p.model.block = block;
   switch (path) {
     case kFeaturesSparse:
-      p.mmw_images = p.ir_image = false;
+      p.images = 0;
       break;
     case kFeaturesDense:
-      p.mmw_images = p.ir_image = false;
+      p.images = 0;
       p.fidelity.pooling = Pooling::dense;
       break;
     case kImages:
       p.features = false;
       break;
     case kMetal:
-      p.mmw_images = p.ir_image = p.features = false;
+      p.images = 0;
+      p.features = false;
       break;
   }
   return p;

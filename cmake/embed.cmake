@@ -1,4 +1,5 @@
-# Writes OUT: a C++ file that defines one std::string_view per input file.
+# Writes OUT: a C++ file that defines one std::string_view per name: the text of its
+# file verbatim, or of several files joined with "+" (concatenated, a newline between).
 # Called as: cmake -DOUT=file.cpp -DNAMES="a|b" -DFILES="x|y" -P embed.cmake
 string(REPLACE "|" ";" NAMES "${NAMES}")
 string(REPLACE "|" ";" FILES "${FILES}")
@@ -7,8 +8,16 @@ list(LENGTH NAMES n)
 math(EXPR last "${n} - 1")
 foreach(i RANGE ${last})
   list(GET NAMES ${i} name)
-  list(GET FILES ${i} file)
-  file(READ "${file}" content)
+  list(GET FILES ${i} entry)
+  string(REPLACE "+" ";" parts "${entry}")
+  set(content "")
+  foreach(file ${parts})
+    file(READ "${file}" part)
+    if(NOT content STREQUAL "")
+      string(APPEND content "\n")
+    endif()
+    string(APPEND content "${part}")
+  endforeach()
   string(APPEND body "extern const std::string_view ${name};\nconst std::string_view ${name} = R\"portalsim_embed(${content})portalsim_embed\";\n")
 endforeach()
 string(APPEND body "}  // namespace portalsim::embedded\n")

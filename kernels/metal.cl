@@ -9,21 +9,21 @@ kernel void metal_zones(global const uchar* influence, global const uchar* varia
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const ulong index = upsample(first.y, first.x) + i;
-  int sum[19];
-  for (int z = 0; z < 19; ++z) sum[z] = 0;
-  for (int r = 0; r < 13; ++r) {
-    const int v = objects[(size_t)i * 13 + r];
+  int sum[PS_ZONES];
+  for (int z = 0; z < PS_ZONES; ++z) sum[z] = 0;
+  for (int r = 0; r < PS_REGIONS; ++r) {
+    const int v = objects[(size_t)i * PS_REGIONS + r];
     if (v < 0) continue;
-    global const uchar* row = influence + ((size_t)variant_category[v] * 13 + r) * 19;
-    for (int z = 0; z < 19; ++z) sum[z] += row[z];
+    global const uchar* row = influence + ((size_t)variant_category[v] * PS_REGIONS + r) * PS_ZONES;
+    for (int z = 0; z < PS_ZONES; ++z) sum[z] += row[z];
   }
-  global const uchar* base = base_zones + (size_t)subject[i] * 19;
-  for (int z = 0; z < 19; ++z) {
+  global const uchar* base = base_zones + (size_t)subject[i] * PS_ZONES;
+  for (int z = 0; z < PS_ZONES; ++z) {
     int value = (int)base[z] - sum[z];
     if (noise > 0 && sum[z] > 0) {
-      const uint4 r = draw(seed, index, STREAM_METAL_NOISE, (uint)z);
+      const uint4 r = draw(seed, index, PS_STREAM_METAL_NOISE, (uint)z);
       value += (int)below(r.x, (uint)noise + 1u) - (int)below(r.y, (uint)noise + 1u);
     }
-    out[(size_t)i * 19 + z] = (uchar)clamp(value, 1, 200);
+    out[(size_t)i * PS_ZONES + z] = (uchar)clamp(value, 1, 200);
   }
 }

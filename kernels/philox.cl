@@ -5,10 +5,6 @@
 // Philox4x32-10: the same generator as host/scene/philox.h (see there for the layout).
 // key = (seed lo, seed hi); counter = (element, stream, scenario lo, scenario hi).
 
-#define STREAM_NOISE_PATTERN 1u
-#define STREAM_METAL_NOISE 2u
-#define STREAM_PIXEL_NOISE 3u
-
 inline uint4 philox4x32_10(uint4 c, uint2 k) {
   for (int r = 0; r < 10; ++r) {
     const uint lo0 = 0xD2511F53u * c.x, hi0 = mul_hi(0xD2511F53u, c.x);

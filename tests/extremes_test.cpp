@@ -248,7 +248,7 @@ Plan images_plan(const ModelSettings& m, Tier t) {
 
 Plan features_plan(const ModelSettings& m, Tier t) {
   Plan p = images_plan(m, t);
-  p.mmw_images = p.ir_image = false;
+  p.images = 0;
   return p;
 }
 
@@ -272,13 +272,13 @@ std::string describe(const ModelSettings& m) {
 // The same shape as the reference: any difference here would make compare_outputs skip a part.
 void expect_same_shape(const BatchOutput& a, const BatchOutput& ref) {
   EXPECT_EQ(a.n, ref.n);
-  EXPECT_EQ(a.mmw_width, ref.mmw_width);
-  EXPECT_EQ(a.mmw_height, ref.mmw_height);
-  EXPECT_EQ(a.ir_width, ref.ir_width);
-  EXPECT_EQ(a.ir_height, ref.ir_height);
-  EXPECT_EQ(a.upper.size(), ref.upper.size());
-  EXPECT_EQ(a.lower.size(), ref.lower.size());
-  EXPECT_EQ(a.ir.size(), ref.ir.size());
+  EXPECT_EQ(a.view("upper").width, ref.view("upper").width);
+  EXPECT_EQ(a.view("upper").height, ref.view("upper").height);
+  EXPECT_EQ(a.view("ir").width, ref.view("ir").width);
+  EXPECT_EQ(a.view("ir").height, ref.view("ir").height);
+  EXPECT_EQ(a.view("upper").pixels.size(), ref.view("upper").pixels.size());
+  EXPECT_EQ(a.view("lower").pixels.size(), ref.view("lower").pixels.size());
+  EXPECT_EQ(a.view("ir").pixels.size(), ref.view("ir").pixels.size());
   EXPECT_EQ(a.metal.size(), ref.metal.size());
   EXPECT_EQ(a.features.size(), ref.features.size());
   EXPECT_EQ(a.layout.block, ref.layout.block);
@@ -414,15 +414,16 @@ std::vector<double> base_features(const World& w, int subject, int block) {
 
 // Each scenario's images equal its subject's bases, in the images plan's output `o`.
 void expect_images_are_bases(const World& w, const SceneBatch& batch, const BatchOutput& o, const std::string& who) {
-  const size_t mmw = size_t(o.mmw_width) * o.mmw_height, ir = size_t(o.ir_width) * o.ir_height;
-  ASSERT_EQ(o.upper.size(), batch.size() * mmw) << who;
-  ASSERT_EQ(o.ir.size(), batch.size() * ir) << who;
+  const size_t mmw = size_t(o.view("upper").width) * o.view("upper").height,
+               ir = size_t(o.view("ir").width) * o.view("ir").height;
+  ASSERT_EQ(o.view("upper").pixels.size(), batch.size() * mmw) << who;
+  ASSERT_EQ(o.view("ir").pixels.size(), batch.size() * ir) << who;
   size_t upper = 0, lower = 0, irs = 0;
   for (size_t i = 0; i < batch.size(); ++i) {
     const auto& b = w.assets.bases[batch.subject[i]];
-    upper += count_differing(o.upper_of(i), b[0].pixels.data(), mmw);
-    lower += count_differing(o.lower_of(i), b[1].pixels.data(), mmw);
-    irs += count_differing(o.ir_of(i), b[2].pixels.data(), ir);
+    upper += count_differing(o.view("upper").of(i), b[0].pixels.data(), mmw);
+    lower += count_differing(o.view("lower").of(i), b[1].pixels.data(), mmw);
+    irs += count_differing(o.view("ir").of(i), b[2].pixels.data(), ir);
   }
   EXPECT_EQ(upper, 0u) << who << ": upper pixels differing from the base";
   EXPECT_EQ(lower, 0u) << who << ": lower pixels differing from the base";
@@ -556,9 +557,9 @@ TEST(ExtremeAlpha, OneMakesSpritesOpaque) {
         if (v < 0) continue;
         const Region& reg = w->cat.regions[r];
         const int view = reg.view == View::upper ? 0 : 1;
-        check_opaque(w->assets.mmw_sprites[v], reg.mmw, view == 0 ? o.upper_of(i) : o.lower_of(i),
-                     w->assets.bases[s.subject][view], mmw);
-        check_opaque(w->assets.ir_sprites[v], reg.ir, o.ir_of(i), w->assets.bases[s.subject][2], ir);
+        check_opaque(w->assets.sprite(Camera::mmw, v), reg.mmw,
+                     view == 0 ? o.view("upper").of(i) : o.view("lower").of(i), w->assets.bases[s.subject][view], mmw);
+        check_opaque(w->assets.sprite(Camera::ir, v), reg.ir, o.view("ir").of(i), w->assets.bases[s.subject][2], ir);
       }
     }
     EXPECT_GT(mmw.checked, 10000u) << who;
@@ -623,7 +624,7 @@ void black_and_white(uint8_t base, uint8_t sprite) {
   for (const auto& views : w->assets.bases)
     for (const Image& img : views)
       ASSERT_TRUE(std::all_of(img.pixels.begin(), img.pixels.end(), [&](uint8_t v) { return v == base; }));
-  for (const Image& sp : w->assets.mmw_sprites) ASSERT_EQ(sp.at(0, 0, 0), sprite);
+  for (const Image& sp : w->assets.sprites[static_cast<int>(Camera::mmw)]) ASSERT_EQ(sp.at(0, 0, 0), sprite);
 
   std::vector<Scenario> scenes;
   for (int subject = 0; subject < 5; ++subject) scenes.push_back(crowded(w->cat, subject, subject));
@@ -638,7 +639,7 @@ void black_and_white(uint8_t base, uint8_t sprite) {
     if (base == sprite) {
       for (size_t t = 0; t < kTiers.size(); ++t) {
         const BatchOutput& o = p->images[t];
-        for (const std::vector<uint8_t>* v : {&o.upper, &o.lower, &o.ir})
+        for (const std::vector<uint8_t>* v : {&o.view("upper").pixels, &o.view("lower").pixels, &o.view("ir").pixels})
           EXPECT_TRUE(std::all_of(v->begin(), v->end(), [&](uint8_t x) { return x == base; }))
               << tier_name(kTiers[t]) << ": a flat scene must stay flat";
         // Every mean of a flat scene is its gray level, exactly.
@@ -661,7 +662,7 @@ void black_and_white(uint8_t base, uint8_t sprite) {
     if (base == sprite) {
       for (size_t t = 0; t < kTiers.size(); ++t) {
         const BatchOutput& o = p->images[t];
-        for (const std::vector<uint8_t>* v : {&o.upper, &o.lower, &o.ir}) {
+        for (const std::vector<uint8_t>* v : {&o.view("upper").pixels, &o.view("lower").pixels, &o.view("ir").pixels}) {
           const auto [lo, hi] = std::minmax_element(v->begin(), v->end());
           if (base == 0)
             EXPECT_LE(*hi, 47) << tier_name(kTiers[t]) << ": black image with sigma 8";
@@ -798,9 +799,9 @@ TEST(ExtremeBlock, SizesFromOnePixelToBeyondTheImage) {
       for (const BatchOutput* o : {&p->ref_images, &p->images[0], &p->images[1], &p->images[2]}) {
         ASSERT_EQ(o->features.size(), batch.size() * (2 + kRegions));
         for (size_t i = 0; i < batch.size(); ++i) {
-          const size_t px = size_t(o->mmw_width) * o->mmw_height;
+          const size_t px = size_t(o->view("upper").width) * o->view("upper").height;
           double up = 0, lo = 0;
-          for (size_t q = 0; q < px; ++q) up += o->upper_of(i)[q], lo += o->lower_of(i)[q];
+          for (size_t q = 0; q < px; ++q) up += o->view("upper").of(i)[q], lo += o->view("lower").of(i)[q];
           EXPECT_NEAR(o->features_of(i)[0], up / px, 1e-3) << "scenario " << i;
           EXPECT_NEAR(o->features_of(i)[1], lo / px, 1e-3) << "scenario " << i;
         }
@@ -896,7 +897,7 @@ TEST(ExtremeSprites, PartlyOutsideTheImage) {
         std::pair{"400x400 sprites, 600x600 noise tile, default regions", set_image_key(big, "noise_size", "600")}}) {
     SCOPED_TRACE(name);
     auto w = make_world(text);
-    ASSERT_EQ(w->assets.mmw_sprites[0].width, 400);
+    ASSERT_EQ(w->assets.sprite(Camera::mmw, 0).width, 400);
     std::vector<Scenario> scenes = coverage(w->cat, 40, 4, false);
     scenes.push_back(crowded(w->cat, 0, 0));
     scenes.push_back(crowded(w->cat, 0, 7));
@@ -917,7 +918,7 @@ TEST(ExtremeNoise, SigmaOfAThousand) {
   const auto p = expect_parity(w, batch, model(91, true, 1000.0), "sigma 1000", FastNoisy::range_only);
   auto share_at_ends = [](const BatchOutput& o) {
     size_t ends = 0, all = 0;
-    for (const std::vector<uint8_t>* v : {&o.upper, &o.lower, &o.ir}) {
+    for (const std::vector<uint8_t>* v : {&o.view("upper").pixels, &o.view("lower").pixels, &o.view("ir").pixels}) {
       for (uint8_t x : *v) ends += x == 0 || x == 255;
       all += v->size();
     }
@@ -945,8 +946,9 @@ TEST(ExtremeSeeds, ZeroAndMaxSeedsAndIndicesNearTheEnd) {
         // Same inputs, same bytes.
         BatchOutput again;
         w.cl->run(batch, images_plan(m, kTiers[t]), again);
-        EXPECT_TRUE(again.upper == p->images[t].upper && again.lower == p->images[t].lower &&
-                    again.ir == p->images[t].ir)
+        EXPECT_TRUE(again.view("upper").pixels == p->images[t].view("upper").pixels &&
+                    again.view("lower").pixels == p->images[t].view("lower").pixels &&
+                    again.view("ir").pixels == p->images[t].view("ir").pixels)
             << who << ": images differ between two identical runs";
         EXPECT_TRUE(again.features == p->images[t].features) << who;
         EXPECT_TRUE(again.metal == p->images[t].metal) << who;
@@ -955,9 +957,11 @@ TEST(ExtremeSeeds, ZeroAndMaxSeedsAndIndicesNearTheEnd) {
         // The last scenario alone, as the first of its own batch.
         BatchOutput one;
         w.cl->run(test::batch_of({scenes[9]}, first + 9), images_plan(m, kTiers[t]), one);
-        const size_t px = size_t(one.mmw_width) * one.mmw_height;
-        ASSERT_EQ(one.upper.size(), px);
-        EXPECT_TRUE(std::equal(one.upper.begin(), one.upper.end(), p->images[t].upper_of(9))) << who;
+        const size_t px = size_t(one.view("upper").width) * one.view("upper").height;
+        ASSERT_EQ(one.view("upper").pixels.size(), px);
+        EXPECT_TRUE(std::equal(one.view("upper").pixels.begin(), one.view("upper").pixels.end(),
+                               p->images[t].view("upper").of(9)))
+            << who;
         EXPECT_TRUE(std::equal(one.metal.begin(), one.metal.end(), p->images[t].metal_of(9))) << who;
       }
     }
@@ -966,7 +970,7 @@ TEST(ExtremeSeeds, ZeroAndMaxSeedsAndIndicesNearTheEnd) {
   const SceneBatch batch = test::batch_of(scenes, kMaxU64 - 9);
   w.cl->run(batch, images_plan(model(0, true, 5.0), Tier::standard), a);
   w.cl->run(batch, images_plan(model(kMaxU64, true, 5.0), Tier::standard), b);
-  EXPECT_NE(a.upper, b.upper);
+  EXPECT_NE(a.view("upper").pixels, b.view("upper").pixels);
 }
 
 // =============================================================================================

@@ -15,7 +15,8 @@ std::vector<int> zones(Backend& b, const std::vector<std::string>& objects, int 
   Scenario s = parse_object_list(catalogue(), objects);
   s.subject = subject;
   Plan plan;
-  plan.mmw_images = plan.ir_image = plan.features = false;
+  plan.images = 0;
+  plan.features = false;
   plan.model = m;
   BatchOutput out;
   b.run(test::batch_of({s}), plan, out);

@@ -75,8 +75,9 @@ Plan images_only(bool pattern, double sigma) {
 }
 
 void expect_images_within_one(const Outputs& o, const char* stage) {
-  for (auto [name, a, b] : {std::tuple{"upper", &o.ref.upper, &o.cl.upper},
-                            std::tuple{"lower", &o.ref.lower, &o.cl.lower}, std::tuple{"ir", &o.ref.ir, &o.cl.ir}}) {
+  for (auto [name, a, b] : {std::tuple{"upper", &o.ref.view("upper").pixels, &o.cl.view("upper").pixels},
+                            std::tuple{"lower", &o.ref.view("lower").pixels, &o.cl.view("lower").pixels},
+                            std::tuple{"ir", &o.ref.view("ir").pixels, &o.cl.view("ir").pixels}}) {
     const Diff d = compare(*a, *b);
     EXPECT_LE(d.max_abs, 1) << stage << " " << name;
     // Ties are rare: fewer than 1 pixel in 1000 may round the other way.
@@ -92,7 +93,7 @@ TEST(Parity, CompositeStage) {
   size_t changed = 0;
   for (size_t i = 0; i < scenes.size(); ++i) {
     const Image& base = assets().bases[scenes[i].subject][0];
-    for (size_t p = 0; p < base.pixels.size(); ++p) changed += o.cl.upper_of(i)[p] != base.pixels[p];
+    for (size_t p = 0; p < base.pixels.size(); ++p) changed += o.cl.view("upper").of(i)[p] != base.pixels[p];
   }
   EXPECT_GT(changed, 100000u);
 }
@@ -102,8 +103,9 @@ TEST(Parity, NoiseStagePatterns) {
   const Outputs with = run_both(scenes, images_only(true, 0));
   expect_images_within_one(with, "pattern noise");
   const Outputs without = run_both(scenes, images_only(false, 0));
-  EXPECT_NE(with.cl.upper, without.cl.upper) << "noise patterns must change the MMW images";
-  EXPECT_EQ(with.cl.ir, without.cl.ir) << "the thesis's noise patterns are MMW only";
+  EXPECT_NE(with.cl.view("upper").pixels, without.cl.view("upper").pixels)
+      << "noise patterns must change the MMW images";
+  EXPECT_EQ(with.cl.view("ir").pixels, without.cl.view("ir").pixels) << "the thesis's noise patterns are MMW only";
 }
 
 TEST(Parity, NoiseStagePerPixelGaussian) {
@@ -118,7 +120,7 @@ TEST(Parity, NoiseStagePerPixelGaussian) {
   size_t n = 0;
   for (size_t p = 0; p < base.pixels.size(); ++p) {
     if (base.pixels[p] < 40 || base.pixels[p] > 215) continue;
-    const double d = double(e.cl.upper_of(0)[p]) - base.pixels[p];
+    const double d = double(e.cl.view("upper").of(0)[p]) - base.pixels[p];
     sum += d;
     sum2 += d * d;
     ++n;
@@ -131,7 +133,8 @@ TEST(Parity, NoiseStagePerPixelGaussian) {
 
 TEST(Parity, MetalStageExact) {
   Plan p;
-  p.mmw_images = p.ir_image = p.features = false;
+  p.images = 0;
+  p.features = false;
   for (int noise : {0, 7}) {
     p.model.metal_noise = noise;
     p.model.seed = 99;
@@ -167,20 +170,20 @@ TEST(Parity, FeaturesAreMeansOfTheImages) {
   const auto scenes = coverage_set(60, 6);
   BatchOutput out;
   make_opencl_backend(catalogue(), assets(), test::runtime())->run(test::batch_of(scenes), p, out);
-  const int W = out.mmw_width, H = out.mmw_height;
+  const int W = out.view("upper").width, H = out.view("upper").height;
   for (size_t i = 0; i < scenes.size(); ++i) {
     const float* f = out.features_of(i);
     // The bottom-right partial block of the lower view: 200 = 28 * 7 + 4.
     const int bx = out.layout.blocks_x - 1, by = out.layout.blocks_y - 1;
     double sum = 0;
     for (int y = by * 7; y < H; ++y)
-      for (int x = bx * 7; x < W; ++x) sum += out.lower_of(i)[y * W + x];
+      for (int x = bx * 7; x < W; ++x) sum += out.view("lower").of(i)[y * W + x];
     EXPECT_FLOAT_EQ(f[out.layout.blocks_x * out.layout.blocks_y + by * out.layout.blocks_x + bx], sum / 16.0);
     // Region 3 (left chest, upper view).
     const Rect& r = catalogue().regions[2].mmw;
     sum = 0;
     for (int y = r.y; y < r.y + r.h; ++y)
-      for (int x = r.x; x < r.x + r.w; ++x) sum += out.upper_of(i)[y * W + x];
+      for (int x = r.x; x < r.x + r.w; ++x) sum += out.view("upper").of(i)[y * W + x];
     EXPECT_NEAR(f[2 * out.layout.blocks_x * out.layout.blocks_y + 2], sum / (r.w * r.h), 1e-3);
   }
 }
@@ -198,8 +201,9 @@ TEST(Determinism, ScenarioDependsOnlyOnSeedAndIndexNotOnBatch) {
   // Scenario 1000 + 17 alone, as the first of a batch.
   BatchOutput one;
   cl->run(test::batch_of({scenes[17]}, 1017), p, one);
-  const size_t px = size_t(whole.mmw_width) * whole.mmw_height;
-  EXPECT_TRUE(std::equal(one.upper.begin(), one.upper.end(), whole.upper.begin() + 17 * px));
+  const size_t px = size_t(whole.view("upper").width) * whole.view("upper").height;
+  EXPECT_TRUE(std::equal(one.view("upper").pixels.begin(), one.view("upper").pixels.end(),
+                         whole.view("upper").pixels.begin() + 17 * px));
   EXPECT_TRUE(std::equal(one.metal.begin(), one.metal.end(), whole.metal.begin() + 17 * kZones));
   const size_t F = whole.layout.image_features();
   EXPECT_TRUE(std::equal(one.features.begin(), one.features.end(), whole.features.begin() + 17 * F));
@@ -207,7 +211,7 @@ TEST(Determinism, ScenarioDependsOnlyOnSeedAndIndexNotOnBatch) {
   p.model.seed = 78;
   BatchOutput other;
   cl->run(test::batch_of({scenes[17]}, 1017), p, other);
-  EXPECT_NE(one.upper, other.upper);
+  EXPECT_NE(one.view("upper").pixels, other.view("upper").pixels);
 }
 
 }  // namespace
@@ -237,7 +241,7 @@ TEST(SparseFeatures, EqualDenseToTheBit) {
   for (int block : {10, 7, 1, 20, 200}) {
     for (bool noise : {true, false}) {
       Plan p;
-      p.mmw_images = p.ir_image = false;
+      p.images = 0;
       p.model.block = block;
       p.model.pattern_noise = noise;
       p.model.seed = 4242;
@@ -282,7 +286,7 @@ TEST(Parity, PlacementJitterIntegerAndBilinear) {
     ref->run(test::batch_of(scenes), p, b);
     const OutputDiff d = compare_outputs(a, b);
     EXPECT_EQ(check_tolerance(d, tier_tolerance(Tier::standard)), "") << "bilinear " << bilinear;
-    EXPECT_NE(a.upper, still.upper) << "jitter must move the sprites";
+    EXPECT_NE(a.view("upper").pixels, still.view("upper").pixels) << "jitter must move the sprites";
     EXPECT_EQ(a.metal, still.metal) << "placement does not touch the metal detector";
   }
   // Bilinear placement without jitter still samples between texels only at whole pixels:

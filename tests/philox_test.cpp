@@ -11,7 +11,7 @@
 
 namespace portalsim {
 namespace embedded {
-extern const std::string_view kernel_philox;
+extern const std::string_view kernel_program;
 }
 
 TEST(Philox, KnownAnswerVectors) {
@@ -45,7 +45,7 @@ TEST(Philox, BelowAndUniformStayInRange) {
 
 TEST(Philox, KernelMatchesHost) {
   OpenCLRuntime rt;
-  const std::string src = std::string(embedded::kernel_philox) + R"(
+  const std::string src = std::string(embedded::kernel_program) + R"(
 kernel void philox_test(global const ulong* seeds, global const ulong* index, global const uint* stream,
                         global const uint* element, global uint4* out, global float2* gauss) {
   const size_t i = get_global_id(0);

@@ -73,13 +73,17 @@ AssetSet build_assets(const Catalogue& cat) {
     body.mmw_level = sub.mmw_level;
     body.ir_core = sub.ir_core;
     body.ir_limb = sub.ir_limb;
-    std::array<Image, 3> views;
-    views[0] = sub.mmw_upper.path.empty() ? procedural::mmw_body(body, true, ic.mmw_width, ic.mmw_height)
-                                          : sized(to_gray(load(sub.mmw_upper), false), ic.mmw_width, ic.mmw_height);
-    views[1] = sub.mmw_lower.path.empty() ? procedural::mmw_body(body, false, ic.mmw_width, ic.mmw_height)
-                                          : sized(to_gray(load(sub.mmw_lower), false), ic.mmw_width, ic.mmw_height);
-    views[2] = sub.ir.path.empty() ? procedural::ir_body(body, ic.ir_width, ic.ir_height)
-                                   : sized(to_temperature(load(sub.ir), a.palette, false), ic.ir_width, ic.ir_height);
+    std::vector<Image> views;
+    for (const Sensor& view : cat.sensors) {
+      const bool ir = view.camera == Camera::ir;
+      const ImageSource& src = sub.image(view.asset_key);
+      if (!src.path.empty())
+        views.push_back(sized(ir ? to_temperature(load(src), a.palette, false) : to_gray(load(src), false), view.width,
+                              view.height));
+      else
+        views.push_back(ir ? procedural::ir_body(body, view.width, view.height)
+                           : procedural::mmw_body(body, view.name == "upper", view.width, view.height));
+    }
     a.bases.push_back(std::move(views));
   }
   // IR sprites keep the objects' physical size: scale by the IR view's pixels per MMW pixel.
@@ -90,12 +94,13 @@ AssetSet build_assets(const Catalogue& cat) {
     const Variant& var = cat.variant(static_cast<int>(v));
     const bool vertical = var.code == "v";
     const int w = vertical ? o.height : o.width, h = vertical ? o.width : o.height;
-    a.mmw_sprites.push_back(var.mmw.path.empty() ? procedural::sprite(o.shape, vertical, w, h, o.mmw_level)
-                                                 : to_gray(load(var.mmw), true));
+    a.sprites[static_cast<int>(Camera::mmw)].push_back(
+        var.mmw.path.empty() ? procedural::sprite(o.shape, vertical, w, h, o.mmw_level) : to_gray(load(var.mmw), true));
     const int iw = std::max(1, static_cast<int>(std::lround(w * sx)));
     const int ih = std::max(1, static_cast<int>(std::lround(h * sy)));
-    a.ir_sprites.push_back(var.ir.path.empty() ? procedural::sprite(o.shape, vertical, iw, ih, o.ir_level)
-                                               : to_temperature(load(var.ir), a.palette, true));
+    a.sprites[static_cast<int>(Camera::ir)].push_back(var.ir.path.empty()
+                                                          ? procedural::sprite(o.shape, vertical, iw, ih, o.ir_level)
+                                                          : to_temperature(load(var.ir), a.palette, true));
   }
   for (size_t k = 0; k < cat.noise.size(); ++k) {
     const NoisePattern& p = cat.noise[k];

@@ -11,14 +11,17 @@ namespace portalsim {
 using Palette = std::array<std::array<uint8_t, 3>, 256>;
 
 struct AssetSet {
-  // Per subject: [0] MMW upper, [1] MMW lower (gray), [2] IR (temperature index); 1 channel,
-  // at the catalogue's view sizes.
-  std::vector<std::array<Image, 3>> bases;
-  // Per variant id: 2 channels (value, alpha). IR sprites are temperature indices.
-  std::vector<Image> mmw_sprites, ir_sprites;
+  // Per subject, per camera view (Catalogue::sensors order): 1 channel at the view's size,
+  // gray (MMW) or temperature index (IR).
+  std::vector<std::vector<Image>> bases;
+  // Per camera (Camera::mmw, Camera::ir), per variant id: 2 channels (value, alpha).
+  // IR sprites are temperature indices at the IR view's scale.
+  std::array<std::vector<Image>, kCameras> sprites;
   // Per noise pattern: 1 channel, 128 = no change, noise_size square.
   std::vector<Image> noise;
   Palette palette{};
+
+  const Image& sprite(Camera c, int variant) const { return sprites[static_cast<int>(c)][variant]; }
 };
 
 // Throws InputError naming the catalogue field and file for a missing or corrupt image.

@@ -1,22 +1,45 @@
 #include "backend/backend.h"
 
+#include <stdexcept>
+
 namespace portalsim {
 
 void prepare_output(BatchOutput& out, const Catalogue& cat, const Plan& plan, size_t n) {
-  const ImagesConfig& ic = cat.images;
   out.n = n;
-  out.mmw_width = ic.mmw_width;
-  out.mmw_height = ic.mmw_height;
-  out.ir_width = ic.ir_width;
-  out.ir_height = ic.ir_height;
+  out.views.resize(cat.sensors.size());
+  for (size_t k = 0; k < cat.sensors.size(); ++k) {
+    const Sensor& s = cat.sensors[k];
+    ViewImages& v = out.views[k];
+    v.name = s.name;
+    v.camera = s.camera;
+    v.palette = s.palette;
+    v.width = s.width;
+    v.height = s.height;
+    v.pixels.resize(plan.image(static_cast<int>(k)) ? n * s.pixels() : 0);
+  }
   out.layout = FeatureLayout::of(cat, plan.model.block);
-  const size_t mmw_px = static_cast<size_t>(ic.mmw_width) * ic.mmw_height;
-  const size_t ir_px = static_cast<size_t>(ic.ir_width) * ic.ir_height;
-  out.upper.resize(plan.mmw_images ? n * mmw_px : 0);
-  out.lower.resize(plan.mmw_images ? n * mmw_px : 0);
-  out.ir.resize(plan.ir_image ? n * ir_px : 0);
   out.metal.resize(plan.metal ? n * kZones : 0);
   out.features.resize(plan.features ? n * out.layout.image_features() : 0);
+}
+
+const ViewImages& BatchOutput::view(std::string_view name) const {
+  for (const ViewImages& v : views)
+    if (v.name == name) return v;
+  throw std::out_of_range("no camera view is called \"" + std::string(name) + "\"");
+}
+
+void append_output(BatchOutput& all, const BatchOutput& part) {
+  all.n += part.n;
+  all.layout = part.layout;
+  all.views.resize(part.views.size());
+  for (size_t k = 0; k < part.views.size(); ++k) {
+    std::vector<uint8_t> pixels = std::move(all.views[k].pixels);
+    all.views[k] = part.views[k];
+    pixels.insert(pixels.end(), part.views[k].pixels.begin(), part.views[k].pixels.end());
+    all.views[k].pixels = std::move(pixels);
+  }
+  all.metal.insert(all.metal.end(), part.metal.begin(), part.metal.end());
+  all.features.insert(all.features.end(), part.features.begin(), part.features.end());
 }
 
 }  // namespace portalsim

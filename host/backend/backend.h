@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "assets/assets.h"
@@ -12,25 +13,38 @@
 
 namespace portalsim {
 
+// One camera view's images for a batch: n images of height x width, 8-bit (MMW gray,
+// IR temperature index); empty when the plan does not keep this view.
+struct ViewImages {
+  std::string name;
+  Camera camera = Camera::mmw;
+  bool palette = false;  // temperature indices, written through the palette
+  int width = 0, height = 0;
+  std::vector<uint8_t> pixels;
+  size_t pixels_per_image() const { return static_cast<size_t>(width) * height; }
+  const uint8_t* of(size_t i) const { return pixels.data() + i * pixels_per_image(); }
+  bool empty() const { return pixels.empty(); }
+};
+
 struct BatchOutput {
   size_t n = 0;
-  int mmw_width = 0, mmw_height = 0, ir_width = 0, ir_height = 0;
-  std::vector<uint8_t> upper, lower;  // n * mmw_height * mmw_width, when planned
-  std::vector<uint8_t> ir;            // n * ir_height * ir_width, temperature index
-  std::vector<uint8_t> metal;         // n * 19
+  std::vector<ViewImages> views;  // one per camera view, in Catalogue::sensors order
+  std::vector<uint8_t> metal;     // n * 19
   FeatureLayout layout;
   std::vector<float> features;  // n * layout.image_features()
 
-  const uint8_t* upper_of(size_t i) const { return upper.data() + i * mmw_width * mmw_height; }
-  const uint8_t* lower_of(size_t i) const { return lower.data() + i * mmw_width * mmw_height; }
-  const uint8_t* ir_of(size_t i) const { return ir.data() + i * ir_width * ir_height; }
-  const uint8_t* metal_of(size_t i) const { return metal.data() + i * 19; }
+  // The view called `name` ("upper", "lower", "ir"); throws std::out_of_range if none is.
+  const ViewImages& view(std::string_view name) const;
+  const uint8_t* metal_of(size_t i) const { return metal.data() + i * kZones; }
   const float* features_of(size_t i) const { return features.data() + i * layout.image_features(); }
 };
 
 // Sizes `out` for n scenarios of `plan` (buffers kept for reuse): what each backend
 // fills in run().
 void prepare_output(BatchOutput& out, const Catalogue& cat, const Plan& plan, size_t n);
+
+// Appends `part`'s scenarios to `all` (same catalogue and plan).
+void append_output(BatchOutput& all, const BatchOutput& part);
 
 class Backend {
  public:

@@ -39,16 +39,24 @@ ImageDiff compare_images(const std::vector<uint8_t>& a, const std::vector<uint8_
 
 OutputDiff compare_outputs(const BatchOutput& test, const BatchOutput& ref) {
   OutputDiff e;
-  const size_t mmw_px = size_t(ref.mmw_width) * ref.mmw_height;
-  if (!ref.upper.empty() && !test.upper.empty()) {
-    std::vector<uint8_t> a(test.upper), b(ref.upper);
-    a.insert(a.end(), test.lower.begin(), test.lower.end());
-    b.insert(b.end(), ref.lower.begin(), ref.lower.end());
-    e.mmw = compare_images(a, b, mmw_px);
+  // Per camera, over all its views: a view one side has and the other lacks is no match.
+  for (Camera cam : {Camera::mmw, Camera::ir}) {
+    std::vector<uint8_t> a, b;
+    size_t per_image = 0;
+    bool mismatch = test.views.size() != ref.views.size();
+    for (size_t k = 0; k < ref.views.size() && k < test.views.size(); ++k) {
+      if (ref.views[k].camera != cam) continue;
+      mismatch |= test.views[k].pixels.size() != ref.views[k].pixels.size();
+      if (ref.views[k].empty() || test.views[k].empty()) continue;
+      // Images of equal size compare together; IR and MMW views differ in size.
+      per_image = ref.views[k].pixels_per_image();
+      a.insert(a.end(), test.views[k].pixels.begin(), test.views[k].pixels.end());
+      b.insert(b.end(), ref.views[k].pixels.begin(), ref.views[k].pixels.end());
+    }
+    ImageDiff& d = cam == Camera::ir ? e.ir : e.mmw;
+    d = compare_images(a, b, per_image);
+    if (mismatch) d.max_abs = 256;
   }
-  e.ir = compare_images(test.ir, ref.ir, size_t(ref.ir_width) * ref.ir_height);
-  for (auto [a, b, d] : {std::tuple{&test.upper, &ref.upper, &e.mmw}, std::tuple{&test.ir, &ref.ir, &e.ir}})
-    if (a->size() != b->size()) d->max_abs = 256;  // one side has images the other lacks
   constexpr double kBroken = std::numeric_limits<double>::infinity();
   if (test.features.size() != ref.features.size()) {
     e.feature_max_abs = e.feature_mean_abs = kBroken;  // a missing or misshapen table is no match

@@ -19,8 +19,10 @@ int list(CatalogueOptions& o) {
   open_catalogue(s, o.common);
   const Catalogue& c = s.catalogue;
   std::printf("catalogue %s (hash %s)\n", c.source.c_str(), c.hash.c_str());
-  std::printf("images: MMW %dx%d per view, IR %dx%d, alpha %.3g\n", c.images.mmw_width, c.images.mmw_height,
-              c.images.ir_width, c.images.ir_height, c.images.alpha);
+  std::printf("camera views:");
+  for (const Sensor& v : c.sensors)
+    std::printf(" %s %s %dx%d;", v.name.c_str(), camera_name(v.camera), v.width, v.height);
+  std::printf(" alpha %.3g\n", c.images.alpha);
   std::printf("\nsubjects:\n");
   for (size_t i = 0; i < c.subjects.size(); ++i) std::printf("  %zu  %s\n", i + 1, c.subjects[i].name.c_str());
   std::printf("\nregions:\n");
@@ -39,16 +41,18 @@ int list(CatalogueOptions& o) {
     StagedFolder folder(o.images);
     for (size_t i = 0; i < s.assets.bases.size(); ++i) {
       const std::string p = "subject" + std::to_string(i + 1);
-      write_image(folder.path(p + "_mmw_upper.png"), s.assets.bases[i][0]);
-      write_image(folder.path(p + "_mmw_lower.png"), s.assets.bases[i][1]);
-      write_image(folder.path(p + "_ir.png"), colourise(s.assets.bases[i][2], s.assets.palette));
+      for (size_t k = 0; k < c.sensors.size(); ++k) {
+        const Image& img = s.assets.bases[i][k];
+        write_image(folder.path(p + "_" + c.sensors[k].asset_key + ".png"),
+                    c.sensors[k].palette ? colourise(img, s.assets.palette) : img);
+      }
     }
     for (size_t v = 0; v < c.variant_list.size(); ++v) {
       std::string n = c.variant_name(static_cast<int>(v));
       for (char& ch : n)
         if (ch == ':') ch = '_';
-      write_image(folder.path(n + "_mmw.png"), s.assets.mmw_sprites[v]);
-      write_image(folder.path(n + "_ir.png"), s.assets.ir_sprites[v]);
+      for (Camera cam : {Camera::mmw, Camera::ir})
+        write_image(folder.path(n + "_" + camera_name(cam) + ".png"), s.assets.sprite(cam, static_cast<int>(v)));
     }
     for (size_t k = 0; k < s.assets.noise.size(); ++k)
       write_image(folder.path("noise" + std::to_string(k + 1) + "_" + c.noise[k].name + ".png"), s.assets.noise[k]);

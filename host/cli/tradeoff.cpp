@@ -46,7 +46,7 @@ Plan images_plan(const ModelSettings& m) {
 Plan features_plan(const ModelSettings& m) {
   Plan p;
   p.model = m;
-  p.mmw_images = p.ir_image = false;
+  p.images = 0;
   return p;
 }
 
@@ -66,26 +66,12 @@ SceneBatch slice(const SceneBatch& b, size_t first, size_t n) {
   return s;
 }
 
-void append(BatchOutput& all, const BatchOutput& part) {
-  all.n += part.n;
-  all.mmw_width = part.mmw_width;
-  all.mmw_height = part.mmw_height;
-  all.ir_width = part.ir_width;
-  all.ir_height = part.ir_height;
-  all.layout = part.layout;
-  all.upper.insert(all.upper.end(), part.upper.begin(), part.upper.end());
-  all.lower.insert(all.lower.end(), part.lower.begin(), part.lower.end());
-  all.ir.insert(all.ir.end(), part.ir.begin(), part.ir.end());
-  all.metal.insert(all.metal.end(), part.metal.begin(), part.metal.end());
-  all.features.insert(all.features.end(), part.features.begin(), part.features.end());
-}
-
 Timed run_timed(Backend& backend, const SceneBatch& batch, const Plan& plan, size_t chunk, double min_seconds) {
   Timed t;
   BatchOutput part;
   for (size_t first = 0; first < batch.size(); first += chunk) {
     backend.run(slice(batch, first, std::min(chunk, batch.size() - first)), plan, part);
-    append(t.out, part);
+    append_output(t.out, part);
   }
   std::vector<double> rates;
   for (int pass = 0; pass < 3; ++pass) {

@@ -9,17 +9,22 @@ namespace portalsim {
 FeatureLayout FeatureLayout::of(const Catalogue& cat, int block) {
   FeatureLayout f;
   f.block = block;
-  f.blocks_x = (cat.images.mmw_width + block - 1) / block;
-  f.blocks_y = (cat.images.mmw_height + block - 1) / block;
+  for (size_t k = 0; k < cat.sensors.size(); ++k) {
+    const Sensor& s = cat.sensors[k];
+    if (!s.pooled) continue;
+    f.pooled.push_back(static_cast<int>(k));
+    f.view_names.push_back(s.name);
+    f.blocks_x = (s.width + block - 1) / block;
+    f.blocks_y = (s.height + block - 1) / block;
+  }
   return f;
 }
 
 std::vector<std::string> FeatureLayout::names() const {
   std::vector<std::string> n;
-  for (const char* view : {"upper", "lower"})
+  for (const std::string& view : view_names)
     for (int by = 0; by < blocks_y; ++by)
-      for (int bx = 0; bx < blocks_x; ++bx)
-        n.push_back(std::string(view) + "_r" + std::to_string(by) + "_c" + std::to_string(bx));
+      for (int bx = 0; bx < blocks_x; ++bx) n.push_back(view + "_r" + std::to_string(by) + "_c" + std::to_string(bx));
   for (int r = 1; r <= kRegions; ++r) n.push_back("region" + std::to_string(r));
   for (int z = 1; z <= kZones; ++z) n.push_back("zone" + std::to_string(z));
   return n;

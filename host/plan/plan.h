@@ -42,6 +42,9 @@ struct Fidelity {
   Pooling pooling = Pooling::sparse;
   bool fast_math = false;  // -cl-fast-relaxed-math
   NoiseModel noise = NoiseModel::per_pixel;
+  // Camera views rendered by the fused render_view kernel (a declared fast path), or by
+  // the chain of stage kernels, one launch per stage; both give the same bits.
+  bool fused = true;
 };
 
 enum class Tier { fast, standard, exact };
@@ -53,34 +56,44 @@ void set_fidelity_knob(Fidelity& f, const std::string& knob, const std::string& 
 const char* tier_name(Tier t);
 const char* precision_name(Precision p);
 
+// Bit k of Plan::images: camera view k (Catalogue::sensors) is materialised.
+constexpr uint32_t kAllViews = ~0u;
+
 struct Plan {
-  bool mmw_images = true;  // materialise upper/lower images
-  bool ir_image = true;    // materialise the IR image
-  bool metal = true;       // metal zones
-  bool features = true;    // block and region means (needs the MMW views)
+  uint32_t images = kAllViews;  // which camera views' images the caller keeps
+  bool metal = true;            // metal zones
+  bool features = true;         // block and region means of the pooled views
   ModelSettings model;
   Fidelity fidelity;
 
+  bool image(int view) const { return (images >> view) & 1u; }
+  // A view is rendered when its images are kept or it is pooled into features; views
+  // nobody asked for are never rendered.
+  bool renders(const Sensor& s, int view) const { return image(view) || (features && s.pooled); }
   // Per-pixel noise drawn pixel by pixel (otherwise none, or the block-mean model).
   bool pixel_noise_per_pixel() const {
-    return model.pixel_sigma > 0 && (mmw_images || ir_image || fidelity.noise == NoiseModel::per_pixel);
+    return model.pixel_sigma > 0 && (images != 0 || fidelity.noise == NoiseModel::per_pixel);
   }
   // Features straight from precomputed tables, never materialising an image. Block sums
   // must stay exact in fp32 (255 * 256^2 < 2^24).
   bool sparse_features() const {
-    return features && !mmw_images && fidelity.pooling == Pooling::sparse && !pixel_noise_per_pixel() &&
+    return features && images == 0 && fidelity.pooling == Pooling::sparse && !pixel_noise_per_pixel() &&
            model.block <= 256 && !model.moves_sprites();
   }
-  bool renders_mmw() const { return mmw_images || features; }
 };
 
-// The layout of a feature row: upper blocks, lower blocks (row-major, partial blocks at
-// the right and bottom edges averaged over the pixels they hold), the 13 region means,
-// then the 19 metal zones; sinks append the class.
+// The layout of a feature row: the blocks of each pooled view in turn (row-major,
+// partial blocks at the right and bottom edges averaged over the pixels they hold), the
+// 13 region means, then the 19 metal zones; sinks append the class. Every pooled view
+// has the same size.
 struct FeatureLayout {
   int block = 10;
-  int blocks_x = 0, blocks_y = 0;  // per MMW view
-  int image_features() const { return 2 * blocks_x * blocks_y + kRegions; }
+  int blocks_x = 0, blocks_y = 0;  // per pooled view
+  std::vector<int> pooled;         // the pooled views (indices into Catalogue::sensors)
+  std::vector<std::string> view_names;
+  int blocks_per_view() const { return blocks_x * blocks_y; }
+  int block_features() const { return static_cast<int>(pooled.size()) * blocks_per_view(); }
+  int image_features() const { return block_features() + kRegions; }
   int row_features() const { return image_features() + kZones; }
   std::vector<std::string> names() const;
   static FeatureLayout of(const Catalogue& cat, int block);

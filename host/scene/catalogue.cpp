@@ -388,6 +388,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
       rd.fail(&t, f, "only the first 5 noise patterns have procedural defaults; give an image");
     cat.noise.push_back(std::move(p));
   }
+  cat.sensors = camera_sensors(cat);
   return cat;
 }
 

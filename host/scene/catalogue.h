@@ -6,15 +6,11 @@
 #include <string_view>
 #include <vector>
 
+#include "scene/sensor.h"
+
 namespace portalsim {
 
-constexpr int kRegions = 13;
-constexpr int kZones = 19;
 constexpr int kUpperRegions = 6;
-
-struct Rect {
-  int x = 0, y = 0, w = 0, h = 0;
-};
 
 enum class View : int { upper = 0, lower = 1 };
 
@@ -30,6 +26,10 @@ struct Subject {
   int mmw_level = 150, ir_core = 215, ir_limb = 175;
   std::array<int, kZones> base_zones{};
   ImageSource mmw_upper, mmw_lower, ir;
+  // The base image named by a camera view's asset key (Sensor::asset_key).
+  const ImageSource& image(std::string_view key) const {
+    return key == "ir" ? ir : key == "mmw_upper" ? mmw_upper : mmw_lower;
+  }
 };
 
 struct Region {
@@ -87,6 +87,7 @@ struct Catalogue {
   // influence[category][region][zone]
   std::vector<std::array<std::array<int, kZones>, kRegions>> influence;
   std::vector<VariantRef> variant_list;
+  std::vector<Sensor> sensors;  // the camera views (scene/sensor.h)
 
   const Object& object_of(int variant_id) const { return objects[variant_list[variant_id].object]; }
   const Variant& variant(int variant_id) const {
@@ -98,6 +99,8 @@ struct Catalogue {
   // Finds an object by name or alias, ignoring case and punctuation ("Iron Rod",
   // "iron_rod", "IRON-ROD" are all iron-rod). Returns -1 when unknown.
   int find_object(std::string_view name) const;
+  // Index of the camera view called `name` in `sensors`, or -1.
+  int sensor_index(std::string_view name) const;
 };
 
 // Reads a catalogue. `source_name` is used in messages; `base_dir` resolves relative

@@ -8,6 +8,8 @@
 #include <array>
 #include <cstdint>
 
+#include "shared.h"
+
 namespace portalsim {
 
 using Philox4 = std::array<uint32_t, 4>;
@@ -27,13 +29,14 @@ inline Philox4 philox4x32_10(Philox4 ctr, std::array<uint32_t, 2> key) {
 }
 
 // Streams: each kind of draw has its own, so adding one never shifts another.
+// Streams (kernels/shared.h): each kind of draw has its own, so adding one never shifts another.
 enum Stream : uint32_t {
-  kStreamNoisePattern = 1,  // which MMW noise pattern a scenario gets
-  kStreamMetalNoise = 2,    // metal detector noise, element = zone
-  kStreamPixelNoise = 3,    // per-pixel sensor noise; element = view << 28 | pixel / 2
-  kStreamBlockNoise = 4,    // block-mean noise model (kernels only), element = feature
-  kStreamJitter = 5,        // sprite placement jitter, element = region
-  kStreamGenerate = 16,     // scenario generators (generate command)
+  kStreamNoisePattern = PS_STREAM_NOISE_PATTERN,
+  kStreamMetalNoise = PS_STREAM_METAL_NOISE,
+  kStreamPixelNoise = PS_STREAM_PIXEL_NOISE,
+  kStreamBlockNoise = PS_STREAM_BLOCK_NOISE,
+  kStreamJitter = PS_STREAM_JITTER,
+  kStreamGenerate = PS_STREAM_GENERATE,
 };
 
 inline Philox4 draw(uint64_t seed, uint64_t index, uint32_t stream, uint32_t element) {

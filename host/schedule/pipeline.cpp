@@ -105,10 +105,9 @@ void draw_progress(uint64_t done, uint64_t total, double seconds) {
 }  // namespace
 
 size_t default_batch(const Plan& plan, const Catalogue& cat) {
-  const ImagesConfig& ic = cat.images;
   size_t bytes = 64 + kZones;
-  if (plan.renders_mmw()) bytes += 2 * static_cast<size_t>(ic.mmw_width) * ic.mmw_height;
-  if (plan.ir_image) bytes += static_cast<size_t>(ic.ir_width) * ic.ir_height;
+  for (size_t k = 0; k < cat.sensors.size(); ++k)
+    if (plan.renders(cat.sensors[k], static_cast<int>(k))) bytes += cat.sensors[k].pixels();
   if (plan.sparse_features()) bytes = 64 + kZones;  // no images, on the device either
   if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
   return std::clamp<size_t>((64u << 20) / bytes, 64, 16384);
@@ -139,8 +138,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
   Plan plan;
   plan.features = spec.wants_features();
   plan.metal = true;
-  plan.mmw_images = spec.wants_images();
-  plan.ir_image = spec.wants_images();
+  plan.images = spec.wants_images() ? kAllViews : 0;
   plan.model = spec.model;
   plan.model.seed = spec.seed;
   plan.fidelity = spec.fidelity();
@@ -250,7 +248,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
   sinks.push_back(make_scenario_list_sink(ctx, resume_state("scenarios.csv")));
   if (plan.features)
     for (const std::string& f : spec.formats) sinks.push_back(make_table_sink(f, ctx, resume_state("features." + f)));
-  if (plan.mmw_images) sinks.push_back(make_image_sink(ctx, resuming, start));
+  if (plan.images) sinks.push_back(make_image_sink(ctx, resuming, start));
 
   const auto save_checkpoint = [&](uint64_t next) {
     json c;
@@ -351,7 +349,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
     }
     s->finish();
   }
-  if (plan.mmw_images) manifest["images"] = {{"folder", "images"}, {"count", res.end - res.begin}};
+  if (plan.images) manifest["images"] = {{"folder", "images"}, {"count", res.end - res.begin}};
   write_text_atomic((out / "manifest.json").string(), manifest.dump(2) + "\n");
   fs::remove_all(state_dir, ec);
   return res;

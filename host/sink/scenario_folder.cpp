@@ -28,11 +28,11 @@ void write(const std::string& path, const Image& img) {
 void write_scenario_folder(const PathOf& path_of, const BatchOutput& b, size_t i, bool threat, const Palette& palette,
                            const FolderOptions& opt) {
   const std::string ext = "." + opt.image_format;
-  if (!b.upper.empty()) {
-    write(path_of("upper" + ext), gray(b.upper_of(i), b.mmw_width, b.mmw_height));
-    write(path_of("lower" + ext), gray(b.lower_of(i), b.mmw_width, b.mmw_height));
+  for (const ViewImages& v : b.views) {
+    if (v.empty()) continue;
+    const Image img = gray(v.of(i), v.width, v.height);
+    write(path_of(v.name + ext), v.palette ? colourise(img, palette) : img);
   }
-  if (!b.ir.empty()) write(path_of("ir" + ext), colourise(gray(b.ir_of(i), b.ir_width, b.ir_height), palette));
   if (!b.metal.empty()) {
     std::string m;
     for (int z = 0; z < kZones; ++z) {

@@ -1,7 +1,10 @@
 #include "backend/opencl/opencl_backend.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+
+#include "backend/stages.h"
 
 namespace portalsim {
 
@@ -34,42 +37,68 @@ cl::Buffer constant(cl::Context& ctx, const std::vector<T>& v) {
   return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, copy.size() * sizeof(T), copy.data());
 }
 
+cl_int4 rect4(const Rect& r) { return {{r.x, r.y, r.w, r.h}}; }
+
 class OpenCLBackend final : public Backend {
  public:
   OpenCLBackend(const Catalogue& cat, const AssetSet& assets, std::shared_ptr<OpenCLRuntime> rt)
       : cat_(cat), assets_(assets), rt_(std::move(rt)) {
+    for (const Sensor& s : cat.sensors) check_chain(s);
     std::vector<uint8_t> atlas;
     auto add = [&](const Image& img) {
       const int off = static_cast<int>(atlas.size());
       atlas.insert(atlas.end(), img.pixels.begin(), img.pixels.end());
       return off;
     };
+    const size_t V = cat.variant_list.size(), views = cat.sensors.size();
     std::vector<cl_int> bases;
-    for (const auto& views : assets.bases)
-      for (const Image& img : views) bases.push_back(add(img));
-    const size_t V = cat.variant_list.size();
-    std::vector<cl_int4> sprites(V * 2), places(V * kRegions);
-    for (size_t v = 0; v < V; ++v) {
-      const Image* sp[2] = {&assets.mmw_sprites[v], &assets.ir_sprites[v]};
-      for (int s = 0; s < 2; ++s) sprites[v * 2 + s] = {{add(*sp[s]), sp[s]->width, sp[s]->height, 0}};
-      for (int r = 0; r < kRegions; ++r) {
-        const Region& reg = cat.regions[r];
-        // Sprite centred in the region; >> 1 floors negative differences too.
-        places[v * kRegions + r] = {
-            {reg.mmw.x + ((reg.mmw.w - sp[0]->width) >> 1), reg.mmw.y + ((reg.mmw.h - sp[0]->height) >> 1),
-             reg.ir.x + ((reg.ir.w - sp[1]->width) >> 1), reg.ir.y + ((reg.ir.h - sp[1]->height) >> 1)}};
+    for (const auto& subject_views : assets.bases)
+      for (const Image& img : subject_views) bases.push_back(add(img));
+    std::vector<cl_int4> sprites(kCameras * V);
+    for (int c = 0; c < kCameras; ++c)
+      for (size_t v = 0; v < V; ++v) {
+        const Image& sp = assets.sprites[c][v];
+        sprites[c * V + v] = {{add(sp), sp.width, sp.height, 0}};
+      }
+    // Each sprite centred in its region's rectangle of each view; >> 1 floors negative
+    // differences too.
+    std::vector<cl_int2> places(views * V * kRegions);
+    for (size_t k = 0; k < views; ++k) {
+      const Sensor& s = cat.sensors[k];
+      for (size_t v = 0; v < V; ++v) {
+        const Image& sp = assets.sprite(s.camera, static_cast<int>(v));
+        for (int r = 0; r < kRegions; ++r) {
+          const Rect& rc = s.rects[r];
+          places[(k * V + v) * kRegions + r] = {{rc.x + ((rc.w - sp.width) >> 1), rc.y + ((rc.h - sp.height) >> 1)}};
+        }
       }
     }
     std::vector<cl_int> noise_offsets;
     std::vector<cl_float> noise_gains;
-    for (const auto& sp : sprites) sprite_offsets_.push_back(sp.s[0]);
     for (size_t k = 0; k < assets.noise.size(); ++k) {
       noise_offsets.push_back(add(assets.noise[k]));
       noise_gains.push_back(static_cast<float>(cat.noise[k].gain));
     }
     if (atlas.size() > 0x7fffffffu) throw std::runtime_error("catalogue images exceed 2 GiB");
-    std::vector<cl_int4> rects;
-    for (const Region& r : cat.regions) rects.push_back({{r.mmw.x, r.mmw.y, r.mmw.w, r.mmw.h}});
+    sprite_offsets_.resize(V);
+    for (size_t v = 0; v < V; ++v) sprite_offsets_[v] = sprites[static_cast<int>(Camera::mmw) * V + v].s[0];
+
+    // Pooled views: each region's rectangle in the pooled view that sees it.
+    const FeatureLayout lay = FeatureLayout::of(cat, 1);
+    std::vector<cl_int> pooled(lay.pooled.begin(), lay.pooled.end()), region_slot(kRegions, 0);
+    std::vector<cl_int4> region_rects(kRegions);
+    for (int r = 0; r < kRegions; ++r)
+      for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
+        const Sensor& s = cat.sensors[lay.pooled[slot]];
+        if (!s.sees(r)) continue;
+        region_slot[r] = static_cast<cl_int>(slot);
+        region_rects[r] = rect4(s.rects[r]);
+        break;
+      }
+    std::vector<cl_int4> view_rects;
+    for (const Sensor& s : cat.sensors)
+      for (const Rect& rc : s.rects) view_rects.push_back(rect4(rc));
+
     std::vector<uint8_t> influence, categories, base_zones;
     for (const auto& table : cat.influence)
       for (const auto& row : table)
@@ -85,21 +114,26 @@ class OpenCLBackend final : public Backend {
     places_ = constant(ctx, places);
     noise_offsets_ = constant(ctx, noise_offsets);
     noise_gains_ = constant(ctx, noise_gains);
-    rects_ = constant(ctx, rects);
+    pooled_ = constant(ctx, pooled);
+    region_slot_ = constant(ctx, region_slot);
+    region_rects_ = constant(ctx, region_rects);
+    for (size_t k = 0; k < views; ++k)
+      view_rects_.push_back(constant(
+          ctx, std::vector<cl_int4>(view_rects.begin() + k * kRegions, view_rects.begin() + (k + 1) * kRegions)));
     influence_ = constant(ctx, influence);
     categories_ = constant(ctx, categories);
     base_zones_ = constant(ctx, base_zones);
+    scratch_.resize(views);
   }
 
   std::string name() const override { return "opencl"; }
 
   void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) override {
-    const ImagesConfig& ic = cat_.images;
     const size_t n = batch.size();
     prepare_output(out, cat_, plan, n);
-    const size_t mmw_px = static_cast<size_t>(ic.mmw_width) * ic.mmw_height;
-    const int row_len = out.layout.image_features();
     if (n == 0) return;
+    const FeatureLayout& lay = out.layout;
+    const int row_len = lay.image_features();
 
     cl::Context& ctx = rt_->context();
     cl::CommandQueue& q = rt_->queue();
@@ -109,93 +143,33 @@ class OpenCLBackend final : public Backend {
     q.enqueueWriteBuffer(subject, CL_FALSE, 0, n, batch.subject.data());
     q.enqueueWriteBuffer(objects, CL_FALSE, 0, n * kRegions * sizeof(int16_t), batch.objects.data());
     const cl_uint2 seed = split(plan.model.seed), first = split(batch.first_index);
-    const cl_uint count = static_cast<cl_uint>(n);
-    const cl_int flags = (plan.model.pattern_noise ? 1 : 0) | (plan.pixel_noise_per_pixel() ? 2 : 0);
 
-    auto render = [&](int view, cl::Buffer& dst, int W, int H) {
-      cl::Kernel& k = K.render;
-      int a = 0;
-      k.setArg(a++, atlas_);
-      k.setArg(a++, bases_);
-      k.setArg(a++, sprites_);
-      k.setArg(a++, places_);
-      k.setArg(a++, noise_offsets_);
-      k.setArg(a++, noise_gains_);
-      k.setArg(a++, subject);
-      k.setArg(a++, objects);
-      k.setArg(a++, count);
-      k.setArg(a++, static_cast<cl_int>(view));
-      k.setArg(a++, static_cast<cl_int>(W));
-      k.setArg(a++, static_cast<cl_int>(H));
-      set(k, a++, param(K, ic.alpha));
-      k.setArg(a++, seed);
-      k.setArg(a++, first);
-      k.setArg(a++, static_cast<cl_int>(cat_.noise.size()));
-      k.setArg(a++, static_cast<cl_int>(ic.noise_size));
-      set(k, a++, param(K, plan.model.pixel_sigma));
-      k.setArg(a++, flags);
-      // Jitter in this view's pixels: the IR view is at its own scale.
-      const double sx = view == 2 ? double(ic.ir_width) / ic.mmw_width : 1.0;
-      const double sy = view == 2 ? double(ic.ir_height) / (2.0 * ic.mmw_height) : 1.0;
-      k.setArg(a++, static_cast<cl_int>(plan.model.bilinear ? 1 : 0));
-      k.setArg(a++, static_cast<cl_float>(plan.model.jitter * sx));
-      k.setArg(a++, static_cast<cl_float>(plan.model.jitter * sy));
-      k.setArg(a++, dst);
-      q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n * H)), cl::NDRange(kLocalSize));
-    };
-
+    const bool sparse = plan.sparse_features();
     cl::Buffer& feats = features_.at_least(ctx, std::max<size_t>(1, n * row_len * sizeof(float)));
-    if (plan.sparse_features()) {
-      sparse_features(K, plan, n, subject, objects, seed, first, feats);
-    } else if (plan.renders_mmw()) {
-      // Images the caller keeps are written in place (no copy back on a CPU device);
-      // images only pooled live in device buffers.
-      cl::Buffer upper = plan.mmw_images ? wrap(out.upper) : upper_.at_least(ctx, n * mmw_px);
-      cl::Buffer lower = plan.mmw_images ? wrap(out.lower) : lower_.at_least(ctx, n * mmw_px);
-      render(0, upper, ic.mmw_width, ic.mmw_height);
-      render(1, lower, ic.mmw_width, ic.mmw_height);
-      if (plan.features) {
-        const FeatureLayout& f = out.layout;
-        int a = 0;
-        K.pool_blocks.setArg(a++, upper);
-        K.pool_blocks.setArg(a++, lower);
-        K.pool_blocks.setArg(a++, count);
-        K.pool_blocks.setArg(a++, static_cast<cl_int>(ic.mmw_width));
-        K.pool_blocks.setArg(a++, static_cast<cl_int>(ic.mmw_height));
-        K.pool_blocks.setArg(a++, static_cast<cl_int>(f.block));
-        K.pool_blocks.setArg(a++, static_cast<cl_int>(f.blocks_x));
-        K.pool_blocks.setArg(a++, static_cast<cl_int>(f.blocks_y));
-        K.pool_blocks.setArg(a++, static_cast<cl_int>(row_len));
-        K.pool_blocks.setArg(a++, feats);
-        q.enqueueNDRangeKernel(K.pool_blocks, cl::NullRange, cl::NDRange(padded(n * 2 * f.blocks_x * f.blocks_y)),
-                               cl::NDRange(kLocalSize));
-        a = 0;
-        K.pool_regions.setArg(a++, upper);
-        K.pool_regions.setArg(a++, lower);
-        K.pool_regions.setArg(a++, count);
-        K.pool_regions.setArg(a++, static_cast<cl_int>(ic.mmw_width));
-        K.pool_regions.setArg(a++, static_cast<cl_int>(ic.mmw_height));
-        K.pool_regions.setArg(a++, rects_);
-        K.pool_regions.setArg(a++, static_cast<cl_int>(2 * f.blocks_x * f.blocks_y));
-        K.pool_regions.setArg(a++, static_cast<cl_int>(row_len));
-        K.pool_regions.setArg(a++, feats);
-        q.enqueueNDRangeKernel(K.pool_regions, cl::NullRange, cl::NDRange(padded(n * kRegions)),
-                               cl::NDRange(kLocalSize));
-      }
-      if (plan.mmw_images) {
-        sync(upper, out.upper);
-        sync(lower, out.lower);
-      }
+    if (plan.features && sparse) sparse_features(K, plan, n, subject, objects, seed, first, feats);
+
+    // Each camera view the plan needs: rendered into the caller's buffer when its images
+    // are kept (PoCL on the CPU writes there directly), else into a device buffer that
+    // only pooling reads.
+    std::vector<cl::Buffer> rendered(cat_.sensors.size());
+    for (size_t k = 0; k < cat_.sensors.size(); ++k) {
+      const Sensor& s = cat_.sensors[k];
+      const int view = static_cast<int>(k);
+      const bool keep = plan.image(view);
+      if (!keep && !(plan.features && s.pooled && !sparse)) continue;
+      rendered[k] = keep ? wrap(out.views[k].pixels) : scratch_[k].at_least(ctx, n * s.pixels());
+      render(K, plan, view, n, subject, objects, seed, first, rendered[k]);
+    }
+    if (plan.features && !sparse) {
+      for (size_t slot = 0; slot < lay.pooled.size(); ++slot)
+        pool(K, lay, n, static_cast<int>(slot), rendered[lay.pooled[slot]], feats);
     }
     if (plan.features) {
       if (plan.model.pixel_sigma > 0 && !plan.pixel_noise_per_pixel()) analytic_noise(K, plan, n, seed, first, feats);
       q.enqueueReadBuffer(feats, CL_FALSE, 0, n * row_len * sizeof(float), out.features.data());
     }
-    if (plan.ir_image) {
-      cl::Buffer ir = wrap(out.ir);
-      render(2, ir, ic.ir_width, ic.ir_height);
-      sync(ir, out.ir);
-    }
+    for (size_t k = 0; k < cat_.sensors.size(); ++k)
+      if (plan.image(static_cast<int>(k))) sync(rendered[k], out.views[k].pixels);
     if (plan.metal) {
       cl::Buffer& metal = metal_out_.at_least(ctx, n * kZones);
       int a = 0;
@@ -204,7 +178,7 @@ class OpenCLBackend final : public Backend {
       K.metal.setArg(a++, base_zones_);
       K.metal.setArg(a++, subject);
       K.metal.setArg(a++, objects);
-      K.metal.setArg(a++, count);
+      K.metal.setArg(a++, static_cast<cl_uint>(n));
       K.metal.setArg(a++, seed);
       K.metal.setArg(a++, first);
       K.metal.setArg(a++, static_cast<cl_int>(plan.model.metal_noise));
@@ -216,6 +190,118 @@ class OpenCLBackend final : public Backend {
   }
 
  private:
+  // The kernels of one program variant (precision, fast math).
+  struct SparseTables {
+    int block = -1;
+    bool noise = false;
+    int patterns = 1;
+    cl::Buffer fps, deltas, region_deltas, base_sums, base_means;
+  };
+  struct Kernels {
+    cl::Program program;
+    cl::Kernel render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, features_sparse,
+        analytic_noise;
+    std::map<std::string, cl::Kernel> stages;  // stage_<name>, made on first use
+    SparseTables tables;
+    bool fp64 = false;  // alpha and sigma are passed as double
+    size_t real_bytes = sizeof(cl_float);
+  };
+
+  // A model parameter at the kernels' parameter precision (see kernels/precision.cl).
+  static void set_param(const Kernels& K, cl::Kernel& k, int index, double v) {
+    if (K.fp64)
+      k.setArg(index, static_cast<cl_double>(v));
+    else
+      k.setArg(index, static_cast<cl_float>(v));
+  }
+
+  // One camera view for the batch: the fused kernel, or the chain of stage kernels over a
+  // field buffer. Both take VIEW_STAGE_ARGS (kernels/composite.cl).
+  void render(Kernels& K, const Plan& plan, int view, size_t n, cl::Buffer& subject, cl::Buffer& objects, cl_uint2 seed,
+              cl_uint2 first, cl::Buffer& dst) {
+    const Sensor& s = cat_.sensors[view];
+    PsViewLaunch L{};
+    L.n = static_cast<uint32_t>(n);
+    L.view = view;
+    L.views = static_cast<int32_t>(cat_.sensors.size());
+    L.sprite_set = static_cast<int32_t>(s.camera);
+    L.variants = static_cast<int32_t>(cat_.variant_list.size());
+    L.region_mask = s.region_mask;
+    L.width = s.width;
+    L.height = s.height;
+    L.seed_lo = seed.s[0];
+    L.seed_hi = seed.s[1];
+    L.first_lo = first.s[0];
+    L.first_hi = first.s[1];
+    L.patterns = static_cast<int32_t>(cat_.noise.size());
+    L.tile_size = cat_.images.noise_size;
+    L.flags = (s.pattern_noise && plan.model.pattern_noise ? PS_FLAG_PATTERN_NOISE : 0) |
+              (plan.pixel_noise_per_pixel() ? PS_FLAG_PIXEL_NOISE : 0) | (plan.model.bilinear ? PS_FLAG_BILINEAR : 0);
+    L.jitter_x = static_cast<float>(plan.model.jitter * s.jitter_scale_x);
+    L.jitter_y = static_cast<float>(plan.model.jitter * s.jitter_scale_y);
+    const bool fused = plan.fidelity.fused && s.chain == fused_chain();
+    cl::Buffer field = fused ? dst : field_.at_least(rt_->context(), n * s.pixels() * K.real_bytes);
+    const auto launch = [&](cl::Kernel& k) {
+      int a = 0;
+      k.setArg(a++, atlas_);
+      k.setArg(a++, bases_);
+      k.setArg(a++, sprites_);
+      k.setArg(a++, places_);
+      k.setArg(a++, noise_offsets_);
+      k.setArg(a++, noise_gains_);
+      k.setArg(a++, subject);
+      k.setArg(a++, objects);
+      k.setArg(a++, sizeof(L), &L);
+      set_param(K, k, a++, cat_.images.alpha);
+      set_param(K, k, a++, plan.model.pixel_sigma);
+      k.setArg(a++, field);
+      k.setArg(a++, dst);
+      rt_->queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n * s.height)), cl::NDRange(kLocalSize));
+    };
+    if (fused) {
+      launch(K.render);
+      return;
+    }
+    for (const std::string& name : s.chain) {
+      const std::string kernel = view_stage(name).kernel();
+      auto it = K.stages.find(kernel);
+      if (it == K.stages.end()) it = K.stages.emplace(kernel, cl::Kernel(K.program, kernel.c_str())).first;
+      launch(it->second);
+    }
+  }
+
+  // Block and region means of one pooled view into its columns of the feature rows.
+  void pool(Kernels& K, const FeatureLayout& lay, size_t n, int slot, cl::Buffer& img, cl::Buffer& feats) {
+    const int view = lay.pooled[slot];
+    const Sensor& s = cat_.sensors[view];
+    const int row_len = lay.image_features();
+    int a = 0;
+    K.pool_blocks.setArg(a++, img);
+    K.pool_blocks.setArg(a++, static_cast<cl_uint>(n));
+    K.pool_blocks.setArg(a++, static_cast<cl_int>(s.width));
+    K.pool_blocks.setArg(a++, static_cast<cl_int>(s.height));
+    K.pool_blocks.setArg(a++, static_cast<cl_int>(lay.block));
+    K.pool_blocks.setArg(a++, static_cast<cl_int>(lay.blocks_x));
+    K.pool_blocks.setArg(a++, static_cast<cl_int>(lay.blocks_y));
+    K.pool_blocks.setArg(a++, static_cast<cl_int>(slot * lay.blocks_per_view()));
+    K.pool_blocks.setArg(a++, static_cast<cl_int>(row_len));
+    K.pool_blocks.setArg(a++, feats);
+    rt_->queue().enqueueNDRangeKernel(K.pool_blocks, cl::NullRange, cl::NDRange(padded(n * lay.blocks_per_view())),
+                                      cl::NDRange(kLocalSize));
+    a = 0;
+    K.pool_regions.setArg(a++, img);
+    K.pool_regions.setArg(a++, static_cast<cl_uint>(n));
+    K.pool_regions.setArg(a++, static_cast<cl_int>(s.width));
+    K.pool_regions.setArg(a++, static_cast<cl_int>(s.height));
+    K.pool_regions.setArg(a++, view_rects_[view]);
+    K.pool_regions.setArg(a++, static_cast<cl_uint>(s.region_mask));
+    K.pool_regions.setArg(a++, static_cast<cl_int>(lay.block_features()));
+    K.pool_regions.setArg(a++, static_cast<cl_int>(row_len));
+    K.pool_regions.setArg(a++, feats);
+    rt_->queue().enqueueNDRangeKernel(K.pool_regions, cl::NullRange, cl::NDRange(padded(n * kRegions)),
+                                      cl::NDRange(kLocalSize));
+  }
+
   // A device view of host memory: PoCL on the CPU writes there directly.
   cl::Buffer wrap(std::vector<uint8_t>& v) {
     return cl::Buffer(rt_->context(), CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, v.size(), v.data());
@@ -225,35 +311,6 @@ class OpenCLBackend final : public Backend {
     void* p = rt_->queue().enqueueMapBuffer(b, CL_TRUE, CL_MAP_READ, 0, v.size());
     if (p != v.data()) std::memcpy(v.data(), p, v.size());
     rt_->queue().enqueueUnmapMemObject(b, p);
-  }
-
-  // The tables of the sparse features path, built once per (block, pattern noise) for
-  // each program variant.
-  struct SparseTables {
-    int block = -1;
-    bool noise = false;
-    int patterns = 1;
-    cl::Buffer fps, deltas, region_deltas, base_sums, base_means;
-  };
-  // The kernels of one program variant (precision, fast math).
-  struct Kernels {
-    cl::Kernel render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, features_sparse,
-        analytic_noise;
-    SparseTables tables;
-    bool fp64 = false;  // alpha and sigma are passed as double
-  };
-
-  // A model parameter at the kernels' parameter precision (see kernels/precision.cl).
-  struct ParamArg {
-    bool fp64;
-    double v;
-  };
-  static ParamArg param(const Kernels& k, double v) { return {k.fp64, v}; }
-  static void set(cl::Kernel& k, int index, ParamArg p) {
-    if (p.fp64)
-      k.setArg(index, static_cast<cl_double>(p.v));
-    else
-      k.setArg(index, static_cast<cl_float>(p.v));
   }
 
   static std::string build_options(const Fidelity& f) {
@@ -268,34 +325,43 @@ class OpenCLBackend final : public Backend {
     const std::string options = build_options(f);
     auto it = variants_.find(options);
     if (it != variants_.end()) return it->second;
-    cl::Program& p = rt_->program(options);
     Kernels k;
-    k.render = cl::Kernel(p, "render_view");
-    k.pool_blocks = cl::Kernel(p, "pool_blocks");
-    k.pool_regions = cl::Kernel(p, "pool_regions");
-    k.metal = cl::Kernel(p, "metal_zones");
-    k.base_features = cl::Kernel(p, "base_features");
-    k.footprint_deltas = cl::Kernel(p, "footprint_deltas");
-    k.features_sparse = cl::Kernel(p, "features_sparse");
-    k.analytic_noise = cl::Kernel(p, "analytic_noise");
+    k.program = rt_->program(options);
+    k.render = cl::Kernel(k.program, "render_view");
+    k.pool_blocks = cl::Kernel(k.program, "pool_blocks");
+    k.pool_regions = cl::Kernel(k.program, "pool_regions");
+    k.metal = cl::Kernel(k.program, "metal_zones");
+    k.base_features = cl::Kernel(k.program, "base_features");
+    k.footprint_deltas = cl::Kernel(k.program, "footprint_deltas");
+    k.features_sparse = cl::Kernel(k.program, "features_sparse");
+    k.analytic_noise = cl::Kernel(k.program, "analytic_noise");
     k.fp64 = f.precision == Precision::fp64;
+    k.real_bytes = k.fp64 ? sizeof(cl_double) : sizeof(cl_float);
     return variants_.emplace(options, std::move(k)).first->second;
+  }
+  // The sparse path's tables assume every pooled view has the first one's size.
+  const Sensor& pooled_view(const FeatureLayout& lay) const { return cat_.sensors[lay.pooled.at(0)]; }
+  int region_slot(const FeatureLayout& lay, int r) const {
+    for (size_t slot = 0; slot < lay.pooled.size(); ++slot)
+      if (cat_.sensors[lay.pooled[slot]].sees(r)) return static_cast<int>(slot);
+    return 0;
   }
 
   // Block-mean noise model: each mean gets N(0, sigma^2 / pixels) from the generator.
   void analytic_noise(Kernels& K, const Plan& plan, size_t n, cl_uint2 seed, cl_uint2 first, cl::Buffer& feats) {
-    const ImagesConfig& ic = cat_.images;
     const FeatureLayout lay = FeatureLayout::of(cat_, plan.model.block);
+    const Sensor& s = pooled_view(lay);
     cl::Kernel& k = K.analytic_noise;
     int a = 0;
     k.setArg(a++, feats);
-    k.setArg(a++, rects_);
+    k.setArg(a++, region_rects_);
     k.setArg(a++, static_cast<cl_uint>(n));
-    k.setArg(a++, static_cast<cl_int>(ic.mmw_width));
-    k.setArg(a++, static_cast<cl_int>(ic.mmw_height));
+    k.setArg(a++, static_cast<cl_int>(s.width));
+    k.setArg(a++, static_cast<cl_int>(s.height));
     k.setArg(a++, static_cast<cl_int>(lay.block));
     k.setArg(a++, static_cast<cl_int>(lay.blocks_x));
     k.setArg(a++, static_cast<cl_int>(lay.blocks_y));
+    k.setArg(a++, static_cast<cl_int>(lay.pooled.size()));
     k.setArg(a++, static_cast<cl_int>(lay.image_features()));
     k.setArg(a++, static_cast<cl_float>(plan.model.pixel_sigma));
     k.setArg(a++, seed);
@@ -308,53 +374,55 @@ class OpenCLBackend final : public Backend {
     cl::Kernel& base_features_ = K.base_features;
     cl::Kernel& footprint_deltas_ = K.footprint_deltas;
     const ImagesConfig& ic = cat_.images;
-    const int block = plan.model.block, W = ic.mmw_width, H = ic.mmw_height, N = ic.noise_size;
+    const FeatureLayout lay = FeatureLayout::of(cat_, plan.model.block);
+    const Sensor& view = pooled_view(lay);
+    const int block = plan.model.block, W = view.width, H = view.height, N = ic.noise_size;
     const bool noise = plan.model.pattern_noise;
     if (tables_.block == block && tables_.noise == noise) return;
     const int S = static_cast<int>(cat_.subjects.size()), V = static_cast<int>(cat_.variant_list.size());
     const int P = noise ? static_cast<int>(cat_.noise.size()) : 1;
-    std::vector<cl_int> fps(static_cast<size_t>(V) * kRegions * 16, 0);
+    std::vector<cl_int> fps(static_cast<size_t>(V) * kRegions * PS_FP_LEN, 0);
     cl_int offset = 0;
     for (int v = 0; v < V; ++v)
       for (int r = 0; r < kRegions; ++r) {
-        const Image& sp = assets_.mmw_sprites[v];
-        const Rect& rc = cat_.regions[r].mmw;
-        cl_int* f = &fps[(static_cast<size_t>(v) * kRegions + r) * 16];
-        f[0] = rc.x + ((rc.w - sp.width) >> 1);
-        f[1] = rc.y + ((rc.h - sp.height) >> 1);
-        f[2] = sp.width;
-        f[3] = sp.height;
-        f[4] = sprite_offsets_[v * 2];
-        f[5] = f[0] + (sp.width >> 1) - (N >> 1);
-        f[6] = f[1] + (sp.height >> 1) - (N >> 1);
-        int x0 = f[0], y0 = f[1], x1 = f[0] + f[2], y1 = f[1] + f[3];
+        const Image& sp = assets_.sprite(Camera::mmw, v);
+        const Rect& rc = cat_.sensors[lay.pooled[region_slot(lay, r)]].rects[r];
+        cl_int* f = &fps[(static_cast<size_t>(v) * kRegions + r) * PS_FP_LEN];
+        f[PS_FP_SPRITE_X0] = rc.x + ((rc.w - sp.width) >> 1);
+        f[PS_FP_SPRITE_Y0] = rc.y + ((rc.h - sp.height) >> 1);
+        f[PS_FP_SPRITE_W] = sp.width;
+        f[PS_FP_SPRITE_H] = sp.height;
+        f[PS_FP_SPRITE_OFFSET] = sprite_offsets_[v];
+        f[PS_FP_TILE_X0] = f[PS_FP_SPRITE_X0] + (sp.width >> 1) - (N >> 1);
+        f[PS_FP_TILE_Y0] = f[PS_FP_SPRITE_Y0] + (sp.height >> 1) - (N >> 1);
+        int x0 = f[PS_FP_SPRITE_X0], y0 = f[PS_FP_SPRITE_Y0], x1 = f[PS_FP_SPRITE_X0] + f[PS_FP_SPRITE_W],
+            y1 = f[PS_FP_SPRITE_Y0] + f[PS_FP_SPRITE_H];
         if (noise) {
-          x0 = std::min(x0, f[5]);
-          y0 = std::min(y0, f[6]);
-          x1 = std::max(x1, f[5] + N);
-          y1 = std::max(y1, f[6] + N);
+          x0 = std::min(x0, f[PS_FP_TILE_X0]);
+          y0 = std::min(y0, f[PS_FP_TILE_Y0]);
+          x1 = std::max(x1, f[PS_FP_TILE_X0] + N);
+          y1 = std::max(y1, f[PS_FP_TILE_Y0] + N);
         }
         x0 = std::max(x0, 0);
         y0 = std::max(y0, 0);
         x1 = std::min(x1, W);
         y1 = std::min(y1, H);
         if (x0 >= x1 || y0 >= y1) x0 = y0 = x1 = y1 = 0;  // wholly outside: touches nothing
-        f[7] = x0;
-        f[8] = y0;
-        f[9] = x1;
-        f[10] = y1;
-        f[11] = x0 / block;
-        f[12] = y0 / block;
-        f[13] = x1 > x0 ? (x1 - 1) / block - f[11] + 1 : 0;
-        f[14] = y1 > y0 ? (y1 - 1) / block - f[12] + 1 : 0;
-        f[15] = offset;
-        const int64_t next = offset + static_cast<int64_t>(S) * P * f[13] * f[14];
+        f[PS_FP_X0] = x0;
+        f[PS_FP_Y0] = y0;
+        f[PS_FP_X1] = x1;
+        f[PS_FP_Y1] = y1;
+        f[PS_FP_BLOCK_X0] = x0 / block;
+        f[PS_FP_BLOCK_Y0] = y0 / block;
+        f[PS_FP_BLOCKS_W] = x1 > x0 ? (x1 - 1) / block - f[PS_FP_BLOCK_X0] + 1 : 0;
+        f[PS_FP_BLOCKS_H] = y1 > y0 ? (y1 - 1) / block - f[PS_FP_BLOCK_Y0] + 1 : 0;
+        f[PS_FP_DELTAS] = offset;
+        const int64_t next = offset + static_cast<int64_t>(S) * P * f[PS_FP_BLOCKS_W] * f[PS_FP_BLOCKS_H];
         if (next > INT32_MAX) throw std::runtime_error("sparse feature tables exceed 2^31 entries; use --block larger");
         offset = static_cast<cl_int>(next);
       }
     cl::Context& ctx = rt_->context();
     cl::CommandQueue& q = rt_->queue();
-    const FeatureLayout lay = FeatureLayout::of(cat_, block);
     const int row_len = lay.image_features(), combos = V * kRegions * S * P;
     tables_.fps = constant(ctx, fps);
     tables_.deltas = cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<size_t>(1, offset) * sizeof(cl_int));
@@ -364,7 +432,11 @@ class OpenCLBackend final : public Backend {
     int a = 0;
     base_features_.setArg(a++, atlas_);
     base_features_.setArg(a++, bases_);
-    base_features_.setArg(a++, rects_);
+    base_features_.setArg(a++, region_rects_);
+    base_features_.setArg(a++, pooled_);
+    base_features_.setArg(a++, static_cast<cl_int>(lay.pooled.size()));
+    base_features_.setArg(a++, static_cast<cl_int>(cat_.sensors.size()));
+    base_features_.setArg(a++, region_slot_);
     base_features_.setArg(a++, static_cast<cl_int>(S));
     base_features_.setArg(a++, static_cast<cl_int>(W));
     base_features_.setArg(a++, static_cast<cl_int>(H));
@@ -382,13 +454,16 @@ class OpenCLBackend final : public Backend {
     footprint_deltas_.setArg(a++, tables_.fps);
     footprint_deltas_.setArg(a++, noise_offsets_);
     footprint_deltas_.setArg(a++, noise_gains_);
-    footprint_deltas_.setArg(a++, rects_);
+    footprint_deltas_.setArg(a++, region_rects_);
+    footprint_deltas_.setArg(a++, pooled_);
+    footprint_deltas_.setArg(a++, static_cast<cl_int>(cat_.sensors.size()));
+    footprint_deltas_.setArg(a++, region_slot_);
     footprint_deltas_.setArg(a++, static_cast<cl_int>(combos));
     footprint_deltas_.setArg(a++, static_cast<cl_int>(S));
     footprint_deltas_.setArg(a++, static_cast<cl_int>(P));
     footprint_deltas_.setArg(a++, static_cast<cl_int>(W));
     footprint_deltas_.setArg(a++, static_cast<cl_int>(block));
-    set(footprint_deltas_, a++, param(K, ic.alpha));
+    set_param(K, footprint_deltas_, a++, ic.alpha);
     footprint_deltas_.setArg(a++, static_cast<cl_int>(N));
     footprint_deltas_.setArg(a++, static_cast<cl_int>(noise ? 1 : 0));
     footprint_deltas_.setArg(a++, tables_.deltas);
@@ -406,6 +481,7 @@ class OpenCLBackend final : public Backend {
     const SparseTables& tables_ = K.tables;
     const ImagesConfig& ic = cat_.images;
     const FeatureLayout lay = FeatureLayout::of(cat_, plan.model.block);
+    const Sensor& view = pooled_view(lay);
     const int row_len = lay.image_features();
     cl::Kernel& k = K.features_sparse;
     int a = 0;
@@ -418,18 +494,22 @@ class OpenCLBackend final : public Backend {
     k.setArg(a++, tables_.base_means);
     k.setArg(a++, noise_offsets_);
     k.setArg(a++, noise_gains_);
-    k.setArg(a++, rects_);
+    k.setArg(a++, region_rects_);
+    k.setArg(a++, pooled_);
+    k.setArg(a++, static_cast<cl_int>(lay.pooled.size()));
+    k.setArg(a++, static_cast<cl_int>(cat_.sensors.size()));
+    k.setArg(a++, region_slot_);
     k.setArg(a++, subject);
     k.setArg(a++, objects);
     k.setArg(a++, static_cast<cl_uint>(n));
     k.setArg(a++, static_cast<cl_int>(cat_.subjects.size()));
     k.setArg(a++, static_cast<cl_int>(tables_.patterns));
-    k.setArg(a++, static_cast<cl_int>(ic.mmw_width));
-    k.setArg(a++, static_cast<cl_int>(ic.mmw_height));
+    k.setArg(a++, static_cast<cl_int>(view.width));
+    k.setArg(a++, static_cast<cl_int>(view.height));
     k.setArg(a++, static_cast<cl_int>(lay.block));
     k.setArg(a++, static_cast<cl_int>(lay.blocks_x));
     k.setArg(a++, static_cast<cl_int>(lay.blocks_y));
-    set(k, a++, param(K, ic.alpha));
+    set_param(K, k, a++, ic.alpha);
     k.setArg(a++, static_cast<cl_int>(ic.noise_size));
     k.setArg(a++, static_cast<cl_int>(tables_.noise ? 1 : 0));
     k.setArg(a++, seed);
@@ -442,11 +522,13 @@ class OpenCLBackend final : public Backend {
   const Catalogue& cat_;
   const AssetSet& assets_;
   std::shared_ptr<OpenCLRuntime> rt_;
-  std::vector<cl_int> sprite_offsets_;
+  std::vector<cl_int> sprite_offsets_;  // atlas offset of each variant's MMW sprite
   std::map<std::string, Kernels> variants_;
-  cl::Buffer atlas_, bases_, sprites_, places_, noise_offsets_, noise_gains_, rects_, influence_, categories_,
-      base_zones_;
-  Grown subject_, objects_, upper_, lower_, metal_out_, features_;
+  cl::Buffer atlas_, bases_, sprites_, places_, noise_offsets_, noise_gains_, pooled_, region_slot_, region_rects_,
+      influence_, categories_, base_zones_;
+  std::vector<cl::Buffer> view_rects_;  // per view: int4 per region
+  Grown subject_, objects_, metal_out_, features_, field_;
+  std::vector<Grown> scratch_;  // per view: images only pooled
 };
 
 }  // namespace

@@ -7,20 +7,10 @@
 namespace portalsim {
 
 namespace embedded {
-extern const std::string_view kernel_philox, kernel_precision, kernel_composite, kernel_noise, kernel_pool,
-    kernel_metal, kernel_render;
+extern const std::string_view kernel_program;
 }
 
-std::string OpenCLRuntime::source() {
-  std::string s;
-  for (std::string_view part :
-       {embedded::kernel_philox, embedded::kernel_precision, embedded::kernel_composite, embedded::kernel_noise,
-        embedded::kernel_pool, embedded::kernel_metal, embedded::kernel_render}) {
-    s += part;
-    s += "\n";
-  }
-  return s;
-}
+std::string OpenCLRuntime::source() { return std::string(embedded::kernel_program); }
 
 OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
   std::vector<cl::Platform> platforms;

@@ -4,6 +4,8 @@
 #include <map>
 #include <string>
 
+#include "shared.h"
+
 namespace portalsim {
 
 struct OpenCLOptions {
@@ -23,7 +25,7 @@ class OpenCLRuntime {
   cl::Program& program(const std::string& options);
   const std::string& device_name() const { return device_name_; }
   double build_seconds() const { return build_seconds_; }
-  static std::string source();  // the kernels/ files, concatenated in build order
+  static std::string source();  // kernels/shared.h and the kernels/ files, in CMakeLists.txt's order
 
  private:
   cl::Context context_;
@@ -37,7 +39,7 @@ class OpenCLRuntime {
 
 // Rounds a work size up to the fixed local size: PoCL compiles a work-group function per
 // local size, so every launch uses the same one.
-constexpr size_t kLocalSize = 64;
+constexpr size_t kLocalSize = PS_LOCAL_SIZE;
 inline size_t padded(size_t n) { return (n + kLocalSize - 1) / kLocalSize * kLocalSize; }
 
 }  // namespace portalsim

@@ -1,0 +1,34 @@
+// What every benchmark shares: the default catalogue, its assets, OpenCL runtimes on all
+// compute units and on one, and generated scenario batches.
+#pragma once
+#include <memory>
+
+#include "assets/assets.h"
+#include "backend/opencl/opencl_backend.h"
+#include "scene/generator.h"
+
+namespace portalsim::bench {
+
+struct Fixture {
+  Catalogue cat = default_catalogue();
+  AssetSet assets = build_assets(cat);
+  std::shared_ptr<OpenCLRuntime> rt = std::make_shared<OpenCLRuntime>();
+  // One compute unit: PoCL runs the kernels on a single thread.
+  std::shared_ptr<OpenCLRuntime> rt1 = std::make_shared<OpenCLRuntime>(OpenCLOptions{"", "", 1});
+};
+inline Fixture& fx() {
+  static Fixture f;
+  return f;
+}
+
+// n scenarios of the generator (seed 1), 0 to max_objects objects each.
+inline SceneBatch make_batch(size_t n, int max_objects = 4) {
+  GeneratorSpec spec;
+  spec.max_objects = max_objects;
+  Generator gen(fx().cat, spec, 1);
+  SceneBatch b;
+  for (size_t i = 0; i < n; ++i) b.push(gen(i));
+  return b;
+}
+
+}  // namespace portalsim::bench

@@ -1,0 +1,83 @@
+// Camera-view stages, one by one: the chain of stage kernels cut after each stage (then
+// display), and
+// the same chain of reference stages, with per-pixel noise on so that every stage works.
+// A stage's cost is the difference between its prefix and the one before it. Also the
+// fused render_view (the declared fast path) against the full chain of stage kernels.
+//   ./build/portalsim_bench --benchmark_filter='Stage|Chain'
+#include <benchmark/benchmark.h>
+
+#include "backend/stages.h"
+#include "fixture.h"
+
+namespace portalsim {
+namespace {
+using bench::fx;
+using bench::make_batch;
+
+// The default catalogue with every view's chain cut to its first `stages` stages, then
+// display (which every chain ends with).
+struct Prefix {
+  Catalogue cat;
+  explicit Prefix(size_t stages) : cat(fx().cat) {
+    for (Sensor& s : cat.sensors) {
+      s.chain.resize(std::min(stages, s.chain.size() - 1));
+      s.chain.push_back("display");
+    }
+  }
+};
+
+Plan images_plan() {
+  Plan p;
+  p.features = false;
+  p.metal = false;
+  p.model.pixel_sigma = 2;
+  p.fidelity.fused = false;
+  return p;
+}
+
+void time_backend(benchmark::State& state, Backend& backend, const Plan& plan, size_t n) {
+  const SceneBatch batch = make_batch(n);
+  BatchOutput out;
+  backend.run(batch, plan, out);  // warm: work-group compilation
+  for (auto _ : state) {
+    backend.run(batch, plan, out);
+    benchmark::DoNotOptimize(out.views.data());
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+  state.SetLabel(fused_chain()[state.range(0) - 1]);
+}
+
+// Arg: the stages kept before display (1 = composite only ... 3 = the whole chain).
+void BM_StageOpenCL(benchmark::State& state) {
+  Prefix p(static_cast<size_t>(state.range(0)));
+  auto b = make_opencl_backend(p.cat, fx().assets, fx().rt);
+  time_backend(state, *b, images_plan(), 1024);
+}
+void BM_StageReference(benchmark::State& state) {
+  Prefix p(static_cast<size_t>(state.range(0)));
+  auto b = make_reference_backend(p.cat, fx().assets);
+  time_backend(state, *b, images_plan(), 32);
+}
+// Arg: 1 fused render_view, 0 the chain of stage kernels.
+void BM_ChainFusedOrStaged(benchmark::State& state) {
+  auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+  Plan plan = images_plan();
+  plan.fidelity.fused = state.range(0) == 1;
+  const size_t n = 1024;
+  const SceneBatch batch = make_batch(n);
+  BatchOutput out;
+  b->run(batch, plan, out);
+  for (auto _ : state) {
+    b->run(batch, plan, out);
+    benchmark::DoNotOptimize(out.views.data());
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+  state.SetLabel(plan.fidelity.fused ? "fused render_view" : "stage kernels");
+}
+
+BENCHMARK(BM_StageOpenCL)->DenseRange(1, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_StageReference)->DenseRange(1, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ChainFusedOrStaged)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace portalsim

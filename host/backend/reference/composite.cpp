@@ -1,0 +1,89 @@
+#include <algorithm>
+#include <cmath>
+
+#include "backend/reference/stages.h"
+#include "scene/philox.h"
+
+namespace portalsim::reference {
+
+ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m, int view, const Scenario& s,
+                     uint64_t index) {
+  const Sensor& sensor = cat.sensors[view];
+  ViewScene vs{cat, assets, m, sensor, view, s, index, {}};
+  for (int r = 0; r < kRegions; ++r) {
+    const int16_t v = s.objects[r];
+    if (v == kNoObject || !sensor.sees(r)) continue;
+    const Image& sp = assets.sprite(sensor.camera, v);
+    const Rect& rect = sensor.rects[r];
+    const int x0 = rect.x + static_cast<int>(std::floor((rect.w - sp.width) / 2.0));
+    const int y0 = rect.y + static_cast<int>(std::floor((rect.h - sp.height) / 2.0));
+    double dx = 0, dy = 0;
+    if (m.jitter > 0) {
+      const Philox4 q = draw(m.seed, index, kStreamJitter, static_cast<uint32_t>(r));
+      dx = m.jitter * sensor.jitter_scale_x * (2.0 * uniform24(q[0]) - 1.0);
+      dy = m.jitter * sensor.jitter_scale_y * (2.0 * uniform24(q[1]) - 1.0);
+    }
+    vs.placed.push_back({&sp, x0, y0, dx, dy});
+  }
+  return vs;
+}
+
+// Thesis algorithm step 8: v = a s + (1 - a) v, a = alpha coverage / 255, objects in
+// region order over the subject's base image.
+void composite(const ViewScene& vs, Field& f) {
+  const Image& base = vs.assets.bases[vs.scenario.subject][vs.view];
+  const int W = base.width, H = base.height;
+  const double alpha = vs.cat.images.alpha;
+  f.width = W;
+  f.height = H;
+  f.v.assign(static_cast<size_t>(W) * H, 0.0);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) f.at(x, y) = base.at(x, y);
+
+  for (const Placed& p : vs.placed) {
+    const Image& sp = *p.sprite;
+    if (!vs.model.bilinear) {
+      const int ox = p.x0 + static_cast<int>(std::floor(p.dx + 0.5));
+      const int oy = p.y0 + static_cast<int>(std::floor(p.dy + 0.5));
+      for (int sy = 0; sy < sp.height; ++sy)
+        for (int sx = 0; sx < sp.width; ++sx) {
+          const int x = ox + sx, y = oy + sy;
+          if (x < 0 || y < 0 || x >= W || y >= H) continue;
+          const double a = alpha * sp.at(sx, sy, 1) / 255.0;
+          double& v = f.at(x, y);
+          v = a * sp.at(sx, sy, 0) + (1.0 - a) * v;
+        }
+      continue;
+    }
+    // Sub-pixel: the sprite's premultiplied value and coverage, sampled bilinearly.
+    const double fx = p.x0 + p.dx, fy = p.y0 + p.dy;
+    const auto texel = [&](int i, int j, double& pv, double& c) {
+      if (i < 0 || j < 0 || i >= sp.width || j >= sp.height) return;
+      const double cov = sp.at(i, j, 1) / 255.0;
+      pv = cov * sp.at(i, j, 0);
+      c = cov;
+    };
+    for (int y = std::max(0, static_cast<int>(std::floor(fy)) - 1);
+         y < std::min(H, static_cast<int>(fy) + sp.height + 2); ++y)
+      for (int x = std::max(0, static_cast<int>(std::floor(fx)) - 1);
+           x < std::min(W, static_cast<int>(fx) + sp.width + 2); ++x) {
+        const double sx = x - fx, sy = y - fy;
+        const int i0 = static_cast<int>(std::floor(sx)), j0 = static_cast<int>(std::floor(sy));
+        const double tx = sx - i0, ty = sy - j0;
+        double pv = 0, c = 0;
+        for (int j = 0; j < 2; ++j)
+          for (int i = 0; i < 2; ++i) {
+            double tpv = 0, tc = 0;
+            texel(i0 + i, j0 + j, tpv, tc);
+            const double w = (i ? tx : 1 - tx) * (j ? ty : 1 - ty);
+            pv += w * tpv;
+            c += w * tc;
+          }
+        if (c == 0) continue;
+        double& v = f.at(x, y);
+        v = (1.0 - alpha * c) * v + alpha * pv;
+      }
+  }
+}
+
+}  // namespace portalsim::reference

@@ -1,0 +1,58 @@
+// The reference's stages: the sensor model written as plainly as possible, in double
+// precision, one pixel at a time. Each is a free function under the stage's name, the
+// same name as its kernel in kernels/ and its entry in backend/stages.h. They share
+// nothing with kernels/ except the random generator (scene/philox.h) and the catalogue.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "assets/assets.h"
+#include "plan/plan.h"
+#include "scene/scene.h"
+
+namespace portalsim::reference {
+
+// A camera view's values before display: gray levels (MMW) or temperature indices (IR).
+struct Field {
+  int width = 0, height = 0;
+  std::vector<double> v;
+  double& at(int x, int y) { return v[static_cast<size_t>(y) * width + x]; }
+};
+
+// One object drawn in a view: its sprite, where it sits centred in its region (the noise
+// tile's place), and its placement jitter in this view's pixels.
+struct Placed {
+  const Image* sprite;
+  int x0, y0;
+  double dx, dy;
+};
+
+// Everything a stage of one camera view reads for one scenario.
+struct ViewScene {
+  const Catalogue& cat;
+  const AssetSet& assets;
+  const ModelSettings& model;
+  const Sensor& sensor;
+  int view;  // index in Catalogue::sensors
+  const Scenario& scenario;
+  uint64_t index;  // the scenario's global index: the random generator's counter
+  std::vector<Placed> placed;
+};
+
+ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSettings& model, int view,
+                     const Scenario& s, uint64_t index);
+
+// The view's chain (thesis model), in order. Each transforms the field in place.
+void composite(const ViewScene& vs, Field& f);      // base image, then sprites in region order
+void pattern_noise(const ViewScene& vs, Field& f);  // the scenario's MMW noise tile over each object
+void sensor_noise(const ViewScene& vs, Field& f);   // per-pixel Gaussian noise, Box-Muller
+void display(const ViewScene& vs, Field& f);        // round half up, clamp to 0..255
+
+// Block means of each pooled view, then each region's mean (thesis 5.6); `views` holds the
+// displayed images of every camera view (empty where not rendered).
+void pool(const Catalogue& cat, const std::vector<std::vector<uint8_t>>& views, const FeatureLayout& layout,
+          float* row);
+// Metal zones (thesis algorithm step 2): base minus every object's influence, clamped.
+void metal(const Catalogue& cat, const ModelSettings& m, const Scenario& s, uint64_t index, uint8_t* zones);
+
+}  // namespace portalsim::reference

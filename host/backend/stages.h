@@ -1,0 +1,31 @@
+// The stages of a camera view's chain, each registered once under one name: its plain
+// double-precision reference function (backend/reference/), its kernel (kernels/, named
+// stage_<name>), its test and its benchmark. A sensor's chain (scene/sensor.h) lists
+// stage names; both backends run the chain through this table. A new stage is its
+// reference file, its kernel and one line in stages.cpp.
+#pragma once
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "backend/reference/stages.h"
+
+namespace portalsim {
+
+struct ViewStage {
+  std::string_view name;
+  void (*reference)(const reference::ViewScene&, reference::Field&);
+  std::string kernel() const { return "stage_" + std::string(name); }
+};
+
+const std::vector<ViewStage>& view_stages();
+// The chain the fused render_view kernel implements (a declared fast path); views whose
+// chain differs run stage by stage.
+const std::vector<std::string>& fused_chain();
+// Throws std::logic_error unless every stage of the view's chain is registered and the
+// chain ends with display (the stage that makes pixels).
+void check_chain(const Sensor& view);
+// Throws std::invalid_argument for a name no stage has.
+const ViewStage& view_stage(std::string_view name);
+
+}  // namespace portalsim

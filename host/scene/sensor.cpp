@@ -1,0 +1,50 @@
+#include "scene/sensor.h"
+
+#include "scene/catalogue.h"
+
+namespace portalsim {
+
+std::vector<Sensor> camera_sensors(const Catalogue& cat) {
+  const ImagesConfig& ic = cat.images;
+  std::vector<Sensor> out;
+  for (View view : {View::upper, View::lower}) {
+    Sensor s;
+    s.name = view == View::upper ? "upper" : "lower";
+    s.asset_key = "mmw_" + s.name;
+    s.camera = Camera::mmw;
+    s.width = ic.mmw_width;
+    s.height = ic.mmw_height;
+    for (const Region& r : cat.regions)
+      if (r.view == view) {
+        s.rects[r.id - 1] = r.mmw;
+        s.region_mask |= 1u << (r.id - 1);
+      }
+    s.pattern_noise = true;
+    s.pooled = true;
+    out.push_back(s);
+  }
+  // The IR camera sees the whole body at its own scale: the two MMW views stacked.
+  Sensor ir;
+  ir.name = "ir";
+  ir.asset_key = "ir";
+  ir.camera = Camera::ir;
+  ir.width = ic.ir_width;
+  ir.height = ic.ir_height;
+  for (const Region& r : cat.regions) {
+    ir.rects[r.id - 1] = r.ir;
+    ir.region_mask |= 1u << (r.id - 1);
+  }
+  ir.palette = true;
+  ir.jitter_scale_x = static_cast<double>(ic.ir_width) / ic.mmw_width;
+  ir.jitter_scale_y = static_cast<double>(ic.ir_height) / (2.0 * ic.mmw_height);
+  out.push_back(ir);
+  return out;
+}
+
+int Catalogue::sensor_index(std::string_view name) const {
+  for (size_t k = 0; k < sensors.size(); ++k)
+    if (sensors[k].name == name) return static_cast<int>(k);
+  return -1;
+}
+
+}  // namespace portalsim

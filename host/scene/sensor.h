@@ -1,0 +1,51 @@
+// A camera view as a descriptor: what it is called, its size, the regions it sees and
+// where they are, which sprites and base images it draws, and which stages apply.
+// Code iterates over Catalogue::sensors; a new camera view is a new entry here plus its
+// assets, not a new field in every struct.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "shared.h"
+
+namespace portalsim {
+
+constexpr int kRegions = PS_REGIONS;
+constexpr int kZones = PS_ZONES;
+
+struct Rect {
+  int x = 0, y = 0, w = 0, h = 0;
+};
+
+// Which sprites and palette a view uses: the camera it belongs to.
+enum class Camera : int { mmw = 0, ir = 1 };
+constexpr int kCameras = 2;
+inline const char* camera_name(Camera c) { return c == Camera::ir ? "ir" : "mmw"; }
+
+struct Sensor {
+  std::string name;       // "upper", "lower", "ir": file stems, column prefixes, data set names
+  std::string asset_key;  // the subject's catalogue key for its base image: "mmw_upper", "ir"
+  Camera camera = Camera::mmw;
+  int width = 0, height = 0;
+  // Region r's rectangle in this view, for the regions it sees (bit r of region_mask).
+  std::array<Rect, kRegions> rects{};
+  uint32_t region_mask = 0;
+  bool pattern_noise = false;  // the thesis's MMW noise patterns are laid over objects
+  bool pooled = false;         // its block and region means are features
+  bool palette = false;        // stored as a temperature index, written through the palette
+  // Jitter is given in MMW pixels; this view's pixels per MMW pixel.
+  double jitter_scale_x = 1.0, jitter_scale_y = 1.0;
+  // The stages of its chain, in order (names registered in backend/stages.cpp).
+  std::vector<std::string> chain{"composite", "pattern_noise", "sensor_noise", "display"};
+
+  bool sees(int region) const { return (region_mask >> region) & 1u; }
+  size_t pixels() const { return static_cast<size_t>(width) * height; }
+};
+
+struct Catalogue;
+// The camera views of a catalogue, in output order: MMW upper, MMW lower, IR.
+std::vector<Sensor> camera_sensors(const Catalogue& cat);
+
+}  // namespace portalsim

@@ -1,0 +1,252 @@
+// ---------------------------------------------------------------------------------
+// Sparse block averaging for features-only runs (no per-pixel noise): blocks that no
+// object touches keep the subject's precomputed base means, and an object's effect on
+// the blocks and regions it touches comes from a table made once per run
+// (footprint_deltas). Only pixels where two objects' footprints overlap are rendered
+// per scenario. Every value is the dense path's to the bit: the same blend() and noise
+// arithmetic, integer sums, and the same final division.
+//
+// The footprint record per (variant, region) is laid out in kernels/shared.h (PS_FP_*).
+// Pooled views: `pooled[k]` is the camera view of the k-th pooled view (its blocks are
+// the k-th run of the row); `region_slot[r]` is the pooled view region r lies in, and
+// rects[r] its rectangle there.
+#define FP_LEN PS_FP_LEN
+
+inline int block_count(int bx, int by, int block, int W, int H) {
+  return (min(bx * block + block, W) - bx * block) * (min(by * block + block, H) - by * block);
+}
+
+// Base means and sums of every subject: one work-item per (subject, feature), features
+// as in a row (upper blocks, lower blocks, regions).
+kernel void base_features(global const uchar* atlas, global const int* bases, global const int4* rects,
+                          global const int* pooled, int npooled, int views, global const int* region_slot, int S,
+                          int W, int H, int block, int bx_count, int by_count, int row_len, global int* sums,
+                          global float* means) {
+  const int g = (int)get_global_id(0);
+  if (g >= S * row_len) return;
+  const int s = g / row_len, f = g % row_len, per_view = bx_count * by_count;
+  uint sum = 0;
+  int count;
+  if (f < npooled * per_view) {
+    const int slot = f / per_view, b = f % per_view;
+    const int x0 = (b % bx_count) * block, y0 = (b / bx_count) * block;
+    const int x1 = min(x0 + block, W), y1 = min(y0 + block, H);
+    global const uchar* img = atlas + bases[s * views + pooled[slot]];
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) sum += img[y * W + x];
+    count = (x1 - x0) * (y1 - y0);
+  } else {
+    const int r = f - npooled * per_view;
+    const int4 rc = rects[r];
+    global const uchar* img = atlas + bases[s * views + pooled[region_slot[r]]];
+    for (int y = rc.y; y < rc.y + rc.w; ++y)
+      for (int x = rc.x; x < rc.x + rc.z; ++x) sum += img[y * W + x];
+    count = rc.z * rc.w;
+  }
+  sums[g] = (int)sum;
+  means[g] = mean_of(sum, count);
+}
+
+// The pixel at (x, y) with one object alone over the base: what the dense kernel gives
+// wherever no other object reaches.
+inline uchar single_pixel(global const uchar* atlas, global const int* fp, uchar base, int x, int y, int W,
+                          param alpha, int tile, int tile_offset, float gain, int use_noise) {
+  real v = from_pixel(base);
+  const int sx = x - fp[PS_FP_SPRITE_X0], sy = y - fp[PS_FP_SPRITE_Y0];
+  if (sx >= 0 && sy >= 0 && sx < fp[PS_FP_SPRITE_W] && sy < fp[PS_FP_SPRITE_H]) {
+    const int o = fp[PS_FP_SPRITE_OFFSET] + (sy * fp[PS_FP_SPRITE_W] + sx) * 2;
+    v = blend(v, atlas[o], atlas[o + 1], alpha);
+  }
+  if (use_noise) {
+    real n = real_zero();
+    const int tx = x - fp[PS_FP_TILE_X0], ty = y - fp[PS_FP_TILE_Y0];
+    if (tx >= 0 && ty >= 0 && tx < tile && ty < tile) n = noise_acc(n, atlas[tile_offset + ty * tile + tx]);
+    v = add_noise(v, gain, n);
+  }
+  return to_pixel(v);
+}
+
+// One work-item per (variant, region, subject, pattern): the sums of (pixel - base)
+// over each block of the footprint and over each region.
+kernel void footprint_deltas(global const uchar* atlas, global const int* bases, global const int* fps,
+                             global const int* noise_offsets, global const float* noise_gains,
+                             global const int4* rects, global const int* pooled, int views,
+                             global const int* region_slot, int combos, int S, int P, int W, int block, param alpha,
+                             int tile, int use_noise, global int* deltas, global int* region_deltas) {
+  const int g = (int)get_global_id(0);
+  if (g >= combos) return;
+  const int p = g % P, s = (g / P) % S, vr = g / (P * S), r = vr % PS_REGIONS;
+  global const int* fp = fps + vr * FP_LEN;
+  const int slot = region_slot[r];
+  global const uchar* base = atlas + bases[s * views + pooled[slot]];
+  global int* d = deltas + fp[PS_FP_DELTAS] + (s * P + p) * fp[PS_FP_BLOCKS_W] * fp[PS_FP_BLOCKS_H];
+  for (int k = 0; k < fp[PS_FP_BLOCKS_W] * fp[PS_FP_BLOCKS_H]; ++k) d[k] = 0;
+  int reg[PS_REGIONS];
+  for (int k = 0; k < PS_REGIONS; ++k) reg[k] = 0;
+  const int toff = noise_offsets[p];
+  const float gain = noise_gains[p];
+  for (int y = fp[PS_FP_Y0]; y < fp[PS_FP_Y1]; ++y)
+    for (int x = fp[PS_FP_X0]; x < fp[PS_FP_X1]; ++x) {
+      const uchar b = base[y * W + x];
+      const int diff = (int)single_pixel(atlas, fp, b, x, y, W, alpha, tile, toff, gain, use_noise) - (int)b;
+      if (diff == 0) continue;
+      d[(y / block - fp[PS_FP_BLOCK_Y0]) * fp[PS_FP_BLOCKS_W] + (x / block - fp[PS_FP_BLOCK_X0])] += diff;
+      for (int q = 0; q < PS_REGIONS; ++q) {
+        if (region_slot[q] != slot) continue;
+        const int4 rc = rects[q];
+        if (x >= rc.x && y >= rc.y && x < rc.x + rc.z && y < rc.y + rc.w) reg[q] += diff;
+      }
+    }
+  for (int k = 0; k < PS_REGIONS; ++k) region_deltas[g * PS_REGIONS + k] = reg[k];
+}
+
+inline int in_rect(int x, int y, global const int* fp) {
+  return x >= fp[PS_FP_X0] && y >= fp[PS_FP_Y0] && x < fp[PS_FP_X1] && y < fp[PS_FP_Y1];
+}
+inline int in_blocks(int bx, int by, global const int* fp) {
+  return bx >= fp[PS_FP_BLOCK_X0] && by >= fp[PS_FP_BLOCK_Y0] && bx < fp[PS_FP_BLOCK_X0] + fp[PS_FP_BLOCKS_W] && by < fp[PS_FP_BLOCK_Y0] + fp[PS_FP_BLOCKS_H];
+}
+
+// One work-item per scenario: a features row from base means, table deltas and the
+// overlap pixels rendered here.
+kernel void features_sparse(global const uchar* atlas, global const int* bases, global const int* fps,
+                            global const int* deltas, global const int* region_deltas, global const int* base_sums,
+                            global const float* base_means, global const int* noise_offsets,
+                            global const float* noise_gains, global const int4* rects, global const int* pooled,
+                            int npooled, int views, global const int* region_slot, global const uchar* subject,
+                            global const short* objects, uint n, int S, int P, int W, int H, int block,
+                            int bx_count, int by_count, param alpha, int tile, int use_noise, uint2 seed,
+                            uint2 first, int row_len, global float* features) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= n) return;
+  const int s = subject[i], per_view = bx_count * by_count;
+  global const short* objs = objects + (size_t)i * PS_REGIONS;
+  global float* row = features + (size_t)i * row_len;
+  global const float* bm = base_means + s * row_len;
+  global const int* bs = base_sums + s * row_len;
+  for (int f = 0; f < row_len; ++f) row[f] = bm[f];
+  int p = 0;
+  if (use_noise) p = (int)below(draw(seed, upsample(first.y, first.x) + i, PS_STREAM_NOISE_PATTERN, 0u).x, (uint)P);
+  const int toff = noise_offsets[p];
+  const float gain = noise_gains[p];
+
+  int reg[PS_REGIONS];
+  for (int r = 0; r < PS_REGIONS; ++r) reg[r] = bs[npooled * per_view + r];
+  int touched_regions = 0;
+
+  for (int slot = 0; slot < npooled; ++slot) {
+    global const int* fp[PS_REGIONS];
+    int comb[PS_REGIONS];
+    int cnt = 0;
+    for (int r = 0; r < PS_REGIONS; ++r) {
+      const int v = objs[r];
+      if (v < 0 || region_slot[r] != slot) continue;
+      fp[cnt] = fps + (v * PS_REGIONS + r) * FP_LEN;
+      comb[cnt] = (v * PS_REGIONS + r) * S * P + s * P + p;
+      ++cnt;
+    }
+    if (cnt == 0) continue;
+    touched_regions = 1;
+    global float* vrow = row + slot * per_view;
+    global const int* vbs = bs + slot * per_view;
+    // Touched blocks hold integer sums (exact in float below 2^24) until the division.
+    for (int k = 0; k < cnt; ++k)
+      for (int by = fp[k][PS_FP_BLOCK_Y0]; by < fp[k][PS_FP_BLOCK_Y0] + fp[k][PS_FP_BLOCKS_H]; ++by)
+        for (int bx = fp[k][PS_FP_BLOCK_X0]; bx < fp[k][PS_FP_BLOCK_X0] + fp[k][PS_FP_BLOCKS_W]; ++bx) {
+          int seen = 0;
+          for (int j = 0; j < k; ++j) seen |= in_blocks(bx, by, fp[j]);
+          if (!seen) vrow[by * bx_count + bx] = (float)vbs[by * bx_count + bx];
+        }
+    for (int k = 0; k < cnt; ++k) {
+      global const int* d = deltas + fp[k][PS_FP_DELTAS] + (s * P + p) * fp[k][PS_FP_BLOCKS_W] * fp[k][PS_FP_BLOCKS_H];
+      for (int by = 0; by < fp[k][PS_FP_BLOCKS_H]; ++by)
+        for (int bx = 0; bx < fp[k][PS_FP_BLOCKS_W]; ++bx)
+          vrow[(fp[k][PS_FP_BLOCK_Y0] + by) * bx_count + fp[k][PS_FP_BLOCK_X0] + bx] += (float)d[by * fp[k][PS_FP_BLOCKS_W] + bx];
+      for (int r = 0; r < PS_REGIONS; ++r) reg[r] += region_deltas[comb[k] * PS_REGIONS + r];
+    }
+    // Where footprints overlap, the table's single-object values are wrong: replace
+    // their sum by the pixel rendered with every object, as the dense kernel does.
+    global const uchar* base = atlas + bases[s * views + pooled[slot]];
+    for (int a = 0; a < cnt; ++a)
+      for (int b = a + 1; b < cnt; ++b) {
+        const int x0 = max(fp[a][PS_FP_X0], fp[b][PS_FP_X0]), y0 = max(fp[a][PS_FP_Y0], fp[b][PS_FP_Y0]);
+        const int x1 = min(fp[a][PS_FP_X1], fp[b][PS_FP_X1]), y1 = min(fp[a][PS_FP_Y1], fp[b][PS_FP_Y1]);
+        for (int y = y0; y < y1; ++y)
+          for (int x = x0; x < x1; ++x) {
+            int earlier = 0;  // a pixel in several overlaps is corrected once
+            for (int a2 = 0; a2 <= a && !earlier; ++a2)
+              for (int b2 = a2 + 1; b2 < (a2 == a ? b : cnt) && !earlier; ++b2)
+                earlier = in_rect(x, y, fp[a2]) && in_rect(x, y, fp[b2]);
+            if (earlier) continue;
+            const uchar bp = base[y * W + x];
+            real v = from_pixel(bp), nsum = real_zero();
+            int singles = 0;
+            for (int k = 0; k < cnt; ++k) {
+              if (!in_rect(x, y, fp[k])) continue;
+              singles += (int)single_pixel(atlas, fp[k], bp, x, y, W, alpha, tile, toff, gain, use_noise) - (int)bp;
+              const int sx = x - fp[k][PS_FP_SPRITE_X0], sy = y - fp[k][PS_FP_SPRITE_Y0];
+              if (sx >= 0 && sy >= 0 && sx < fp[k][PS_FP_SPRITE_W] && sy < fp[k][PS_FP_SPRITE_H]) {
+                const int o = fp[k][PS_FP_SPRITE_OFFSET] + (sy * fp[k][PS_FP_SPRITE_W] + sx) * 2;
+                v = blend(v, atlas[o], atlas[o + 1], alpha);
+              }
+            }
+            if (use_noise) {
+              for (int k = 0; k < cnt; ++k) {
+                const int tx = x - fp[k][PS_FP_TILE_X0], ty = y - fp[k][PS_FP_TILE_Y0];
+                if (tx >= 0 && ty >= 0 && tx < tile && ty < tile) nsum = noise_acc(nsum, atlas[toff + ty * tile + tx]);
+              }
+              v = add_noise(v, gain, nsum);
+            }
+            const int corr = (int)to_pixel(v) - (int)bp - singles;
+            if (corr == 0) continue;
+            vrow[(y / block) * bx_count + x / block] += (float)corr;
+            for (int r = 0; r < PS_REGIONS; ++r) {
+              if (region_slot[r] != slot) continue;
+              const int4 rc = rects[r];
+              if (x >= rc.x && y >= rc.y && x < rc.x + rc.z && y < rc.y + rc.w) reg[r] += corr;
+            }
+          }
+      }
+    for (int k = 0; k < cnt; ++k)
+      for (int by = fp[k][PS_FP_BLOCK_Y0]; by < fp[k][PS_FP_BLOCK_Y0] + fp[k][PS_FP_BLOCKS_H]; ++by)
+        for (int bx = fp[k][PS_FP_BLOCK_X0]; bx < fp[k][PS_FP_BLOCK_X0] + fp[k][PS_FP_BLOCKS_W]; ++bx) {
+          int seen = 0;
+          for (int j = 0; j < k; ++j) seen |= in_blocks(bx, by, fp[j]);
+          if (!seen) vrow[by * bx_count + bx] = mean_of((uint)vrow[by * bx_count + bx], block_count(bx, by, block, W, H));
+        }
+  }
+  if (touched_regions)
+    for (int r = 0; r < PS_REGIONS; ++r) {
+      const int4 rc = rects[r];
+      row[npooled * per_view + r] = mean_of((uint)reg[r], rc.z * rc.w);
+    }
+}
+
+// The block-mean noise model (tier "fast", features-only runs with pixel noise): rather
+// than drawing sigma * N(0,1) for every pixel, each mean over c pixels gets one draw of
+// N(0, sigma^2 / c), clipped to the pixel range. Rounding and clipping of single pixels
+// are not modelled; tradeoff measures what that costs. One work-item per scenario.
+kernel void analytic_noise(global float* features, global const int4* rects, uint n, int W, int H, int block,
+                           int bx_count, int by_count, int npooled, int row_len, float sigma, uint2 seed, uint2 first) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= n) return;
+  const ulong index = upsample(first.y, first.x) + i;
+  const int per_view = bx_count * by_count;
+  global float* row = features + (size_t)i * row_len;
+  for (int f = 0; f < row_len; f += 2) {
+    const uint4 r = draw(seed, index, PS_STREAM_BLOCK_NOISE, (uint)f);
+    const float2 g = gauss2(r.x, r.y);
+    for (int k = 0; k < 2 && f + k < row_len; ++k) {
+      const int q = f + k;
+      int count;
+      if (q < npooled * per_view) {
+        const int b = q % per_view;
+        count = block_count(b % bx_count, b / bx_count, block, W, H);
+      } else {
+        const int4 rc = rects[q - npooled * per_view];
+        count = rc.z * rc.w;
+      }
+      row[q] = clamp(row[q] + sigma * rsqrt((float)count) * (k ? g.y : g.x), 0.0f, 255.0f);
+    }
+  }
+}

@@ -1,0 +1,78 @@
+/* Constants shared by the host (C++) and the kernels (OpenCL C): counts, random
+ * stream ids, flags and record layouts. The host includes this file; the kernel
+ * program is this file followed by the kernels/ sources. Plain #defines only, so it is valid
+ * in both languages. */
+#ifndef PORTALSIM_SHARED_H
+#define PORTALSIM_SHARED_H
+
+/* The body's regions (thesis 4.1) and the metal detector's zones. */
+#define PS_REGIONS 13
+#define PS_ZONES 19
+/* Most sprites one camera view draws: one per region. */
+#define PS_MAX_LAYERS PS_REGIONS
+
+/* Random streams of the counter generator: each kind of draw has its own, so adding one
+ * never shifts another. element = the index within the stream named beside it. */
+#define PS_STREAM_NOISE_PATTERN 1u /* which MMW noise pattern a scenario gets; element 0 */
+#define PS_STREAM_METAL_NOISE 2u   /* metal detector noise; element = zone */
+#define PS_STREAM_PIXEL_NOISE 3u   /* per-pixel sensor noise; element = view << 28 | pixel / 2 */
+#define PS_STREAM_BLOCK_NOISE 4u   /* block-mean noise model; element = feature */
+#define PS_STREAM_JITTER 5u        /* sprite placement jitter; element = region */
+#define PS_STREAM_GENERATE 16u     /* scenario generators (host only) */
+#define PS_PIXEL_NOISE_VIEW_SHIFT 28
+
+/* Per-launch flags of the render kernels. */
+#define PS_FLAG_PATTERN_NOISE 1
+#define PS_FLAG_PIXEL_NOISE 2
+#define PS_FLAG_BILINEAR 4
+
+/* Footprint record of the sparse features path, per (variant, region), ints. */
+#define PS_FP_SPRITE_X0 0
+#define PS_FP_SPRITE_Y0 1
+#define PS_FP_SPRITE_W 2
+#define PS_FP_SPRITE_H 3
+#define PS_FP_SPRITE_OFFSET 4 /* atlas offset of the sprite */
+#define PS_FP_TILE_X0 5
+#define PS_FP_TILE_Y0 6
+#define PS_FP_X0 7 /* footprint, clipped to the view, exclusive ends */
+#define PS_FP_Y0 8
+#define PS_FP_X1 9
+#define PS_FP_Y1 10
+#define PS_FP_BLOCK_X0 11
+#define PS_FP_BLOCK_Y0 12
+#define PS_FP_BLOCKS_W 13
+#define PS_FP_BLOCKS_H 14
+#define PS_FP_DELTAS 15 /* offset of its block delta table */
+#define PS_FP_LEN 16
+
+/* One camera view's launch of a render stage, passed by value to every stage kernel.
+ * 4-byte fields only, so host and device lay it out alike. */
+#ifdef __OPENCL_VERSION__
+#define PS_U32 uint
+#define PS_I32 int
+#define PS_F32 float
+#else
+#include <stdint.h>
+#define PS_U32 uint32_t
+#define PS_I32 int32_t
+#define PS_F32 float
+#endif
+typedef struct {
+  PS_U32 n;           /* scenarios in the batch */
+  PS_I32 view;        /* camera view: base image slot, pixel noise element */
+  PS_I32 views;       /* camera views per subject (stride of the base table) */
+  PS_I32 sprite_set;  /* 0 MMW, 1 IR: row of the sprite table */
+  PS_I32 variants;    /* stride of the sprite and place tables */
+  PS_U32 region_mask; /* bit r: region r is drawn in this view */
+  PS_I32 width, height;
+  PS_U32 seed_lo, seed_hi, first_lo, first_hi;
+  PS_I32 patterns;  /* noise patterns in the catalogue */
+  PS_I32 tile_size; /* noise tile side */
+  PS_I32 flags;     /* PS_FLAG_* */
+  PS_F32 jitter_x, jitter_y; /* in this view's pixels */
+} PsViewLaunch;
+
+/* Work-group size of every launch: fixed, so PoCL compiles each kernel once. */
+#define PS_LOCAL_SIZE 64
+
+#endif
