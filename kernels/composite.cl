@@ -5,13 +5,16 @@
 
 // The arguments of every camera-view stage kernel (stage_<name>) and of the fused
 // render_view, in one order, so the host sets them in one place.
-//   sprites: int4 (atlas offset, width, height, 0) per (sprite set, variant)
+//   sprites: int4 (atlas offset, width, height, padded offset) per (sprite set, variant)
+//   noise_offsets: atlas offset of each noise pattern, then of its padded copy
 //   places:  int2 (x0, y0) per (view, variant, region), the sprite centred in its region
+//   records: the view's placement record per scenario (kernels/shared.h, PS_REC_*)
 //   field:   the view's values before display, n * height * width, at the build's precision
 #define VIEW_STAGE_ARGS                                                                                          \
   global const uchar *atlas, global const int *bases, global const int4 *sprites, global const int2 *places,     \
       global const int *noise_offsets, global const float *noise_gains, global const uchar *subject,             \
-      global const short *objects, PsViewLaunch L, param alpha, param sigma, global real *field, global uchar *out
+      global const short *objects, PsViewLaunch L, param alpha, param sigma, global int *records,                 \
+      global real *field, global uchar *out
 
 // The scenario and image row of a work-item (one per (scenario, row)).
 #define VIEW_STAGE_ROW                                           \
@@ -21,16 +24,16 @@
   if (i >= L.n) return;                                          \
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);              \
   const ulong index = upsample(L.first_hi, L.first_lo) + i;      \
-  global const short* objs = objects + (size_t)i * PS_REGIONS;   \
+  global const int* rec = records + (size_t)i * PS_REC_LEN;      \
   const size_t row0 = ((size_t)i * L.height + y) * L.width;      \
   (void)seed;                                                    \
-  (void)index;                                                   \
-  (void)objs
+  (void)index
 
 typedef struct {
   int count;
   int bilinear;
   int offset[PS_MAX_LAYERS];  // atlas offset of the sprite's row that meets this image row
+  int voff[PS_MAX_LAYERS];    // the same row of the padded copy (integer placement)
   int x0[PS_MAX_LAYERS];
   int width[PS_MAX_LAYERS];
   // Bilinear placement: the second sprite row (-1 if outside), its weight, and the
@@ -40,52 +43,77 @@ typedef struct {
   float fx[PS_MAX_LAYERS];
 } Layers;
 
-inline int4 sprite_of(global const int4* sprites, const PsViewLaunch* L, int v) {
-  return sprites[L->sprite_set * L->variants + v];
-}
-inline int2 place_of(global const int2* places, const PsViewLaunch* L, int v, int r) {
-  return places[((size_t)L->view * L->variants + v) * PS_REGIONS + r];
+// Step "place" before every chain: one work-item per scenario writes the view's record.
+// With jitter, each region's sprite moves by (jx, jy) * (2u - 1), u uniform from the
+// counter generator: rounded to whole pixels (integer placement) or kept (bilinear).
+kernel void place_view(VIEW_STAGE_ARGS) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= L.n) return;
+  (void)atlas, (void)bases, (void)subject, (void)alpha, (void)sigma, (void)field, (void)out;
+  const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
+  const ulong index = upsample(L.first_hi, L.first_lo) + i;
+  global const short* objs = objects + (size_t)i * PS_REGIONS;
+  global int* rec = records + (size_t)i * PS_REC_LEN;
+  rec[PS_REC_PATTERN] = (L.flags & PS_FLAG_PATTERN_NOISE)
+                            ? (int)below(draw(seed, index, PS_STREAM_NOISE_PATTERN, 0u).x, (uint)L.patterns)
+                            : -1;
+  int count = 0;
+  for (int r = 0; r < PS_REGIONS; ++r) {
+    const int v = objs[r];
+    if (v < 0 || !((L.region_mask >> r) & 1u)) continue;
+    const int4 sp = sprites[L.sprite_set * L.variants + v];
+    const int2 pl = places[((size_t)L.view * L.variants + v) * PS_REGIONS + r];
+    float dx = 0.0f, dy = 0.0f;
+    if (L.jitter_x > 0.0f || L.jitter_y > 0.0f) {
+      const uint4 q = draw(seed, index, PS_STREAM_JITTER, (uint)r);
+      dx = L.jitter_x * (2.0f * uniform24(q.x) - 1.0f);
+      dy = L.jitter_y * (2.0f * uniform24(q.y) - 1.0f);
+    }
+    global int* ly = rec + PS_REC_LAYERS + count * PS_LAYER_LEN;
+    ly[PS_LAYER_X0] = pl.x + (int)floor(dx + 0.5f);
+    ly[PS_LAYER_Y0] = pl.y + (int)floor(dy + 0.5f);
+    ly[PS_LAYER_FX] = as_int((float)pl.x + dx);
+    ly[PS_LAYER_FY] = as_int((float)pl.y + dy);
+    ly[PS_LAYER_W] = sp.y;
+    ly[PS_LAYER_H] = sp.z;
+    ly[PS_LAYER_OFFSET] = sp.x;
+    ly[PS_LAYER_PADDED] = sp.w;
+    ly[PS_LAYER_TILE_X0] = pl.x + (sp.y >> 1) - (L.tile_size >> 1);
+    ly[PS_LAYER_TILE_Y0] = pl.y + (sp.z >> 1) - (L.tile_size >> 1);
+    ++count;
+  }
+  rec[PS_REC_COUNT] = count;
 }
 
-// Collects the sprites of the view's regions that cross row y. With jitter, each
-// region's sprite moves by (jx, jy) * (2u - 1), u uniform from the counter generator:
-// rounded to whole pixels (integer placement) or kept (bilinear placement).
-inline void composite_layers(Layers* Ly, global const short* objects, global const int4* sprites,
-                             global const int2* places, const PsViewLaunch* L, int y, uint2 seed, ulong index) {
+// Collects the layers of the scenario's record that cross row y.
+inline void composite_layers(Layers* Ly, global const int* rec, const PsViewLaunch* L, int y) {
   Ly->count = 0;
   Ly->bilinear = (L->flags & PS_FLAG_BILINEAR) != 0;
-  for (int r = 0; r < PS_REGIONS; ++r) {
-    const int v = objects[r];
-    if (v < 0 || !((L->region_mask >> r) & 1u)) continue;
-    const int4 sp = sprite_of(sprites, L, v);
-    const int2 pl = place_of(places, L, v, r);
-    float dx = 0.0f, dy = 0.0f;
-    if (L->jitter_x > 0.0f || L->jitter_y > 0.0f) {
-      const uint4 q = draw(seed, index, PS_STREAM_JITTER, (uint)r);
-      dx = L->jitter_x * (2.0f * uniform24(q.x) - 1.0f);
-      dy = L->jitter_y * (2.0f * uniform24(q.y) - 1.0f);
-    }
+  for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
+    global const int* ly = rec + PS_REC_LAYERS + j * PS_LAYER_LEN;
+    const int w = ly[PS_LAYER_W], h = ly[PS_LAYER_H];
     if (!Ly->bilinear) {
-      const int x0 = pl.x + (int)floor(dx + 0.5f);
-      const int y0 = pl.y + (int)floor(dy + 0.5f);
-      if (y < y0 || y >= y0 + sp.z) continue;
+      const int y0 = ly[PS_LAYER_Y0];
+      if (y < y0 || y >= y0 + h) continue;
       const int k = Ly->count++;
-      Ly->offset[k] = sp.x + (y - y0) * sp.y * 2;
-      Ly->x0[k] = x0;
-      Ly->width[k] = sp.y;
+      Ly->offset[k] = ly[PS_LAYER_OFFSET] + (y - y0) * w * 2;
+      Ly->voff[k] = ly[PS_LAYER_PADDED] + (y - y0) * 2 * (w + 2 * PS_PAD);
+      Ly->x0[k] = ly[PS_LAYER_X0];
+      Ly->width[k] = w;
     } else {
-      const float fx = (float)pl.x + dx;
-      const float sy = (float)y - ((float)pl.y + dy);
+      const float fx = as_float(ly[PS_LAYER_FX]);
+      const float sy = (float)y - as_float(ly[PS_LAYER_FY]);
       const float j0f = floor(sy);
       const int j0 = (int)j0f;
-      if (j0 < -1 || j0 >= sp.z) continue;
+      if (j0 < -1 || j0 >= h) continue;
       const int k = Ly->count++;
-      Ly->offset[k] = j0 >= 0 ? sp.x + j0 * sp.y * 2 : -1;
-      Ly->offset1[k] = j0 + 1 < sp.z ? sp.x + (j0 + 1) * sp.y * 2 : -1;
+      const int off = ly[PS_LAYER_OFFSET];
+      Ly->offset[k] = j0 >= 0 ? off + j0 * w * 2 : -1;
+      Ly->offset1[k] = j0 + 1 < h ? off + (j0 + 1) * w * 2 : -1;
       Ly->wy[k] = sy - j0f;
       Ly->fx[k] = fx;
       Ly->x0[k] = (int)floor(fx);
-      Ly->width[k] = sp.y + 1;  // the span a sub-pixel sprite can touch
+      Ly->width[k] = w + 1;  // the span a sub-pixel sprite can touch
     }
   }
 }
@@ -141,6 +169,6 @@ kernel void stage_composite(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;
   global const uchar* base = base_row(atlas, bases, subject, &L, i, y);
   Layers Ly;
-  composite_layers(&Ly, objs, sprites, places, &L, y, seed, index);
+  composite_layers(&Ly, rec, &L, y);
   for (int x = 0; x < L.width; ++x) field[row0 + x] = composite_pixel(&Ly, atlas, from_pixel(base[x]), x, alpha);
 }

@@ -5,34 +5,33 @@
 typedef struct {
   int count;
   int offset[PS_MAX_LAYERS];  // atlas offset of the tile row that meets this image row
+  int poff[PS_MAX_LAYERS];    // the same row of the padded copy
   int x0[PS_MAX_LAYERS];
 } Tiles;
 
-// The scenario's pattern: its atlas offset, and its gain in *gain.
-inline int noise_pattern(global const int* noise_offsets, global const float* noise_gains, const PsViewLaunch* L,
-                         uint2 seed, ulong index, float* gain) {
-  const uint k = below(draw(seed, index, PS_STREAM_NOISE_PATTERN, 0u).x, (uint)L->patterns);
-  *gain = noise_gains[k];
-  return noise_offsets[k];
-}
-
-// Collects the noise tiles of the view's regions that cross row y.
-inline void noise_tiles(Tiles* T, global const short* objects, global const int4* sprites, global const int2* places,
-                        const PsViewLaunch* L, int tile_offset, int y) {
+// Collects the noise tiles of the scenario's record that cross row y (none when it has
+// no pattern).
+inline void noise_tiles(Tiles* T, global const int* rec, global const int* noise_offsets, const PsViewLaunch* L,
+                        int y) {
   T->count = 0;
+  const int pattern = rec[PS_REC_PATTERN];
+  if (pattern < 0) return;
   const int tile = L->tile_size;
-  for (int r = 0; r < PS_REGIONS; ++r) {
-    const int v = objects[r];
-    if (v < 0 || !((L->region_mask >> r) & 1u)) continue;
-    const int4 sp = sprite_of(sprites, L, v);
-    const int2 pl = place_of(places, L, v, r);
-    const int tx0 = pl.x + (sp.y >> 1) - (tile >> 1);
-    const int ty0 = pl.y + (sp.z >> 1) - (tile >> 1);
+  const int tile_offset = noise_offsets[pattern], padded_offset = noise_offsets[L->patterns + pattern];
+  for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
+    global const int* ly = rec + PS_REC_LAYERS + j * PS_LAYER_LEN;
+    const int ty0 = ly[PS_LAYER_TILE_Y0];
     if (y < ty0 || y >= ty0 + tile) continue;
     const int k = T->count++;
     T->offset[k] = tile_offset + (y - ty0) * tile;
-    T->x0[k] = tx0;
+    T->poff[k] = padded_offset + (y - ty0) * (tile + 2 * PS_PAD);
+    T->x0[k] = ly[PS_LAYER_TILE_X0];
   }
+}
+
+// The gain of the scenario's pattern (0 for none).
+inline float pattern_gain(global const int* rec, global const float* noise_gains) {
+  return rec[PS_REC_PATTERN] < 0 ? 0.0f : noise_gains[rec[PS_REC_PATTERN]];
 }
 
 // v with the pattern noise of every tile over pixel x added (tile values summed first).
@@ -48,11 +47,9 @@ inline real pattern_noise(const Tiles* T, global const uchar* atlas, int tile_si
 
 kernel void stage_pattern_noise(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;
-  if (!(L.flags & PS_FLAG_PATTERN_NOISE)) return;
-  float gain;
-  const int tile_offset = noise_pattern(noise_offsets, noise_gains, &L, seed, index, &gain);
   Tiles T;
-  noise_tiles(&T, objs, sprites, places, &L, tile_offset, y);
+  noise_tiles(&T, rec, noise_offsets, &L, y);
   if (T.count == 0) return;
+  const float gain = pattern_gain(rec, noise_gains);
   for (int x = 0; x < L.width; ++x) field[row0 + x] = pattern_noise(&T, atlas, L.tile_size, gain, field[row0 + x], x);
 }

@@ -1,3 +1,9 @@
+// 16 bytes at any address in one vector load or store. PoCL lowers vstore16 to 16 byte
+// stores; a store through an align(1) vector type is one unaligned vector store.
+typedef uchar16 __attribute__((aligned(1))) uchar16_any;
+inline uchar16 load16(global const uchar* p) { return *(global const uchar16_any*)p; }
+inline void store16(uchar16 v, global uchar* p) { *(global uchar16_any*)p = v; }
+
 // The arithmetic of a pixel value, chosen at build time (the fidelity tiers):
 //   default          fp32
 //   PRECISION_FP64   fp64, the reference's formulas (tier "exact")
@@ -63,4 +69,35 @@ inline real add_noise(real v, float gain, real n) { return v + gain * n; }
 inline real add_gauss(real v, param sigma, float g) { return fma(sigma, g, v); }
 inline uchar to_pixel(real v) { return (uchar)clamp(floor(v + 0.5f), 0.0f, 255.0f); }
 inline real real_zero(void) { return 0.0f; }
+#endif
+
+// The same arithmetic on 16 pixels at once, element for element (so bit for bit), for the
+// vector render path. fp64 (tier "exact") renders pixel by pixel.
+#if !defined(PRECISION_FP64)
+#define VECTOR_RENDER 1
+#if defined(PRECISION_FIXED)
+typedef int16 real16;
+inline real16 from_pixel16(uchar16 b) { return convert_int16(b) << 8; }
+inline real16 blend16(real16 v, uchar16 value, uchar16 coverage, param alpha) {
+  const int16 a = convert_int16(alpha * convert_float16(coverage) * (256.0f / 255.0f) + 0.5f);
+  return v + ((a * ((convert_int16(value) << 8) - v)) >> 8);
+}
+inline real16 noise_acc16(real16 n, uchar16 t) { return n + (convert_int16(t) - 128); }
+inline real16 add_noise16(real16 v, float gain, real16 n) { return v + (int)rint(gain * 256.0f) * n; }
+inline real16 add_gauss16(real16 v, param sigma, float16 g) { return v + convert_int16(rint(sigma * g * 256.0f)); }
+inline uchar16 to_pixel16(real16 v) { return convert_uchar16(clamp((v + 128) >> 8, 0, 255)); }
+inline real16 real16_zero(void) { return (int16)(0); }
+#else
+typedef float16 real16;
+inline real16 from_pixel16(uchar16 b) { return convert_float16(b); }
+inline real16 blend16(real16 v, uchar16 value, uchar16 coverage, param alpha) {
+  const float16 a = alpha * convert_float16(coverage) / 255.0f;
+  return fma(a, convert_float16(value) - v, v);
+}
+inline real16 noise_acc16(real16 n, uchar16 t) { return n + (convert_float16(t) - 128.0f); }
+inline real16 add_noise16(real16 v, float gain, real16 n) { return v + gain * n; }
+inline real16 add_gauss16(real16 v, param sigma, float16 g) { return fma((float16)(sigma), g, v); }
+inline uchar16 to_pixel16(real16 v) { return convert_uchar16(clamp(floor(v + 0.5f), 0.0f, 255.0f)); }
+inline real16 real16_zero(void) { return (float16)(0.0f); }
+#endif
 #endif

@@ -1,7 +1,60 @@
 // Stage "sensor_noise": per-pixel Gaussian noise, sigma gray levels. One Philox draw
-// feeds a Box-Muller pair (pixels 2k, 2k+1 of the view), computed at the build's
-// Gaussian precision.
+// feeds a Box-Muller pair (pixels 2k, 2k+1 of the view): u1 = 1 - r.x/2^32 (24 bits),
+// u2 = r.y/2^32, g = sqrt(-2 ln u1) (cos, sin)(2 pi u2).
+//
+// fp32 and fixed16 builds compute ln and sincos with polynomials, defined once below for
+// one value and for 8 (PoCL's own log, sin and cos are slow scalar library calls):
+//   ln x, x in [2^-24, 1]: x = m 2^e with m in [sqrt(1/2), sqrt(2)), ln m = 2 atanh(s),
+//     s = (m - 1) / (m + 1), |s| <= 0.1716, series to s^9 (truncation < 3e-9 relative);
+//   sincos(2 pi u): t = u - rint(u), quadrant k = rint(4 t), a = 2 pi (t - k/4) in
+//     [-pi/4, pi/4], sin to a^9 and cos to a^10 (truncation < 3e-9), then rotated by k.
+// Against double-precision libm the draws differ by a few float ulps (tests/stages_test.cpp
+// and the tier tolerances hold the pixels). fp64 builds (tier "exact") use libm.
 
+#define GAUSS_POLY(F, I)                                                                                      \
+  inline F __attribute__((overloadable)) ln_poly(F x) {                                                     \
+    const I bits = as_##I(x);                                                                               \
+    I e = ((bits >> 23) & 0xff) - 127;                                                                      \
+    F m = as_##F((bits & 0x7fffff) | 0x3f800000);                                                           \
+    const I big = m > (F)(1.41421356f);                                                                     \
+    m = select(m, m * 0.5f, big);                                                                           \
+    e = select(e, e + 1, big);                                                                              \
+    const F s = (m - 1.0f) / (m + 1.0f), s2 = s * s;                                                        \
+    const F p = 2.0f * s *                                                                                  \
+                (1.0f + s2 * (0.33333333f + s2 * (0.2f + s2 * (0.14285714f + s2 * 0.11111111f))));         \
+    return convert_##F(e) * 0.69314718f + p;                                                                \
+  }                                                                                                         \
+  inline void __attribute__((overloadable)) sincos_turns(F u, F* sn, F* cs) {                               \
+    const F t = u - rint(u);                                                                                \
+    const F kf = rint(t * 4.0f);                                                                            \
+    const F a = (t - kf * 0.25f) * 6.2831853f, a2 = a * a;                                                  \
+    const F s = a * (1.0f + a2 * (-0.16666667f + a2 * (8.3333333e-3f + a2 * (-1.9841270e-4f +               \
+                                                                                 a2 * 2.7557319e-6f))));    \
+    const F c = 1.0f + a2 * (-0.5f + a2 * (4.1666667e-2f + a2 * (-1.3888889e-3f +                           \
+                                                               a2 * (2.4801587e-5f + a2 * -2.7557319e-7f)))); \
+    const I k = convert_##I(kf) & 3;                                                                        \
+    *cs = select(select(select(c, -s, k == 1), -c, k == 2), s, k == 3);                                     \
+    *sn = select(select(select(s, c, k == 1), -s, k == 2), -c, k == 3);                                     \
+  }
+GAUSS_POLY(float, int)
+GAUSS_POLY(float16, int16)
+
+// Philox4x32-10 of 16 counters at once (kernels/philox.cl, lane by lane). The 32x32-bit
+// products are written as 64-bit ones: PoCL's mul_hi on vectors splits into 16-bit parts.
+inline void philox16(uint16* c0, uint16* c1, uint16* c2, uint16* c3, uint2 k) {
+  for (int r = 0; r < 10; ++r) {
+    const ulong16 p0 = convert_ulong16(*c0) * 0xD2511F53ul, p1 = convert_ulong16(*c2) * 0xCD9E8D57ul;
+    const uint16 lo0 = convert_uint16(p0), hi0 = convert_uint16(p0 >> 32);
+    const uint16 lo1 = convert_uint16(p1), hi1 = convert_uint16(p1 >> 32);
+    *c0 = hi1 ^ *c1 ^ k.x;
+    *c1 = lo1;
+    *c2 = hi0 ^ *c3 ^ k.y;
+    *c3 = lo0;
+    k += (uint2)(0x9E3779B9u, 0xBB67AE85u);
+  }
+}
+
+#if defined(PRECISION_FP64)
 inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {
   const uint4 r = draw(seed, index, PS_STREAM_PIXEL_NOISE, ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) | (uint)pair);
   const greal u1 = (greal)1 - (greal)(r.x >> 8) * ((greal)1 / (greal)16777216);
@@ -10,6 +63,35 @@ inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {
   const greal th = (greal)6.283185307179586 * u2;
   return (greal2)(rad * cos(th), rad * sin(th));
 }
+#else
+inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {
+  const uint4 r = draw(seed, index, PS_STREAM_PIXEL_NOISE, ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) | (uint)pair);
+  const float u1 = 1.0f - (float)(r.x >> 8) * (1.0f / 16777216.0f);
+  const float u2 = (float)(r.y >> 8) * (1.0f / 16777216.0f);
+  const float rad = sqrt(-2.0f * ln_poly(u1));
+  float s, c;
+  sincos_turns(u2, &s, &c);
+  return (float2)(rad * c, rad * s);
+}
+
+// The draws of pixels 2 pair .. 2 pair + 31: 16 Box-Muller pairs, interleaved, the first
+// 16 pixels in *g0 and the next 16 in *g1.
+__attribute__((always_inline)) inline void gauss32(uint2 seed, ulong index, int view, int pair, float16* g0, float16* g1) {
+  uint16 c0 = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
+              ((uint)pair + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+  uint16 c1 = (uint16)(PS_STREAM_PIXEL_NOISE), c2 = (uint16)((uint)index), c3 = (uint16)((uint)(index >> 32));
+  philox16(&c0, &c1, &c2, &c3, seed);
+  const float16 u1 = 1.0f - convert_float16(c0 >> 8) * (1.0f / 16777216.0f);
+  const float16 u2 = convert_float16(c1 >> 8) * (1.0f / 16777216.0f);
+  const float16 rad = sqrt(-2.0f * ln_poly(u1));
+  float16 s, c;
+  sincos_turns(u2, &s, &c);
+  c *= rad;
+  s *= rad;
+  *g0 = shuffle2(c, s, (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23));
+  *g1 = shuffle2(c, s, (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
+}
+#endif
 
 kernel void stage_sensor_noise(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;

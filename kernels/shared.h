@@ -72,6 +72,29 @@ typedef struct {
   PS_F32 jitter_x, jitter_y; /* in this view's pixels */
 } PsViewLaunch;
 
+/* A camera view's placement record per scenario, written by place_view and read by
+ * every render stage: the objects it draws, in region order, and the noise pattern. */
+#define PS_REC_COUNT 0   /* layers */
+#define PS_REC_PATTERN 1 /* the scenario's noise pattern, -1 for none */
+#define PS_REC_LAYERS 2
+#define PS_LAYER_X0 0 /* whole-pixel top-left corner, jitter rounded */
+#define PS_LAYER_Y0 1
+#define PS_LAYER_FX 2 /* sub-pixel top-left corner (float bits) */
+#define PS_LAYER_FY 3
+#define PS_LAYER_W 4
+#define PS_LAYER_H 5
+#define PS_LAYER_OFFSET 6 /* atlas offset of the sprite */
+#define PS_LAYER_PADDED 7 /* atlas offset of its padded copy */
+#define PS_LAYER_TILE_X0 8 /* the noise tile, centred on the unmoved sprite */
+#define PS_LAYER_TILE_Y0 9
+#define PS_LAYER_LEN 10
+#define PS_REC_LEN (PS_REC_LAYERS + PS_MAX_LAYERS * PS_LAYER_LEN)
+
+/* The vector render path reads 16 pixels of a sprite or noise tile row at a time, so
+ * each also lives padded: every row with PS_PAD neutral pixels on both sides (sprites:
+ * coverage 0, as value row then coverage row; tiles: 128). */
+#define PS_PAD 16
+
 /* Work-group size of every launch: fixed, so PoCL compiles each kernel once. */
 #define PS_LOCAL_SIZE 64
 

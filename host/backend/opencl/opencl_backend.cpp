@@ -54,11 +54,33 @@ class OpenCLBackend final : public Backend {
     std::vector<cl_int> bases;
     for (const auto& subject_views : assets.bases)
       for (const Image& img : subject_views) bases.push_back(add(img));
+    // The vector render path's copies (kernels/shared.h, PS_PAD): each sprite row as a
+    // value row and a coverage row, each tile row, with neutral pixels on both sides.
+    auto add_padded_sprite = [&](const Image& img) {
+      const int off = static_cast<int>(atlas.size());
+      for (int y = 0; y < img.height; ++y)
+        for (int c = 0; c < 2; ++c) {
+          atlas.insert(atlas.end(), PS_PAD, 0);
+          for (int x = 0; x < img.width; ++x) atlas.push_back(img.at(x, y, c));
+          atlas.insert(atlas.end(), PS_PAD, 0);
+        }
+      return off;
+    };
+    auto add_padded_tile = [&](const Image& img) {
+      const int off = static_cast<int>(atlas.size());
+      for (int y = 0; y < img.height; ++y) {
+        atlas.insert(atlas.end(), PS_PAD, 128);
+        for (int x = 0; x < img.width; ++x) atlas.push_back(img.at(x, y));
+        atlas.insert(atlas.end(), PS_PAD, 128);
+      }
+      return off;
+    };
     std::vector<cl_int4> sprites(kCameras * V);
     for (int c = 0; c < kCameras; ++c)
       for (size_t v = 0; v < V; ++v) {
         const Image& sp = assets.sprites[c][v];
-        sprites[c * V + v] = {{add(sp), sp.width, sp.height, 0}};
+        const int plain = add(sp);
+        sprites[c * V + v] = {{plain, sp.width, sp.height, add_padded_sprite(sp)}};
       }
     // Each sprite centred in its region's rectangle of each view; >> 1 floors negative
     // differences too.
@@ -79,6 +101,7 @@ class OpenCLBackend final : public Backend {
       noise_offsets.push_back(add(assets.noise[k]));
       noise_gains.push_back(static_cast<float>(cat.noise[k].gain));
     }
+    for (const Image& tile : assets.noise) noise_offsets.push_back(add_padded_tile(tile));
     if (atlas.size() > 0x7fffffffu) throw std::runtime_error("catalogue images exceed 2 GiB");
     sprite_offsets_.resize(V);
     for (size_t v = 0; v < V; ++v) sprite_offsets_[v] = sprites[static_cast<int>(Camera::mmw) * V + v].s[0];
@@ -199,7 +222,7 @@ class OpenCLBackend final : public Backend {
   };
   struct Kernels {
     cl::Program program;
-    cl::Kernel render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, features_sparse,
+    cl::Kernel place, render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, features_sparse,
         analytic_noise;
     std::map<std::string, cl::Kernel> stages;  // stage_<name>, made on first use
     SparseTables tables;
@@ -241,7 +264,8 @@ class OpenCLBackend final : public Backend {
     L.jitter_y = static_cast<float>(plan.model.jitter * s.jitter_scale_y);
     const bool fused = plan.fidelity.fused && s.chain == fused_chain();
     cl::Buffer field = fused ? dst : field_.at_least(rt_->context(), n * s.pixels() * K.real_bytes);
-    const auto launch = [&](cl::Kernel& k) {
+    cl::Buffer& records = records_.at_least(rt_->context(), n * PS_REC_LEN * sizeof(cl_int));
+    const auto launch = [&](cl::Kernel& k, size_t items) {
       int a = 0;
       k.setArg(a++, atlas_);
       k.setArg(a++, bases_);
@@ -254,19 +278,21 @@ class OpenCLBackend final : public Backend {
       k.setArg(a++, sizeof(L), &L);
       set_param(K, k, a++, cat_.images.alpha);
       set_param(K, k, a++, plan.model.pixel_sigma);
+      k.setArg(a++, records);
       k.setArg(a++, field);
       k.setArg(a++, dst);
-      rt_->queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n * s.height)), cl::NDRange(kLocalSize));
+      rt_->queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(items)), cl::NDRange(kLocalSize));
     };
+    launch(K.place, n);  // one placement record per scenario, read by every row below
     if (fused) {
-      launch(K.render);
+      launch(K.render, n * s.height);
       return;
     }
     for (const std::string& name : s.chain) {
       const std::string kernel = view_stage(name).kernel();
       auto it = K.stages.find(kernel);
       if (it == K.stages.end()) it = K.stages.emplace(kernel, cl::Kernel(K.program, kernel.c_str())).first;
-      launch(it->second);
+      launch(it->second, n * s.height);
     }
   }
 
@@ -327,6 +353,7 @@ class OpenCLBackend final : public Backend {
     if (it != variants_.end()) return it->second;
     Kernels k;
     k.program = rt_->program(options);
+    k.place = cl::Kernel(k.program, "place_view");
     k.render = cl::Kernel(k.program, "render_view");
     k.pool_blocks = cl::Kernel(k.program, "pool_blocks");
     k.pool_regions = cl::Kernel(k.program, "pool_regions");
@@ -527,7 +554,7 @@ class OpenCLBackend final : public Backend {
   cl::Buffer atlas_, bases_, sprites_, places_, noise_offsets_, noise_gains_, pooled_, region_slot_, region_rects_,
       influence_, categories_, base_zones_;
   std::vector<cl::Buffer> view_rects_;  // per view: int4 per region
-  Grown subject_, objects_, metal_out_, features_, field_;
+  Grown subject_, objects_, metal_out_, features_, field_, records_;
   std::vector<Grown> scratch_;  // per view: images only pooled
 };
 
