@@ -66,9 +66,9 @@ typedef struct {
   PS_U32 region_mask; /* bit r: region r is drawn in this view */
   PS_I32 width, height;
   PS_U32 seed_lo, seed_hi, first_lo, first_hi;
-  PS_I32 patterns;  /* noise patterns in the catalogue */
-  PS_I32 tile_size; /* noise tile side */
-  PS_I32 flags;     /* PS_FLAG_* */
+  PS_I32 patterns;           /* noise patterns in the catalogue */
+  PS_I32 tile_size;          /* noise tile side */
+  PS_I32 flags;              /* PS_FLAG_* */
   PS_F32 jitter_x, jitter_y; /* in this view's pixels */
 } PsViewLaunch;
 
@@ -83,8 +83,8 @@ typedef struct {
 #define PS_LAYER_FY 3
 #define PS_LAYER_W 4
 #define PS_LAYER_H 5
-#define PS_LAYER_OFFSET 6 /* atlas offset of the sprite */
-#define PS_LAYER_PADDED 7 /* atlas offset of its padded copy */
+#define PS_LAYER_OFFSET 6  /* atlas offset of the sprite */
+#define PS_LAYER_PADDED 7  /* atlas offset of its padded copy */
 #define PS_LAYER_TILE_X0 8 /* the noise tile, centred on the unmoved sprite */
 #define PS_LAYER_TILE_Y0 9
 #define PS_LAYER_LEN 10
