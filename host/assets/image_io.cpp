@@ -124,18 +124,19 @@ Image resize_image(const Image& img, int width, int height) {
 }
 
 void write_image(const std::string& path, const Image& img, int jpeg_quality) {
+  // Failures here are the disk's or the folder's (full, read-only): output errors.
   auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw std::runtime_error(path + ": cannot write image: " + OIIO::geterror());
+  if (!out) throw OutputError(path + ": cannot write image: " + OIIO::geterror());
   OIIO::ImageSpec spec = spec_of(img);
   spec.attribute("CompressionQuality", jpeg_quality);
   // PNG: fast deflate, no row filter. Measured on 500 scenarios: 1.15 s of CPU against
   // 5.5 s at OpenImageIO's default, for files 15% larger. Data sets are written in bulk.
   spec.attribute("png:compressionLevel", 1);
   spec.attribute("png:filter", 8);  // PNG_FILTER_NONE
-  if (!out->open(path, spec)) throw std::runtime_error(path + ": cannot write image: " + out->geterror());
+  if (!out->open(path, spec)) throw OutputError(path + ": cannot write image: " + out->geterror());
   const bool ok = out->write_image(OIIO::TypeDesc::UINT8, img.pixels.data());
   const bool closed = out->close();
-  if (!ok || !closed) throw std::runtime_error(path + ": cannot write image: " + out->geterror());
+  if (!ok || !closed) throw OutputError(path + ": cannot write image: " + out->geterror());
 }
 
 }  // namespace portalsim

@@ -20,7 +20,7 @@ Image read_image(const std::string& path, const std::string& origin);
 // the size already matches.
 Image resize_image(const Image& img, int width, int height);
 
-// Writes by file extension (png, jpg, tif, ...). Throws std::runtime_error on failure.
+// Writes by file extension (png, jpg, tif, ...). Throws OutputError on failure.
 void write_image(const std::string& path, const Image& img, int jpeg_quality = 95);
 
 }  // namespace portalsim
