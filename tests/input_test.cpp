@@ -111,6 +111,13 @@ TEST(InputToml, NestingIsCappedBeforeTomlPlusPlusSeesIt) {
                             std::string(100, '[') + "'''\n[x]\n[[y]]\n";
   EXPECT_NO_THROW(portalsim::io::parse_toml(quiet, "q.toml"));
   EXPECT_THROW(portalsim::io::parse_toml("a = 1\na = 2\n", "d.toml"), InputError) << "duplicate keys";
+  // Dotted keys and headers nest tables too: 32,000 parts crashed toml++ (SIGSEGV).
+  std::string parts = "a";
+  for (int i = 0; i < 32000; ++i) parts += ".a";
+  EXPECT_THROW(portalsim::io::parse_toml(parts + " = 1\n", "k.toml"), InputError);
+  EXPECT_THROW(portalsim::io::parse_toml("[" + parts + "]\n", "h.toml"), InputError);
+  EXPECT_THROW(portalsim::io::parse_toml("t = {" + parts + " = 1}\n", "i.toml"), InputError);
+  EXPECT_NO_THROW(portalsim::io::parse_toml("[a.b.c]\nd.e.f = [[1], {g.h = 2}]\n", "ok.toml"));
 }
 
 TEST(InputToml, UnknownKeyNamesTheNearestKnownOne) {

@@ -11,19 +11,27 @@ namespace portalsim::io {
 namespace {
 
 // Walks the text as TOML's lexer would (strings, comments, table headers) and counts
-// the nesting of [ and { inside values.
+// nesting: [ and { inside values, plus each part of a dotted key or table header
+// (a.b.c = 1 nests tables too, and toml++ recurses on those as well).
 void check_depth(std::string_view s, const std::string& source) {
-  int depth = 0;
-  size_t line = 1, line_start = 0;
+  int depth = 0, header_levels = 0, key_levels = 0;
+  std::string open;           // the brackets open in the current value, innermost last
+  bool in_key = true;         // reading a key: at a line's start, or after { or , in an inline table
   bool line_has_key = false;  // a '[' before any key on a line at depth 0 opens a header
+  size_t line = 1, line_start = 0;
+  const auto fail = [&](size_t at) {
+    throw InputError(where(source, line, at - line_start + 1) + ": arrays and tables nested deeper than " +
+                     std::to_string(kMaxTomlDepth) + " levels");
+  };
   for (size_t i = 0; i < s.size(); ++i) {
     const char c = s[i];
     const auto starts = [&](std::string_view t) { return s.substr(i, t.size()) == t; };
     if (c == '\n') {
       ++line, line_start = i + 1, line_has_key = false;
+      if (depth == 0) in_key = true, key_levels = 0;
     } else if (c == '#') {
       while (i + 1 < s.size() && s[i + 1] != '\n') ++i;
-    } else if (starts("\"\"\"") || starts("'''")) {
+    } else if (starts("\"\"\"") || starts("\'\'\'")) {
       const std::string_view q = s.substr(i, 3);
       i += 3;
       while (i < s.size() && !starts(q)) {
@@ -39,14 +47,25 @@ void check_depth(std::string_view s, const std::string& source) {
       for (++i; i < s.size() && s[i] != c && s[i] != '\n'; ++i)
         if (s[i] == '\\' && c == '"') ++i;
       line_has_key = true;
-    } else if ((c == '[' || c == '{') && !(c == '[' && depth == 0 && !line_has_key)) {
-      if (++depth > kMaxTomlDepth)
-        throw InputError(where(source, line, i - line_start + 1) + ": arrays and tables nested deeper than " +
-                         std::to_string(kMaxTomlDepth) + " levels");
+    } else if (c == '[' && depth == 0 && !line_has_key) {  // a [table] or [[array]] header
+      header_levels = 1;
+      for (; i + 1 < s.size() && s[i + 1] != '\n' && s[i + 1] != '#'; ++i)
+        if (s[i + 1] == '.' && ++header_levels > kMaxTomlDepth) fail(i + 1);
+    } else if (c == '[' || c == '{') {
+      open.push_back(c);
+      if (++depth + header_levels + key_levels > kMaxTomlDepth) fail(i);
+      in_key = c == '{', key_levels = 0;
     } else if ((c == ']' || c == '}') && depth > 0) {
       --depth;
-    } else if (c == '[' && depth == 0) {
-      while (i + 1 < s.size() && s[i + 1] != '\n' && s[i + 1] != '#') ++i;  // a [table] header
+      open.pop_back();
+    } else if (c == ',' && !open.empty() && open.back() == '{') {
+      in_key = true, key_levels = 0;
+    } else if (c == '=' && in_key) {
+      in_key = false;
+      line_has_key = true;
+    } else if (c == '.' && in_key) {
+      if (depth + header_levels + ++key_levels > kMaxTomlDepth) fail(i);
+      line_has_key = true;
     } else if (c != ' ' && c != '\t' && c != '\r') {
       line_has_key = true;
     }
