@@ -747,18 +747,19 @@ TEST(GenerateResume, KillNineThenResumeMatchesAnUninterruptedRun) {
   EXPECT_EQ(read_all(dir / "manifest.json"), manifest);
 }
 
-TEST(GenerateResume, CtrlCStopsConsistentlyAndResumes) {
+// SIGINT (Ctrl-C) and SIGTERM: the batch in hand is finished, checkpointed, exit 130.
+void ExpectSignalStopsConsistentlyAndResumes(int sig) {
   GenTempDir t;
   const fs::path dir = t.w() / "stopped", ref = t.w() / "ref";
   const Started reference = start_ps(t, gen(with(kLongSpec, "--batch", "1000"), ref));
   const Started victim = start_ps(t, gen(kLongSpec, dir));
   const bool progressed = wait_for_checkpoint(victim, dir, 1);
-  send_signal(victim, SIGINT);
+  send_signal(victim, sig);
   const RunResult k = wait_for(victim);
   ExpectOk(wait_for(reference));
   ASSERT_TRUE(progressed) << describe_run(k);
   SCOPED_TRACE(describe_run(k));
-  ASSERT_FALSE(k.signaled) << "SIGINT must stop the run cleanly, not kill it";
+  ASSERT_FALSE(k.signaled) << strsignal(sig) << " must stop the run cleanly, not kill it";
   EXPECT_TRUE(k.exited);
   EXPECT_EQ(k.status, 130) << "an interrupted run exits with 130";
   EXPECT_TRUE(has(k.err, "--resume")) << "the message must say how to continue";
@@ -775,6 +776,10 @@ TEST(GenerateResume, CtrlCStopsConsistentlyAndResumes) {
   ExpectOk(r);
   ExpectSameTree(dir, ref);
 }
+
+TEST(GenerateResume, CtrlCStopsConsistentlyAndResumes) { ExpectSignalStopsConsistentlyAndResumes(SIGINT); }
+
+TEST(GenerateResume, SigtermStopsConsistentlyAndResumes) { ExpectSignalStopsConsistentlyAndResumes(SIGTERM); }
 
 TEST(GenerateResume, ImagesKillNineThenResumeMatchesAnUninterruptedRun) {
   GenTempDir t;

@@ -370,3 +370,34 @@ TEST(OutputFolder, AnErrorNeverDeletesWhatTheUserMade) {
 }
 
 }  // namespace
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// The OpenCL environment: what is missing is named, and the way around it.
+
+TEST(Environment, NoOpenClPlatformSaysSoAndNamesTheReferenceBackend) {
+  TempDir t;
+  const Result r = portalsim::test::finish(portalsim::test::start_program(
+      t.cap(), "/usr/bin/env",
+      {"OCL_ICD_VENDORS=/nonexistent", PORTALSIM_BINARY, "simulate", "gun", "--out", (t.w() / "o").string()}));
+  SCOPED_TRACE(describe(r));
+  EXPECT_TRUE(r.exited && r.status != 0);
+  EXPECT_TRUE(has(r.err, "no OpenCL platform found")) << "not clGetPlatformIDs";
+  EXPECT_TRUE(has(r.err, "--backend reference"));
+  EXPECT_FALSE(fs::exists(t.w() / "o"));
+}
+
+TEST(Environment, ReadOnlyPoclCacheIsNamed) {
+  TempDir t;
+  const fs::path cache = t.w() / "cache";
+  const std::string cmd = "POCL_CACHE_DIR=" + portalsim::test::quoted(cache.string()) + " " + PORTALSIM_BINARY +
+                          " simulate gun --out " + portalsim::test::quoted((t.w() / "o").string());
+  const Result r = portalsim::test::run_on_tmpfs(t.cap(), cache, "1m", true, cmd);
+  SCOPED_TRACE(describe(r));
+  EXPECT_TRUE(r.exited && r.status != 0);
+  EXPECT_TRUE(has(r.err, cache.string())) << "the message must name the cache folder";
+  EXPECT_TRUE(has(r.err, "writable"));
+}
+
+}  // namespace
