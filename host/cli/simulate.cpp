@@ -64,7 +64,7 @@ int simulate(SimulateOptions& o) {
   if (output_folder_state(o.out) == FolderState::has_files)
     throw OutputError(o.out + ": is not empty; choose a new folder");
   StagedFolder folder(o.out);
-  const FolderLock lock(o.out, true);
+  const FolderLock lock(o.out);
   if (output_folder_state(o.out) == FolderState::has_files)  // filled while this run waited for the lock
     throw OutputError(o.out + ": is not empty; choose a new folder");
 

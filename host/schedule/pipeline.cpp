@@ -189,7 +189,10 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
   json checkpoint;
   bool resuming = false;
   if (fs::exists(out / "manifest.json", ec)) {
-    if (!opt.resume) throw OutputError(dir + ": holds a finished run (manifest.json); choose a new folder");
+    if (!opt.resume)
+      throw OutputError(dir +
+                        ": is not empty: it holds a finished run (manifest.json); choose a new folder (--resume "
+                        "only checks that it is complete)");
     json manifest;
     try {
       manifest = json::parse(read_file(out / "manifest.json"));
@@ -201,8 +204,9 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
     if (const std::string diff = differing_keys(was, identity); !diff.empty())
       throw InputError("--resume: " + dir + " holds a finished run with other parameters: " + diff +
                        "; give the same parameters, or another folder");
-    // Complete; a crash after the manifest was written may have left the state folder.
+    // Complete; a crash after the manifest was written may have left the checkpoint.
     fs::remove(checkpoint_path, ec);
+    fs::remove(started_path, ec);
     res.already_complete = true;
     return res;
   }

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -32,25 +33,36 @@ FolderState output_folder_state(const std::string& dir) {
   return FolderState::empty;
 }
 
-FolderLock::FolderLock(const std::string& dir, bool remove) : remove_(remove) {
+FolderLock::FolderLock(const std::string& dir) {
   const fs::path state = fs::path(dir) / kStateDir, path = state / "lock";
   path_ = path.string();
   std::error_code ec;
   fs::create_directories(state, ec);
   if (ec) throw OutputError(dir + ": cannot create " + state.string() + ": " + ec.message());
-  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
-  if (fd_ < 0) throw OutputError(path.string() + ": cannot open the lock file: " + std::strerror(errno));
-  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-    const int err = errno;
-    char pid[32] = {};
-    const ssize_t n = ::pread(fd_, pid, sizeof pid - 1, 0);
+  // The holder removes the file on release: a lock taken on a file already unlinked is
+  // no lock, so try again on the new one.
+  for (int attempt = 0;; ++attempt) {
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd_ < 0) throw OutputError(path.string() + ": cannot open the lock file: " + std::strerror(errno));
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      const int err = errno;
+      char pid[32] = {};
+      const ssize_t n = ::pread(fd_, pid, sizeof pid - 1, 0);
+      ::close(fd_);
+      fd_ = -1;
+      if (err != EWOULDBLOCK) throw OutputError(path.string() + ": cannot lock: " + std::strerror(err));
+      std::string holder(pid, n > 0 ? static_cast<size_t>(n) : 0);
+      while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
+      throw OutputError(dir + ": another portalsim run (PID " + (holder.empty() ? "unknown" : holder) +
+                        ") is writing here; wait for it to finish or stop it");
+    }
+    struct stat held, now;
+    if (::fstat(fd_, &held) == 0 && ::stat(path.c_str(), &now) == 0 && held.st_ino == now.st_ino &&
+        held.st_dev == now.st_dev)
+      break;
     ::close(fd_);
     fd_ = -1;
-    if (err != EWOULDBLOCK) throw OutputError(path.string() + ": cannot lock: " + std::strerror(err));
-    std::string holder(pid, n > 0 ? static_cast<size_t>(n) : 0);
-    while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
-    throw OutputError(dir + ": another portalsim run (PID " + (holder.empty() ? "unknown" : holder) +
-                      ") is writing here; wait for it to finish or stop it");
+    if (attempt == 10) throw OutputError(path.string() + ": the lock file keeps changing; is another run starting?");
   }
   const std::string me = std::to_string(::getpid()) + "\n";
   if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, me.data(), me.size(), 0) != static_cast<ssize_t>(me.size())) {
@@ -62,12 +74,10 @@ FolderLock::FolderLock(const std::string& dir, bool remove) : remove_(remove) {
 
 FolderLock::~FolderLock() {
   if (fd_ < 0) return;
-  if (remove_) {
-    std::error_code ec;
-    fs::remove(path_, ec);
-    fs::remove(fs::path(path_).parent_path(), ec);  // only if empty
-  }
-  ::close(fd_);  // releases the flock
+  std::error_code ec;
+  fs::remove(path_, ec);                          // before the unlock, so that a waiting run finds a fresh file
+  fs::remove(fs::path(path_).parent_path(), ec);  // only if empty
+  ::close(fd_);                                   // releases the flock
 }
 
 }  // namespace portalsim

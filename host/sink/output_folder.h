@@ -17,11 +17,12 @@ enum class FolderState { missing, empty, has_files };
 FolderState output_folder_state(const std::string& dir);
 
 // An exclusive flock on dir/.portalsim/lock, created if needed; the file holds the PID.
-// Throws OutputError naming the PID of the run that holds it. Released on destruction;
-// with `remove` the lock file goes too, and .portalsim/ when nothing else is in it.
+// Throws OutputError naming the PID of the run that holds it. On release the lock file
+// goes, and .portalsim/ too when nothing else is in it: a refused or finished run leaves
+// the folder as it found it.
 class FolderLock {
  public:
-  explicit FolderLock(const std::string& dir, bool remove = false);
+  explicit FolderLock(const std::string& dir);
   FolderLock(const FolderLock&) = delete;
   FolderLock& operator=(const FolderLock&) = delete;
   ~FolderLock();
@@ -29,7 +30,6 @@ class FolderLock {
  private:
   int fd_ = -1;
   std::string path_;
-  bool remove_;
 };
 
 }  // namespace portalsim
