@@ -36,38 +36,6 @@ constexpr const char* kEmptyMetal = "200,200,200,200,200,200,200,200,200,200,200
 
 using Args = std::vector<std::string>;
 
-// A fresh folder under /tmp for one test: w/ is the test's workspace, cap/ holds the captured
-// stdout and stderr of every run (kept apart so that w/ shows only what portalsim wrote).
-class TempDir {
- public:
-  TempDir() {
-    char tmpl[] = "/tmp/portalsim-cli-XXXXXX";
-    if (!::mkdtemp(tmpl)) throw std::runtime_error(std::string("mkdtemp: ") + std::strerror(errno));
-    root_ = tmpl;
-    fs::create_directory(root_ / "w");
-    fs::create_directory(root_ / "cap");
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  ~TempDir() {
-    // A test may have made a folder read-only; give it back before removing everything.
-    std::error_code ec;
-    fs::permissions(root_, fs::perms::owner_all, fs::perm_options::add, ec);
-    for (auto it = fs::recursive_directory_iterator(root_, fs::directory_options::skip_permission_denied, ec);
-         !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
-      std::error_code ec2;
-      if (it->is_directory(ec2) && !it->is_symlink(ec2))
-        fs::permissions(it->path(), fs::perms::owner_all, fs::perm_options::add, ec2);
-    }
-    fs::remove_all(root_, ec);
-  }
-  fs::path w() const { return root_ / "w"; }
-  fs::path cap() const { return root_ / "cap"; }
-
- private:
-  fs::path root_;
-};
-
 using portalsim::test::describe;
 using portalsim::test::finish;
 using portalsim::test::quoted;
@@ -75,6 +43,7 @@ using portalsim::test::Result;
 using portalsim::test::Running;
 using portalsim::test::slurp;
 using portalsim::test::spit;
+using portalsim::test::TempDir;
 
 Running start(const TempDir& t, const Args& args) { return portalsim::test::start(t.cap(), args); }
 
@@ -654,39 +623,76 @@ TEST(CliOutput, OutIsARegularFile) {
   EXPECT_EQ(names_in(t.w()), (std::vector<std::string>{"afile"}));
 }
 
+// Root ignores permissions, so the read-only and full-disk tests use a small tmpfs in a
+// private mount namespace (unshare -m): read-only, or too small for the images.
+// The script prints what the folder holds afterwards; the mount goes with the namespace.
+struct TmpfsRun {
+  Result r;
+  std::vector<std::string> left;  // paths under the mount after the run
+};
+
+TmpfsRun run_on_tmpfs(const TempDir& t, const std::string& size, bool read_only, const std::string& prepare,
+                      const Args& args) {
+  const fs::path mnt = t.w() / "mnt";
+  std::string cmd = quoted(PORTALSIM_BINARY);
+  for (const std::string& a : args) {
+    cmd += ' ';  // appended apart: g++ 12 warns (-Wrestrict) on " " + std::string&&
+    cmd += quoted(a);
+  }
+  const std::string listing = (t.cap() / "listing").string();
+  const std::string script = (prepare.empty() ? "" : prepare + " && ") +
+                             (read_only ? "mount -o remount,ro " + quoted(mnt.string()) + " && " : "") + cmd +
+                             "; rc=$?; (cd " + quoted(mnt.string()) + " && find . -mindepth 1) > " + quoted(listing) +
+                             "; exit $rc";
+  TmpfsRun out;
+  out.r = portalsim::test::run_on_tmpfs(t.cap(), mnt, size, false, script);
+  std::istringstream in(slurp(listing));
+  for (std::string line; std::getline(in, line);) out.left.push_back(line);
+  return out;
+}
+
 TEST(CliOutput, ReadOnlyParent) {
-  if (::geteuid() == 0) GTEST_SKIP() << "running as root: permissions do not stop writes (see ParentIsARegularFile)";
   TempDir t;
-  const fs::path parent = t.w() / "readonly";
-  fs::create_directory(parent);
-  ASSERT_EQ(::chmod(parent.c_str(), 0500), 0);
-  const fs::path out = parent / "out";
-  const Result r = run(t, simulate({"gun"}, out));
-  ExpectCleanFailure(r, out, false, {out.string()});
-  EXPECT_TRUE(names_in(parent).empty());
-  ::chmod(parent.c_str(), 0700);
+  const fs::path out = t.w() / "mnt" / "out";
+  const TmpfsRun x = run_on_tmpfs(t, "1m", true, "", simulate({"gun"}, out));
+  ExpectCleanFailure(x.r, out, false, {out.string()});
+  EXPECT_EQ(x.r.status, 4) << "an output problem exits 4";
+  EXPECT_TRUE(x.left.empty()) << testing::PrintToString(x.left);
 }
 
 TEST(CliOutput, ReadOnlyOutFolder) {
-  if (::geteuid() == 0) GTEST_SKIP() << "running as root: permissions do not stop writes";
   TempDir t;
-  const fs::path out = t.w() / "out";
-  fs::create_directory(out);
-  ASSERT_EQ(::chmod(out.c_str(), 0500), 0);
-  const Result r = run(t, simulate({"gun"}, out));
-  ExpectCleanFailure(r, out, true, {out.string()});
-  ::chmod(out.c_str(), 0700);
+  const fs::path out = t.w() / "mnt" / "out";
+  const TmpfsRun x = run_on_tmpfs(t, "1m", true, "mkdir " + quoted(out.string()), simulate({"gun"}, out));
+  ExpectCleanFailure(x.r, out, false, {out.string()});  // out lived on the tmpfs, gone now
+  EXPECT_EQ(x.r.status, 4) << "an output problem exits 4";
+  EXPECT_EQ(x.left, std::vector<std::string>{"./out"});
 }
 
-TEST(CliOutput, NoFoldersLeftWhenSetupFailsAfterCreatingThem) {
-  // The output folder is created before the OpenCL device is opened; when that fails, the
-  // folders the run created (here a/ and a/b/ as well as out/) must all be gone.
+TEST(CliOutput, NoFoldersLeftWhenTheDiskFillsAfterCreatingThem) {
+  // The disk (a 16 KiB tmpfs) fills while the images are written, after out/ and the folders
+  // above it (a/, a/b/) were made: all of them must go, and the exit says output problem.
   TempDir t;
-  const fs::path out = t.w() / "a" / "b" / "out";
-  const Result r = run(t, simulate({"gun", "--device", "no-such-device-anywhere"}, out));
-  ExpectCleanFailure(r, out, false, {"no-such-device-anywhere"});
-  EXPECT_TRUE(names_in(t.w()).empty()) << "left behind: " << testing::PrintToString(names_in(t.w()))
-                                       << (fs::exists(t.w() / "a" / "b") ? " (a/b exists)" : "");
+  const fs::path out = t.w() / "mnt" / "a" / "b" / "out";
+  const TmpfsRun x = run_on_tmpfs(t, "16k", false, "", simulate({"gun"}, out));
+  ExpectCleanFailure(x.r, out, false, {});
+  EXPECT_EQ(x.r.status, 4) << "a full disk is an output problem\n" << describe(x.r);
+  EXPECT_TRUE(x.left.empty()) << "left behind: " << testing::PrintToString(x.left);
+}
+
+TEST(CliOutput, FeaturesOnAFullDiskLeavesNoPartialFile) {
+  TempDir t;
+  const fs::path scans = t.w() / "scans";
+  ASSERT_EQ(run(t, simulate({"gun"}, scans / "s1")).status, 0);
+  const fs::path table = t.w() / "mnt" / "table.csv";
+  // Block 1: one feature per pixel, a table far larger than the 64 KiB disk.
+  const TmpfsRun x =
+      run_on_tmpfs(t, "64k", false, "", {"features", scans.string(), "--block", "1", "--out", table.string()});
+  SCOPED_TRACE(describe(x.r));
+  EXPECT_TRUE(x.r.exited);
+  EXPECT_EQ(x.r.status, 4);
+  EXPECT_TRUE(contains(x.r.err, table.string()));
+  EXPECT_TRUE(x.left.empty()) << "left behind: " << testing::PrintToString(x.left);
 }
 
 // ---------------------------------------------------------------------------------------------

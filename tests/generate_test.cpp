@@ -42,27 +42,7 @@ const auto& write_all = portalsim::test::spit;
 // Running the binary (the same approach as cli_test.cpp).
 
 // A fresh folder under /tmp for one test: w/ is the workspace, cap/ holds captured output.
-class GenTempDir {
- public:
-  GenTempDir() {
-    char tmpl[] = "/tmp/portalsim-gen-XXXXXX";
-    if (!::mkdtemp(tmpl)) throw std::runtime_error(std::string("mkdtemp: ") + std::strerror(errno));
-    root_ = tmpl;
-    fs::create_directory(root_ / "w");
-    fs::create_directory(root_ / "cap");
-  }
-  GenTempDir(const GenTempDir&) = delete;
-  GenTempDir& operator=(const GenTempDir&) = delete;
-  ~GenTempDir() {
-    std::error_code ec;
-    fs::remove_all(root_, ec);
-  }
-  fs::path w() const { return root_ / "w"; }
-  fs::path cap() const { return root_ / "cap"; }
-
- private:
-  fs::path root_;
-};
+using GenTempDir = portalsim::test::TempDir;
 
 bool has(const std::string& hay, const std::string& needle) { return hay.find(needle) != std::string::npos; }
 
@@ -461,7 +441,8 @@ TEST(GenerateArff, HeaderRowsAndWekaLearnsTheGunRule) {
 
   const fs::path jar = "/usr/share/java/weka.jar";
   const std::string java = find_on_path("java");
-  if (java.empty() || !fs::exists(jar)) GTEST_SKIP() << "java or " << jar << " is not installed: WEKA part skipped";
+  ASSERT_FALSE(java.empty()) << "java is not installed (tools/setup.sh installs it)";
+  ASSERT_TRUE(fs::exists(jar)) << jar << " is not installed (tools/setup.sh installs weka)";
   const RunResult w = wait_for(start_program(
       t, java, {"-cp", jar.string(), "weka.classifiers.trees.J48", "-t", (out / "features.arff").string()}));
   ASSERT_TRUE(w.exited && w.status == 0) << describe_run(w);
@@ -766,18 +747,19 @@ TEST(GenerateResume, KillNineThenResumeMatchesAnUninterruptedRun) {
   EXPECT_EQ(read_all(dir / "manifest.json"), manifest);
 }
 
-TEST(GenerateResume, CtrlCStopsConsistentlyAndResumes) {
+// SIGINT (Ctrl-C) and SIGTERM: the batch in hand is finished, checkpointed, exit 130.
+void ExpectSignalStopsConsistentlyAndResumes(int sig) {
   GenTempDir t;
   const fs::path dir = t.w() / "stopped", ref = t.w() / "ref";
   const Started reference = start_ps(t, gen(with(kLongSpec, "--batch", "1000"), ref));
   const Started victim = start_ps(t, gen(kLongSpec, dir));
   const bool progressed = wait_for_checkpoint(victim, dir, 1);
-  send_signal(victim, SIGINT);
+  send_signal(victim, sig);
   const RunResult k = wait_for(victim);
   ExpectOk(wait_for(reference));
   ASSERT_TRUE(progressed) << describe_run(k);
   SCOPED_TRACE(describe_run(k));
-  ASSERT_FALSE(k.signaled) << "SIGINT must stop the run cleanly, not kill it";
+  ASSERT_FALSE(k.signaled) << strsignal(sig) << " must stop the run cleanly, not kill it";
   EXPECT_TRUE(k.exited);
   EXPECT_EQ(k.status, 130) << "an interrupted run exits with 130";
   EXPECT_TRUE(has(k.err, "--resume")) << "the message must say how to continue";
@@ -794,6 +776,10 @@ TEST(GenerateResume, CtrlCStopsConsistentlyAndResumes) {
   ExpectOk(r);
   ExpectSameTree(dir, ref);
 }
+
+TEST(GenerateResume, CtrlCStopsConsistentlyAndResumes) { ExpectSignalStopsConsistentlyAndResumes(SIGINT); }
+
+TEST(GenerateResume, SigtermStopsConsistentlyAndResumes) { ExpectSignalStopsConsistentlyAndResumes(SIGTERM); }
 
 TEST(GenerateResume, ImagesKillNineThenResumeMatchesAnUninterruptedRun) {
   GenTempDir t;
@@ -1099,7 +1085,7 @@ TEST(GenerateBadSpec, TooRareBalancedRuleLeavesNoHalfWrittenFolder) {
       run_ps(t, gen({"--count", "10", "--seed", "1", "--balance", "--rule",
                      "gun:h&gun:v&iron-rod:h&iron-rod:v&pendant&belt-buckle", "--objects", "6..6", "--quiet"},
                     out));
-  if (r.exited && r.status == 0) GTEST_SKIP() << "the rule was drawn after all; nothing to check";
+  ASSERT_FALSE(r.exited && r.status == 0) << "seed 1 draws this rule after all; pick a rarer rule";
   ExpectRefused(r, out, false, {"balance"});
 }
 
@@ -1196,7 +1182,7 @@ fs::path case_spec(const std::string& name) { return fs::path(PORTALSIM_SOURCE_D
 
 TEST(GenerateThesisCases, Case1GunIsBalanced) {
   const fs::path spec = case_spec("case1-gun.toml");
-  if (!fs::exists(spec)) GTEST_SKIP() << spec << " does not exist yet";
+  ASSERT_TRUE(fs::exists(spec)) << spec << " is missing";
   GenTempDir t;
   const fs::path out = t.w() / "case1";
   ExpectOk(run_ps(t, gen({"--spec", spec.string(), "--count", "200", "--quiet"}, out)));
@@ -1213,7 +1199,7 @@ TEST(GenerateThesisCases, Case1GunIsBalanced) {
 
 TEST(GenerateThesisCases, Case2RodAndPlateUsesItsPoolAndIsBalanced) {
   const fs::path spec = case_spec("case2-rod-plate.toml");
-  if (!fs::exists(spec)) GTEST_SKIP() << spec << " does not exist yet";
+  ASSERT_TRUE(fs::exists(spec)) << spec << " is missing";
   GenTempDir t;
   const fs::path out = t.w() / "case2";
   ExpectOk(run_ps(t, gen({"--spec", spec.string(), "--count", "200", "--quiet"}, out)));

@@ -36,9 +36,13 @@ TEST(Philox, DrawLayoutSeparatesEveryArgument) {
 TEST(Philox, BelowAndUniformStayInRange) {
   for (uint32_t r : {0u, 1u, 0x7fffffffu, 0xffffffffu}) {
     EXPECT_LT(below(r, 5), 5u);
-    EXPECT_GE(uniform24(r), 0.0);
     EXPECT_LT(uniform24(r), 1.0);
   }
+  // The top 24 bits over 2^24: exact values at both ends and in between.
+  EXPECT_EQ(uniform24(0xffu), 0.0);
+  EXPECT_EQ(uniform24(0x100u), 1.0 / 16777216.0);
+  EXPECT_EQ(uniform24(0x80000000u), 0.5);
+  EXPECT_EQ(uniform24(0xffffffffu), 16777215.0 / 16777216.0);
   EXPECT_EQ(below(0xffffffffu, 5), 4u);
   EXPECT_EQ(below(0, 5), 0u);
 }

@@ -23,6 +23,40 @@ extern char** environ;
 
 namespace portalsim::test {
 
+// A fresh folder under /tmp for one test: w/ is the test's workspace, cap/ holds the captured
+// stdout and stderr of every run (kept apart so that w/ shows only what portalsim wrote).
+class TempDir {
+ public:
+  TempDir() {
+    char tmpl[] = "/tmp/portalsim-test-XXXXXX";
+    if (!::mkdtemp(tmpl)) throw std::runtime_error(std::string("mkdtemp: ") + std::strerror(errno));
+    root_ = tmpl;
+    std::filesystem::create_directory(root_ / "w");
+    std::filesystem::create_directory(root_ / "cap");
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  ~TempDir() {
+    // A test may have made a folder read-only; give it back before removing everything.
+    std::error_code ec;
+    std::filesystem::permissions(root_, std::filesystem::perms::owner_all, std::filesystem::perm_options::add, ec);
+    for (auto it = std::filesystem::recursive_directory_iterator(
+             root_, std::filesystem::directory_options::skip_permission_denied, ec);
+         !ec && it != std::filesystem::recursive_directory_iterator(); it.increment(ec)) {
+      std::error_code ec2;
+      if (it->is_directory(ec2) && !it->is_symlink(ec2))
+        std::filesystem::permissions(it->path(), std::filesystem::perms::owner_all, std::filesystem::perm_options::add,
+                                     ec2);
+    }
+    std::filesystem::remove_all(root_, ec);
+  }
+  std::filesystem::path w() const { return root_ / "w"; }
+  std::filesystem::path cap() const { return root_ / "cap"; }
+
+ private:
+  std::filesystem::path root_;
+};
+
 struct Result {
   std::string command;
   bool exited = false;
@@ -141,6 +175,17 @@ inline Result finish(const Running& r, int limit_s = 120) {
   res.out = slurp(r.out_path);
   res.err = slurp(r.err_path);
   return res;
+}
+
+// Runs `script` with sh in a private mount namespace (unshare -m, as root) after mounting
+// a tmpfs of `size` (e.g. "64k") at `mount_point`, read-only when asked. The mount is
+// gone when the script ends, so the script itself lists what the test must inspect.
+inline Result run_on_tmpfs(const std::filesystem::path& cap, const std::filesystem::path& mount_point,
+                           const std::string& size, bool read_only, const std::string& script) {
+  std::filesystem::create_directories(mount_point);
+  const std::string mount = "mount -t tmpfs -o size=" + size + " tmpfs " + quoted(mount_point.string());
+  const std::string ro = read_only ? " && mount -o remount,ro " + quoted(mount_point.string()) : "";
+  return finish(start_program(cap, "/usr/bin/unshare", {"-m", "sh", "-c", mount + ro + " && " + script}));
 }
 
 }  // namespace portalsim::test

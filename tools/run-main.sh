@@ -5,7 +5,7 @@
 # thesis's worked example (a gun in the right abdomen). Everything lands in out/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash tools/setup.sh
+PORTALSIM_TARGET=portalsim bash tools/setup.sh
 rm -rf out && mkdir -p out
 ./build/portalsim simulate none none none gun --rule gun --out out/gun --timing
 for case in case1-gun case2-rod-plate; do

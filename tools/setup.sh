@@ -10,7 +10,8 @@ packages=(build-essential cmake pkg-config
   libopenimageio-dev openimageio-tools
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libxxhash-dev libgtest-dev libbenchmark-dev
-  weka default-jre-headless python3 python3-matplotlib clang-format)
+  weka default-jre-headless python3 python3-matplotlib clang-format
+  clang libclang-rt-14-dev)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -26,4 +27,5 @@ fi
 
 build_dir=${PORTALSIM_BUILD_DIR:-build}
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release ${PORTALSIM_CMAKE_ARGS:-} >/dev/null
-cmake --build "$build_dir" -j "$(nproc)"
+# PORTALSIM_TARGET builds one target (the main job needs only portalsim).
+cmake --build "$build_dir" -j "$(nproc)" ${PORTALSIM_TARGET:+--target "$PORTALSIM_TARGET"}

@@ -6,15 +6,21 @@
 
 namespace portalsim {
 
-// Reads any format OpenImageIO knows into 8 bits per channel, keeping its channels.
-// Throws InputError("<origin>: <path>: <reason>") when missing, unreadable or corrupt.
+// Limits checked from an image's header before it is decoded.
+inline constexpr int kMaxImageSide = 8192;
+inline constexpr long long kMaxImagePixels = 4096LL * 4096;
+
+// Reads any format OpenImageIO knows into 8 bits per channel, keeping its channels:
+// a regular file of at most io::kMaxImageBytes, within the limits above, 1 to 4
+// channels of 8- or 16-bit integers. Throws InputError("<origin>: <path>: <reason>") when missing, unreadable or
+// corrupt.
 Image read_image(const std::string& path, const std::string& origin);
 
 // Resamples to width x height (OpenImageIO's filtered resize); returns the input when
 // the size already matches.
 Image resize_image(const Image& img, int width, int height);
 
-// Writes by file extension (png, jpg, tif, ...). Throws std::runtime_error on failure.
+// Writes by file extension (png, jpg, tif, ...). Throws OutputError on failure.
 void write_image(const std::string& path, const Image& img, int jpeg_quality = 95);
 
 }  // namespace portalsim

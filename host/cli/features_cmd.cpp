@@ -50,9 +50,10 @@ int features(FeaturesOptions& o) {
   ctx.threads = 1;
   std::error_code ec;
   if (!fs::is_directory(ctx.dir, ec)) throw OutputError(ctx.dir + ": no such folder for --out");
-  std::unique_ptr<Sink> sink = make_table_sink(format, ctx, nullptr, out.filename().string());
+  std::unique_ptr<Sink> sink;
   size_t positive = 0;
   try {
+    sink = make_table_sink(format, ctx, nullptr, out.filename().string());  // writes the header: may fail too
     for (size_t first = 0; first < folders.size(); first += chunk) {
       const size_t n = std::min(chunk, folders.size() - first);
       rows.n = n;

@@ -136,7 +136,8 @@ int generate(GenerateOptions& o) {
                 r.compute_seconds > 0 ? r.done / r.compute_seconds : 0.0, r.write_wait_seconds,
                 s.runtime ? (", kernel build " + std::to_string(s.runtime->build_seconds()) + " s").c_str() : "");
   if (r.interrupted) {
-    std::fprintf(stderr, "portalsim: interrupted; %s is consistent, continue it with --resume\n", o.out.c_str());
+    std::fprintf(stderr, "portalsim: interrupted; %s is consistent, run the same command with --resume to finish it\n",
+                 o.out.c_str());
     return 130;
   }
   return 0;

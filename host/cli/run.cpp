@@ -2,9 +2,30 @@
 #include <map>
 
 #include "cli/commands.h"
+#include "io/input_file.h"
 #include "scene/error.h"
 
 namespace portalsim::cli {
+
+namespace {
+
+// Exit codes (README, "Exit codes"): a bad flag or value 2, a bad input file 3, an
+// output problem 4, anything else 1. Errors in flag values name the flag first.
+constexpr int kUsage = 2, kBadInput = 3, kOutput = 4, kInternal = 1;
+
+int fail(const char* what, int code) {
+  std::fprintf(stderr, "portalsim: error: %s\n", what);
+  return code;
+}
+
+// Every value given on the command line passes the input layer's byte checks.
+void check_values(const CLI::App& app) {
+  for (const CLI::Option* o : app.get_options())
+    for (const std::string& v : o->results()) io::check_flag_value(v, o->get_name());
+  for (const CLI::App* sub : app.get_subcommands()) check_values(*sub);
+}
+
+}  // namespace
 
 int run(int argc, char** argv) {
   CLI::App app{"portalsim: simulated MMW, IR and metal detector outputs for security portal scenarios"};
@@ -19,22 +40,25 @@ int run(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kUsage;
+  }
+  try {
+    check_values(app);
+  } catch (const InputError& e) {
+    return fail(e.what(), kUsage);
   }
   try {
     for (const auto& [name, fn] : commands)
       if (app.got_subcommand(name)) return fn();
   } catch (const InputError& e) {
-    std::fprintf(stderr, "portalsim: error: %s\n", e.what());
-    return 2;
+    return fail(e.what(), std::string_view(e.what()).starts_with("--") ? kUsage : kBadInput);
   } catch (const OutputError& e) {
-    std::fprintf(stderr, "portalsim: error: %s\n", e.what());
-    return 3;
+    return fail(e.what(), kOutput);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "portalsim: error: %s\n", e.what());
-    return 1;
+    return fail(e.what(), kInternal);
   }
-  return 1;
+  return kInternal;
 }
 
 }  // namespace portalsim::cli

@@ -6,6 +6,7 @@
 #include "cli/common.h"
 #include "scene/error.h"
 #include "scene/rules.h"
+#include "sink/output_folder.h"
 #include "sink/scenario_folder.h"
 #include "sink/staging.h"
 
@@ -59,7 +60,13 @@ int simulate(SimulateOptions& o) {
   validate(plan, cat);
 
   open_backend(s, o.common);
+  // The output-folder rules of generate: new or empty, locked while written.
+  if (output_folder_state(o.out) == FolderState::has_files)
+    throw OutputError(o.out + ": is not empty; choose a new folder");
   StagedFolder folder(o.out);
+  const FolderLock lock(o.out);
+  if (output_folder_state(o.out) == FolderState::has_files)  // filled while this run waited for the lock
+    throw OutputError(o.out + ": is not empty; choose a new folder");
 
   SceneBatch batch;
   batch.push(scene);

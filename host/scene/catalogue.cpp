@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "assets/procedural.h"
+#include "io/input_file.h"
+#include "io/toml_input.h"
 #include "scene/error.h"
 
 namespace portalsim {
@@ -181,14 +183,9 @@ int Catalogue::find_object(std::string_view name) const {
 Catalogue parse_catalogue(std::string_view text, const std::string& source_name, const std::string& base_dir,
                           const std::string& assets_dir) {
   Reader rd{source_name, base_dir, assets_dir};
-  toml::table root;
-  try {
-    root = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream s;
-    s << source_name << ":" << e.source().begin.line << ": syntax: " << e.description();
-    throw InputError(s.str());
-  }
+  const toml::table root = io::parse_toml(text, source_name);
+  io::reject_unknown_keys(root, {"format", "images", "metal", "subjects", "regions", "objects", "noise"}, source_name,
+                          "");
   Catalogue cat;
   cat.source = source_name;
   cat.hash = fnv1a_hex(text);
@@ -199,6 +196,8 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   const toml::node* imgs_node = rd.need(root, "images", "images");
   const toml::table* imgs = imgs_node->as_table();
   if (!imgs) rd.fail(imgs_node, "images", "expected a table");
+  io::reject_unknown_keys(*imgs, {"mmw_width", "mmw_height", "ir_width", "ir_height", "alpha", "noise_size"},
+                          source_name, "images");
   ImagesConfig& ic = cat.images;
   ic.mmw_width = rd.integer(*imgs, "mmw_width", "images", 1, 4096);
   ic.mmw_height = rd.integer(*imgs, "mmw_height", "images", 1, 4096);
@@ -211,6 +210,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   const toml::node* metal_node = rd.need(root, "metal", "metal");
   const toml::table* metal = metal_node->as_table();
   if (!metal) rd.fail(metal_node, "metal", "expected a table");
+  io::reject_unknown_keys(*metal, {"categories", "influence"}, source_name, "metal");
   {
     const toml::node* cn = rd.need(*metal, "categories", "metal.categories");
     const toml::array* ca = cn->as_array();
@@ -249,6 +249,9 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   for (size_t i = 0; i < subjects.size(); ++i) {
     const toml::table& t = *subjects.get(i)->as_table();
     const std::string f = "subjects[" + std::to_string(i + 1) + "]";
+    io::reject_unknown_keys(
+        t, {"name", "build", "mmw_level", "ir_core", "ir_limb", "base_zones", "mmw_upper", "mmw_lower", "ir"},
+        source_name, f);
     Subject s;
     s.name = rd.string(t, "name", f);
     s.build = rd.number(t, "build", f, 0.5, 1.5, 1.0);
@@ -271,6 +274,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   for (size_t i = 0; i < regions.size(); ++i) {
     const toml::table& t = *regions.get(i)->as_table();
     const std::string f = "regions[" + std::to_string(i + 1) + "]";
+    io::reject_unknown_keys(t, {"id", "name", "view", "mmw", "ir"}, source_name, f);
     const int id = rd.integer(t, "id", f, 1, kRegions);
     if (seen[id - 1]) rd.fail(t.get("id"), f + ".id", "region " + std::to_string(id) + " is defined twice");
     seen[id - 1] = true;
@@ -297,6 +301,10 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   for (size_t i = 0; i < objects.size(); ++i) {
     const toml::table& t = *objects.get(i)->as_table();
     const std::string f = "objects[" + std::to_string(i + 1) + "]";
+    io::reject_unknown_keys(t,
+                            {"name", "aliases", "material", "metal", "shape", "size", "mmw_level", "ir_level",
+                             "variants", "mmw", "ir", "mmw_h", "mmw_v", "ir_h", "ir_v"},
+                            source_name, f);
     Object o;
     o.name = rd.string(t, "name", f);
     if (normalise_name(o.name).empty() || normalise_name(o.name) == "none")
@@ -380,6 +388,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   for (size_t i = 0; i < noise.size(); ++i) {
     const toml::table& t = *noise.get(i)->as_table();
     const std::string f = "noise[" + std::to_string(i + 1) + "]";
+    io::reject_unknown_keys(t, {"name", "gain", "image"}, source_name, f);
     NoisePattern p;
     p.name = rd.string(t, "name", f);
     p.gain = rd.number(t, "gain", f, 0.0, 100.0, 1.0);
@@ -393,13 +402,9 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
 }
 
 Catalogue load_catalogue(const std::string& path, const std::string& assets_dir) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot read the catalogue file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  if (in.bad()) throw InputError(path + ": error while reading the catalogue file");
+  const std::string text = io::read_file(path, "catalogue file", io::kMaxTextBytes);
   const std::string dir = std::filesystem::absolute(path).parent_path().string();
-  return parse_catalogue(s.str(), path, dir, assets_dir);
+  return parse_catalogue(text, path, dir, assets_dir);
 }
 
 Catalogue default_catalogue(const std::string& assets_dir) {

@@ -3,6 +3,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "io/input_file.h"
 #include "scene/error.h"
 #include "scene/philox.h"
 
@@ -83,11 +84,16 @@ Scenario Generator::operator()(uint64_t index) const {
 }
 
 std::vector<Scenario> read_scenario_file(const Catalogue& cat, const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot read the scenario file");
+  const std::string raw = io::read_file(path, "scenario file", io::kMaxTextBytes);
+  return parse_scenario_list(cat, raw, path);
+}
+
+std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view raw, const std::string& path) {
+  // A BOM is allowed: spreadsheets write one. CRLF line ends are too.
+  std::istringstream in(std::string(io::check_text(raw, path, io::Bom::skip)));
   std::string line;
   size_t lineno = 0;
-  auto split = [](const std::string& l) {
+  auto split = [&](const std::string& l) {
     std::vector<std::string> f;
     std::string cur;
     for (char c : l) {
@@ -99,9 +105,13 @@ std::vector<Scenario> read_scenario_file(const Catalogue& cat, const std::string
       }
     }
     f.push_back(cur);
-    for (std::string& s : f) {
+    for (size_t k = 0; k < f.size(); ++k) {
+      std::string& s = f[k];
       const size_t a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t");
       s = a == std::string::npos ? "" : s.substr(a, b - a + 1);
+      if (s.size() > kMaxFieldBytes)
+        throw InputError(path + ":" + std::to_string(lineno) + ": column " + std::to_string(k + 1) +
+                         ": field longer than " + std::to_string(kMaxFieldBytes) + " bytes");
     }
     return f;
   };
@@ -116,6 +126,10 @@ std::vector<Scenario> read_scenario_file(const Catalogue& cat, const std::string
   col_region.fill(-1);
   for (size_t c = 0; c < header.size(); ++c) {
     const std::string h = normalise_name(header[c]);
+    for (size_t d = 0; d < c; ++d)
+      if (normalise_name(header[d]) == h)
+        throw InputError(path + ":" + std::to_string(lineno) + ": column " + std::to_string(c + 1) + " \"" + header[c] +
+                         "\": duplicates column " + std::to_string(d + 1));
     if (h == "subject")
       col_subject = static_cast<int>(c);
     else if (h == "label" || h == "class" || h == "threat")

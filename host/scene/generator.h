@@ -37,5 +37,9 @@ class Generator {
 // An explicit list: CSV with a header naming subject, region1..region13 and optionally
 // label (yes/no/positive/negative/1/0). Subjects are 1-based. Errors name file, line, column.
 std::vector<Scenario> read_scenario_file(const Catalogue& cat, const std::string& path);
+// The same from text already read; `path` names it in errors. Fields hold at most
+// kMaxFieldBytes.
+inline constexpr size_t kMaxFieldBytes = 256;
+std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view text, const std::string& path);
 
 }  // namespace portalsim

@@ -13,6 +13,7 @@
 
 #include "scene/error.h"
 #include "schedule/parallel.h"
+#include "sink/output_folder.h"
 #include "sink/sinks.h"
 #include "sink/staging.h"
 
@@ -102,6 +103,25 @@ void draw_progress(uint64_t done, uint64_t total, double seconds) {
   std::fflush(stderr);
 }
 
+// "spec.seed (1 there, 2 now), spec.count (...)": every entry that differs, one level
+// into objects; empty when equal.
+std::string differing_keys(const json& was, const json& now, const std::string& prefix = "") {
+  if (!was.is_object()) return differing_keys(json::object(), now, prefix);
+  std::string out;
+  const auto add = [&](const std::string& k, const json& a, const json& b) {
+    if (a == b) return;
+    std::string d = a.is_object() && b.is_object() && prefix.empty()
+                        ? differing_keys(a, b, k + ".")
+                        : prefix + k + " (" + (a.is_null() ? "absent" : a.dump()) + " there, " +
+                              (b.is_null() ? "absent" : b.dump()) + " now)";
+    out += (out.empty() ? "" : ", ") + d;
+  };
+  for (const auto& [k, v] : now.items()) add(k, was.value(k, json()), v);
+  for (const auto& [k, v] : was.items())
+    if (!now.contains(k)) add(k, v, json());
+  return out;
+}
+
 }  // namespace
 
 size_t default_batch(const Plan& plan, const Catalogue& cat) {
@@ -153,15 +173,38 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
   if (!spec.scenarios.empty()) identity["spec"]["scenarios_count"] = total;
   identity["shard"] = {{"index", opt.shard}, {"count", opt.shards}, {"begin", res.begin}, {"end", res.end}};
 
-  // The output folder: new, or an interrupted run of the same identity to resume.
-  const fs::path out(dir), state_dir = out / ".portalsim", checkpoint_path = state_dir / "checkpoint.json";
+  // The output folder: new, or an interrupted run of the same identity to resume. The
+  // lock is taken before anything in it is read or changed.
+  const fs::path out(dir), state_dir = out / kStateDir, checkpoint_path = state_dir / "checkpoint.json",
+                           started_path = state_dir / "started";
   std::error_code ec;
+  const bool created_dir = output_folder_state(dir) == FolderState::missing;
+  if (created_dir) {
+    fs::create_directories(out, ec);
+    if (ec) throw OutputError(dir + ": cannot create the output folder: " + ec.message());
+  }
+  const FolderLock lock(dir);
   json checkpoint;
   bool resuming = false;
-  if (fs::exists(out, ec) && !fs::is_directory(out, ec)) throw OutputError(dir + ": exists and is not a folder");
-  if (opt.resume && fs::exists(out / "manifest.json", ec)) {
-    // Complete; a crash after the manifest was written may have left the state folder.
-    fs::remove_all(state_dir, ec);
+  if (fs::exists(out / "manifest.json", ec)) {
+    if (!opt.resume)
+      throw OutputError(dir +
+                        ": is not empty: it holds a finished run (manifest.json); choose a new folder (--resume "
+                        "only checks that it is complete)");
+    json manifest;
+    try {
+      manifest = json::parse(read_file(out / "manifest.json"));
+    } catch (const json::exception& e) {
+      throw OutputError(dir + "/manifest.json: unreadable: " + e.what());
+    }
+    json was = json::object();
+    for (const auto& [k, v] : identity.items()) was[k] = manifest.value(k, json());
+    if (const std::string diff = differing_keys(was, identity); !diff.empty())
+      throw InputError("--resume: " + dir + " holds a finished run with other parameters: " + diff +
+                       "; give the same parameters, or another folder");
+    // Complete; a crash after the manifest was written may have left the checkpoint.
+    fs::remove(checkpoint_path, ec);
+    fs::remove(started_path, ec);
     res.already_complete = true;
     return res;
   }
@@ -171,39 +214,22 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
     } catch (const json::exception& e) {
       throw OutputError(checkpoint_path.string() + ": unreadable checkpoint: " + e.what());
     }
-    if (checkpoint.value("identity", json()) != identity) {
-      // Name the first differing entry, with both values.
-      std::string what = "identity";
-      const json was = checkpoint.value("identity", json::object());
-      for (const std::string k : {"spec", "catalogue", "shard", "portalsim"}) {  // the likeliest cause first
-        const json& v = identity[k];
-        const json old = was.value(k, json());
-        if (old == v) continue;
-        what = k + " (" + old.dump() + " there, " + v.dump() + " now)";
-        if (v.is_object() && old.is_object())
-          for (auto& [k2, v2] : v.items())
-            if (old.value(k2, json()) != v2) {
-              what = k + "." + k2 + " (" + old.value(k2, json()).dump() + " there, " + v2.dump() + " now)";
-              break;
-            }
-        break;
-      }
-      throw InputError("--resume: " + dir + " was made by a different run: " + what +
-                       "; give the same spec, or another folder");
-    }
+    if (const std::string diff = differing_keys(checkpoint.value("identity", json::object()), identity); !diff.empty())
+      throw InputError("--resume: " + dir + " was made by a different run: " + diff +
+                       "; give the same parameters, or another folder");
     resuming = true;
-  } else if (opt.resume && fs::exists(out, ec) && !fs::is_empty(out, ec)) {
-    throw OutputError(dir +
-                      ": holds no interrupted run to resume (no .portalsim/checkpoint.json); "
-                      "choose a new folder");
-  } else if (fs::exists(out, ec) && !fs::is_empty(out, ec)) {
-    throw OutputError(dir +
-                      ": is not empty; use --resume to continue an interrupted run there, or choose a new folder");
+  } else if (fs::exists(started_path, ec) && !fs::exists(checkpoint_path, ec)) {
+    // A run stopped before its first checkpoint: all that is here is its own; start again.
+    for (const auto& entry : fs::directory_iterator(out, ec))
+      if (entry.path().filename() != kStateDir) fs::remove_all(entry.path(), ec);
+  } else if (output_folder_state(dir) == FolderState::has_files || fs::exists(checkpoint_path, ec)) {
+    throw OutputError(dir + (opt.resume ? ": holds no interrupted run to resume (no .portalsim/checkpoint.json); "
+                                          "choose a new folder"
+                                        : ": is not empty; use --resume to continue an interrupted run there, or "
+                                          "choose a new folder"));
   }
-  const bool created_dir = !fs::exists(out, ec);
-  fs::create_directories(state_dir, ec);
-  if (ec) throw OutputError(dir + ": cannot create the output folder: " + ec.message());
-  // A fresh run that fails before any batch is written leaves nothing behind.
+  // A fresh run that fails before any batch is written leaves nothing of its own
+  // behind; the folder was empty, or is one this run made.
   struct Cleanup {
     fs::path dir;
     bool created, armed;
@@ -217,6 +243,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
       }
     }
   } cleanup{out, created_dir, !resuming};
+  if (!resuming) write_text_atomic(started_path.string(), identity.dump() + "\n");
   if (::access(state_dir.c_str(), W_OK) != 0) throw OutputError(dir + ": the output folder is not writable");
 
   const uint64_t start = resuming ? checkpoint["next"].get<uint64_t>() : res.begin;
@@ -262,7 +289,10 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
         c["files"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"xxh3", f.xxh3}});
     write_text_atomic(checkpoint_path.string(), c.dump(1) + "\n");
   };
-  if (!resuming) save_checkpoint(start);
+  if (!resuming) {
+    save_checkpoint(start);
+    fs::remove(started_path, ec);
+  }
 
   // Writer thread: sinks, then the checkpoint, batch after batch.
   Handover hand;

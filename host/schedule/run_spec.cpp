@@ -1,10 +1,10 @@
 #include "schedule/run_spec.h"
 
-#include <toml++/toml.h>
-
 #include <cmath>
 #include <filesystem>
 
+#include "io/input_file.h"
+#include "io/toml_input.h"
 #include "scene/error.h"
 
 namespace portalsim {
@@ -90,14 +90,11 @@ void parse_object_range(const std::string& text, const std::string& where, RunSp
 }
 
 void read_spec_file(const std::string& path, RunSpec& spec) {
-  toml::table t;
-  try {
-    t = toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    if (e.source().begin.line == 0)
-      throw InputError(path + ": cannot read the spec file: " + std::string(e.description()));
-    throw InputError(path + ":" + std::to_string(e.source().begin.line) + ": syntax: " + std::string(e.description()));
-  }
+  parse_spec(io::read_file(path, "spec file", io::kMaxTextBytes), path, spec);
+}
+
+void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
+  const toml::table t = io::parse_toml(text, path);
   const auto at = [&](const toml::node& n, const std::string& key) {
     return path + ":" + std::to_string(n.source().begin.line) + ": " + key;
   };

@@ -47,6 +47,8 @@ struct RunSpec {
 // subjects, balance, what, format, block, image_format, pattern_noise, pixel_noise,
 // metal_noise, scenarios) over `spec`. Errors name the file, line and key.
 void read_spec_file(const std::string& path, RunSpec& spec);
+// The same from text already read; `path` names it in errors.
+void parse_spec(std::string_view text, const std::string& path, RunSpec& spec);
 // "a, b,c" -> {"a", "b", "c"}: comma-separated names, spaces dropped, empty items skipped.
 std::vector<std::string> split_list(const std::string& text);
 // "MIN..MAX" or "N".

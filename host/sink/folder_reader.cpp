@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 
 #include "assets/assets.h"
 #include "assets/image_io.h"
+#include "io/input_file.h"
 #include "scene/error.h"
 
 namespace portalsim {
@@ -24,12 +24,12 @@ std::string find_image(const fs::path& dir, const std::string& stem) {
   return "";
 }
 
-std::string read_line(const fs::path& p) {
-  std::ifstream in(p);
-  if (!in) throw InputError(p.string() + ": cannot read");
-  std::string line;
-  std::getline(in, line);
-  while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+// The one line of a small text file: checked text, one line, trailing blanks dropped.
+std::string one_line(std::string_view raw, const std::string& source) {
+  std::string line(io::check_text(raw, source, io::Bom::refuse));
+  while (!line.empty() && (line.back() == '\n' || line.back() == '\r' || line.back() == ' ')) line.pop_back();
+  if (const size_t nl = line.find('\n'); nl != std::string::npos)
+    throw InputError(source + ":2: expected one line, found more");
   return line;
 }
 
@@ -100,33 +100,48 @@ bool read_scenario_folder(const std::string& dir, const Catalogue& cat, BatchOut
       for (int x = r.mmw.x; x < r.mmw.x + r.mmw.w; ++x) sum += img.at(x, y);
     row[k++] = mean_of(sum, r.mmw.w * r.mmw.h);
   }
-  // metal.txt: 19 integers 1..200, separated by commas and/or spaces.
   const fs::path metal = d / "metal.txt";
-  const std::string line = read_line(metal);
+  const std::array<uint8_t, kZones> zones =
+      parse_metal_text(io::read_file(metal.string(), "metal file", io::kMaxTextBytes), metal.string());
+  std::copy(zones.begin(), zones.end(), out.metal.begin() + static_cast<std::ptrdiff_t>(i * kZones));
+  const fs::path threat = d / "threat.txt";
+  return parse_threat_text(io::read_file(threat.string(), "label file", io::kMaxTextBytes), threat.string());
+}
+
+std::array<uint8_t, kZones> parse_metal_text(std::string_view text, const std::string& source) {
+  // 19 integers 0..200, separated by commas and/or spaces.
+  const std::string line = one_line(text, source);
   std::vector<int> zones;
   std::string cur;
   for (char c : line + ",") {
     if (c == ',' || c == ' ' || c == '\t') {
       if (cur.empty()) continue;
       if (cur.size() > 3 || cur.find_first_not_of("0123456789") != std::string::npos)
-        throw InputError(metal.string() + ":1: zone " + std::to_string(zones.size() + 1) + ": \"" + cur +
+        throw InputError(source + ":1: zone " + std::to_string(zones.size() + 1) + ": \"" + cur +
                          "\" is not an integer 0..200");
       zones.push_back(std::stoi(cur));
       if (zones.back() > 200)
-        throw InputError(metal.string() + ":1: zone " + std::to_string(zones.size()) + ": " + cur + " is above 200");
+        throw InputError(source + ":1: zone " + std::to_string(zones.size()) + ": " + cur + " is above 200");
+      if (zones.size() > kZones) break;
       cur.clear();
     } else {
       cur.push_back(c);
     }
   }
   if (zones.size() != kZones)
-    throw InputError(metal.string() + ":1: expected 19 zone values, found " + std::to_string(zones.size()));
-  for (int z = 0; z < kZones; ++z) out.metal[i * kZones + z] = static_cast<uint8_t>(zones[z]);
-  const fs::path threat = d / "threat.txt";
-  const std::string t = normalise_name(read_line(threat));
+    throw InputError(source + ":1: expected 19 zone values, found " +
+                     (zones.size() > kZones ? "more" : std::to_string(zones.size())));
+  std::array<uint8_t, kZones> out;
+  for (int z = 0; z < kZones; ++z) out[z] = static_cast<uint8_t>(zones[z]);
+  return out;
+}
+
+bool parse_threat_text(std::string_view text, const std::string& source) {
+  const std::string raw = one_line(text, source);
+  const std::string t = normalise_name(raw);
   if (t == "yes" || t == "positive" || t == "threat" || t == "1") return true;
   if (t == "no" || t == "negative" || t == "0") return false;
-  throw InputError(threat.string() + ":1: \"" + t + "\" is not yes or no");
+  throw InputError(source + ":1: \"" + raw + "\" is not yes or no");
 }
 
 }  // namespace portalsim

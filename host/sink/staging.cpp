@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "scene/error.h"
+#include "sink/output_folder.h"
 
 namespace portalsim {
 
@@ -15,11 +16,11 @@ namespace fs = std::filesystem;
 StagedFolder::StagedFolder(const std::string& final_dir) : final_dir_(final_dir) {
   if (final_dir_.empty()) throw OutputError("--out: empty folder name");
   std::error_code ec;
-  if (fs::exists(final_dir_, ec) && !fs::is_directory(final_dir_, ec))
-    throw OutputError(final_dir_ + ": exists and is not a folder");
-  // Remember each missing ancestor, so that a failure removes all that was made.
-  for (fs::path p = fs::absolute(final_dir_, ec).lexically_normal(); !p.empty() && !fs::exists(p, ec);
-       p = p.parent_path()) {
+  (void)output_folder_state(final_dir_);  // refuses a file or a dangling symlink
+  // Remember each missing ancestor, so that a failure removes all that was made (and
+  // nothing else: a symlink counts as existing, whatever it points to).
+  for (fs::path p = fs::absolute(final_dir_, ec).lexically_normal();
+       !p.empty() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path()) {
     created_.insert(created_.begin(), p.string());
     if (p == p.parent_path()) break;
   }

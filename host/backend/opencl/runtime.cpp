@@ -1,6 +1,7 @@
 #include "backend/opencl/runtime.h"
 
 #include <chrono>
+#include <cstdlib>
 #include <stdexcept>
 #include <string_view>
 
@@ -12,9 +13,26 @@ extern const std::string_view kernel_program;
 
 std::string OpenCLRuntime::source() { return std::string(embedded::kernel_program); }
 
+namespace {
+// Where PoCL keeps compiled kernels: POCL_CACHE_DIR, else $XDG_CACHE_HOME/pocl, else ~/.cache/pocl.
+std::string pocl_cache() {
+  if (const char* d = std::getenv("POCL_CACHE_DIR"); d && *d) return d;
+  if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return std::string(x) + "/pocl";
+  const char* home = std::getenv("HOME");
+  return std::string(home && *home ? home : "~") + "/.cache/pocl";
+}
+}  // namespace
+
 OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
   std::vector<cl::Platform> platforms;
-  cl::Platform::get(&platforms);
+  try {
+    cl::Platform::get(&platforms);
+  } catch (const cl::Error&) {
+    platforms.clear();  // no platform at all: said below
+  }
+  if (platforms.empty())
+    throw std::runtime_error(
+        "no OpenCL platform found (is pocl-opencl-icd installed?); --backend reference works without one");
   bool found = false;
   for (const cl::Platform& p : platforms) {
     std::vector<cl::Device> devices;
@@ -37,8 +55,11 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
     if (found) break;
   }
   if (!found)
-    throw std::runtime_error(options.device.empty() ? "no OpenCL CPU device found (is pocl-opencl-icd installed?)"
-                                                    : "no OpenCL device matches \"" + options.device + "\"");
+    throw std::runtime_error(options.device.empty()
+                                 ? "no OpenCL CPU device found (is pocl-opencl-icd installed? PoCL also offers none "
+                                   "when its kernel cache, " +
+                                       pocl_cache() + ", is not writable); --backend reference works without one"
+                                 : "no OpenCL device matches \"" + options.device + "\"");
   if (options.compute_units > 0) {
     // Device fission: PoCL runs a sub-device's work on that many threads.
     const cl_uint max_units = device_.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
@@ -60,7 +81,9 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
   try {
     program_.build({device_}, ("-cl-std=CL1.2 " + options.build_options).c_str());
   } catch (const cl::Error&) {
-    throw std::runtime_error("OpenCL program build failed:\n" + program_.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_));
+    throw std::runtime_error("OpenCL program build failed; PoCL compiles into its kernel cache, " + pocl_cache() +
+                             ", which must be writable (or set POCL_CACHE_DIR):\n" +
+                             program_.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_));
   }
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   variants_[""] = program_;
@@ -77,7 +100,8 @@ cl::Program& OpenCLRuntime::program(const std::string& options) {
   try {
     p.build({device_}, ("-cl-std=CL1.2 " + base_options_ + " " + options).c_str());
   } catch (const cl::Error&) {
-    throw std::runtime_error("OpenCL program build failed (" + options + "):\n" +
+    throw std::runtime_error("OpenCL program build failed (" + options + "); PoCL's kernel cache, " + pocl_cache() +
+                             ", must be writable (or set POCL_CACHE_DIR):\n" +
                              p.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_));
   }
   return variants_.emplace(options, p).first->second;

@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Runs every libFuzzer target for SECONDS (default 50) from the seed corpus in
+# tests/fuzz/corpus/TARGET, in a scratch copy (the checkout is not written). Builds
+# build-fuzz/ with clang first. Exits non-zero on the first crash, leaving the input in
+# build-fuzz/crashes/TARGET/; add it to tests/fuzz/crashes/TARGET/ as a regression.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+seconds=${1:-50}
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPORTALSIM_FUZZ=ON \
+  -DPORTALSIM_TESTS=OFF -DPORTALSIM_BENCH=OFF ${PORTALSIM_CMAKE_ARGS:-} >/dev/null
+cmake --build build-fuzz -j "$(nproc)"
+for target in catalogue spec scenarios feature_table image; do
+  work=build-fuzz/corpus/$target crashes=build-fuzz/crashes/$target
+  rm -rf "$work" && mkdir -p "$work" "$crashes"
+  echo "== fuzz_$target, $seconds s"
+  ASAN_OPTIONS=detect_leaks=0 build-fuzz/fuzz_$target -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    -max_len=65536 -artifact_prefix="$crashes/" -print_final_stats=1 "$work" "tests/fuzz/corpus/$target" \
+    2>build-fuzz/fuzz_$target.log || { tail -40 build-fuzz/fuzz_$target.log; exit 1; }
+  grep -E "^stat::number_of_executed_units|^stat::average_exec_per_sec|^Done" build-fuzz/fuzz_$target.log || true
+done
