@@ -147,6 +147,9 @@ struct Server::Impl {
     r.plan.model.seed = cli::parse_u64(r.seed, "--seed");
     r.plan.model.pattern_noise = r.pattern_noise;
     r.plan.model.pixel_sigma = r.pixel_noise;
+    // The command line's own check (CLI11's IsMember) and its words.
+    if (r.tier != "fast" && r.tier != "standard" && r.tier != "exact")
+      throw InputError("--tier: " + r.tier + " not in {fast,standard,exact}");
     r.plan.fidelity = tier_fidelity(parse_tier(r.tier, "--tier"));
     validate(r.plan, s.catalogue);
     return r;

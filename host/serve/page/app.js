@@ -27,7 +27,8 @@ function drawZones(metal) {
   $("zones").value = metal.join(",");
   for (let z = 0; z < metal.length; ++z) {
     const row = $("zone" + (z + 1));
-    row.querySelector(".bar div").style.width = (metal[z] / 200 * 100) + "%";
+    // The bar is the metal signal: empty at 200 (nothing), full at 0.
+    row.querySelector(".bar div").style.width = ((200 - metal[z]) / 200 * 100) + "%";
     row.querySelector(".value").textContent = metal[z];
     row.classList.toggle("hit", metal[z] < 200);
     row.setAttribute("aria-label", "zone " + (z + 1) + ": " + metal[z]);
