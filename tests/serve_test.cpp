@@ -47,6 +47,7 @@ class Serve : public ::testing::Test {
       ::kill(server_.pid, SIGTERM);
       const auto r = portalsim::test::finish(server_, 30);
       EXPECT_FALSE(r.timed_out);
+      EXPECT_EQ(r.status, 0) << "SIGTERM stops the server cleanly\n" << describe(r);
     }
     std::error_code ec;
     fs::remove_all(tmp_, ec);

@@ -1,7 +1,9 @@
 // portalsim serve: the thesis's GUI as a local web page (README, "serve").
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
+#include <thread>
 
 #include "cli/commands.h"
 #include "cli/common.h"
@@ -17,6 +19,13 @@ struct ServeCmd {
 };
 
 int serve(ServeCmd& o) {
+  // SIGINT/SIGTERM stop the server cleanly (its scratch folder is removed): every thread
+  // (PoCL's too, so before the session opens) blocks them and one waits for them.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   Session s = open_session(o.common);
   char self[4096];
   const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
@@ -29,7 +38,15 @@ int serve(ServeCmd& o) {
   const int port = server.bind();
   std::printf("portalsim serve: http://%s:%d/ (root %s)\n", o.serve.bind.c_str(), port, o.serve.root.c_str());
   std::fflush(stdout);
+  std::thread waiter([&] {
+    int sig = 0;
+    sigwait(&stop_signals, &sig);
+    server.stop();
+  });
   server.listen();
+  // listen() also returns when the socket fails; wake the waiter in that case.
+  ::kill(::getpid(), SIGTERM);
+  waiter.join();
   return 0;
 }
 }  // namespace

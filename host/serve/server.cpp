@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -125,6 +126,9 @@ struct Server::Impl {
     routes();
   }
   ~Impl() {
+    // A running generate is interrupted the way generate documents: it checkpoints and
+    // can be continued with --resume.
+    if (job && job->running) ::kill(job->pid, SIGTERM);
     if (job_waiter.joinable()) job_waiter.join();
     std::error_code ec;
     fs::remove_all(scratch, ec);
@@ -282,7 +286,15 @@ struct Server::Impl {
     posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&fa, 1, jb->log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    const int rc = posix_spawn(&jb->pid, argv[0], &fa, nullptr, argv.data(), environ);
+    // The child gets default signal handling back (serve blocks SIGINT/SIGTERM in its threads).
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    sigset_t none;
+    sigemptyset(&none);
+    posix_spawnattr_setsigmask(&attr, &none);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK);
+    const int rc = posix_spawn(&jb->pid, argv[0], &fa, &attr, argv.data(), environ);
+    posix_spawnattr_destroy(&attr);
     posix_spawn_file_actions_destroy(&fa);
     if (rc != 0) throw OutputError("generate: cannot start " + opt.self + ": " + std::strerror(rc));
     jb->running = true;
