@@ -103,6 +103,7 @@ TEST_F(Serve, BadInputsGet400WithTheCommandLinesMessage) {
       {{{"objects", kGun}, {"rule", "gun&"}}, {"none", "none", "none", "gun", "--rule", "gun&"}},
       {{{"objects", kGun}, {"seed", "12x"}}, {"none", "none", "none", "gun", "--seed", "12x"}},
       {{{"objects", kGun}, {"tier", "turbo"}}, {"none", "none", "none", "gun", "--tier", "turbo"}},
+      {{{"objects", kGun}, {"threat", "maybe"}}, {"none", "none", "none", "gun", "--threat", "maybe"}},
       {{{"objects", kGun}, {"rule", "gun"}, {"threat", "yes"}},
        {"none", "none", "none", "gun", "--rule", "gun", "--threat", "yes"}},
   };
@@ -120,13 +121,20 @@ TEST_F(Serve, BadInputsGet400WithTheCommandLinesMessage) {
   }
   for (
       const std::string body :
-      {"", "not json", "[1,2]", R"({"objects":"gun"})", R"({"subject":"one"})",
+      {"", "not json", "[1,2]", R"({"objects":"gun"})", R"({"subject":"one"})", R"({"subject":1.5})",
+       R"({"subject":1e300})", R"({"subject":18446744073709551615})", R"({"seed":5})",
        R"({"objects":["none","none","none","none","none","none","none","none","none","none","none","none","none","gun"]})"}) {
     auto r = client().Post("/api/render", body, "application/json");
     ASSERT_TRUE(r);
     EXPECT_EQ(r->status, 400) << body;
     EXPECT_FALSE(error_of(r).empty()) << body;
   }
+  // A rule nested deeper than the parser may recurse: refused, the server stays up.
+  auto deep =
+      post("/api/render", {{"objects", kGun}, {"rule", std::string(30000, '(') + "gun" + std::string(30000, ')')}});
+  ASSERT_TRUE(deep);
+  EXPECT_EQ(deep->status, 400);
+  EXPECT_NE(error_of(deep).find("--rule: parentheses nested deeper"), std::string::npos) << deep->body;
   EXPECT_TRUE(fs::is_empty(root()));
 }
 
@@ -219,10 +227,15 @@ TEST_F(Serve, GenerateRunsAndLinksItsResults) {
   ASSERT_TRUE(manifest);
   EXPECT_EQ(manifest->status, 200);
   EXPECT_EQ(manifest->body, slurp(root() / "ds" / "manifest.json"));
-  auto bad = post("/api/generate", {{"objects", kGun}, {"name", "ds2"}, {"count", 0}});
-  ASSERT_TRUE(bad);
-  EXPECT_EQ(bad->status, 400);
-  EXPECT_NE(error_of(bad).find("--count"), std::string::npos);
+  for (const char* count : {"0", "1000001", "-99999999999999999999", "1e300", "\"10\""}) {
+    const std::string body =
+        R"({"objects":["none","none","none","gun"],"name":"ds2","count":)" + std::string(count) + "}";
+    auto bad = client().Post("/api/generate", body, "application/json");
+    ASSERT_TRUE(bad);
+    EXPECT_EQ(bad->status, 400) << body;
+    EXPECT_NE(error_of(bad).find("count"), std::string::npos) << bad->body;
+  }
+  EXPECT_FALSE(fs::exists(root() / "ds2"));
 }
 
 long rss_kib(pid_t pid, const char* field) {

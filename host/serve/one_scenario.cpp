@@ -8,6 +8,8 @@
 
 namespace portalsim {
 
+constexpr int kMaxRuleDepth = 64;
+
 Scenario make_scenario(const Catalogue& cat, const ScenarioInputs& in) {
   Scenario scene = parse_object_list(cat, in.objects);
   const int subjects = static_cast<int>(cat.subjects.size());
@@ -17,7 +19,12 @@ Scenario make_scenario(const Catalogue& cat, const ScenarioInputs& in) {
   scene.subject = in.subject - 1;
   if (!in.rule.empty() && !in.threat.empty()) throw InputError("--rule and --threat: give one or the other");
   if (!in.threat.empty() && in.threat != "yes" && in.threat != "no")
-    throw InputError("--threat: \"" + in.threat + "\" is not yes or no");
+    throw InputError("--threat: " + in.threat + " not in {yes,no}");  // CLI11's words
+  // The rule parser recurses per parenthesis; a deep nest would overflow the stack.
+  int depth = 0;
+  for (char c : in.rule)
+    if ((depth += c == '(' ? 1 : c == ')' ? -1 : 0) > kMaxRuleDepth)
+      throw InputError("--rule: parentheses nested deeper than " + std::to_string(kMaxRuleDepth) + " levels");
   if (!in.rule.empty())
     scene.label = ThreatRule(cat, in.rule)(scene) ? 1 : 0;
   else

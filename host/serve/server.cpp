@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -63,6 +64,14 @@ std::string base64(const std::string& in) {
 template <class T>
 T field(const json& j, const char* name, const T& fallback) {
   if (!j.contains(name) || j[name].is_null()) return fallback;
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    if (!j[name].is_number_integer())
+      throw InputError(std::string("request: field \"") + name + "\" is not a whole number");
+    // Out-of-range values become a range error of their own field, never a wrap.
+    if (j[name].is_number_unsigned() ? j[name].get<uint64_t>() > uint64_t(std::numeric_limits<T>::max())
+                                     : j[name].get<int64_t>() < int64_t(std::numeric_limits<T>::min()))
+      throw InputError(std::string("request: field \"") + name + "\" is out of range");
+  }
   try {
     return j[name].get<T>();
   } catch (const json::exception&) {
