@@ -103,6 +103,7 @@ TEST_F(Serve, BadInputsGet400WithTheCommandLinesMessage) {
       {{{"objects", kGun}, {"rule", "gun&"}}, {"none", "none", "none", "gun", "--rule", "gun&"}},
       {{{"objects", kGun}, {"seed", "12x"}}, {"none", "none", "none", "gun", "--seed", "12x"}},
       {{{"objects", kGun}, {"tier", "turbo"}}, {"none", "none", "none", "gun", "--tier", "turbo"}},
+      {{{"objects", kGun}, {"placement", "cubic"}}, {"none", "none", "none", "gun", "--placement", "cubic"}},
       {{{"objects", kGun}, {"threat", "maybe"}}, {"none", "none", "none", "gun", "--threat", "maybe"}},
       {{{"objects", kGun}, {"rule", "gun"}, {"threat", "yes"}},
        {"none", "none", "none", "gun", "--rule", "gun", "--threat", "yes"}},

@@ -155,6 +155,10 @@ struct Server::Impl {
     r.tier = field<std::string>(j, "tier", "standard");
     r.pattern_noise = field<bool>(j, "pattern_noise", true);
     r.pixel_noise = field<double>(j, "pixel_noise", 0.0);
+    const std::string placement = field<std::string>(j, "placement", "integer");
+    if (placement != "integer" && placement != "bilinear")
+      throw InputError("--placement: " + placement + " not in {integer,bilinear}");
+    r.plan.model.bilinear = placement == "bilinear";
     if (r.in.objects.size() > static_cast<size_t>(kRegions))
       throw InputError("objects: " + std::to_string(r.in.objects.size()) + " given, at most 13 regions");
     r.plan.model.seed = cli::parse_u64(r.seed, "--seed");
@@ -275,6 +279,10 @@ struct Server::Impl {
                                   r.tier,
                                   "--pattern-noise",
                                   r.pattern_noise ? "on" : "off",
+                                  "--pixel-noise",
+                                  std::to_string(r.pixel_noise),
+                                  "--placement",
+                                  r.plan.model.bilinear ? "bilinear" : "integer",
                                   "--what",
                                   "both",
                                   "--batch",
