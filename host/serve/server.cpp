@@ -214,6 +214,8 @@ struct Server::Impl {
     const Request r = parse(body);
     json j = json::parse(body);
     const Scenario scene = make_scenario(s.catalogue, r.in);
+    // One save at a time: the name check, the folder and the list row go together.
+    std::lock_guard<std::mutex> lock(csv_mutex);
     const fs::path dir = new_folder(field<std::string>(j, "name", ""));
     const fs::path csv = root / "scenarios.csv";
     {
@@ -227,7 +229,6 @@ struct Server::Impl {
     for (int i = 0; i < kRegions; ++i)
       line += "," + (scene.objects[i] == kNoObject ? std::string("none") : s.catalogue.variant_name(scene.objects[i]));
     line += scene.label == 1 ? ",yes\n" : ",no\n";
-    std::lock_guard<std::mutex> lock(csv_mutex);
     std::string text = fs::exists(csv) ? read_file(csv) : std::string();
     if (text.empty()) {
       text = "subject";
