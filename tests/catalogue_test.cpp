@@ -86,6 +86,19 @@ TEST(Rules, ThesisCasesAndCombinations) {
   EXPECT_FALSE(vertical(scene({"gun:v", "plate"})));
   for (const char* bad : {"", "gun &", "gun | | rod", "(gun", "gun)", "laser", "none", "gun:q"})
     EXPECT_THROW(ThreatRule(c, bad), InputError) << bad;
+  // Nesting: 64 levels parse; 65, and a 100000-deep nest, are refused instead of overflowing the stack.
+  auto nest = [](int n, const std::string& open, const std::string& close) {
+    std::string r;
+    for (int i = 0; i < n; ++i) r += open;
+    r += "gun";
+    for (int i = 0; i < n; ++i) r += close;
+    return r;
+  };
+  EXPECT_TRUE(ThreatRule(c, nest(kMaxRuleDepth, "(", ")"))(scene({"gun"})));
+  EXPECT_TRUE(ThreatRule(c, nest(kMaxRuleDepth, "!", ""))(scene({"gun"})));  // 64 negations
+  for (const std::string& deep : {nest(kMaxRuleDepth + 1, "(", ")"), nest(kMaxRuleDepth + 1, "!", ""),
+                                  nest(100000, "(", ")"), nest(100000, "!(", ")")})
+    EXPECT_THROW(ThreatRule(c, deep), InputError) << deep.size();
 }
 
 }  // namespace

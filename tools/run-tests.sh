@@ -3,5 +3,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
+# The browser test's driver (puppeteer-core, pinned by tests/browser/package-lock.json).
+command -v npm >/dev/null || DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends nodejs npm
+(cd tests/browser && npm ci --no-audit --no-fund --loglevel=error)
 cd "${PORTALSIM_BUILD_DIR:-build}"
 ctest --output-on-failure -j "$(nproc)" "$@"

@@ -37,6 +37,7 @@ int run(int argc, char** argv) {
   commands["generate"] = add_generate(app);
   commands["features"] = add_features(app);
   commands["tradeoff"] = add_tradeoff(app);
+  commands["serve"] = add_serve(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -5,10 +5,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "scene/error.h"
-#include "scene/rules.h"
-#include "sink/output_folder.h"
-#include "sink/scenario_folder.h"
-#include "sink/staging.h"
+#include "serve/one_scenario.h"
 
 namespace portalsim::cli {
 
@@ -33,17 +30,7 @@ int simulate(SimulateOptions& o) {
   const Catalogue& cat = s.catalogue;
 
   // Everything the user gave is checked before any backend work or any file is written.
-  Scenario scene = parse_object_list(cat, o.objects);
-  const int subjects = static_cast<int>(cat.subjects.size());
-  if (o.subject < 1 || o.subject > subjects)
-    throw InputError("--subject: " + std::to_string(o.subject) + " is out of range (1 to " + std::to_string(subjects) +
-                     ")");
-  scene.subject = o.subject - 1;
-  if (!o.rule.empty() && !o.threat.empty()) throw InputError("--rule and --threat: give one or the other");
-  if (!o.rule.empty())
-    scene.label = ThreatRule(cat, o.rule)(scene) ? 1 : 0;
-  else
-    scene.label = o.threat == "yes" ? 1 : 0;
+  const Scenario scene = make_scenario(cat, ScenarioInputs{o.subject, o.objects, o.rule, o.threat});
 
   Plan plan;
   plan.model = o.model;
@@ -60,26 +47,10 @@ int simulate(SimulateOptions& o) {
   validate(plan, cat);
 
   open_backend(s, o.common);
-  // The output-folder rules of generate: new or empty, locked while written.
-  if (output_folder_state(o.out) == FolderState::has_files)
-    throw OutputError(o.out + ": is not empty; choose a new folder");
-  StagedFolder folder(o.out);
-  const FolderLock lock(o.out);
-  if (output_folder_state(o.out) == FolderState::has_files)  // filled while this run waited for the lock
-    throw OutputError(o.out + ": is not empty; choose a new folder");
-
-  SceneBatch batch;
-  batch.push(scene);
   BatchOutput out;
-  const auto t_run = std::chrono::steady_clock::now();
-  s.backend->run(batch, plan, out);
-  const double run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_run).count();
-
-  const auto t_write = std::chrono::steady_clock::now();
-  write_scenario_folder([&](const std::string& f) { return folder.path(f); }, out, 0, scene.label == 1,
-                        s.assets.palette, FolderOptions{o.image_format});
-  folder.commit();
-  const double write_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_write).count();
+  const OneScenarioTimes t =
+      write_one_scenario(o.out, *s.backend, scene, plan, s.assets.palette, FolderOptions{o.image_format}, out);
+  const double run_seconds = t.run_seconds, write_seconds = t.write_seconds;
 
   std::printf("%s: subject %d, threat %s, metal", o.out.c_str(), o.subject, scene.label ? "yes" : "no");
   for (int z = 0; z < kZones; ++z) std::printf("%s%d", z ? "," : " ", out.metal_of(0)[z]);

@@ -43,9 +43,11 @@ struct Parser {
   const std::string& s;
   const std::string& where;
   size_t pos = 0;
+  int depth = 0;  // '!' and '(' recurse; a deep nest would overflow the stack
 
   [[noreturn]] void fail(const std::string& msg) const {
-    throw InputError(where + ": \"" + s + "\" at character " + std::to_string(pos + 1) + ": " + msg);
+    const std::string shown = s.size() > 80 ? s.substr(0, 60) + "..." : s;  // a long rule is cut, not echoed whole
+    throw InputError(where + ": \"" + shown + "\" at character " + std::to_string(pos + 1) + ": " + msg);
   }
   void skip() {
     while (pos < s.size() && std::isspace(static_cast<unsigned char>(s[pos]))) ++pos;
@@ -69,15 +71,20 @@ ThreatRule::ThreatRule(const Catalogue& cat, const std::string& text, const std:
   Parser p{cat, text, where};
   std::function<std::unique_ptr<Node>()> rule, term, factor;
   factor = [&]() -> std::unique_ptr<Node> {
-    if (p.eat('!')) {
-      auto n = std::make_unique<Node>();
-      n->kind = Node::negate;
-      n->kids.push_back(factor());
-      return n;
-    }
-    if (p.eat('(')) {
-      auto n = rule();
-      if (!p.eat(')')) p.fail("expected ')'");
+    const bool negate = p.eat('!');
+    if (negate || p.eat('(')) {
+      if (++p.depth > kMaxRuleDepth)
+        p.fail("'!' and '(' nested deeper than " + std::to_string(kMaxRuleDepth) + " levels");
+      std::unique_ptr<Node> n;
+      if (negate) {
+        n = std::make_unique<Node>();
+        n->kind = Node::negate;
+        n->kids.push_back(factor());
+      } else {
+        n = rule();
+        if (!p.eat(')')) p.fail("expected ')'");
+      }
+      --p.depth;
       return n;
     }
     p.skip();

@@ -12,6 +12,9 @@
 
 namespace portalsim {
 
+// '!' and '(' nest at most this deep; deeper rules are refused (InputError).
+constexpr int kMaxRuleDepth = 64;
+
 class ThreatRule {
  public:
   // Throws InputError naming `where` and the offending position.

@@ -1,0 +1,36 @@
+// One scenario from what a user typed (subject, objects per region, rule or label) to its
+// folder: shared by `simulate` and `serve`, so both check the same way and write the
+// same bytes.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "assets/assets.h"
+#include "backend/backend.h"
+#include "plan/plan.h"
+#include "scene/catalogue.h"
+#include "scene/scene.h"
+#include "sink/scenario_folder.h"
+
+namespace portalsim {
+
+struct ScenarioInputs {
+  int subject = 1;                   // 1-based, as typed
+  std::vector<std::string> objects;  // tokens for regions 1..13 ("none", "gun:v")
+  std::string rule;                  // threat rule, or empty
+  std::string threat;                // "yes" / "no" / empty; not together with rule
+};
+
+// Checks the inputs with the command line's messages (InputError) and builds the scenario.
+Scenario make_scenario(const Catalogue& cat, const ScenarioInputs& in);
+
+struct OneScenarioTimes {
+  double run_seconds = 0, write_seconds = 0;
+};
+
+// Runs `scene` on `backend` and writes its folder to `dir` all or nothing. `out` keeps
+// the backend's outputs (metal zones etc.) for the caller.
+OneScenarioTimes write_one_scenario(const std::string& dir, Backend& backend, const Scenario& scene, const Plan& plan,
+                                    const Palette& palette, const FolderOptions& opt, BatchOutput& out);
+
+}  // namespace portalsim

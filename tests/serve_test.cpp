@@ -1,0 +1,291 @@
+// portalsim serve at the HTTP level: the real binary on a free loopback port, driven by
+// cpp-httplib's client. Bad inputs, names that try to leave --root, oversized requests,
+// Save against simulate, and 8 clients x 200 requests at once.
+#include <gtest/gtest.h>
+#include <httplib.h>
+
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "run_binary.h"
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using portalsim::test::describe;
+using portalsim::test::slurp;
+
+namespace {
+
+const std::vector<std::string> kGun{"none", "none", "none", "gun"};
+
+// One server per test, rooted in a fresh folder: tmp/root is --root, tmp/cap the captured output.
+class Serve : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char tmpl[] = "/tmp/portalsim-serve-test-XXXXXX";
+    ASSERT_NE(::mkdtemp(tmpl), nullptr);
+    tmp_ = tmpl;
+    fs::create_directories(tmp_ / "root");
+    fs::create_directories(tmp_ / "cap");
+    server_ = portalsim::test::start(tmp_ / "cap", {"serve", "--port", "0", "--root", (tmp_ / "root").string()});
+    // The URL line says the server is listening.
+    for (int i = 0; i < 6000 && port_ == 0; ++i) {
+      const std::string out = slurp(server_.out_path);
+      const size_t at = out.find("http://127.0.0.1:");
+      if (at != std::string::npos && out.find('/', at + 17) != std::string::npos)
+        port_ = std::stoi(out.substr(at + 17));
+      if (port_ == 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ASSERT_GT(port_, 0) << "no URL printed: " << slurp(server_.err_path);
+  }
+  void TearDown() override {
+    if (server_.pid > 0) {
+      ::kill(server_.pid, SIGTERM);
+      const auto r = portalsim::test::finish(server_, 30);
+      EXPECT_FALSE(r.timed_out);
+      EXPECT_EQ(r.status, 0) << "SIGTERM stops the server cleanly\n" << describe(r);
+    }
+    std::error_code ec;
+    fs::remove_all(tmp_, ec);
+  }
+  httplib::Client client() const {
+    httplib::Client c("127.0.0.1", port_);
+    c.set_read_timeout(60, 0);
+    return c;
+  }
+  httplib::Result post(const std::string& path, const json& body) const {
+    return client().Post(path.c_str(), body.dump(), "application/json");
+  }
+  std::string error_of(const httplib::Result& r) const { return json::parse(r->body).value("error", ""); }
+  fs::path root() const { return tmp_ / "root"; }
+
+  fs::path tmp_;
+  portalsim::test::Running server_;
+  int port_ = 0;
+};
+
+TEST_F(Serve, PageAndCatalogueAreServed) {
+  auto page = client().Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("<script src=\"/app.js\">"), std::string::npos);
+  auto cat = client().Get("/api/catalogue");
+  ASSERT_TRUE(cat);
+  const json j = json::parse(cat->body);
+  EXPECT_EQ(j["regions"].size(), 13u);
+  EXPECT_NE(std::find(j["objects"].begin(), j["objects"].end(), "gun:v"), j["objects"].end());
+}
+
+TEST_F(Serve, RenderGivesTheThesisGunExample) {
+  auto r = post("/api/render", {{"objects", kGun}, {"rule", "gun"}});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const json j = json::parse(r->body);
+  EXPECT_EQ(j["metal"].get<std::vector<int>>(),
+            (std::vector<int>{193, 112, 75, 2, 1, 1, 96, 200, 200, 190, 196, 53, 53, 94, 64, 82, 53, 200, 200}));
+  EXPECT_TRUE(j["threat"].get<bool>());
+  EXPECT_EQ(j["upper"].get<std::string>().rfind("data:image/png;base64,iVBORw0KGgo", 0), 0u);
+}
+
+// Each bad input gets HTTP 400 and the message simulate prints for the same input.
+TEST_F(Serve, BadInputsGet400WithTheCommandLinesMessage) {
+  struct Case {
+    json body;
+    std::vector<std::string> cli;
+  };
+  const std::vector<Case> cases{
+      {{{"objects", {"none", "bazooka"}}}, {"none", "bazooka"}},
+      {{{"objects", kGun}, {"subject", 9}}, {"none", "none", "none", "gun", "--subject", "9"}},
+      {{{"objects", kGun}, {"rule", "gun&"}}, {"none", "none", "none", "gun", "--rule", "gun&"}},
+      {{{"objects", kGun}, {"seed", "12x"}}, {"none", "none", "none", "gun", "--seed", "12x"}},
+      {{{"objects", kGun}, {"tier", "turbo"}}, {"none", "none", "none", "gun", "--tier", "turbo"}},
+      {{{"objects", kGun}, {"placement", "cubic"}}, {"none", "none", "none", "gun", "--placement", "cubic"}},
+      {{{"objects", kGun}, {"threat", "maybe"}}, {"none", "none", "none", "gun", "--threat", "maybe"}},
+      {{{"objects", kGun}, {"rule", "gun"}, {"threat", "yes"}},
+       {"none", "none", "none", "gun", "--rule", "gun", "--threat", "yes"}},
+  };
+  for (const Case& c : cases) {
+    auto r = post("/api/render", c.body);
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 400) << c.body.dump();
+    std::vector<std::string> args{"simulate", "--out", (tmp_ / "sim-bad").string()};
+    args.insert(args.end(), c.cli.begin(), c.cli.end());
+    const auto sim = portalsim::test::finish(portalsim::test::start(tmp_ / "cap", args));
+    ASSERT_NE(sim.status, 0) << describe(sim);
+    const std::string msg = error_of(r);
+    EXPECT_FALSE(msg.empty());
+    EXPECT_NE(sim.err.find(msg), std::string::npos) << "server: " << msg << "\n" << describe(sim);
+  }
+  for (
+      const std::string body :
+      {"", "not json", "[1,2]", R"({"objects":"gun"})", R"({"subject":"one"})", R"({"subject":1.5})",
+       R"({"subject":1e300})", R"({"subject":18446744073709551615})", R"({"seed":5})",
+       R"({"objects":["none","none","none","none","none","none","none","none","none","none","none","none","none","gun"]})"}) {
+    auto r = client().Post("/api/render", body, "application/json");
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 400) << body;
+    EXPECT_FALSE(error_of(r).empty()) << body;
+  }
+  // A rule nested deeper than the parser may recurse: refused, the server stays up.
+  auto deep =
+      post("/api/render", {{"objects", kGun}, {"rule", std::string(30000, '(') + "gun" + std::string(30000, ')')}});
+  ASSERT_TRUE(deep);
+  EXPECT_EQ(deep->status, 400);
+  EXPECT_NE(error_of(deep).find("nested deeper than 64 levels"), std::string::npos) << deep->body;
+  EXPECT_TRUE(fs::is_empty(root()));
+}
+
+TEST_F(Serve, NamesCannotLeaveRoot) {
+  fs::create_directories(tmp_ / "outside");
+  fs::create_directory_symlink(tmp_ / "outside", root() / "link");
+  for (const std::string name : {"../escape", "..", "/tmp/escape", "a/b", "link", ".hidden", "", "a\\b", "x\n"}) {
+    for (const char* path : {"/api/save", "/api/generate"}) {
+      auto r = post(path, {{"objects", kGun}, {"name", name}, {"count", 10}});
+      ASSERT_TRUE(r);
+      EXPECT_EQ(r->status, 400) << path << " " << name << ": " << r->body;
+      EXPECT_NE(error_of(r).find("name"), std::string::npos) << r->body;
+    }
+  }
+  EXPECT_TRUE(fs::is_empty(tmp_ / "outside"));
+  EXPECT_FALSE(fs::exists(tmp_ / "escape"));
+  EXPECT_FALSE(fs::exists("/tmp/escape"));
+  // Files: only regular files under root, never through a symlink or "..".
+  portalsim::test::spit(tmp_ / "outside" / "secret.txt", "TOP-SECRET-CONTENT");
+  for (const char* p : {"/files/link/secret.txt", "/files/../outside/secret.txt", "/files/%2e%2e/outside/secret.txt",
+                        "/files//etc/passwd"}) {
+    auto r = client().Get(p);
+    ASSERT_TRUE(r);
+    EXPECT_NE(r->status, 200) << p;
+    EXPECT_EQ(r->body.find("TOP-SECRET-CONTENT"), std::string::npos) << p;
+  }
+  // scenarios.csv as a symlink out of root is refused too.
+  fs::create_symlink(tmp_ / "outside" / "list.csv", root() / "scenarios.csv");
+  auto r = post("/api/save", {{"objects", kGun}, {"name", "ok"}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 400) << r->body;
+  EXPECT_FALSE(fs::exists(tmp_ / "outside" / "list.csv"));
+}
+
+TEST_F(Serve, OversizedRequestsAreRefused) {
+  json body{{"objects", kGun}, {"rule", std::string(200 * 1024, 'g')}};
+  auto r = post("/api/render", body);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 413);
+  auto ok = post("/api/render", {{"objects", kGun}});
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200);
+}
+
+// Save writes simulate's folder byte for byte and a scenarios.csv that generate accepts.
+TEST_F(Serve, SaveEqualsSimulateAndFeedsGenerate) {
+  for (const char* name : {"gun4", "gun4b"}) {
+    auto r = post("/api/save", {{"objects", kGun}, {"rule", "gun"}, {"name", name}});
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 200) << r->body;
+  }
+  auto again = post("/api/save", {{"objects", kGun}, {"name", "gun4"}});
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->status, 400) << "an existing folder must not be overwritten";
+  const auto sim = portalsim::test::finish(portalsim::test::start(
+      tmp_ / "cap", {"simulate", "none", "none", "none", "gun", "--rule", "gun", "--out", (tmp_ / "sim").string()}));
+  ASSERT_EQ(sim.status, 0) << describe(sim);
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(tmp_ / "sim")) names.push_back(e.path().filename().string());
+  std::vector<std::string> saved;
+  for (const auto& e : fs::directory_iterator(root() / "gun4")) saved.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  std::sort(saved.begin(), saved.end());
+  EXPECT_EQ(names, saved);
+  for (const std::string& n : names) EXPECT_EQ(slurp(tmp_ / "sim" / n), slurp(root() / "gun4" / n)) << n;
+
+  const auto gen = portalsim::test::finish(
+      portalsim::test::start(tmp_ / "cap", {"generate", "--scenarios", (root() / "scenarios.csv").string(), "--out",
+                                            (tmp_ / "gen").string(), "--what", "both", "--quiet"}));
+  ASSERT_EQ(gen.status, 0) << describe(gen);
+  EXPECT_NE(gen.out.find("2 scenarios"), std::string::npos) << gen.out;
+  EXPECT_NE(gen.out.find("positive 2"), std::string::npos) << gen.out;
+}
+
+TEST_F(Serve, GenerateRunsAndLinksItsResults) {
+  auto r = post("/api/generate", {{"objects", kGun}, {"rule", "gun"}, {"name", "ds"}, {"count", 200}});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  json s;
+  for (int i = 0; i < 1200; ++i) {
+    auto g = client().Get("/api/generate");
+    ASSERT_TRUE(g);
+    s = json::parse(g->body);
+    if (s["state"] != "running") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_EQ(s["state"], "done") << s.dump();
+  EXPECT_EQ(s["done"], 200);
+  auto manifest = client().Get("/files/ds/manifest.json");
+  ASSERT_TRUE(manifest);
+  EXPECT_EQ(manifest->status, 200);
+  EXPECT_EQ(manifest->body, slurp(root() / "ds" / "manifest.json"));
+  for (const char* count : {"0", "1000001", "-99999999999999999999", "1e300", "\"10\""}) {
+    const std::string body =
+        R"({"objects":["none","none","none","gun"],"name":"ds2","count":)" + std::string(count) + "}";
+    auto bad = client().Post("/api/generate", body, "application/json");
+    ASSERT_TRUE(bad);
+    EXPECT_EQ(bad->status, 400) << body;
+    EXPECT_NE(error_of(bad).find("count"), std::string::npos) << bad->body;
+  }
+  EXPECT_FALSE(fs::exists(root() / "ds2"));
+}
+
+long rss_kib(pid_t pid, const char* field) {
+  const std::string status = slurp("/proc/" + std::to_string(pid) + "/status");
+  const size_t at = status.find(field);
+  return at == std::string::npos ? -1 : std::stol(status.substr(at + std::strlen(field) + 1));
+}
+
+// 8 clients x 200 requests at once: every answer is the right one, the server stays up
+// and its memory stays bounded (the second half adds no more than a few MiB).
+TEST_F(Serve, EightClientsTwoHundredRequestsEach) {
+  std::atomic<int> wrong{0}, done{0};
+  long rss_half = 0;
+  auto wave = [&](int requests) {
+    std::vector<std::thread> clients;
+    for (int c = 0; c < 8; ++c)
+      clients.emplace_back([&, c] {
+        httplib::Client cl = client();
+        for (int i = 0; i < requests; ++i) {
+          const int kind = (c + i) % 4;
+          const int want = kind < 2 ? 200 : 400;
+          auto r = [&] {
+            if (kind == 0)
+              return cl.Post("/api/render",
+                             json{{"objects", {"none", "none", "none", "gun"}}, {"seed", std::to_string(i)}}.dump(),
+                             "application/json");
+            if (kind == 1) return cl.Get("/api/catalogue");
+            if (kind == 2) return cl.Post("/api/render", R"({"objects":["bazooka"]})", "application/json");
+            return cl.Get("/files/../../etc/passwd");
+          }();
+          if (!r || r->status != want) ++wrong;
+          ++done;
+        }
+      });
+    for (auto& t : clients) t.join();
+  };
+  wave(100);
+  rss_half = rss_kib(server_.pid, "VmRSS:");
+  wave(100);
+  const long rss_end = rss_kib(server_.pid, "VmRSS:"), peak = rss_kib(server_.pid, "VmHWM:");
+  std::printf("serve load: %d requests, %d wrong answers, RSS after half %ld KiB, at end %ld KiB, peak %ld KiB\n",
+              done.load(), wrong.load(), rss_half, rss_end, peak);
+  EXPECT_EQ(done, 1600);
+  EXPECT_EQ(wrong, 0);
+  EXPECT_GT(peak, 0);
+  EXPECT_LT(rss_end - rss_half, 64 * 1024) << "memory grows with the number of requests";
+  auto r = post("/api/render", {{"objects", kGun}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+}
+
+}  // namespace
