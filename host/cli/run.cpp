@@ -16,6 +16,7 @@ int run(int argc, char** argv) {
   commands["generate"] = add_generate(app);
   commands["features"] = add_features(app);
   commands["tradeoff"] = add_tradeoff(app);
+  commands["validate"] = add_validate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
