@@ -38,6 +38,7 @@ int run(int argc, char** argv) {
   commands["features"] = add_features(app);
   commands["tradeoff"] = add_tradeoff(app);
   commands["serve"] = add_serve(app);
+  commands["validate"] = add_validate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -8,18 +8,33 @@
 
 namespace portalsim::cli {
 
-std::optional<double> j48_cv_accuracy(const std::string& arff, std::string& why) {
+namespace {
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+}  // namespace
+
+std::optional<WekaScore> weka_score(const std::string& classifier, const std::string& train, const std::string& test,
+                                    int folds, int seed, std::string& why) {
   const char* jar = "/usr/share/java/weka.jar";
   if (!std::filesystem::exists(jar)) {
     why = std::string(jar) + " not found (apt-get install weka)";
     return std::nullopt;
   }
-  // The path goes through a shell: quote it.
-  std::string quoted = "'";
-  for (char c : arff) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  quoted += "'";
-  const std::string cmd =
-      "java -Xmx4g -cp " + std::string(jar) + " weka.classifiers.trees.J48 -x 10 -o -t " + quoted + " 2>&1";
+  if (std::system("command -v java >/dev/null 2>&1") != 0) {
+    why = "java not found on PATH (apt-get install default-jre-headless)";
+    return std::nullopt;
+  }
+  std::string cmd = "java -Xmx4g -cp " + std::string(jar) + " " + classifier + " -o -t " + quote(train);
+  if (test.empty())
+    cmd += " -x " + std::to_string(folds) + " -s " + std::to_string(seed);
+  else
+    cmd += " -T " + quote(test);
+  cmd += " 2>&1";
   FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) {
     why = "cannot run java";
@@ -31,23 +46,33 @@ std::optional<double> j48_cv_accuracy(const std::string& arff, std::string& why)
   while ((got = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, got);
   const int status = ::pclose(p);
   if (status != 0) {
-    why = "WEKA J48 failed: " + out.substr(0, 300);
+    why = "WEKA " + classifier + " failed: " + out.substr(0, 300);
     return std::nullopt;
   }
-  const size_t cv = out.find("=== Stratified cross-validation ===");
-  const size_t line = out.find("Correctly Classified Instances", cv == std::string::npos ? 0 : cv);
-  if (line == std::string::npos) {
+  const char* section = test.empty() ? "=== Stratified cross-validation ===" : "=== Error on test data ===";
+  const size_t at = out.find(section);
+  const size_t ok = at == std::string::npos ? at : out.find("Correctly Classified Instances", at);
+  const size_t bad = at == std::string::npos ? at : out.find("Incorrectly Classified Instances", at);
+  if (ok == std::string::npos || bad == std::string::npos) {
     why = "no accuracy in WEKA's output";
     return std::nullopt;
   }
-  std::istringstream in(out.substr(line + 30));
-  double count = 0, percent = 0;
-  in >> count >> percent;
-  if (!in) {
+  WekaScore score;
+  double count = 0;
+  std::istringstream ok_in(out.substr(ok + 30)), bad_in(out.substr(bad + 32));
+  ok_in >> count >> score.correct_percent;
+  bad_in >> score.misclassified;
+  if (!ok_in || !bad_in) {
     why = "unreadable accuracy in WEKA's output";
     return std::nullopt;
   }
-  return percent;
+  return score;
+}
+
+std::optional<double> j48_cv_accuracy(const std::string& arff, std::string& why) {
+  auto s = weka_score("weka.classifiers.trees.J48", arff, "", 10, 1, why);
+  if (!s) return std::nullopt;
+  return s->correct_percent;
 }
 
 }  // namespace portalsim::cli

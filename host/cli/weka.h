@@ -1,5 +1,5 @@
-// WEKA's J48 (C4.5) under 10-fold cross-validation, as the thesis scored its data
-// (chapter 6), run through Debian's weka package.
+// WEKA's classifiers run through Debian's weka package, scored as the thesis scored its
+// data (chapter 6): stratified cross-validation, or train on one set and test on another.
 #pragma once
 #include <optional>
 #include <string>
@@ -9,5 +9,16 @@ namespace portalsim::cli {
 // Accuracy in percent, or nothing (with `why`) when java or weka.jar is missing or
 // WEKA fails.
 std::optional<double> j48_cv_accuracy(const std::string& arff, std::string& why);
+
+struct WekaScore {
+  double correct_percent = 0;
+  long misclassified = 0;
+};
+
+// `classifier` is WEKA's class name (weka.classifiers.trees.J48, ...), default settings.
+// With `test` empty: `folds`-fold stratified cross-validation of `train` with `seed`;
+// otherwise trained on `train` and scored on `test`. Nothing (with `why`) on failure.
+std::optional<WekaScore> weka_score(const std::string& classifier, const std::string& train, const std::string& test,
+                                    int folds, int seed, std::string& why);
 
 }  // namespace portalsim::cli
