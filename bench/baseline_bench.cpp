@@ -52,5 +52,40 @@ void BM_ImagesVsBaseline(benchmark::State& state) {
 }
 BENCHMARK(BM_ImagesVsBaseline)->Arg(0)->Arg(2)->Unit(benchmark::kMillisecond)->UseManualTime();
 
+// The thesis's features-only path (block 10, pattern noise, no metal): the sparse kernels
+// against the same algorithm as loops, tables made before timing in both.
+void BM_FeaturesVsBaseline(benchmark::State& state) {
+  auto cl = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+  Plan plan;
+  plan.images = 0;
+  plan.metal = false;
+  const size_t n = 16384;
+  const SceneBatch batch = make_batch(n);
+  BatchOutput kernel, loop;
+  cl->run(batch, plan, kernel);
+  prepare_output(loop, fx().cat, plan, n);
+  const baseline::SparseFeatures features(fx().cat, fx().assets, plan.model);
+  features.run(batch, loop);
+  double t_kernel = 0, t_loop = 0;
+  for (auto _ : state) {
+    auto t0 = Clock::now();
+    cl->run(batch, plan, kernel);
+    const double k = seconds(t0);
+    t0 = Clock::now();
+    features.run(batch, loop);
+    const double b = seconds(t0);
+    state.SetIterationTime(k);
+    t_kernel += k;
+    t_loop += b;
+    benchmark::DoNotOptimize(loop.features.data());
+  }
+  const double scenarios = static_cast<double>(state.iterations() * n);
+  state.counters["kernel_per_s"] = scenarios / t_kernel;
+  state.counters["baseline_per_s"] = scenarios / t_loop;
+  state.counters["kernel_vs_baseline"] = t_loop / t_kernel;
+  state.SetItemsProcessed(static_cast<int64_t>(scenarios));
+}
+BENCHMARK(BM_FeaturesVsBaseline)->Unit(benchmark::kMillisecond)->UseManualTime();
+
 }  // namespace
 }  // namespace portalsim

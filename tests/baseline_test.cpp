@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include "support.h"
 
 namespace portalsim {
@@ -41,6 +43,38 @@ TEST(Baseline, ImagesEqualTheStandardTierBitForBit) {
   }
 }
 
+TEST(Baseline, FeaturesEqualTheStandardTierSparsePathBitForBit) {
+  std::vector<Scenario> scenes;
+  for (uint64_t k = 0; k < 400; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 8));
+  auto cl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  for (int block : {10, 7}) {
+    for (bool pattern : {true, false}) {
+      SCOPED_TRACE("block " + std::to_string(block) + (pattern ? ", pattern noise" : ""));
+      const SceneBatch batch = test::batch_of(scenes, 0xfffffff00ull);
+      Plan plan;
+      plan.images = 0;
+      plan.metal = false;
+      plan.model.seed = 0x9e3779b97f4aull;
+      plan.model.block = block;
+      plan.model.pattern_noise = pattern;
+      BatchOutput kernel, loop;
+      cl->run(batch, plan, kernel);
+      prepare_output(loop, catalogue(), plan, batch.size());
+      const baseline::SparseFeatures features(catalogue(), assets(), plan.model);
+      features.run(batch, loop);
+      ASSERT_EQ(kernel.features.size(), loop.features.size());
+      ASSERT_FALSE(kernel.features.empty());
+      size_t differ = 0, changed = 0;
+      for (size_t f = 0; f < kernel.features.size(); ++f) {
+        differ += std::memcmp(&kernel.features[f], &loop.features[f], sizeof(float)) != 0;
+        changed += kernel.features[f] != kernel.features[f % kernel.layout.image_features()];
+      }
+      EXPECT_EQ(differ, 0u);
+      EXPECT_GT(changed, kernel.features.size() / 100);  // the scenarios differ from each other
+    }
+  }
+}
+
 TEST(Baseline, RefusesWhatItDoesNotModel) {
   SceneBatch batch = test::batch_of({test::random_scenario(catalogue(), 1)});
   Plan plan;
@@ -49,6 +83,10 @@ TEST(Baseline, RefusesWhatItDoesNotModel) {
   ModelSettings m;
   m.jitter = 1;
   EXPECT_THROW(baseline::render_images(catalogue(), assets(), batch, m, out), std::invalid_argument);
+  EXPECT_THROW(baseline::SparseFeatures(catalogue(), assets(), m), std::invalid_argument);
+  m.jitter = 0;
+  m.pixel_sigma = 2;
+  EXPECT_THROW(baseline::SparseFeatures(catalogue(), assets(), m), std::invalid_argument);
 }
 
 }  // namespace

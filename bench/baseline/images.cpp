@@ -6,28 +6,11 @@
 #include <stdexcept>
 
 #include "baseline.h"
+#include "philox_words.h"
 
 namespace portalsim::baseline {
 
 namespace {
-
-// Philox4x32-10, words 0 and 1 of the result, for counters (element, stream, index).
-inline void philox2(uint32_t element, uint32_t stream, uint64_t index, uint64_t seed, uint32_t& r0, uint32_t& r1) {
-  uint32_t c0 = element, c1 = stream, c2 = static_cast<uint32_t>(index), c3 = static_cast<uint32_t>(index >> 32);
-  uint32_t k0 = static_cast<uint32_t>(seed), k1 = static_cast<uint32_t>(seed >> 32);
-  for (int r = 0; r < 10; ++r) {
-    const uint64_t p0 = static_cast<uint64_t>(c0) * 0xD2511F53u, p1 = static_cast<uint64_t>(c2) * 0xCD9E8D57u;
-    const uint32_t n0 = static_cast<uint32_t>(p1 >> 32) ^ c1 ^ k0, n2 = static_cast<uint32_t>(p0 >> 32) ^ c3 ^ k1;
-    c1 = static_cast<uint32_t>(p1);
-    c3 = static_cast<uint32_t>(p0);
-    c0 = n0;
-    c2 = n2;
-    k0 += 0x9E3779B9u;
-    k1 += 0xBB67AE85u;
-  }
-  r0 = c0;
-  r1 = c1;
-}
 
 // The kernels' Box-Muller pair (kernels/sensor_noise.cl): polynomial ln and sincos in
 // float, the same operations in the same order.
@@ -85,7 +68,7 @@ void render_images(const Catalogue& cat, const AssetSet& assets, const SceneBatc
       const uint64_t index = batch.first_index + i;
       const int16_t* objects = &batch.objects[i * kRegions];
       uint32_t r0, r1;
-      philox2(0, PS_STREAM_NOISE_PATTERN, index, m.seed, r0, r1);
+      philox_words(0, PS_STREAM_NOISE_PATTERN, index, m.seed, r0, r1);
       const int pattern = static_cast<int>((static_cast<uint64_t>(r0) * static_cast<uint32_t>(patterns)) >> 32);
       for (size_t k = 0; k < cat.sensors.size(); ++k) {
         const Sensor& s = cat.sensors[k];
@@ -148,8 +131,8 @@ void render_images(const Catalogue& cat, const AssetSet& assets, const SceneBatc
             const int p0 = y * W, first_pair = p0 >> 1, pairs = ((p0 + W - 1) >> 1) - first_pair + 1;
             const uint32_t view_bits = static_cast<uint32_t>(k) << PS_PIXEL_NOISE_VIEW_SHIFT;
             for (int q = 0; q < pairs; ++q)
-              philox2(view_bits | static_cast<uint32_t>(first_pair + q), PS_STREAM_PIXEL_NOISE, index, m.seed, w0[q],
-                      w1[q]);
+              philox_words(view_bits | static_cast<uint32_t>(first_pair + q), PS_STREAM_PIXEL_NOISE, index, m.seed,
+                           w0[q], w1[q]);
             for (int q = 0; q < pairs; ++q) gauss_pair(w0[q], w1[q], g[2 * q], g[2 * q + 1]);
             const float* gx = g.data() + (p0 & 1);
             for (int x = 0; x < W; ++x) v[x] = std::fma(sigma, gx[x], v[x]);
