@@ -382,9 +382,30 @@ TEST(Environment, NoOpenClPlatformSaysSoAndNamesTheReferenceBackend) {
       t.cap(), "/usr/bin/env",
       {"OCL_ICD_VENDORS=/nonexistent", PORTALSIM_BINARY, "simulate", "gun", "--out", (t.w() / "o").string()}));
   SCOPED_TRACE(describe(r));
-  EXPECT_TRUE(r.exited && r.status != 0);
+  EXPECT_TRUE(r.exited && r.status == 5) << "5: the OpenCL environment";
   EXPECT_TRUE(has(r.err, "no OpenCL platform found")) << "not clGetPlatformIDs";
   EXPECT_TRUE(has(r.err, "--backend reference"));
+  EXPECT_FALSE(fs::exists(t.w() / "o"));
+}
+
+TEST(Environment, WithoutOpenClTheReferenceBackendStillRuns) {
+  TempDir t;
+  const Result r = portalsim::test::finish(
+      portalsim::test::start_program(t.cap(), "/usr/bin/env",
+                                     {"OCL_ICD_VENDORS=/nonexistent", PORTALSIM_BINARY, "simulate", "gun", "--backend",
+                                      "reference", "--out", (t.w() / "o").string()}));
+  SCOPED_TRACE(describe(r));
+  EXPECT_TRUE(r.exited && r.status == 0);
+  EXPECT_TRUE(fs::exists(t.w() / "o" / "upper.png"));
+}
+
+TEST(Environment, AnUnknownDeviceIsAUsageError) {
+  TempDir t;
+  const Result r = portalsim::test::finish(portalsim::test::start_program(
+      t.cap(), PORTALSIM_BINARY, {"simulate", "gun", "--device", "no-such-device", "--out", (t.w() / "o").string()}));
+  SCOPED_TRACE(describe(r));
+  EXPECT_TRUE(r.exited && r.status == 2);
+  EXPECT_TRUE(has(r.err, "--device: no OpenCL device matches"));
   EXPECT_FALSE(fs::exists(t.w() / "o"));
 }
 
@@ -395,7 +416,7 @@ TEST(Environment, ReadOnlyPoclCacheIsNamed) {
                           " simulate gun --out " + portalsim::test::quoted((t.w() / "o").string());
   const Result r = portalsim::test::run_on_tmpfs(t.cap(), cache, "1m", true, cmd);
   SCOPED_TRACE(describe(r));
-  EXPECT_TRUE(r.exited && r.status != 0);
+  EXPECT_TRUE(r.exited && r.status == 5) << "5: the OpenCL environment";
   EXPECT_TRUE(has(r.err, cache.string())) << "the message must name the cache folder";
   EXPECT_TRUE(has(r.err, "writable"));
 }

@@ -10,8 +10,9 @@ namespace portalsim::cli {
 namespace {
 
 // Exit codes (README, "Exit codes"): a bad flag or value 2, a bad input file 3, an
-// output problem 4, anything else 1. Errors in flag values name the flag first.
-constexpr int kUsage = 2, kBadInput = 3, kOutput = 4, kInternal = 1;
+// output problem 4, a missing OpenCL environment 5, anything else 1. Errors in flag
+// values name the flag first.
+constexpr int kUsage = 2, kBadInput = 3, kOutput = 4, kEnvironment = 5, kInternal = 1;
 
 int fail(const char* what, int code) {
   std::fprintf(stderr, "portalsim: error: %s\n", what);
@@ -57,6 +58,8 @@ int run(int argc, char** argv) {
     return fail(e.what(), std::string_view(e.what()).starts_with("--") ? kUsage : kBadInput);
   } catch (const OutputError& e) {
     return fail(e.what(), kOutput);
+  } catch (const EnvironmentError& e) {
+    return fail(e.what(), kEnvironment);
   } catch (const std::exception& e) {
     return fail(e.what(), kInternal);
   }

@@ -21,3 +21,14 @@ class OutputError : public std::runtime_error {
 };
 
 }  // namespace portalsim
+
+namespace portalsim {
+
+// The machine lacks something the run needs (no OpenCL platform or device, PoCL's kernel
+// cache not writable, no fp64): the user fixes it by installing or choosing otherwise.
+class EnvironmentError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace portalsim

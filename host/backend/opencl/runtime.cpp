@@ -1,11 +1,18 @@
 #include "backend/opencl/runtime.h"
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <stdexcept>
 #include <string_view>
 
+#include "scene/error.h"
+
 namespace portalsim {
+
+namespace fs = std::filesystem;
 
 namespace embedded {
 extern const std::string_view kernel_program;
@@ -31,7 +38,7 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
     platforms.clear();  // no platform at all: said below
   }
   if (platforms.empty())
-    throw std::runtime_error(
+    throw EnvironmentError(
         "no OpenCL platform found (is pocl-opencl-icd installed?); --backend reference works without one");
   bool found = false;
   for (const cl::Platform& p : platforms) {
@@ -54,12 +61,13 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
     }
     if (found) break;
   }
+  if (!found && !options.device.empty())
+    throw InputError("--device: no OpenCL device matches \"" + options.device + "\"");
   if (!found)
-    throw std::runtime_error(options.device.empty()
-                                 ? "no OpenCL CPU device found (is pocl-opencl-icd installed? PoCL also offers none "
-                                   "when its kernel cache, " +
-                                       pocl_cache() + ", is not writable); --backend reference works without one"
-                                 : "no OpenCL device matches \"" + options.device + "\"");
+    throw EnvironmentError(
+        "no OpenCL CPU device found (is pocl-opencl-icd installed? PoCL also offers none when its "
+        "kernel cache, " +
+        pocl_cache() + ", is not writable); --backend reference works without one");
   if (options.compute_units > 0) {
     // Device fission: PoCL runs a sub-device's work on that many threads.
     const cl_uint max_units = device_.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
@@ -81,13 +89,25 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
   try {
     program_.build({device_}, ("-cl-std=CL1.2 " + options.build_options).c_str());
   } catch (const cl::Error&) {
-    throw std::runtime_error("OpenCL program build failed; PoCL compiles into its kernel cache, " + pocl_cache() +
-                             ", which must be writable (or set POCL_CACHE_DIR):\n" +
-                             program_.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_));
+    build_failed(program_, "");
   }
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   variants_[""] = program_;
   base_options_ = options.build_options;
+}
+
+// PoCL compiles into its kernel cache: an unwritable cache is the machine's problem (exit
+// 5), anything else a bug in the kernels (internal).
+void OpenCLRuntime::build_failed(const cl::Program& p, const std::string& options) const {
+  const std::string log = p.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
+  const std::string what = "OpenCL program build failed" + (options.empty() ? "" : " (" + options + ")");
+  std::error_code ec;
+  fs::path dir = pocl_cache();
+  while (!dir.empty() && !fs::exists(dir, ec) && dir != dir.parent_path()) dir = dir.parent_path();
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw EnvironmentError(what + ": PoCL's kernel cache, " + pocl_cache() +
+                           ", must be writable (or set POCL_CACHE_DIR)\n" + log);
+  throw std::runtime_error(what + ":\n" + log);
 }
 
 cl::Program& OpenCLRuntime::program(const std::string& options) {
@@ -95,14 +115,12 @@ cl::Program& OpenCLRuntime::program(const std::string& options) {
   if (it != variants_.end()) return it->second;
   if (options.find("PRECISION_FP64") != std::string::npos &&
       device_.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") == std::string::npos)
-    throw std::runtime_error("the exact tier needs fp64, and " + device_name_ + " has no cl_khr_fp64");
+    throw EnvironmentError("the exact tier needs fp64, and " + device_name_ + " has no cl_khr_fp64");
   cl::Program p(context_, source());
   try {
     p.build({device_}, ("-cl-std=CL1.2 " + base_options_ + " " + options).c_str());
   } catch (const cl::Error&) {
-    throw std::runtime_error("OpenCL program build failed (" + options + "); PoCL's kernel cache, " + pocl_cache() +
-                             ", must be writable (or set POCL_CACHE_DIR):\n" +
-                             p.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_));
+    build_failed(p, options);
   }
   return variants_.emplace(options, p).first->second;
 }

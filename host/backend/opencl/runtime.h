@@ -28,6 +28,8 @@ class OpenCLRuntime {
   static std::string source();  // kernels/shared.h and the kernels/ files, in CMakeLists.txt's order
 
  private:
+  [[noreturn]] void build_failed(const cl::Program& p, const std::string& options) const;
+
   cl::Context context_;
   cl::Device device_;
   cl::CommandQueue queue_;
