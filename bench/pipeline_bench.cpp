@@ -5,6 +5,7 @@
 
 #include <filesystem>
 
+#include "cli/common.h"
 #include "scene/generator.h"
 #include "schedule/pipeline.h"
 
@@ -32,7 +33,7 @@ void BM_Pipeline_features(benchmark::State& state) {
   for (auto _ : state) {
     std::filesystem::remove_all(dir);
     PipelineOptions opt;
-    const PipelineResult r = run_pipeline(spec, session(), dir, opt);
+    const PipelineResult r = run_pipeline(spec, session().catalogue, session().assets, *session().backend, dir, opt);
     benchmark::DoNotOptimize(r.done);
   }
   std::filesystem::remove_all(dir);

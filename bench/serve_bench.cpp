@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "cli/common.h"
 #include "serve/server.h"
 
 namespace portalsim {
@@ -21,7 +22,7 @@ void BM_Serve_update(benchmark::State& state) {
   ServeOptions opt;
   opt.port = 0;
   opt.root = std::filesystem::temp_directory_path().string();
-  Server server(session, opt);
+  Server server(session.catalogue, session.assets, *session.backend, opt);
   const int port = server.bind();
   std::thread listener([&] { server.listen(); });
   httplib::Client client("127.0.0.1", port);

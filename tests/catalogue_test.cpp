@@ -1,7 +1,7 @@
 // The default catalogue's contents, object names and the threat rules.
 #include <gtest/gtest.h>
 
-#include "scene/error.h"
+#include "base/error.h"
 #include "scene/rules.h"
 #include "support.h"
 

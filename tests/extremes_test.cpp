@@ -39,10 +39,10 @@
 
 #include "assets/image_io.h"
 #include "backend/compare.h"
+#include "base/error.h"
 #include "plan/plan.h"
 #include "plan/tolerance.h"
 #include "run_binary.h"
-#include "scene/error.h"
 #include "support.h"
 
 namespace portalsim::embedded {

@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
+#include "base/error.h"
 #include "fuzz/targets.h"
 #include "io/input_file.h"
 #include "io/toml_input.h"
 #include "run_binary.h"
-#include "scene/error.h"
 
 namespace {
 

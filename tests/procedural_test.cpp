@@ -49,9 +49,16 @@ double mean(const Image& im, int cx, int cy, int r = 2, int c = 0) {
   return sum / n;
 }
 
-TEST(ProceduralTest, IsShapeAcceptsExactlyTheTwelveNames) {
-  for (const auto& s : kShapes) EXPECT_TRUE(is_shape(s)) << s;
-  for (const char* s : {"", "Gun", "GUN", "knife", "disc", "gun ", "pistol"}) EXPECT_FALSE(is_shape(s)) << s;
+TEST(ProceduralTest, TheDeclaredShapesAreExactlyTheDrawnOnes) {
+  ASSERT_EQ(kProceduralShapes.size(), kShapes.size());
+  for (const auto& s : kShapes) {
+    EXPECT_TRUE(is_procedural_shape(s)) << s;
+    EXPECT_NO_THROW(sprite(s, false, 40, 20, 200)) << s;
+  }
+  for (const char* s : {"", "Gun", "GUN", "knife", "disc", "gun ", "pistol"}) {
+    EXPECT_FALSE(is_procedural_shape(s)) << s;
+    EXPECT_THROW(sprite(s, false, 40, 20, 200), std::invalid_argument) << s;
+  }
 }
 
 TEST(ProceduralTest, DeterministicBytes) {
@@ -63,7 +70,8 @@ TEST(ProceduralTest, DeterministicBytes) {
   EXPECT_EQ(ir_body(b, 100, 200).pixels, ir_body(b, 100, 200).pixels);
   for (const auto& s : kShapes)
     for (bool v : {false, true}) EXPECT_EQ(sprite_of(s, v).pixels, sprite_of(s, v).pixels) << s;
-  for (int k = 0; k < kNoisePatterns; ++k) EXPECT_EQ(noise_pattern(k, 64).pixels, noise_pattern(k, 64).pixels) << k;
+  for (int k = 0; k < kProceduralNoisePatterns; ++k)
+    EXPECT_EQ(noise_pattern(k, 64).pixels, noise_pattern(k, 64).pixels) << k;
   EXPECT_EQ(ir_palette(), ir_palette());
 }
 
@@ -338,7 +346,7 @@ TEST(ProceduralTest, IrSilhouetteMatchesMmwAtHalfScale) {
 
 TEST(ProceduralTest, NoisePatternsAreLocalAndDistinct) {
   for (int size : {64, 17, 3}) {
-    for (int k = 0; k < kNoisePatterns; ++k) {
+    for (int k = 0; k < kProceduralNoisePatterns; ++k) {
       const Image n = noise_pattern(k, size);
       for (int i = 0; i < size; ++i) {
         EXPECT_EQ(n.at(i, 0), 128) << k;
@@ -355,9 +363,9 @@ TEST(ProceduralTest, NoisePatternsAreLocalAndDistinct) {
     }
   }
   std::vector<Image> all;
-  for (int k = 0; k < kNoisePatterns; ++k) all.push_back(noise_pattern(k, 64));
-  for (int a = 0; a < kNoisePatterns; ++a)
-    for (int b = a + 1; b < kNoisePatterns; ++b) {
+  for (int k = 0; k < kProceduralNoisePatterns; ++k) all.push_back(noise_pattern(k, 64));
+  for (int a = 0; a < kProceduralNoisePatterns; ++a)
+    for (int b = a + 1; b < kProceduralNoisePatterns; ++b) {
       long diff = 0;
       for (size_t i = 0; i < all[a].pixels.size(); ++i) diff += std::abs(all[a].pixels[i] - all[b].pixels[i]);
       EXPECT_GT(diff / static_cast<double>(all[a].pixels.size()), 4.0) << a << " vs " << b;
@@ -429,7 +437,7 @@ TEST(ProceduralTest, InvalidArgumentsThrow) {
   EXPECT_THROW(sprite("knife", false, 10, 10, 100), std::invalid_argument);
   EXPECT_THROW(sprite("", false, 10, 10, 100), std::invalid_argument);
   EXPECT_THROW(noise_pattern(-1, 64), std::invalid_argument);
-  EXPECT_THROW(noise_pattern(kNoisePatterns, 64), std::invalid_argument);
+  EXPECT_THROW(noise_pattern(kProceduralNoisePatterns, 64), std::invalid_argument);
   EXPECT_THROW(noise_pattern(0, 0), std::invalid_argument);
 }
 
@@ -451,7 +459,7 @@ TEST(ProceduralTest, TinySizesWork) {
         }
     }
   }
-  for (int k = 0; k < kNoisePatterns; ++k) {
+  for (int k = 0; k < kProceduralNoisePatterns; ++k) {
     EXPECT_EQ(noise_pattern(k, 1).pixels, std::vector<uint8_t>{128});
     EXPECT_EQ(noise_pattern(k, 2).pixels, std::vector<uint8_t>(4, 128));
   }

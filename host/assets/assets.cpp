@@ -4,7 +4,7 @@
 
 #include "assets/image_io.h"
 #include "assets/procedural.h"
-#include "scene/error.h"
+#include "base/error.h"
 
 namespace portalsim {
 

@@ -10,8 +10,8 @@
 #include <filesystem>
 #include <mutex>
 
+#include "base/error.h"
 #include "io/input_file.h"
-#include "scene/error.h"
 
 namespace portalsim {
 

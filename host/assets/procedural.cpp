@@ -663,8 +663,6 @@ constexpr Stop kIron[] = {{0, 0, 0, 0},       {36, 22, 0, 92},    {78, 92, 0, 15
 
 }  // namespace
 
-bool is_shape(const std::string& name) { return make_shape(name, 1.0, 1.0) != nullptr; }
-
 Image mmw_body(const Body& body, bool upper, int width, int height) {
   check_size(width, height, "mmw_body");
   const BodyModel model(body);
@@ -795,8 +793,8 @@ Image sprite(const std::string& shape, bool vertical, int width, int height, int
 }
 
 Image noise_pattern(int k, int size) {
-  if (k < 0 || k >= kNoisePatterns)
-    throw std::invalid_argument("noise_pattern: k must be in 0.." + std::to_string(kNoisePatterns - 1));
+  if (k < 0 || k >= kProceduralNoisePatterns)
+    throw std::invalid_argument("noise_pattern: k must be in 0.." + std::to_string(kProceduralNoisePatterns - 1));
   check_size(size, size, "noise_pattern");
   Image img(size, size, 1, 128);
   if (size < 3) return img;  // all border

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "assets/image.h"
+#include "scene/builtin_images.h"
 
 namespace portalsim::procedural {
 
@@ -34,12 +35,11 @@ Image ir_body(const Body& body, int width, int height);
 // Returns 2 channels: value (gray for MMW, temperature index for IR) and alpha
 // (coverage, 255 inside, 0 outside, anti-aliased edge). `level` is the mean value of
 // the object's material; the drawing adds shading and detail around it.
-bool is_shape(const std::string& name);
+// Throws std::invalid_argument for a name not in kProceduralShapes.
 Image sprite(const std::string& shape, bool vertical, int width, int height, int level);
 
-// The k-th (0..4) MMW noise pattern: 1 channel, 128 means no change, value-128 is added
+// The k-th (0 .. kProceduralNoisePatterns-1) MMW noise pattern: 1 channel, 128 means no change, value-128 is added
 // to the image. Its amplitude falls to 0 at the tile's border, so it stays local.
-constexpr int kNoisePatterns = 5;
 Image noise_pattern(int k, int size);
 
 // 256-entry RGB palette for IR temperature indices, like the thesis's figure 4.13:

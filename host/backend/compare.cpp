@@ -79,4 +79,22 @@ OutputDiff compare_outputs(const BatchOutput& test, const BatchOutput& ref) {
   return e;
 }
 
+std::string check_tolerance(const OutputDiff& d, const Tolerance& t) {
+  std::string why;
+  for (auto [name, img] : {std::pair{"MMW", &d.mmw}, std::pair{"IR", &d.ir}}) {
+    if (img->max_abs > t.pixel_max_abs)
+      why += std::string(name) + " max abs " + std::to_string(img->max_abs) + " > " + std::to_string(t.pixel_max_abs) +
+             "; ";
+    if (img->share_differing > t.pixel_share_differing)
+      why += std::string(name) + " share differing " + std::to_string(img->share_differing) + " > " +
+             std::to_string(t.pixel_share_differing) + "; ";
+  }
+  if (d.feature_max_abs > t.feature_max_abs)
+    why += "feature max abs " + std::to_string(d.feature_max_abs) + " > " + std::to_string(t.feature_max_abs) + "; ";
+  if (d.feature_mean_abs > t.feature_mean_abs)
+    why += "feature mean abs " + std::to_string(d.feature_mean_abs) + " > " + std::to_string(t.feature_mean_abs) + "; ";
+  if (d.metal_exact < 1.0) why += "metal zones differ; ";
+  return why;
+}
+
 }  // namespace portalsim

@@ -2,8 +2,10 @@
 // tests and of `portalsim tradeoff`.
 #pragma once
 #include <cstddef>
+#include <string>
 
 #include "backend/backend.h"
+#include "plan/tolerance.h"
 
 namespace portalsim {
 
@@ -25,5 +27,8 @@ struct OutputDiff {
 
 // Compares what both outputs hold (images, features, metal); `test` against `ref`.
 OutputDiff compare_outputs(const BatchOutput& test, const BatchOutput& ref);
+
+// Empty when `d` is within `t` (features checked only where present); else what broke.
+std::string check_tolerance(const OutputDiff& d, const Tolerance& t);
 
 }  // namespace portalsim

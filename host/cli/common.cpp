@@ -3,7 +3,7 @@
 #include <chrono>
 
 #include "backend/opencl/opencl_backend.h"
-#include "scene/error.h"
+#include "base/error.h"
 
 namespace portalsim::cli {
 
@@ -35,31 +35,6 @@ void add_fidelity_options(CLI::App& app, std::string& tier, std::map<std::string
   app.add_option("--noise-model", knobs["noise_model"],
                  "pixel noise in features-only runs: per-pixel or block-mean (overrides the tier)")
       ->check(CLI::IsMember({"per-pixel", "block-mean"}));
-}
-
-uint64_t parse_u64(const std::string& text, const std::string& field) {
-  const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
-  std::string digits = hex ? text.substr(2) : text;
-  while (digits.size() > 1 && digits[0] == '0') digits.erase(0, 1);
-  const auto bad = [&]() {
-    return InputError(field + ": \"" + text + "\" is not an unsigned 64-bit integer (0 to 18446744073709551615)");
-  };
-  if (digits.empty() || digits.size() > 20) throw bad();
-  unsigned __int128 v = 0;
-  for (char c : digits) {
-    int d;
-    if (c >= '0' && c <= '9')
-      d = c - '0';
-    else if (hex && c >= 'a' && c <= 'f')
-      d = c - 'a' + 10;
-    else if (hex && c >= 'A' && c <= 'F')
-      d = c - 'A' + 10;
-    else
-      throw bad();
-    v = v * (hex ? 16 : 10) + d;
-    if (v > UINT64_MAX) throw bad();
-  }
-  return static_cast<uint64_t>(v);
 }
 
 void open_catalogue(Session& s, const CommonOptions& o) {

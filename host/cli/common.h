@@ -27,9 +27,6 @@ void add_common_options(CLI::App& app, CommonOptions& o);
 // --tier and the single knobs that override it (README, "Fidelity tiers").
 void add_fidelity_options(CLI::App& app, std::string& tier, std::map<std::string, std::string>& knobs);
 
-// Parses a decimal or 0x-hexadecimal unsigned 64-bit integer; throws InputError naming `field`.
-uint64_t parse_u64(const std::string& text, const std::string& field);
-
 // The catalogue, its assets and a backend, with the time each took.
 struct Session {
   Catalogue catalogue;

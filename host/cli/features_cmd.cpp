@@ -3,9 +3,9 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "scene/error.h"
 #include "sink/folder_reader.h"
 #include "sink/sinks.h"
 

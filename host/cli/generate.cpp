@@ -4,9 +4,10 @@
 #include <csignal>
 #include <cstdio>
 
+#include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "scene/error.h"
+#include "io/input_file.h"
 #include "schedule/pipeline.h"
 
 namespace portalsim::cli {
@@ -46,11 +47,11 @@ int generate(GenerateOptions& o) {
     return g;
   };
   if (given("--count")) {
-    spec.count = parse_u64(o.count, "--count");
+    spec.count = io::parse_u64(o.count, "--count");
     if (spec.count < 1 || spec.count > (1ull << 40))
       throw InputError("--count: \"" + o.count + "\" is not between 1 and 2^40");
   }
-  if (given("--seed")) spec.seed = parse_u64(o.common.seed, "--seed");
+  if (given("--seed")) spec.seed = io::parse_u64(o.common.seed, "--seed");
   if (given("--rule")) spec.rule = o.spec.rule;
   if (given("--pool")) {
     spec.pool = split_list(o.pool);
@@ -96,8 +97,8 @@ int generate(GenerateOptions& o) {
   if (!o.shard.empty()) {
     const size_t slash = o.shard.find('/');
     if (slash == std::string::npos) throw InputError("--shard: \"" + o.shard + "\" is not i/k");
-    popt.shard = parse_u64(o.shard.substr(0, slash), "--shard");
-    popt.shards = parse_u64(o.shard.substr(slash + 1), "--shard");
+    popt.shard = io::parse_u64(o.shard.substr(0, slash), "--shard");
+    popt.shards = io::parse_u64(o.shard.substr(slash + 1), "--shard");
     if (popt.shards < 1 || popt.shard >= popt.shards) throw InputError("--shard: \"" + o.shard + "\" needs 0 <= i < k");
   }
   if (app.get_option("--batch")->count() > 0 && (o.batch < 1 || o.batch > 1000000))
@@ -116,7 +117,7 @@ int generate(GenerateOptions& o) {
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  const PipelineResult r = run_pipeline(spec, s, o.out, popt);
+  const PipelineResult r = run_pipeline(spec, s.catalogue, s.assets, *s.backend, o.out, popt);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
 

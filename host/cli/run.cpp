@@ -1,9 +1,9 @@
 #include <cstdio>
 #include <map>
 
+#include "base/error.h"
 #include "cli/commands.h"
 #include "io/input_file.h"
-#include "scene/error.h"
 
 namespace portalsim::cli {
 

@@ -34,7 +34,7 @@ int serve(ServeCmd& o) {
     CLI::Option* opt = o.app->get_option_no_throw(flag);
     if (opt && opt->count() > 0) o.serve.session.insert(o.serve.session.end(), {flag, opt->as<std::string>()});
   }
-  Server server(s, o.serve);
+  Server server(s.catalogue, s.assets, *s.backend, o.serve);
   const int port = server.bind();
   std::printf("portalsim serve: http://%s:%d/ (root %s)\n", o.serve.bind.c_str(), port, o.serve.root.c_str());
   std::fflush(stdout);

@@ -2,9 +2,10 @@
 #include <chrono>
 #include <cstdio>
 
+#include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "scene/error.h"
+#include "io/input_file.h"
 #include "serve/one_scenario.h"
 
 namespace portalsim::cli {
@@ -34,7 +35,7 @@ int simulate(SimulateOptions& o) {
 
   Plan plan;
   plan.model = o.model;
-  plan.model.seed = parse_u64(o.common.seed, "--seed");
+  plan.model.seed = io::parse_u64(o.common.seed, "--seed");
   plan.model.pattern_noise = o.pattern_noise == "on";
   plan.model.bilinear = o.placement == "bilinear";
   plan.fidelity = tier_fidelity(parse_tier(o.tier, "--tier"));

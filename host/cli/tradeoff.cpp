@@ -10,10 +10,11 @@
 
 #include "backend/compare.h"
 #include "backend/opencl/opencl_backend.h"
+#include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "cli/weka.h"
-#include "scene/error.h"
+#include "io/input_file.h"
 #include "scene/generator.h"
 #include "sink/sinks.h"
 #include "sink/staging.h"
@@ -112,7 +113,7 @@ int tradeoff(TradeoffOptions& o) {
   open_catalogue(s, o.common);
   const Catalogue& cat = s.catalogue;
   ModelSettings model = o.model;
-  model.seed = parse_u64(o.common.seed, "--seed");
+  model.seed = io::parse_u64(o.common.seed, "--seed");
   Plan check = images_plan(model);
   validate(check, cat);
   std::error_code ec;

@@ -11,9 +11,9 @@
 #include <sstream>
 #include <vector>
 
+#include "base/error.h"
 #include "cli/commands.h"
 #include "cli/weka.h"
-#include "scene/error.h"
 #include "sink/staging.h"
 
 namespace portalsim::cli {

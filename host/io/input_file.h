@@ -3,6 +3,7 @@
 // for bytes none of our formats allow before any parser sees it.
 #pragma once
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -35,5 +36,8 @@ std::string read_text_file(const std::string& path, const std::string& what, Bom
 // A value given on the command line: the same byte rules as files, at most
 // kMaxLineBytes. Throws InputError starting with `flag` (a usage error).
 void check_flag_value(std::string_view value, const std::string& flag);
+
+// A decimal or 0x-hexadecimal unsigned 64-bit integer; throws InputError naming `field`.
+uint64_t parse_u64(const std::string& text, const std::string& field);
 
 }  // namespace portalsim::io

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <vector>
 
+#include "base/error.h"
 #include "io/input_file.h"
-#include "scene/error.h"
 
 namespace portalsim::io {
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "scene/error.h"
+#include "base/error.h"
 
 namespace portalsim {
 

@@ -1,9 +1,8 @@
 // Each fidelity tier's stated tolerance against the fp64 CPU reference. Tests hold the
-// kernels to these; `portalsim tradeoff` reports where each tier actually lands.
+// kernels to these (check_tolerance in backend/compare.h); `portalsim tradeoff` reports
+// where each tier actually lands.
 #pragma once
-#include <string>
 
-#include "backend/compare.h"
 #include "plan/plan.h"
 
 namespace portalsim {
@@ -31,25 +30,6 @@ inline Tolerance tier_tolerance(Tier t) {
       return {2, 0.5, 2.0, 0.5};
   }
   return {0, 0, 0, 0};
-}
-
-// Empty when `d` is within `t` (features checked only where present); else what broke.
-inline std::string check_tolerance(const OutputDiff& d, const Tolerance& t) {
-  std::string why;
-  for (auto [name, img] : {std::pair{"MMW", &d.mmw}, std::pair{"IR", &d.ir}}) {
-    if (img->max_abs > t.pixel_max_abs)
-      why += std::string(name) + " max abs " + std::to_string(img->max_abs) + " > " + std::to_string(t.pixel_max_abs) +
-             "; ";
-    if (img->share_differing > t.pixel_share_differing)
-      why += std::string(name) + " share differing " + std::to_string(img->share_differing) + " > " +
-             std::to_string(t.pixel_share_differing) + "; ";
-  }
-  if (d.feature_max_abs > t.feature_max_abs)
-    why += "feature max abs " + std::to_string(d.feature_max_abs) + " > " + std::to_string(t.feature_max_abs) + "; ";
-  if (d.feature_mean_abs > t.feature_mean_abs)
-    why += "feature mean abs " + std::to_string(d.feature_mean_abs) + " > " + std::to_string(t.feature_mean_abs) + "; ";
-  if (d.metal_exact < 1.0) why += "metal zones differ; ";
-  return why;
 }
 
 }  // namespace portalsim

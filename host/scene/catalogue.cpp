@@ -8,10 +8,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "assets/procedural.h"
+#include "base/error.h"
 #include "io/input_file.h"
 #include "io/toml_input.h"
-#include "scene/error.h"
+#include "scene/builtin_images.h"
 
 namespace portalsim {
 
@@ -356,7 +356,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     }
     const bool file_images =
         t.get("mmw") || t.get("ir") || t.get("mmw_h") || t.get("mmw_v") || t.get("ir_h") || t.get("ir_v");
-    if (!procedural::is_shape(o.shape) && !file_images)
+    if (!is_procedural_shape(o.shape) && !file_images)
       rd.fail(t.get("shape"), f + ".shape", "unknown shape \"" + o.shape + "\" and no image files given");
     if (codes.size() > 1)
       for (const char* key : {"mmw", "ir"})
@@ -393,8 +393,10 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     p.name = rd.string(t, "name", f);
     p.gain = rd.number(t, "gain", f, 0.0, 100.0, 1.0);
     p.image = rd.image(t, "image", f);
-    if (p.image.path.empty() && i >= static_cast<size_t>(procedural::kNoisePatterns))
-      rd.fail(&t, f, "only the first 5 noise patterns have procedural defaults; give an image");
+    if (p.image.path.empty() && i >= static_cast<size_t>(kProceduralNoisePatterns))
+      rd.fail(&t, f,
+              "only the first " + std::to_string(kProceduralNoisePatterns) +
+                  " noise patterns have procedural defaults; give an image");
     cat.noise.push_back(std::move(p));
   }
   cat.sensors = camera_sensors(cat);

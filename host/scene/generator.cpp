@@ -3,8 +3,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "base/error.h"
 #include "io/input_file.h"
-#include "scene/error.h"
 #include "scene/philox.h"
 
 namespace portalsim {

@@ -3,7 +3,7 @@
 #include <cctype>
 #include <functional>
 
-#include "scene/error.h"
+#include "base/error.h"
 
 namespace portalsim {
 

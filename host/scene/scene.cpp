@@ -1,6 +1,6 @@
 #include "scene/scene.h"
 
-#include "scene/error.h"
+#include "base/error.h"
 
 namespace portalsim {
 

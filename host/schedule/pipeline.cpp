@@ -11,8 +11,8 @@
 #include <optional>
 #include <thread>
 
-#include "scene/error.h"
-#include "schedule/parallel.h"
+#include "base/error.h"
+#include "base/parallel.h"
 #include "sink/output_folder.h"
 #include "sink/sinks.h"
 #include "sink/staging.h"
@@ -133,10 +133,9 @@ size_t default_batch(const Plan& plan, const Catalogue& cat) {
   return std::clamp<size_t>((64u << 20) / bytes, 64, 16384);
 }
 
-PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const std::string& dir,
-                            const PipelineOptions& opt) {
+PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const AssetSet& assets, Backend& backend,
+                            const std::string& dir, const PipelineOptions& opt) {
   const auto t0 = Clock::now();
-  const Catalogue& cat = session.catalogue;
   PipelineResult res;
 
   // The scenario source.
@@ -256,7 +255,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
   SinkContext ctx;
   ctx.dir = dir;
   ctx.cat = &cat;
-  ctx.assets = &session.assets;
+  ctx.assets = &assets;
   ctx.layout = FeatureLayout::of(cat, plan.model.block);
   ctx.rows = res.end - res.begin;
   ctx.threads = threads;
@@ -340,7 +339,7 @@ PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const st
         }
       });
       const auto tc = Clock::now();
-      session.backend->run(b, plan, job->out);
+      backend.run(b, plan, job->out);
       res.compute_seconds += since(tc);
       const auto tw = Clock::now();
       hand.put(std::move(job));

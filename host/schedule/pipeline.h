@@ -6,7 +6,9 @@
 #include <atomic>
 #include <string>
 
-#include "cli/common.h"
+#include "assets/assets.h"
+#include "backend/backend.h"
+#include "scene/catalogue.h"
 #include "schedule/run_spec.h"
 
 namespace portalsim {
@@ -29,8 +31,8 @@ struct PipelineResult {
   bool already_complete = false, interrupted = false;
 };
 
-PipelineResult run_pipeline(const RunSpec& spec, cli::Session& session, const std::string& dir,
-                            const PipelineOptions& options);
+PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const AssetSet& assets, Backend& backend,
+                            const std::string& dir, const PipelineOptions& options);
 
 // Scenarios per batch for a plan: about 64 MiB of outputs, between 64 and 16384.
 size_t default_batch(const Plan& plan, const Catalogue& cat);

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <filesystem>
 
+#include "base/error.h"
 #include "io/input_file.h"
 #include "io/toml_input.h"
-#include "scene/error.h"
 
 namespace portalsim {
 

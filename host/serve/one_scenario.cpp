@@ -2,7 +2,7 @@
 
 #include <chrono>
 
-#include "scene/error.h"
+#include "base/error.h"
 #include "scene/rules.h"
 #include "sink/output_folder.h"
 #include "sink/staging.h"

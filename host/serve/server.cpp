@@ -18,7 +18,8 @@
 #include <sstream>
 #include <thread>
 
-#include "scene/error.h"
+#include "base/error.h"
+#include "io/input_file.h"
 #include "serve/one_scenario.h"
 #include "sink/staging.h"
 
@@ -113,7 +114,9 @@ struct Job {
 }  // namespace
 
 struct Server::Impl {
-  cli::Session& s;
+  const Catalogue& cat;
+  const AssetSet& assets;
+  Backend& backend;
   ServeOptions opt;
   fs::path root, scratch;
   httplib::Server http;
@@ -122,7 +125,8 @@ struct Server::Impl {
   std::shared_ptr<Job> job;
   std::thread job_waiter;
 
-  Impl(cli::Session& session, const ServeOptions& o) : s(session), opt(o) {
+  Impl(const Catalogue& c, const AssetSet& a, Backend& b, const ServeOptions& o)
+      : cat(c), assets(a), backend(b), opt(o) {
     std::error_code ec;
     if (!fs::is_directory(opt.root, ec)) throw InputError("--root: " + opt.root + " is not a folder");
     root = fs::canonical(opt.root, ec);
@@ -161,14 +165,14 @@ struct Server::Impl {
     r.plan.model.bilinear = placement == "bilinear";
     if (r.in.objects.size() > static_cast<size_t>(kRegions))
       throw InputError("objects: " + std::to_string(r.in.objects.size()) + " given, at most 13 regions");
-    r.plan.model.seed = cli::parse_u64(r.seed, "--seed");
+    r.plan.model.seed = io::parse_u64(r.seed, "--seed");
     r.plan.model.pattern_noise = r.pattern_noise;
     r.plan.model.pixel_sigma = r.pixel_noise;
     // The command line's own check (CLI11's IsMember) and its words.
     if (r.tier != "fast" && r.tier != "standard" && r.tier != "exact")
       throw InputError("--tier: " + r.tier + " not in {fast,standard,exact}");
     r.plan.fidelity = tier_fidelity(parse_tier(r.tier, "--tier"));
-    validate(r.plan, s.catalogue);
+    validate(r.plan, cat);
     return r;
   }
 
@@ -176,13 +180,13 @@ struct Server::Impl {
   std::vector<int> run(const Request& r, const Scenario& scene, const std::string& dir) {
     BatchOutput out;
     std::lock_guard<std::mutex> lock(backend_mutex);
-    write_one_scenario(dir, *s.backend, scene, r.plan, s.assets.palette, FolderOptions{}, out);
+    write_one_scenario(dir, backend, scene, r.plan, assets.palette, FolderOptions{}, out);
     return std::vector<int>(out.metal_of(0), out.metal_of(0) + kZones);
   }
 
   json render(const std::string& body) {
     const Request r = parse(body);
-    const Scenario scene = make_scenario(s.catalogue, r.in);
+    const Scenario scene = make_scenario(cat, r.in);
     const fs::path dir = scratch / ("r" + std::to_string(counter++));
     json res;
     try {
@@ -213,7 +217,7 @@ struct Server::Impl {
   json save(const std::string& body) {
     const Request r = parse(body);
     json j = json::parse(body);
-    const Scenario scene = make_scenario(s.catalogue, r.in);
+    const Scenario scene = make_scenario(cat, r.in);
     // One save at a time: the name check, the folder and the list row go together.
     std::lock_guard<std::mutex> lock(csv_mutex);
     const fs::path dir = new_folder(field<std::string>(j, "name", ""));
@@ -227,7 +231,7 @@ struct Server::Impl {
     res["metal"] = run(r, scene, dir.string());
     std::string line = std::to_string(scene.subject + 1);
     for (int i = 0; i < kRegions; ++i)
-      line += "," + (scene.objects[i] == kNoObject ? std::string("none") : s.catalogue.variant_name(scene.objects[i]));
+      line.append(",").append(scene.objects[i] == kNoObject ? std::string("none") : cat.variant_name(scene.objects[i]));
     line += scene.label == 1 ? ",yes\n" : ",no\n";
     std::string text = fs::exists(csv) ? read_file(csv) : std::string();
     if (text.empty()) {
@@ -245,14 +249,14 @@ struct Server::Impl {
   json generate(const std::string& body) {
     const Request r = parse(body);
     json j = json::parse(body);
-    const Scenario scene = make_scenario(s.catalogue, r.in);
+    const Scenario scene = make_scenario(cat, r.in);
     const int64_t count = field<int64_t>(j, "count", 0);
     if (count < 1 || count > 1000000) throw InputError("--count: " + std::to_string(count) + " is not 1 to 1000000");
     std::string pool;
     int placed = 0;
     for (int16_t v : scene.objects)
       if (v != kNoObject) {
-        const std::string name = s.catalogue.object_of(v).name;
+        const std::string name = cat.object_of(v).name;
         if (pool.find("," + name + ",") == std::string::npos && pool.rfind(name + ",", 0) != 0) pool += name + ",";
         ++placed;
       }
@@ -429,7 +433,7 @@ struct Server::Impl {
   }
 
   json catalogue() const {
-    const Catalogue& c = s.catalogue;
+    const Catalogue& c = cat;
     json j;
     j["mmw"] = {c.images.mmw_width, c.images.mmw_height};
     j["subjects"] = json::array();
@@ -447,7 +451,8 @@ struct Server::Impl {
   }
 };
 
-Server::Server(cli::Session& session, const ServeOptions& opt) : impl_(std::make_unique<Impl>(session, opt)) {}
+Server::Server(const Catalogue& cat, const AssetSet& assets, Backend& backend, const ServeOptions& opt)
+    : impl_(std::make_unique<Impl>(cat, assets, backend, opt)) {}
 Server::~Server() = default;
 
 int Server::bind() {

@@ -4,8 +4,11 @@
 #pragma once
 #include <memory>
 #include <string>
+#include <vector>
 
-#include "cli/common.h"
+#include "assets/assets.h"
+#include "backend/backend.h"
+#include "scene/catalogue.h"
 
 namespace portalsim {
 
@@ -21,7 +24,7 @@ struct ServeOptions {
 class Server {
  public:
   // Checks --root and --bind; throws InputError.
-  Server(cli::Session& session, const ServeOptions& opt);
+  Server(const Catalogue& cat, const AssetSet& assets, Backend& backend, const ServeOptions& opt);
   ~Server();
   // Binds the socket; returns the port (useful with port 0). Throws OutputError.
   int bind();

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "scene/error.h"
+#include "base/error.h"
 
 namespace portalsim {
 

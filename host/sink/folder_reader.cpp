@@ -6,8 +6,8 @@
 
 #include "assets/assets.h"
 #include "assets/image_io.h"
+#include "base/error.h"
 #include "io/input_file.h"
-#include "scene/error.h"
 
 namespace portalsim {
 

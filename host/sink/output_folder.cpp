@@ -9,7 +9,7 @@
 #include <cstring>
 #include <filesystem>
 
-#include "scene/error.h"
+#include "base/error.h"
 
 namespace portalsim {
 

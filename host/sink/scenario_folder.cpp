@@ -3,7 +3,7 @@
 #include <cstring>
 
 #include "assets/image_io.h"
-#include "scene/error.h"
+#include "base/error.h"
 #include "sink/feature_rows.h"
 #include "sink/staging.h"
 

@@ -5,8 +5,8 @@
 #include <filesystem>
 
 #include "assets/image_io.h"
-#include "scene/error.h"
-#include "schedule/parallel.h"
+#include "base/error.h"
+#include "base/parallel.h"
 #include "sink/feature_rows.h"
 #include "sink/scenario_folder.h"
 #include "sink/staging.h"

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "scene/error.h"
+#include "base/error.h"
 #include "sink/output_folder.h"
 
 namespace portalsim {

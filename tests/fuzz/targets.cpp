@@ -7,8 +7,8 @@
 #include <string_view>
 
 #include "assets/image_io.h"
+#include "base/error.h"
 #include "scene/catalogue.h"
-#include "scene/error.h"
 #include "scene/generator.h"
 #include "schedule/run_spec.h"
 #include "sink/folder_reader.h"

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "scene/error.h"
+#include "base/error.h"
 
 namespace portalsim {
 
