@@ -362,7 +362,9 @@ long long checkpoint_next(const fs::path& dir) {
 // Polls the run's checkpoint until "next" reaches `at_least` (-1: the checkpoint just exists).
 // False when the run ended first or 60 s passed.
 bool wait_for_checkpoint(const Started& r, const fs::path& dir, long long at_least) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  // Generous: under the sanitizers on a loaded 2-core machine the kernel build alone can
+  // take a minute.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(300);
   while (std::chrono::steady_clock::now() < deadline) {
     const long long next = checkpoint_next(dir);
     if (next >= 0 && next >= at_least) return true;
@@ -805,9 +807,11 @@ TEST(GenerateResume, ImagesKillNineThenResumeMatchesAnUninterruptedRun) {
 // checkpoint exists.
 void make_interrupted(const GenTempDir& t, const fs::path& dir) {
   const Started s = start_ps(t, gen(kLongSpec, dir));
-  wait_for_checkpoint(s, dir, -1);
+  // At least one batch written, so the interrupted folder holds data, not only a checkpoint.
+  const bool progressed = wait_for_checkpoint(s, dir, 1);
   send_signal(s, SIGINT);
   const RunResult r = wait_for(s);
+  ASSERT_TRUE(progressed) << "the run never checkpointed a batch\n" << describe_run(r);
   ASSERT_TRUE(r.exited && r.status == 130) << describe_run(r);
 }
 

@@ -13,6 +13,7 @@ std::function<int()> add_features(CLI::App& app);
 std::function<int()> add_tradeoff(CLI::App& app);
 std::function<int()> add_serve(CLI::App& app);
 std::function<int()> add_validate(CLI::App& app);
+std::function<int()> add_knobs(CLI::App& app);
 
 // Parses argv and runs the chosen subcommand; prints errors, returns the exit status.
 int run(int argc, char** argv);

@@ -4,6 +4,7 @@
 
 #include "backend/opencl/opencl_backend.h"
 #include "base/error.h"
+#include "plan/knobs.h"
 
 namespace portalsim::cli {
 
@@ -23,18 +24,22 @@ void add_common_options(CLI::App& app, CommonOptions& o) {
   app.add_flag("--timing", o.timing, "print where the time went");
 }
 
-void add_fidelity_options(CLI::App& app, std::string& tier, std::map<std::string, std::string>& knobs) {
+void add_knob_options(CLI::App& app, std::string& tier, std::map<std::string, std::string>& values) {
   app.add_option("--tier", tier, "fidelity tier: fast, standard (default) or exact")
       ->check(CLI::IsMember({"fast", "standard", "exact"}));
-  app.add_option("--precision", knobs["precision"], "kernel arithmetic: fp32, fp64 or fixed16 (overrides the tier)")
-      ->check(CLI::IsMember({"fp32", "fp64", "fixed16"}));
-  app.add_option("--pooling", knobs["pooling"], "features: sparse or dense (overrides the tier)")
-      ->check(CLI::IsMember({"sparse", "dense"}));
-  app.add_option("--fast-math", knobs["fast_math"], "-cl-fast-relaxed-math: on or off (overrides the tier)")
-      ->check(CLI::IsMember({"on", "off"}));
-  app.add_option("--noise-model", knobs["noise_model"],
-                 "pixel noise in features-only runs: per-pixel or block-mean (overrides the tier)")
-      ->check(CLI::IsMember({"per-pixel", "block-mean"}));
+  for (const Knob& k : knobs()) {
+    std::string help = k.help + ": " + k.values() + (k.fidelity ? " (overrides the tier)" : "");
+    // Checked by set_knob, not CLI11, so that a flag, a spec key and a serve request get
+    // one message for one mistake.
+    app.add_option(k.flag(), values[k.key], help);
+  }
+}
+
+std::map<std::string, std::string> given_knobs(const CLI::App& app, const std::map<std::string, std::string>& values) {
+  std::map<std::string, std::string> given;
+  for (const Knob& k : knobs())
+    if (app.get_option(k.flag())->count() > 0) given[k.key] = values.at(k.key);
+  return given;
 }
 
 void open_catalogue(Session& s, const CommonOptions& o) {

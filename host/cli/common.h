@@ -24,8 +24,10 @@ struct CommonOptions {
 };
 
 void add_common_options(CLI::App& app, CommonOptions& o);
-// --tier and the single knobs that override it (README, "Fidelity tiers").
-void add_fidelity_options(CLI::App& app, std::string& tier, std::map<std::string, std::string>& knobs);
+// --tier and a flag for every knob of plan/knobs.h; each knob's text lands in values[key].
+void add_knob_options(CLI::App& app, std::string& tier, std::map<std::string, std::string>& values);
+// The knobs given on the command line, by key, as text.
+std::map<std::string, std::string> given_knobs(const CLI::App& app, const std::map<std::string, std::string>& values);
 
 // The catalogue, its assets and a backend, with the time each took.
 struct Session {

@@ -21,9 +21,7 @@ struct GenerateOptions {
   CommonOptions common;
   RunSpec spec;
   std::string count, out, spec_file, objects, pool, subjects, formats, shard;
-  std::string pattern_noise;
   std::map<std::string, std::string> knobs;
-  std::string placement = "integer";
   long long batch = 0;
   unsigned threads = 0;
   bool resume = false, quiet = false;
@@ -42,7 +40,6 @@ int generate(GenerateOptions& o) {
       for (char& c : key)
         if (c == '-') c = '_';
       spec.origin.erase(key);
-      if (key == "image_format") spec.origin.erase("image_format");
     }
     return g;
   };
@@ -69,22 +66,13 @@ int generate(GenerateOptions& o) {
   if (given("--balance")) spec.balance = o.spec.balance;
   if (given("--what")) spec.what = o.spec.what;
   if (given("--format")) spec.formats = split_list(o.formats);
-  if (given("--block")) spec.model.block = o.spec.model.block;
   if (given("--image-format")) spec.image_format = o.spec.image_format;
-  if (given("--pattern-noise")) spec.model.pattern_noise = o.pattern_noise == "on";
-  if (given("--pixel-noise")) spec.model.pixel_sigma = o.spec.model.pixel_sigma;
-  if (given("--metal-noise")) spec.model.metal_noise = o.spec.model.metal_noise;
   if (given("--scenarios")) spec.scenarios = o.spec.scenarios;
   if (given("--tier")) spec.tier = o.spec.tier;
-  if (given("--placement")) spec.model.bilinear = o.placement == "bilinear";
-  if (given("--jitter")) spec.model.jitter = o.spec.model.jitter;
-  for (const char* knob : {"--precision", "--pooling", "--fast-math", "--noise-model"})
-    if (given(knob)) {
-      std::string key = knob + 2;
-      for (char& c : key)
-        if (c == '-') c = '_';
-      spec.knobs[key] = o.knobs[key];
-    }
+  for (const auto& [key, text] : given_knobs(app, o.knobs)) {
+    spec.origin.erase(key);
+    spec.set_knob_text(key, text, spec.where(key));
+  }
   spec.validate();
   if (o.out.empty()) throw InputError("--out: empty folder name");
 
@@ -109,9 +97,7 @@ int generate(GenerateOptions& o) {
   {
     // Check the generator's spec before any output exists.
     if (spec.scenarios.empty()) Generator check(s.catalogue, generator_spec(spec, s.catalogue), spec.seed);
-    Plan plan;
-    plan.model = spec.model;
-    validate(plan, s.catalogue);
+    validate(spec.settings(), s.catalogue);
   }
   open_backend(s, o.common);
 
@@ -161,17 +147,9 @@ std::function<int()> add_generate(CLI::App& app) {
   sub->add_flag("--balance", o->spec.balance, "equal classes: even indices threats, odd not");
   sub->add_option("--what", o->spec.what, "features, images or both (default features)");
   sub->add_option("--format", o->formats, "feature tables: arff,csv,npy (default arff)");
-  sub->add_option("--block", o->spec.model.block, "block side for the averaged features (default 10)");
   sub->add_option("--image-format", o->spec.image_format, "png or jpg (default png)");
-  sub->add_option("--pattern-noise", o->pattern_noise, "the thesis's MMW noise patterns: on (default) or off")
-      ->check(CLI::IsMember({"on", "off"}));
-  sub->add_option("--pixel-noise", o->spec.model.pixel_sigma, "per-pixel Gaussian sensor noise sigma (default 0)");
-  sub->add_option("--metal-noise", o->spec.model.metal_noise, "metal detector noise half-width (default 0)");
   sub->add_option("--scenarios", o->spec.scenarios, "explicit scenario list (CSV: subject, region1..13, label)");
-  add_fidelity_options(*sub, o->spec.tier, o->knobs);
-  sub->add_option("--placement", o->placement, "sprite placement: integer (default) or bilinear (sub-pixel)")
-      ->check(CLI::IsMember({"integer", "bilinear"}));
-  sub->add_option("--jitter", o->spec.model.jitter, "move each object by up to this many pixels (default 0)");
+  add_knob_options(*sub, o->spec.tier, o->knobs);
   sub->add_option("--batch", o->batch, "scenarios per kernel launch (default: about 64 MiB of outputs)");
   sub->add_option("--threads", o->threads, "host threads for generating and writing (default: all cores)");
   sub->add_option("--shard", o->shard, "i/k: make only part i (0-based) of k of the index range");

@@ -40,6 +40,7 @@ int run(int argc, char** argv) {
   commands["tradeoff"] = add_tradeoff(app);
   commands["serve"] = add_serve(app);
   commands["validate"] = add_validate(app);
+  commands["knobs"] = add_knobs(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

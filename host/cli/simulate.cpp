@@ -6,6 +6,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "io/input_file.h"
+#include "plan/knobs.h"
 #include "serve/one_scenario.h"
 
 namespace portalsim::cli {
@@ -16,11 +17,8 @@ struct SimulateOptions {
   int subject = 1;
   std::string rule, threat, out = "portalsim-out", image_format = "png";
   std::vector<std::string> objects;
-  ModelSettings model;
-  std::string pattern_noise = "on";
   std::string tier = "standard";
   std::map<std::string, std::string> knobs;
-  std::string placement = "integer";
   CLI::App* app = nullptr;
 };
 
@@ -34,17 +32,12 @@ int simulate(SimulateOptions& o) {
   const Scenario scene = make_scenario(cat, ScenarioInputs{o.subject, o.objects, o.rule, o.threat});
 
   Plan plan;
-  plan.model = o.model;
-  plan.model.seed = io::parse_u64(o.common.seed, "--seed");
-  plan.model.pattern_noise = o.pattern_noise == "on";
-  plan.model.bilinear = o.placement == "bilinear";
   plan.fidelity = tier_fidelity(parse_tier(o.tier, "--tier"));
-  for (const auto& [k, v] : o.knobs) {
-    std::string flag = "--" + k;
-    for (char& c : flag)
-      if (c == '_') c = '-';
-    if (o.app->get_option(flag)->count() > 0) set_fidelity_knob(plan.fidelity, k, v, flag);
+  for (const auto& [key, text] : given_knobs(*o.app, o.knobs)) {
+    const Knob& k = *find_knob(key);
+    set_knob(plan, k, text, k.flag());
   }
+  plan.model.seed = io::parse_u64(o.common.seed, "--seed");
   validate(plan, cat);
 
   open_backend(s, o.common);
@@ -79,16 +72,7 @@ std::function<int()> add_simulate(CLI::App& app) {
   sub->add_option("--threat", o->threat, "label the scenario yes or no")->check(CLI::IsMember({"yes", "no"}));
   sub->add_option("--out", o->out, "output folder (default portalsim-out)");
   sub->add_option("--image-format", o->image_format, "png or jpg")->check(CLI::IsMember({"png", "jpg"}));
-  sub->add_option("--block", o->model.block, "block side for the averaged features (default 10)");
-  sub->add_option("--pattern-noise", o->pattern_noise, "the thesis's MMW noise patterns: on (default) or off")
-      ->check(CLI::IsMember({"on", "off"}));
-  sub->add_option("--pixel-noise", o->model.pixel_sigma,
-                  "per-pixel Gaussian sensor noise sigma, gray levels (default 0)");
-  sub->add_option("--metal-noise", o->model.metal_noise, "metal detector noise half-width in counts (default 0: off)");
-  add_fidelity_options(*sub, o->tier, o->knobs);
-  sub->add_option("--placement", o->placement, "sprite placement: integer (default) or bilinear (sub-pixel)")
-      ->check(CLI::IsMember({"integer", "bilinear"}));
-  sub->add_option("--jitter", o->model.jitter, "move each object by up to this many pixels (default 0)");
+  add_knob_options(*sub, o->tier, o->knobs);
   o->app = sub;
   return [o] { return simulate(*o); };
 }

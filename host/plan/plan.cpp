@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "base/error.h"
+#include "plan/knobs.h"
 
 namespace portalsim {
 
@@ -55,60 +56,14 @@ Tier parse_tier(const std::string& name, const std::string& where) {
   throw InputError(where + ": \"" + name + "\" is not a tier (fast, standard, exact)");
 }
 
-void set_fidelity_knob(Fidelity& f, const std::string& knob, const std::string& value, const std::string& where) {
-  const auto bad = [&](const char* allowed) {
-    return InputError(where + ": \"" + value + "\" is not one of " + allowed);
-  };
-  if (knob == "precision") {
-    if (value == "fp32")
-      f.precision = Precision::fp32;
-    else if (value == "fp64")
-      f.precision = Precision::fp64;
-    else if (value == "fixed16")
-      f.precision = Precision::fixed16;
-    else
-      throw bad("fp32, fp64, fixed16");
-  } else if (knob == "pooling") {
-    if (value == "sparse")
-      f.pooling = Pooling::sparse;
-    else if (value == "dense")
-      f.pooling = Pooling::dense;
-    else
-      throw bad("sparse, dense");
-  } else if (knob == "fast_math") {
-    if (value == "on" || value == "true")
-      f.fast_math = true;
-    else if (value == "off" || value == "false")
-      f.fast_math = false;
-    else
-      throw bad("on, off");
-  } else if (knob == "noise_model") {
-    if (value == "per-pixel")
-      f.noise = NoiseModel::per_pixel;
-    else if (value == "block-mean")
-      f.noise = NoiseModel::block_mean;
-    else
-      throw bad("per-pixel, block-mean");
-  } else {
-    throw InputError(where + ": unknown fidelity knob \"" + knob + "\"");
-  }
-}
-
 const char* tier_name(Tier t) { return t == Tier::fast ? "fast" : t == Tier::exact ? "exact" : "standard"; }
 const char* precision_name(Precision p) {
   return p == Precision::fp64 ? "fp64" : p == Precision::fixed16 ? "fixed16" : "fp32";
 }
 
 void validate(const Plan& plan, const Catalogue& cat) {
-  const ModelSettings& m = plan.model;
   (void)cat;
-  if (m.block < 1 || m.block > 65536)
-    throw InputError("--block: " + std::to_string(m.block) + " must be between 1 and 65536 pixels");
-  if (!std::isfinite(m.pixel_sigma) || m.pixel_sigma < 0 || m.pixel_sigma > 1000)
-    throw InputError("--pixel-noise: must be a finite number between 0 and 1000 gray levels");
-  if (!std::isfinite(m.jitter) || m.jitter < 0 || m.jitter > 1000)
-    throw InputError("--jitter: must be a finite number of pixels between 0 and 1000");
-  if (m.metal_noise < 0 || m.metal_noise > 199) throw InputError("--metal-noise: must be between 0 and 199");
+  check_knobs(plan);
 }
 
 }  // namespace portalsim

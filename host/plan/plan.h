@@ -50,9 +50,6 @@ struct Fidelity {
 enum class Tier { fast, standard, exact };
 Fidelity tier_fidelity(Tier t);
 Tier parse_tier(const std::string& name, const std::string& where);
-// Sets one knob by name ("precision", "pooling", "fast_math", "noise_model") from text;
-// throws InputError naming `where`.
-void set_fidelity_knob(Fidelity& f, const std::string& knob, const std::string& value, const std::string& where);
 const char* tier_name(Tier t);
 const char* precision_name(Precision p);
 

@@ -154,13 +154,10 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   res.begin = total * opt.shard / opt.shards;
   res.end = total * (opt.shard + 1) / opt.shards;
 
-  Plan plan;
+  Plan plan = spec.settings();
   plan.features = spec.wants_features();
   plan.metal = true;
   plan.images = spec.wants_images() ? kAllViews : 0;
-  plan.model = spec.model;
-  plan.model.seed = spec.seed;
-  plan.fidelity = spec.fidelity();
   validate(plan, cat);
   res.batch = opt.batch ? opt.batch : default_batch(plan, cat);
   const unsigned threads = opt.threads ? opt.threads : default_threads();

@@ -6,6 +6,7 @@
 #include "base/error.h"
 #include "io/input_file.h"
 #include "io/toml_input.h"
+#include "plan/knobs.h"
 
 namespace portalsim {
 
@@ -22,26 +23,27 @@ nlohmann::json RunSpec::to_json() const {
   j["what"] = what;
   j["format"] = formats;
   j["image_format"] = image_format;
-  j["block"] = model.block;
-  j["pattern_noise"] = model.pattern_noise;
-  j["pixel_noise"] = model.pixel_sigma;
-  j["metal_noise"] = model.metal_noise;
-  j["placement"] = model.bilinear ? "bilinear" : "integer";
-  j["jitter"] = model.jitter;
   // The fidelity changes the numbers (within its tier's tolerance), so it is part of
-  // the identity; pooling is not (sparse and dense agree to the bit).
-  const Fidelity f = fidelity();
+  // the identity; knobs that never change a bit (pooling) are not.
+  const Plan p = settings();
   j["tier"] = tier;
-  j["precision"] = precision_name(f.precision);
-  j["fast_math"] = f.fast_math;
-  j["noise_model"] = f.noise == NoiseModel::block_mean ? "block-mean" : "per-pixel";
+  for (const Knob& k : portalsim::knobs())
+    if (k.identity) j[k.key] = k.get(p);
   return j;
 }
 
-Fidelity RunSpec::fidelity() const {
-  Fidelity f = tier_fidelity(parse_tier(tier, where("tier")));
-  for (const auto& [k, v] : knobs) set_fidelity_knob(f, k, v, where(k));
-  return f;
+Plan RunSpec::settings() const {
+  Plan p;
+  p.fidelity = tier_fidelity(parse_tier(tier, where("tier")));
+  for (const auto& [key, text] : knobs) set_knob(p, *find_knob(key), text, where(key));
+  p.model.seed = seed;
+  return p;
+}
+
+void RunSpec::set_knob_text(const std::string& key, const std::string& text, const std::string& at) {
+  Plan scratch;
+  set_knob(scratch, *find_knob(key), text, at);
+  knobs[key] = text;
 }
 
 void RunSpec::validate() const {
@@ -59,7 +61,7 @@ void RunSpec::validate() const {
   if (image_format != "png" && image_format != "jpg")
     throw InputError(where("image_format") + ": \"" + image_format + "\" is not png or jpg");
   if (balance && rule.empty()) throw InputError(where("balance") + ": needs a threat rule (--rule)");
-  (void)fidelity();  // checks the tier and knobs
+  (void)settings();  // checks the tier and knobs
 }
 
 std::vector<std::string> split_list(const std::string& text) {
@@ -88,6 +90,31 @@ void parse_object_range(const std::string& text, const std::string& where, RunSp
   spec.min_objects = lo;
   spec.max_objects = hi;
 }
+
+namespace {
+
+// A TOML value as the knob's text ("10", "2.5", "on", "bilinear"); the type is checked here,
+// the value by set_knob.
+std::string knob_value(const Knob& k, const toml::node& n, const std::string& at) {
+  switch (k.kind) {
+    case KnobKind::integer:
+      if (!n.is_integer()) throw InputError(at + ": expected an integer");
+      return std::to_string(n.as_integer()->get());
+    case KnobKind::number:
+      if (n.is_integer()) return std::to_string(n.as_integer()->get());
+      if (!n.is_floating_point()) throw InputError(at + ": expected a number");
+      return knob_text(n.as_floating_point()->get());
+    case KnobKind::on_off:
+      if (!n.is_boolean()) throw InputError(at + ": expected true or false");
+      return n.as_boolean()->get() ? "on" : "off";
+    case KnobKind::choice:
+      if (!n.is_string()) throw InputError(at + ": expected a string (" + k.values() + ")");
+      return n.as_string()->get();
+  }
+  return "";
+}
+
+}  // namespace
 
 void read_spec_file(const std::string& path, RunSpec& spec) {
   parse_spec(io::read_file(path, "spec file", io::kMaxTextBytes), path, spec);
@@ -160,46 +187,18 @@ void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
       spec.formats = strings(node, key);
     } else if (key == "image_format") {
       spec.image_format = string(node, key);
-    } else if (key == "block") {
-      spec.model.block = static_cast<int>(integer(node, key, 1, 4096));
-    } else if (key == "pattern_noise") {
-      spec.model.pattern_noise = boolean(node, key);
-    } else if (key == "pixel_noise") {
-      double v = node.is_integer()          ? static_cast<double>(node.as_integer()->get())
-                 : node.is_floating_point() ? node.as_floating_point()->get()
-                                            : throw InputError(at(node, key) + ": expected a number");
-      if (!std::isfinite(v) || v < 0 || v > 1000)
-        throw InputError(at(node, key) + ": must be a finite number between 0 and 1000");
-      spec.model.pixel_sigma = v;
-    } else if (key == "metal_noise") {
-      spec.model.metal_noise = static_cast<int>(integer(node, key, 0, 199));
-    } else if (key == "placement") {
-      const std::string v = string(node, key);
-      if (v != "integer" && v != "bilinear")
-        throw InputError(at(node, key) + ": \"" + v + "\" is not integer or bilinear");
-      spec.model.bilinear = v == "bilinear";
-    } else if (key == "jitter") {
-      double v = node.is_integer()          ? static_cast<double>(node.as_integer()->get())
-                 : node.is_floating_point() ? node.as_floating_point()->get()
-                                            : throw InputError(at(node, key) + ": expected a number");
-      if (!std::isfinite(v) || v < 0 || v > 1000)
-        throw InputError(at(node, key) + ": must be a finite number of pixels between 0 and 1000");
-      spec.model.jitter = v;
     } else if (key == "tier") {
       spec.tier = string(node, key);
-    } else if (key == "precision" || key == "pooling" || key == "noise_model") {
-      spec.knobs[key] = string(node, key);
-    } else if (key == "fast_math") {
-      spec.knobs[key] = boolean(node, key) ? "on" : "off";
     } else if (key == "scenarios") {
       std::filesystem::path p(string(node, key));
       spec.scenarios = (p.is_relative() ? std::filesystem::path(dir) / p : p).string();
+    } else if (const Knob* knob = find_knob(key)) {
+      spec.set_knob_text(key, knob_value(*knob, node, at(node, key)), at(node, key));
     } else {
-      throw InputError(at(node, key) +
-                       ": unknown key (count, seed, rule, pool, objects, subjects, balance, what, format, "
-                       "image_format, block, pattern_noise, pixel_noise, metal_noise, scenarios, placement, jitter, "
-                       "tier, precision, pooling, "
-                       "fast_math, noise_model)");
+      std::string known =
+          "count, seed, rule, pool, objects, subjects, balance, what, format, image_format, scenarios, tier";
+      for (const Knob& k : portalsim::knobs()) known += ", " + k.key;
+      throw InputError(at(node, key) + ": unknown key (" + known + ")");
     }
   }
 }

@@ -24,28 +24,34 @@ struct RunSpec {
   std::string what = "features";  // features | images | both
   std::vector<std::string> formats{"arff"};
   std::string image_format = "png";
-  ModelSettings model;                       // seed is copied from `seed`
-  std::string tier = "standard";             // fast | standard | exact; the knobs below override it
-  std::map<std::string, std::string> knobs;  // precision, pooling, fast_math, noise_model
-  Fidelity fidelity() const;
+  std::string tier = "standard";             // fast | standard | exact; fidelity knobs override it
+  std::map<std::string, std::string> knobs;  // the knobs given (plan/knobs.h), by key, as text
+  // The model and fidelity: the tier's, then every given knob; the model's seed is `seed`.
+  Plan settings() const;
   // Where each key came from in a spec file ("spec.toml:3: pool"); keys given on the
   // command line are named by their flag instead.
   std::map<std::string, std::string> origin;
   std::string where(const std::string& key) const {
     auto it = origin.find(key);
-    return it != origin.end() ? it->second : "--" + key;
+    if (it != origin.end()) return it->second;
+    std::string flag = "--" + key;
+    for (char& c : flag)
+      if (c == '_') c = '-';
+    return flag;
   }
 
   bool wants_features() const { return what != "images"; }
   bool wants_images() const { return what != "features"; }
   nlohmann::json to_json() const;
+  // Sets a knob (checked at once; throws InputError naming `where`).
+  void set_knob_text(const std::string& key, const std::string& text, const std::string& where);
   // Checks values that need no catalogue; throws InputError naming the option.
   void validate() const;
 };
 
 // Reads a TOML spec (keys as the long options: count, seed, rule, pool, objects,
-// subjects, balance, what, format, block, image_format, pattern_noise, pixel_noise,
-// metal_noise, scenarios) over `spec`. Errors name the file, line and key.
+// subjects, balance, what, format, image_format, scenarios, tier and every knob's key)
+// over `spec`. Errors name the file, line and key.
 void read_spec_file(const std::string& path, RunSpec& spec);
 // The same from text already read; `path` names it in errors.
 void parse_spec(std::string_view text, const std::string& path, RunSpec& spec);

@@ -20,6 +20,7 @@
 
 #include "base/error.h"
 #include "io/input_file.h"
+#include "plan/knobs.h"
 #include "serve/one_scenario.h"
 #include "sink/staging.h"
 
@@ -99,8 +100,6 @@ struct Request {
   ScenarioInputs in;
   Plan plan;
   std::string seed = "0", tier = "standard";
-  bool pattern_noise = true;
-  double pixel_noise = 0;
 };
 
 struct Job {
@@ -157,17 +156,17 @@ struct Server::Impl {
     r.in.threat = field<std::string>(j, "threat", "");
     r.seed = field<std::string>(j, "seed", "0");
     r.tier = field<std::string>(j, "tier", "standard");
-    r.pattern_noise = field<bool>(j, "pattern_noise", true);
-    r.pixel_noise = field<double>(j, "pixel_noise", 0.0);
-    const std::string placement = field<std::string>(j, "placement", "integer");
-    if (placement != "integer" && placement != "bilinear")
-      throw InputError("--placement: " + placement + " not in {integer,bilinear}");
-    r.plan.model.bilinear = placement == "bilinear";
+    // The page's knobs, checked as their flags are.
+    const auto knob = [&](const char* key, const std::string& text) {
+      const Knob& k = *find_knob(key);
+      set_knob(r.plan, k, text, k.flag());
+    };
+    knob("pattern_noise", field<bool>(j, "pattern_noise", true) ? "on" : "off");
+    knob("pixel_noise", knob_text(field<double>(j, "pixel_noise", 0.0)));
+    knob("placement", field<std::string>(j, "placement", "integer"));
     if (r.in.objects.size() > static_cast<size_t>(kRegions))
       throw InputError("objects: " + std::to_string(r.in.objects.size()) + " given, at most 13 regions");
     r.plan.model.seed = io::parse_u64(r.seed, "--seed");
-    r.plan.model.pattern_noise = r.pattern_noise;
-    r.plan.model.pixel_sigma = r.pixel_noise;
     // The command line's own check (CLI11's IsMember) and its words.
     if (r.tier != "fast" && r.tier != "standard" && r.tier != "exact")
       throw InputError("--tier: " + r.tier + " not in {fast,standard,exact}");
@@ -282,16 +281,12 @@ struct Server::Impl {
                                   std::to_string(r.in.subject),
                                   "--tier",
                                   r.tier,
-                                  "--pattern-noise",
-                                  r.pattern_noise ? "on" : "off",
-                                  "--pixel-noise",
-                                  std::to_string(r.pixel_noise),
-                                  "--placement",
-                                  r.plan.model.bilinear ? "bilinear" : "integer",
                                   "--what",
                                   "both",
                                   "--batch",
                                   "64"};
+    for (const Knob& k : knobs())  // the page's model, knob by knob; the tier sets the rest
+      if (!k.fidelity) args.insert(args.end(), {k.flag(), knob_text(k.get(r.plan))});
     if (!r.in.rule.empty()) args.insert(args.end(), {"--rule", r.in.rule});
     args.insert(args.end(), opt.session.begin(), opt.session.end());
     if (job_waiter.joinable()) job_waiter.join();

@@ -1,0 +1,182 @@
+#include "plan/knobs.h"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+#include "base/error.h"
+
+namespace portalsim {
+
+namespace {
+
+std::string format_number(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+Knob integer(std::string key, int lo, int hi, std::string unit, std::string help,
+             std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
+  return Knob{std::move(key), KnobKind::integer, double(lo),    double(hi), {}, std::move(unit), std::move(help), false,
+              true,           std::move(set),    std::move(get)};
+}
+
+Knob number(std::string key, double lo, double hi, std::string unit, std::string help,
+            std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
+  return Knob{std::move(key), KnobKind::number, lo, hi, {}, std::move(unit), std::move(help), false, true,
+              std::move(set), std::move(get)};
+}
+
+Knob on_off(std::string key, std::string help, bool fidelity, std::function<void(Plan&, double)> set,
+            std::function<nlohmann::json(const Plan&)> get) {
+  return Knob{std::move(key), KnobKind::on_off, 0, 1, {"on", "off"}, "", std::move(help), fidelity, true,
+              std::move(set), std::move(get)};
+}
+
+Knob choice(std::string key, std::vector<std::string> choices, std::string help, bool fidelity, bool identity,
+            std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
+  return Knob{std::move(key), KnobKind::choice, 0, 0, std::move(choices), "", std::move(help), fidelity, identity,
+              std::move(set), std::move(get)};
+}
+
+std::vector<Knob> declare() {
+  std::vector<Knob> k;
+  // The sensor model (README, "The model"); defaults are the thesis's.
+  k.push_back(integer(
+      "block", 1, 65536, "pixels", "side of the averaged pixel blocks of the features (thesis 5.6)",
+      [](Plan& p, double v) { p.model.block = static_cast<int>(v); }, [](const Plan& p) { return p.model.block; }));
+  k.push_back(on_off(
+      "pattern_noise", "the thesis's MMW noise patterns, one over each object (thesis 4.2)", false,
+      [](Plan& p, double v) { p.model.pattern_noise = v != 0; }, [](const Plan& p) { return p.model.pattern_noise; }));
+  k.push_back(number(
+      "pixel_noise", 0, 1000, "gray levels", "per-pixel Gaussian sensor noise sigma (MMW and IR)",
+      [](Plan& p, double v) { p.model.pixel_sigma = v; }, [](const Plan& p) { return p.model.pixel_sigma; }));
+  k.push_back(integer(
+      "metal_noise", 0, 199, "counts", "metal detector noise: triangular integer noise of this half-width",
+      [](Plan& p, double v) { p.model.metal_noise = static_cast<int>(v); },
+      [](const Plan& p) { return p.model.metal_noise; }));
+  k.push_back(choice(
+      "placement", {"integer", "bilinear"}, "sprite placement: whole pixels, or sub-pixel with bilinear sampling",
+      false, true, [](Plan& p, double v) { p.model.bilinear = v != 0; },
+      [](const Plan& p) { return p.model.bilinear ? "bilinear" : "integer"; }));
+  k.push_back(number(
+      "jitter", 0, 1000, "pixels", "move each object by up to this much in x and y",
+      [](Plan& p, double v) { p.model.jitter = v; }, [](const Plan& p) { return p.model.jitter; }));
+  // The fidelity tiers' knobs (README, "Fidelity tiers"): each overrides --tier.
+  k.push_back(choice(
+      "precision", {"fp32", "fp64", "fixed16"},
+      "the kernels' pixel arithmetic: fp32; fp64 with the reference's formulas; 8.8 fixed point in "
+      "integers (alpha and noise gain quantised to 1/256)",
+      true, true, [](Plan& p, double v) { p.fidelity.precision = static_cast<Precision>(v); },
+      [](const Plan& p) { return precision_name(p.fidelity.precision); }));
+  // Sparse and dense pooling agree to the bit, so pooling is not part of the identity.
+  k.push_back(choice(
+      "pooling", {"sparse", "dense"},
+      "features-only runs from precomputed tables and overlap pixels (sparse), or by rendering "
+      "every image and pooling it (dense); identical results",
+      true, false, [](Plan& p, double v) { p.fidelity.pooling = static_cast<Pooling>(v); },
+      [](const Plan& p) { return p.fidelity.pooling == Pooling::dense ? "dense" : "sparse"; }));
+  k.push_back(on_off(
+      "fast_math", "-cl-fast-relaxed-math for the kernel build", true,
+      [](Plan& p, double v) { p.fidelity.fast_math = v != 0; }, [](const Plan& p) { return p.fidelity.fast_math; }));
+  k.push_back(choice(
+      "noise_model", {"per-pixel", "block-mean"},
+      "in features-only runs with pixel noise: draw every pixel's noise, or give each mean over c "
+      "pixels one draw of N(0, sigma^2/c) (ignores rounding and clipping of single pixels, keeps the sparse path)",
+      true, true, [](Plan& p, double v) { p.fidelity.noise = static_cast<NoiseModel>(v); },
+      [](const Plan& p) { return p.fidelity.noise == NoiseModel::block_mean ? "block-mean" : "per-pixel"; }));
+  return k;
+}
+
+// The whole text as a number, or nothing.
+bool parse_number(const std::string& text, double& v) {
+  const char* end = text.data() + text.size();
+  const auto r = std::from_chars(text.data(), end, v);
+  return r.ec == std::errc() && r.ptr == end;
+}
+
+}  // namespace
+
+std::string Knob::flag() const {
+  std::string f = "--" + key;
+  for (char& c : f)
+    if (c == '_') c = '-';
+  return f;
+}
+
+std::string Knob::values() const {
+  if (kind == KnobKind::integer || kind == KnobKind::number)
+    return format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit);
+  std::string s;
+  for (const std::string& c : choices) s += (s.empty() ? "" : ", ") + c;
+  return s;
+}
+
+const std::vector<Knob>& knobs() {
+  static const std::vector<Knob> all = declare();
+  return all;
+}
+
+const Knob* find_knob(std::string_view key) {
+  for (const Knob& k : knobs())
+    if (k.key == key) return &k;
+  return nullptr;
+}
+
+void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::string& where) {
+  double v = 0;
+  switch (knob.kind) {
+    case KnobKind::integer:
+      if (!parse_number(text, v) || v != std::floor(v) || text.find_first_of(".eE") != std::string::npos)
+        throw InputError(where + ": \"" + text + "\" is not a whole number");
+      if (v < knob.min || v > knob.max)
+        throw InputError(where + ": " + text + " is out of range [" + knob.values() + "]");
+      break;
+    case KnobKind::number:
+      if (!parse_number(text, v) || !std::isfinite(v) || v < knob.min || v > knob.max)
+        throw InputError(where + ": \"" + text + "\" must be a finite number between " + knob.values());
+      break;
+    case KnobKind::on_off:
+      if (text != "on" && text != "off") throw InputError(where + ": \"" + text + "\" is not on or off");
+      v = text == "on";
+      break;
+    case KnobKind::choice: {
+      size_t i = 0;
+      while (i < knob.choices.size() && knob.choices[i] != text) ++i;
+      if (i == knob.choices.size()) throw InputError(where + ": \"" + text + "\" is not one of " + knob.values());
+      v = static_cast<double>(i);
+      break;
+    }
+  }
+  knob.set(plan, v);
+}
+
+void check_knobs(const Plan& plan) {
+  for (const Knob& k : knobs()) {
+    if (k.kind != KnobKind::integer && k.kind != KnobKind::number) continue;
+    const double v = k.get(plan).get<double>();
+    if (!std::isfinite(v) || v < k.min || v > k.max)
+      throw InputError(k.flag() + ": " + format_number(v) + " must be a finite number between " + k.values());
+  }
+}
+
+std::string knob_text(const nlohmann::json& value) {
+  if (value.is_boolean()) return value.get<bool>() ? "on" : "off";
+  if (value.is_string()) return value.get<std::string>();
+  return format_number(value.get<double>());
+}
+
+std::string knob_table_markdown() {
+  Plan thesis;
+  thesis.fidelity = tier_fidelity(Tier::standard);
+  std::ostringstream md;
+  md << "| flag | spec key | values | default | what it does |\n| --- | --- | --- | --- | --- |\n";
+  for (const Knob& k : knobs())
+    md << "| `" << k.flag() << "` | `" << k.key << "` | " << k.values() << " | " << knob_text(k.get(thesis))
+       << (k.fidelity ? " (standard tier)" : "") << " | " << k.help << (k.fidelity ? "; overrides `--tier`" : "")
+       << " |\n";
+  return md.str();
+}
+
+}  // namespace portalsim

@@ -1,0 +1,51 @@
+// Every knob of the sensor model and of the fidelity tiers, declared once: its key, the
+// values it takes, its default and its help. The command-line flags, the spec-file keys,
+// the checks, the manifest entries and the README's knob table all come from this list.
+#pragma once
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "plan/plan.h"
+
+namespace portalsim {
+
+enum class KnobKind { integer, number, on_off, choice };
+
+struct Knob {
+  std::string key;  // spec-file key and manifest entry; the flag is "--" + key with '-' for '_'
+  KnobKind kind;
+  double min = 0, max = 0;           // integer and number
+  std::vector<std::string> choices;  // choice
+  std::string unit;                  // integer and number, for the help and the README
+  std::string help;
+  bool fidelity = false;  // overrides the tier (its default comes from the tier)
+  bool identity = true;   // part of a data set's identity (checked on --resume)
+  // Sets the knob from a checked value: the number, 0/1 for on_off, or the choice's index.
+  std::function<void(Plan&, double)> set;
+  // The knob's value in `plan`: a number, a bool (on_off) or the choice's name.
+  std::function<nlohmann::json(const Plan&)> get;
+
+  std::string flag() const;
+  // "0 .. 1000 gray levels", "on, off", "fp32, fp64, fixed16".
+  std::string values() const;
+};
+
+const std::vector<Knob>& knobs();
+// Null when no knob has this key.
+const Knob* find_knob(std::string_view key);
+
+// Checks `text` against the knob ("2.5", "on", "bilinear"), then sets it in `plan`;
+// throws InputError starting with `where` (a flag or "file:line: key").
+void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::string& where);
+// Throws InputError naming the knob's flag when a value in `plan` is outside its range.
+void check_knobs(const Plan& plan);
+// The value as set_knob reads it back: "10", "2.5", "on", "bilinear".
+std::string knob_text(const nlohmann::json& value);
+
+// The README's knob table (Markdown), from the declarations.
+std::string knob_table_markdown();
+
+}  // namespace portalsim
