@@ -395,6 +395,7 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   if (plan.images && !spec.image_tensors()) manifest["images"] = {{"folder", "images"}, {"count", res.end - res.begin}};
   write_text_atomic((out / "manifest.json").string(), manifest.dump(2) + "\n");
   fs::remove_all(state_dir, ec);
+  res.seconds = since(t0);  // with the finishing work (data.h5 is built there)
   return res;
 }
 
