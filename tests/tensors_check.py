@@ -57,6 +57,12 @@ def main():
         expect(json.loads(f.attrs["spec"]) == manifest["spec"], "data.h5: attribute spec differs from the manifest")
         expect(list(f.attrs["class_names"]) == ["negative", "positive"], "data.h5: class_names")
         expect(len(f.attrs["region_names"]) == 13, "data.h5: region_names")
+        drawings = list(f.attrs["object_drawings"])
+        expect(len(drawings) == len(f.attrs["object_names"]), "data.h5: object_drawings and object_names differ")
+        obj, ori = f["region_object"][:], f["region_orientation"][:]
+        expect(((obj < 0) == (ori < 0)).all(), "data.h5: region_orientation set where no object is")
+        for o, d in zip(obj[obj >= 0], ori[obj >= 0]):
+            expect(d < max(1, len(drawings[o].split(","))), f"data.h5: drawing {d} of object {o} ({drawings[o]})")
         label = f["label"][:]
         expect(label.sum() == N // 2, f"data.h5: --balance gave {label.sum()} threats of {N}")
         expect((f["region_label"][:].max(axis=1) == label).all(), "data.h5: label is not 'any region is a threat'")

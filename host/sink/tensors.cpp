@@ -316,11 +316,17 @@ class TensorSink final : public Sink {
     write_string(file, "spec", opt_.identity.value("spec", nlohmann::json::object()).dump(), path);
     write_string(file, "identity", opt_.identity.dump(), path);
     write_strings(file, "class_names", {"negative", "positive"}, path);
-    std::vector<std::string> objects, regions;
-    for (const Object& o : cat.objects) objects.push_back(o.name);
+    std::vector<std::string> objects, regions, drawings;
+    for (const Object& o : cat.objects) {
+      objects.push_back(o.name);
+      std::string codes;  // region_orientation indexes these: "h,v", or "" for one drawing
+      for (const Variant& v : o.variants) codes += (codes.empty() ? "" : ",") + v.code;
+      drawings.push_back(codes);
+    }
     for (const Region& r : cat.regions) regions.push_back(r.name);
     write_strings(file, "object_names", objects, path);
     write_strings(file, "region_names", regions, path);
+    write_strings(file, "object_drawings", drawings, path);
     write_string(file, "region_label_rule", opt_.rule ? opt_.rule->text() : std::string(), path);
   }
 };
