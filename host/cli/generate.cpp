@@ -67,6 +67,7 @@ int generate(GenerateOptions& o) {
   if (given("--what")) spec.what = o.spec.what;
   if (given("--format")) spec.formats = split_list(o.formats);
   if (given("--image-format")) spec.image_format = o.spec.image_format;
+  if (given("--compress")) spec.compress = o.spec.compress;
   if (given("--scenarios")) spec.scenarios = o.spec.scenarios;
   if (given("--tier")) spec.tier = o.spec.tier;
   for (const auto& [key, text] : given_knobs(app, o.knobs)) {
@@ -146,7 +147,10 @@ std::function<int()> add_generate(CLI::App& app) {
   sub->add_option("--subjects", o->subjects, "subjects to draw from, e.g. 1,2,5 (default: all)");
   sub->add_flag("--balance", o->spec.balance, "equal classes: even indices threats, odd not");
   sub->add_option("--what", o->spec.what, "features, images or both (default features)");
-  sub->add_option("--format", o->formats, "feature tables: arff,csv,npy (default arff)");
+  sub->add_option("--format", o->formats,
+                  "arff,csv,npy feature tables; h5: data.h5 with image tensors and labels; npy with --what images: "
+                  "image tensors as .npy (default arff)");
+  sub->add_flag("--compress", o->spec.compress, "gzip data.h5's datasets (--format h5)");
   sub->add_option("--image-format", o->spec.image_format, "png or jpg (default png)");
   sub->add_option("--scenarios", o->spec.scenarios, "explicit scenario list (CSV: subject, region1..13, label)");
   add_knob_options(*sub, o->spec.tier, o->knobs);

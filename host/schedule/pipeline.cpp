@@ -16,6 +16,7 @@
 #include "sink/output_folder.h"
 #include "sink/sinks.h"
 #include "sink/staging.h"
+#include "sink/tensors.h"
 
 namespace portalsim {
 
@@ -143,10 +144,10 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   std::vector<Scenario> listed;
   std::optional<ThreatRule> rule;
   uint64_t total = spec.count;
+  if (!spec.rule.empty()) rule.emplace(cat, spec.rule, "--rule");  // listed scenarios' labels; region labels
   if (!spec.scenarios.empty()) {
     listed = read_scenario_file(cat, spec.scenarios);
     total = listed.size();
-    if (!spec.rule.empty()) rule.emplace(cat, spec.rule, "--rule");
   } else {
     generator.emplace(cat, generator_spec(spec, cat), spec.seed);
   }
@@ -270,8 +271,24 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   std::vector<std::unique_ptr<Sink>> sinks;
   sinks.push_back(make_scenario_list_sink(ctx, resume_state("scenarios.csv")));
   if (plan.features)
-    for (const std::string& f : spec.formats) sinks.push_back(make_table_sink(f, ctx, resume_state("features." + f)));
-  if (plan.images) sinks.push_back(make_image_sink(ctx, resuming, start));
+    for (const std::string& f : spec.formats)
+      if (f != "h5") sinks.push_back(make_table_sink(f, ctx, resume_state("features." + f)));
+  if (plan.images && !spec.image_tensors()) sinks.push_back(make_image_sink(ctx, resuming, start));
+  TensorOptions topt;
+  topt.rule = rule ? &*rule : nullptr;
+  topt.identity = identity;
+  if (spec.has_format("h5")) {
+    topt.h5 = true;
+    topt.compress = spec.compress;
+    topt.images = spec.wants_images();
+    topt.features = spec.wants_features();
+    sinks.push_back(make_tensor_sink(ctx, topt, resuming ? &saved : nullptr));
+  }
+  if (spec.npy_image_tensors()) {
+    topt.h5 = false;
+    topt.images = true;
+    sinks.push_back(make_tensor_sink(ctx, topt, resuming ? &saved : nullptr));
+  }
 
   const auto save_checkpoint = [&](uint64_t next) {
     json c;
@@ -368,16 +385,17 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   manifest["classes"] = {{"positive", res.positive}, {"negative", res.negative}};
   manifest["outputs"] = json::array();
   for (auto& s : sinks) {
+    s->finish();  // before files(): data.h5 exists only once finished
     for (const FileState& f : s->files()) {
       char hash[17];
       std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(f.xxh3));
       manifest["outputs"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"xxh3_64", hash}});
     }
-    s->finish();
   }
-  if (plan.images) manifest["images"] = {{"folder", "images"}, {"count", res.end - res.begin}};
+  if (plan.images && !spec.image_tensors()) manifest["images"] = {{"folder", "images"}, {"count", res.end - res.begin}};
   write_text_atomic((out / "manifest.json").string(), manifest.dump(2) + "\n");
   fs::remove_all(state_dir, ec);
+  res.seconds = since(t0);  // with the finishing work (data.h5 is built there)
   return res;
 }
 

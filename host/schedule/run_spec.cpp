@@ -23,6 +23,7 @@ nlohmann::json RunSpec::to_json() const {
   j["what"] = what;
   j["format"] = formats;
   j["image_format"] = image_format;
+  j["compress"] = compress;
   // The fidelity changes the numbers (within its tier's tolerance), so it is part of
   // the identity; knobs that never change a bit (pooling) are not.
   const Plan p = settings();
@@ -53,11 +54,12 @@ void RunSpec::validate() const {
     throw InputError(where("what") + ": \"" + what + "\" is not features, images or both");
   if (wants_features() && formats.empty()) throw InputError(where("format") + ": give at least one of arff, csv, npy");
   for (size_t i = 0; i < formats.size(); ++i) {
-    if (formats[i] != "arff" && formats[i] != "csv" && formats[i] != "npy")
-      throw InputError(where("format") + ": \"" + formats[i] + "\" is not arff, csv or npy");
+    if (formats[i] != "arff" && formats[i] != "csv" && formats[i] != "npy" && formats[i] != "h5")
+      throw InputError(where("format") + ": \"" + formats[i] + "\" is not arff, csv, npy or h5");
     for (size_t j = 0; j < i; ++j)
       if (formats[j] == formats[i]) throw InputError(where("format") + ": \"" + formats[i] + "\" given twice");
   }
+  if (compress && !has_format("h5")) throw InputError(where("compress") + ": only applies to --format h5");
   if (image_format != "png" && image_format != "jpg")
     throw InputError(where("image_format") + ": \"" + image_format + "\" is not png or jpg");
   if (balance && rule.empty()) throw InputError(where("balance") + ": needs a threat rule (--rule)");
@@ -187,6 +189,8 @@ void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
       spec.formats = strings(node, key);
     } else if (key == "image_format") {
       spec.image_format = string(node, key);
+    } else if (key == "compress") {
+      spec.compress = boolean(node, key);
     } else if (key == "tier") {
       spec.tier = string(node, key);
     } else if (key == "scenarios") {
@@ -196,7 +200,7 @@ void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
       spec.set_knob_text(key, knob_value(*knob, node, at(node, key)), at(node, key));
     } else {
       std::string known =
-          "count, seed, rule, pool, objects, subjects, balance, what, format, image_format, scenarios, tier";
+          "count, seed, rule, pool, objects, subjects, balance, what, format, image_format, compress, scenarios, tier";
       for (const Knob& k : portalsim::knobs()) known += ", " + k.key;
       throw InputError(at(node, key) + ": unknown key (" + known + ")");
     }

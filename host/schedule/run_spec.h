@@ -2,6 +2,7 @@
 // and checked on --resume. Batch size, threads and backend are not part of it: they
 // never change the data.
 #pragma once
+#include <algorithm>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -24,6 +25,7 @@ struct RunSpec {
   std::string what = "features";  // features | images | both
   std::vector<std::string> formats{"arff"};
   std::string image_format = "png";
+  bool compress = false;                     // gzip data.h5's datasets (--format h5)
   std::string tier = "standard";             // fast | standard | exact; fidelity knobs override it
   std::map<std::string, std::string> knobs;  // the knobs given (plan/knobs.h), by key, as text
   // The model and fidelity: the tier's, then every given knob; the model's seed is `seed`.
@@ -42,6 +44,11 @@ struct RunSpec {
 
   bool wants_features() const { return what != "images"; }
   bool wants_images() const { return what != "features"; }
+  bool has_format(const std::string& f) const { return std::find(formats.begin(), formats.end(), f) != formats.end(); }
+  // Images go to tensors instead of image folders: data.h5 (format h5), or <view>.npy
+  // (format npy with --what images; with --what both, npy is the feature table).
+  bool npy_image_tensors() const { return what == "images" && has_format("npy"); }
+  bool image_tensors() const { return wants_images() && (has_format("h5") || npy_image_tensors()); }
   nlohmann::json to_json() const;
   // Sets a knob (checked at once; throws InputError naming `where`).
   void set_knob_text(const std::string& key, const std::string& text, const std::string& where);

@@ -17,6 +17,27 @@ namespace {
 XXH3_state_t* state_of(void* p) { return static_cast<XXH3_state_t*>(p); }
 }  // namespace
 
+FileState hash_file(const std::string& dir, const std::string& name) {
+  const std::string path = (std::filesystem::path(dir) / name).string();
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw OutputError(path + ": cannot open: " + std::strerror(errno));
+  XXH3_state_t* h = XXH3_createState();
+  XXH3_64bits_reset(h);
+  std::vector<char> buf(1 << 20);
+  FileState s{name, 0, 0};
+  ssize_t r;
+  while ((r = ::read(fd, buf.data(), buf.size())) > 0) {
+    XXH3_64bits_update(h, buf.data(), static_cast<size_t>(r));
+    s.bytes += static_cast<uint64_t>(r);
+  }
+  const int err = errno;
+  ::close(fd);
+  s.xxh3 = XXH3_64bits_digest(h);
+  XXH3_freeState(h);
+  if (r < 0) throw OutputError(path + ": cannot read: " + std::strerror(err));
+  return s;
+}
+
 AppendFile::AppendFile(const std::string& dir, const std::string& name, const FileState* resume)
     : partial_((std::filesystem::path(dir) / (name + ".partial")).string()),
       final_((std::filesystem::path(dir) / name).string()),

@@ -13,6 +13,9 @@ struct FileState {
   uint64_t xxh3 = 0;  // XXH3-64 of the bytes so far
 };
 
+// The state of a finished file dir/name (its size and XXH3-64). Throws OutputError.
+FileState hash_file(const std::string& dir, const std::string& name);
+
 class AppendFile {
  public:
   // Opens dir/(name + ".partial"). With `resume`, truncates it to resume->bytes (it must

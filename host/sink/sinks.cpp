@@ -10,6 +10,7 @@
 #include "sink/feature_rows.h"
 #include "sink/scenario_folder.h"
 #include "sink/staging.h"
+#include "sink/tensors.h"
 
 namespace portalsim {
 
@@ -29,18 +30,7 @@ std::string arff_header(const FeatureLayout& layout) {
   return h;
 }
 
-std::string npy_header(uint64_t rows, size_t columns) {
-  std::string dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(rows) + ", " +
-                     std::to_string(columns) + "), }";
-  // Magic (6) + version (2) + length (2) + dict + padding + '\n', a multiple of 64.
-  const size_t total = (10 + dict.size() + 1 + 63) / 64 * 64;
-  dict.append(total - 10 - dict.size() - 1, ' ');
-  dict.push_back('\n');
-  std::string h("\x93NUMPY\x01\x00", 8);
-  h.push_back(static_cast<char>(dict.size() & 0xff));
-  h.push_back(static_cast<char>(dict.size() >> 8));
-  return h + dict;
-}
+std::string npy_header(uint64_t rows, size_t columns) { return npy_array_header("<f4", {rows, columns}); }
 
 namespace {
 

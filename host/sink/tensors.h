@@ -1,0 +1,41 @@
+// Tensor outputs for deep learning: per-scenario arrays, each appended batch by batch to
+// one .npy file (an AppendFile, so it is checkpointed and resumed like every table).
+//   --format npy: the files are the output, <name>.npy in the folder.
+//   --format h5:  the files live under .portalsim/tensors/ while the run goes; at the end
+//                 data.h5 is built from them (written to a temporary name, then renamed),
+//                 so a kill -9 never leaves a half-written HDF5 file to resume from.
+// Tensors (N scenarios): upper, lower uint8 NxHxW; ir uint8 NxHxWx3 (RGB through the
+// palette) and ir_index uint8 NxHxW (temperature index); metal uint8 Nx19; features
+// float32 NxF (image features, when computed); label, subject uint8 N; region_object,
+// region_orientation int16 Nx13 (object and drawing index, -1 for none); region_label
+// uint8 Nx13 (the rule applied to each region's object on its own).
+#pragma once
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "scene/rules.h"
+#include "sink/sinks.h"
+
+namespace portalsim {
+
+struct TensorOptions {
+  bool h5 = false;                   // build data.h5 at the end; otherwise <name>.npy files
+  bool compress = false;             // gzip the HDF5 datasets
+  bool images = false;               // the camera views
+  bool features = false;             // the image features
+  bool scenario = true;              // label, subject, metal, region_* (always in h5)
+  const ThreatRule* rule = nullptr;  // for region_label; null = every region 0
+  nlohmann::json identity;           // the run's identity (version, catalogue, spec): HDF5 attributes
+};
+
+// `resume` maps a file name (as FileState::name) to its checkpointed state; null when new.
+std::unique_ptr<Sink> make_tensor_sink(const SinkContext& ctx, const TensorOptions& opt,
+                                       const std::map<std::string, FileState>* resume);
+
+// The .npy header of an array of `shape` with numpy dtype `descr` ("|u1", "<i2", "<f4").
+std::string npy_array_header(const std::string& descr, const std::vector<uint64_t>& shape);
+
+}  // namespace portalsim

@@ -1,0 +1,89 @@
+#!/usr/bin/env python3
+"""ctest tensors.python: data.h5 read from Python, and a CNN that learns from it.
+
+    tensors_check.py PORTALSIM WORKDIR
+
+Generates a small balanced gun set with --format h5, checks every dataset's shape and
+dtype and the attributes with h5py, reads items through tools/portalsim_dataset.py, and
+runs tools/train_example.py on it: fails if the file cannot be read or if the model's
+held-out accuracy is not clearly above chance.
+"""
+import json
+import pathlib
+import shutil
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tools"))
+from portalsim_dataset import PortalsimDataset  # noqa: E402
+
+N = 1000
+
+
+def expect(cond, msg):
+    if not cond:
+        raise AssertionError(msg)
+
+
+def main():
+    portalsim, work = sys.argv[1], pathlib.Path(sys.argv[2])
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    out = work / "gunset"
+    subprocess.run([portalsim, "generate", "--count", str(N), "--seed", "1", "--rule", "gun", "--balance",
+                    "--what", "both", "--format", "h5", "--compress", "--out", str(out), "--quiet"], check=True)
+    manifest = json.loads((out / "manifest.json").read_text())
+    with h5py.File(out / "data.h5", "r") as f:
+        want = {"upper": ((N, 200, 200), np.uint8), "lower": ((N, 200, 200), np.uint8),
+                "ir": ((N, 200, 100, 3), np.uint8), "ir_index": ((N, 200, 100), np.uint8),
+                "metal": ((N, 19), np.uint8), "label": ((N,), np.uint8), "subject": ((N,), np.uint8),
+                "region_object": ((N, 13), np.int16), "region_orientation": ((N, 13), np.int16),
+                "region_label": ((N, 13), np.uint8)}
+        for name, (shape, dtype) in want.items():
+            expect(name in f, f"data.h5: no dataset {name}")
+            expect(f[name].shape == shape, f"data.h5: {name} has shape {f[name].shape}, expected {shape}")
+            expect(f[name].dtype == dtype, f"data.h5: {name} is {f[name].dtype}, expected {dtype}")
+            expect(f[name].chunks[0] == 64, f"data.h5: {name} is chunked {f[name].chunks}, expected 64 along N")
+            expect(f[name].compression == "gzip", f"data.h5: {name} is not gzip-compressed under --compress")
+        feats = f["features"]
+        expect(feats.dtype == np.float32 and feats.shape[0] == N, f"data.h5: features is {feats.dtype} {feats.shape}")
+        expect(len(feats.attrs["columns"]) == feats.shape[1], "data.h5: features' column names do not match")
+        expect(f.attrs["portalsim"] == manifest["portalsim"], "data.h5: attribute portalsim differs from manifest")
+        expect(f.attrs["catalogue_hash"] == manifest["catalogue"]["hash"], "data.h5: catalogue_hash differs")
+        expect(json.loads(f.attrs["spec"]) == manifest["spec"], "data.h5: attribute spec differs from the manifest")
+        expect(list(f.attrs["class_names"]) == ["negative", "positive"], "data.h5: class_names")
+        expect(len(f.attrs["region_names"]) == 13, "data.h5: region_names")
+        drawings = list(f.attrs["object_drawings"])
+        expect(len(drawings) == len(f.attrs["object_names"]), "data.h5: object_drawings and object_names differ")
+        obj, ori = f["region_object"][:], f["region_orientation"][:]
+        expect(((obj < 0) == (ori < 0)).all(), "data.h5: region_orientation set where no object is")
+        for o, d in zip(obj[obj >= 0], ori[obj >= 0]):
+            expect(d < max(1, len(drawings[o].split(","))), f"data.h5: drawing {d} of object {o} ({drawings[o]})")
+        label = f["label"][:]
+        expect(label.sum() == N // 2, f"data.h5: --balance gave {label.sum()} threats of {N}")
+        expect((f["region_label"][:].max(axis=1) == label).all(), "data.h5: label is not 'any region is a threat'")
+        expect((f["subject"][:] >= 1).all(), "data.h5: subject numbers are 1-based")
+        expect((f["ir"][:5] > 0).any() and (f["upper"][:5] > 0).any(), "data.h5: images are all zero")
+
+    ds = PortalsimDataset(out / "data.h5", views=("upper", "lower"))
+    x, y = ds[3]
+    expect(tuple(x.shape) == (2, 200, 200) and float(x.max()) <= 1.0, f"dataset item has shape {tuple(x.shape)}")
+    expect(int(y) == int(label[3]), "dataset label differs from the file's")
+    ir = PortalsimDataset(out / "data.h5", views=("ir",), target="region_label")
+    x, y = ir[0]
+    expect(tuple(x.shape) == (3, 200, 100) and tuple(y.shape) == (13,), f"ir item {tuple(x.shape)}, {tuple(y.shape)}")
+
+    r = subprocess.run([sys.executable, str(ROOT / "tools" / "train_example.py"), str(out / "data.h5"),
+                        "--steps", "250"], capture_output=True, text=True)
+    print(r.stdout, r.stderr, end="")
+    expect(r.returncode == 0, "train_example.py: the model did not learn (accuracy at chance) or failed")
+    shutil.rmtree(work, ignore_errors=True)
+    print("tensors.python: ok")
+
+
+if __name__ == "__main__":
+    main()

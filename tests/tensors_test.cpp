@@ -1,0 +1,264 @@
+// generate --format h5 and --what images --format npy: the tensors read back with libhdf5
+// and compared against the PNG folders and feature table of the same spec; byte identity
+// across --batch and --threads; exact resume after kill -9.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "assets/image_io.h"
+#include "run_binary.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using Args = std::vector<std::string>;
+using portalsim::test::slurp;
+
+Args plus(Args a, const Args& more) {
+  a.insert(a.end(), more.begin(), more.end());
+  return a;
+}
+
+portalsim::test::Result run(const portalsim::test::TempDir& t, Args args, const fs::path& out) {
+  args.insert(args.begin(), "generate");
+  args.insert(args.end(), {"--out", out.string(), "--quiet"});
+  return portalsim::test::finish(portalsim::test::start_program(t.cap(), PORTALSIM_BINARY, args), 300);
+}
+
+void ExpectOk(const portalsim::test::Result& r) {
+  EXPECT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+}
+
+struct Dataset {
+  std::vector<hsize_t> dims;
+  std::vector<uint8_t> bytes;  // in the dataset's native type
+  size_t count() const {
+    size_t n = 1;
+    for (hsize_t d : dims) n *= d;
+    return n;
+  }
+};
+
+// Reads a whole dataset of data.h5 with libhdf5 as `type` (a native type).
+Dataset read_h5(const fs::path& file, const std::string& name, hid_t type) {
+  Dataset d;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  EXPECT_GE(f, 0) << file;
+  if (f < 0) return d;
+  const hid_t ds = H5Dopen2(f, name.c_str(), H5P_DEFAULT);
+  EXPECT_GE(ds, 0) << file << ": no dataset " << name;
+  if (ds >= 0) {
+    const hid_t space = H5Dget_space(ds);
+    d.dims.resize(static_cast<size_t>(H5Sget_simple_extent_ndims(space)));
+    H5Sget_simple_extent_dims(space, d.dims.data(), nullptr);
+    d.bytes.resize(d.count() * H5Tget_size(type));
+    EXPECT_GE(H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, d.bytes.data()), 0) << name;
+    H5Sclose(space);
+    H5Dclose(ds);
+  }
+  H5Fclose(f);
+  return d;
+}
+
+// A scalar variable-length string attribute of the file's root group.
+std::string read_h5_string(const fs::path& file, const std::string& name) {
+  std::string s;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  const hid_t a = H5Aopen(f, name.c_str(), H5P_DEFAULT);
+  EXPECT_GE(a, 0) << file << ": no attribute " << name;
+  if (a >= 0) {
+    const hid_t type = H5Aget_type(a);
+    char* p = nullptr;
+    if (H5Tis_variable_str(type) > 0 && H5Aread(a, type, &p) >= 0 && p) {
+      s = p;
+      H5free_memory(p);
+    }
+    H5Tclose(type);
+    H5Aclose(a);
+  }
+  H5Fclose(f);
+  return s;
+}
+
+// The data bytes of a .npy file (after its header).
+std::string npy_data(const fs::path& p) {
+  const std::string s = slurp(p);
+  EXPECT_GE(s.size(), 10u) << p;
+  if (s.size() < 10) return "";
+  const size_t header = 10 + static_cast<uint8_t>(s[8]) + 256u * static_cast<uint8_t>(s[9]);
+  return s.substr(header);
+}
+
+const Args kSpec{"--count", "40", "--seed", "7", "--rule", "gun", "--objects", "1..4", "--what", "both"};
+
+TEST(TensorsH5, RoundTripMatchesImageFoldersAndFeatureTable) {
+  portalsim::test::TempDir t;
+  const fs::path png = t.w() / "png", h5 = t.w() / "h5";
+  ExpectOk(run(t, plus(kSpec, {"--format", "npy"}), png));
+  ExpectOk(run(t, plus(kSpec, {"--format", "h5"}), h5));
+  const fs::path file = h5 / "data.h5";
+  ASSERT_TRUE(fs::exists(file));
+  EXPECT_FALSE(fs::exists(h5 / "images")) << "--format h5 writes no image folders";
+  EXPECT_FALSE(fs::exists(h5 / ".portalsim")) << "the checkpointed tensors go once data.h5 is built";
+  const size_t N = 40;
+
+  // Images: each view against the PNG the same spec wrote.
+  for (const std::string view : {"upper", "lower", "ir"}) {
+    const Dataset d = read_h5(file, view, H5T_NATIVE_UINT8);
+    ASSERT_EQ(d.dims.size(), view == "ir" ? 4u : 3u) << view;
+    ASSERT_EQ(d.dims[0], N) << view;
+    const size_t per = d.count() / N;
+    for (size_t i = 0; i < N; ++i) {
+      char name[16];
+      std::snprintf(name, sizeof name, "%08zu", i);
+      const portalsim::Image img = portalsim::read_image((png / "images" / name / (view + ".png")).string(), view);
+      ASSERT_EQ(static_cast<size_t>(img.width), d.dims[2]) << view;
+      ASSERT_EQ(static_cast<size_t>(img.height), d.dims[1]) << view;
+      ASSERT_EQ(img.pixels.size(), per) << view << " has " << img.channels << " channels in the PNG";
+      ASSERT_EQ(std::memcmp(img.pixels.data(), d.bytes.data() + i * per, per), 0) << view << " scenario " << i;
+    }
+  }
+  const Dataset index = read_h5(file, "ir_index", H5T_NATIVE_UINT8);
+  ASSERT_EQ(index.dims.size(), 3u);
+
+  // Features, metal zones and labels against features.npy (features, 19 zones, class).
+  const std::string table = npy_data(png / "features.npy");
+  const Dataset feat = read_h5(file, "features", H5T_NATIVE_FLOAT);
+  const Dataset metal = read_h5(file, "metal", H5T_NATIVE_UINT8);
+  const Dataset label = read_h5(file, "label", H5T_NATIVE_UINT8);
+  ASSERT_EQ(feat.dims.size(), 2u);
+  ASSERT_EQ(metal.dims, (std::vector<hsize_t>{N, 19}));
+  ASSERT_EQ(label.dims, (std::vector<hsize_t>{N}));
+  const size_t F = feat.dims[1], cols = F + 19 + 1;
+  ASSERT_EQ(table.size(), N * cols * sizeof(float));
+  int positives = 0;
+  for (size_t i = 0; i < N; ++i) {
+    std::vector<float> row(cols);
+    std::memcpy(row.data(), table.data() + i * cols * sizeof(float), cols * sizeof(float));
+    EXPECT_EQ(std::memcmp(row.data(), feat.bytes.data() + i * F * sizeof(float), F * sizeof(float)), 0) << i;
+    for (size_t z = 0; z < 19; ++z) EXPECT_EQ(row[F + z], metal.bytes[i * 19 + z]) << i << " zone " << z;
+    EXPECT_EQ(row[F + 19], label.bytes[i]) << i;
+    positives += label.bytes[i];
+  }
+  EXPECT_GT(positives, 0);
+  EXPECT_LT(positives, static_cast<int>(N));
+
+  // Per-region labels: with the rule "gun", region r is a threat exactly when it holds a gun,
+  // and a scenario is a threat exactly when one of its regions is.
+  const Dataset obj = read_h5(file, "region_object", H5T_NATIVE_INT16);
+  const Dataset rl = read_h5(file, "region_label", H5T_NATIVE_UINT8);
+  ASSERT_EQ(obj.dims, (std::vector<hsize_t>{N, 13}));
+  ASSERT_EQ(rl.dims, (std::vector<hsize_t>{N, 13}));
+  const auto* objects = reinterpret_cast<const int16_t*>(obj.bytes.data());
+  int gun_regions = 0;
+  for (size_t i = 0; i < N; ++i) {
+    bool any = false;
+    for (size_t r = 0; r < 13; ++r) {
+      const bool gun = objects[i * 13 + r] == 0;  // "gun" is the catalogue's first object
+      EXPECT_EQ(rl.bytes[i * 13 + r], gun ? 1 : 0) << i << " region " << r;
+      any |= gun;
+      gun_regions += gun;
+    }
+    EXPECT_EQ(label.bytes[i], any ? 1 : 0) << i;
+  }
+  EXPECT_GT(gun_regions, 0);
+
+  // Attributes.
+  EXPECT_EQ(read_h5_string(file, "portalsim"), PORTALSIM_VERSION);
+  const nlohmann::json manifest = nlohmann::json::parse(slurp(h5 / "manifest.json"));
+  EXPECT_EQ(read_h5_string(file, "catalogue_hash"), manifest["catalogue"]["hash"].get<std::string>());
+  EXPECT_EQ(nlohmann::json::parse(read_h5_string(file, "spec")), manifest["spec"]);
+  EXPECT_EQ(read_h5_string(file, "region_label_rule"), "gun");
+}
+
+TEST(TensorsNpy, ImageTensorsEqualTheH5Datasets) {
+  portalsim::test::TempDir t;
+  const Args spec{"--count", "30", "--seed", "8", "--rule", "gun", "--what", "images"};
+  const fs::path npy = t.w() / "npy", h5 = t.w() / "h5";
+  ExpectOk(run(t, plus(spec, {"--format", "npy"}), npy));
+  ExpectOk(run(t, plus(spec, {"--format", "h5"}), h5));
+  EXPECT_FALSE(fs::exists(npy / "images")) << "--what images --format npy writes no image folders";
+  EXPECT_FALSE(fs::exists(h5 / "data.h5.tmp"));
+  for (const std::string name : {"upper", "lower", "ir", "ir_index", "metal", "label", "subject", "region_label"}) {
+    const std::string data = npy_data(npy / (name + ".npy"));
+    const std::string header = slurp(npy / (name + ".npy")).substr(0, 128);
+    EXPECT_NE(header.find("'descr': '|u1'"), std::string::npos) << name << ": not uint8";
+    const Dataset d = read_h5(h5 / "data.h5", name, H5T_NATIVE_UINT8);
+    ASSERT_EQ(data.size(), d.bytes.size()) << name;
+    EXPECT_TRUE(std::memcmp(data.data(), d.bytes.data(), data.size()) == 0) << name;
+  }
+}
+
+TEST(TensorsH5, ByteIdenticalForAnyBatchAndThreads) {
+  portalsim::test::TempDir t;
+  const Args spec{"--count", "150", "--seed", "9", "--rule", "gun", "--what", "both", "--format", "h5"};
+  for (const bool compress : {false, true}) {
+    const Args s = compress ? plus(spec, {"--compress"}) : spec;
+    const std::string tag = compress ? "z" : "";
+    const fs::path a = t.w() / ("a" + tag), b = t.w() / ("b" + tag), c = t.w() / ("c" + tag);
+    ExpectOk(run(t, plus(s, {"--batch", "7", "--threads", "1"}), a));
+    ExpectOk(run(t, plus(s, {"--batch", "64", "--threads", "2"}), b));
+    ExpectOk(run(t, plus(s, {"--batch", "1000"}), c));
+    const std::string ha = slurp(a / "data.h5");
+    ASSERT_GT(ha.size(), 150u * 200 * 200);
+    EXPECT_TRUE(ha == slurp(b / "data.h5")) << "--batch 7 --threads 1 and --batch 64 --threads 2 differ";
+    EXPECT_TRUE(ha == slurp(c / "data.h5")) << "--batch 7 and --batch 1000 differ";
+    EXPECT_EQ(slurp(a / "manifest.json"), slurp(b / "manifest.json"));
+  }
+  EXPECT_LT(fs::file_size(t.w() / "az" / "data.h5"), fs::file_size(t.w() / "a" / "data.h5"))
+      << "--compress must make data.h5 smaller";
+}
+
+// "next" in the run's checkpoint, or -1.
+long long checkpoint_next(const fs::path& dir) {
+  std::error_code ec;
+  const fs::path p = dir / ".portalsim" / "checkpoint.json";
+  if (!fs::exists(p, ec)) return -1;
+  const nlohmann::json j = nlohmann::json::parse(slurp(p), nullptr, false);
+  if (j.is_discarded() || !j.contains("next") || !j["next"].is_number_unsigned()) return -1;
+  return static_cast<long long>(j["next"].get<uint64_t>());
+}
+
+TEST(TensorsH5, ResumeAfterKill9IsExact) {
+  portalsim::test::TempDir t;
+  const Args spec{"--count", "4000", "--seed", "10", "--rule", "gun", "--what", "both", "--format", "h5,csv"};
+  const fs::path ref = t.w() / "ref", dir = t.w() / "killed";
+  ExpectOk(run(t, plus(spec, {"--batch", "500"}), ref));
+  Args victim_args{"generate"};
+  victim_args.insert(victim_args.end(), spec.begin(), spec.end());
+  victim_args.insert(victim_args.end(), {"--batch", "100", "--out", dir.string(), "--quiet"});
+  const portalsim::test::Running victim = portalsim::test::start_program(t.cap(), PORTALSIM_BINARY, victim_args);
+  ASSERT_GT(victim.pid, 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (checkpoint_next(dir) < 300 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ::kill(victim.pid, SIGKILL);
+  const portalsim::test::Result k = portalsim::test::finish(victim, 120);
+  ASSERT_TRUE(k.signaled) << "the run ended before it could be killed: " << portalsim::test::describe(k);
+  ASSERT_FALSE(fs::exists(dir / "data.h5")) << "killed mid-run, there is no data.h5 yet";
+  ASSERT_TRUE(fs::exists(dir / ".portalsim" / "tensors")) << "the batches are checkpointed as .npy files";
+  ExpectOk(run(t, plus(spec, {"--batch", "333", "--resume"}), dir));
+  EXPECT_TRUE(slurp(dir / "data.h5") == slurp(ref / "data.h5")) << "the resumed data.h5 differs";
+  EXPECT_EQ(slurp(dir / "features.csv"), slurp(ref / "features.csv"));
+  EXPECT_EQ(slurp(dir / "manifest.json"), slurp(ref / "manifest.json"));
+  EXPECT_FALSE(fs::exists(dir / ".portalsim"));
+}
+
+TEST(TensorsH5, CompressWithoutH5IsRefusedNamingTheFlag) {
+  portalsim::test::TempDir t;
+  const portalsim::test::Result r = run(t, {"--count", "5", "--compress"}, t.w() / "x");
+  EXPECT_TRUE(r.exited && r.status == 2) << portalsim::test::describe(r);
+  EXPECT_NE(r.err.find("--compress"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(t.w() / "x"));
+}
+
+}  // namespace
