@@ -10,7 +10,7 @@ packages=(build-essential cmake pkg-config
   libopenimageio-dev openimageio-tools
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libxxhash-dev libgtest-dev libbenchmark-dev libcpp-httplib-dev
-  weka default-jre-headless python3 python3-matplotlib clang-format
+  weka default-jdk-headless python3 python3-matplotlib python3-scipy libboost-dev clang-format
   clang libclang-rt-14-dev chromium)
 
 missing=()

@@ -6,6 +6,7 @@
 #include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "cli/features_table.h"
 #include "sink/folder_reader.h"
 #include "sink/sinks.h"
 
@@ -20,25 +21,36 @@ struct FeaturesOptions {
 };
 
 int features(FeaturesOptions& o) {
-  namespace fs = std::filesystem;
-  Session s;
-  open_catalogue(s, o.common);
-  Plan plan;
-  plan.model.block = o.block;
-  validate(plan, s.catalogue);
   std::string format = o.format;
   if (format.empty()) {
-    format = fs::path(o.out).extension().string();
+    format = std::filesystem::path(o.out).extension().string();
     if (!format.empty()) format.erase(0, 1);
   }
+  const FeaturesCount n = write_features(o.folders, o.out, format, o.block, o.common.catalogue);
+  std::printf("%s: %zu rows (%zu positive, %zu negative) from %zu folders\n", o.out.c_str(), n.rows, n.positive,
+              n.rows - n.positive, n.rows);
+  return 0;
+}
+}  // namespace
+
+FeaturesCount write_features(const std::vector<std::string>& folder_args, const std::string& out_name,
+                             const std::string& format, int block, const std::string& catalogue) {
+  namespace fs = std::filesystem;
+  Session s;
+  CommonOptions common;
+  common.catalogue = catalogue;
+  open_catalogue(s, common);
+  Plan plan;
+  plan.model.block = block;
+  validate(plan, s.catalogue);
   if (format != "arff" && format != "csv" && format != "npy")
-    throw InputError("--out: \"" + o.out + "\": name it .arff, .csv or .npy, or give --format");
-  const fs::path out(o.out);
-  if (fs::exists(out)) throw OutputError(o.out + ": already exists; choose a new file name");
-  const std::vector<std::string> folders = find_scenario_folders(o.folders);
+    throw InputError("--out: \"" + out_name + "\": name it .arff, .csv or .npy, or give --format");
+  const fs::path out(out_name);
+  if (fs::exists(out)) throw OutputError(out_name + ": already exists; choose a new file name");
+  const std::vector<std::string> folders = find_scenario_folders(folder_args);
 
   BatchOutput rows;
-  rows.layout = FeatureLayout::of(s.catalogue, o.block);
+  rows.layout = FeatureLayout::of(s.catalogue, block);
   SceneBatch labels;
   const size_t chunk = 1024;
   SinkContext ctx;
@@ -76,11 +88,8 @@ int features(FeaturesOptions& o) {
     if (format == "npy") fs::remove(fs::path(ctx.dir) / (out.stem().string() + ".columns.txt"), ec);
     throw;
   }
-  std::printf("%s: %zu rows (%zu positive, %zu negative) from %zu folders\n", o.out.c_str(), folders.size(), positive,
-              folders.size() - positive, folders.size());
-  return 0;
+  return {folders.size(), positive};
 }
-}  // namespace
 
 std::function<int()> add_features(CLI::App& app) {
   auto o = std::make_shared<FeaturesOptions>();
