@@ -179,6 +179,40 @@ TEST(Validate, ReadsCsvAndSelectsFeatureSets) {
   fs::remove_all(d);
 }
 
+// Folders of scenario folders become tables as `portalsim features` makes them; block 40 on
+// the 200x200 MMW views is the thesis's 5x5 grid, and its 69 attributes (appendix D.4).
+TEST(Validate, ReadsScenarioFolders) {
+  const fs::path d = fresh_dir();
+  fs::create_directories(d / "cap");
+  for (const char* seed : {"3", "4"}) {
+    const auto g = finish(
+        start(d / "cap", {"generate", "--spec", PORTALSIM_SOURCE_DIR "/scenarios/case2-rod-plate.toml", "--count", "30",
+                          "--seed", seed, "--what", "images", "--out", (d / (std::string("set") + seed)).string()}));
+    ASSERT_TRUE(g.exited && g.status == 0) << portalsim::test::describe(g);
+  }
+  const auto f = finish(start(
+      d / "cap", {"features", (d / "set3" / "images").string(), "--block", "40", "--out", (d / "set3.arff").string()}));
+  ASSERT_TRUE(f.exited && f.status == 0) << portalsim::test::describe(f);
+  const auto r =
+      validate(d, "set3/images", "set4/images",
+               {"--block", "40", "--features", "blocks", "--classifiers", "j48", "--runs", "1", "--curve-steps", "0"});
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  const auto report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  EXPECT_EQ(report["attributes"].get<int>(), 69);  // 2 views x 25 block means + 19 metal zones
+  EXPECT_EQ(report["sim_instances"].get<int>(), 30);
+  EXPECT_EQ(report["real_instances"].get<int>(), 30);
+  // The same rows as `portalsim features` writes: J48 on the whole set gives the same tree.
+  fs::remove_all(d / "out");
+  const auto t =
+      validate(d, "set3.arff", "set4/images",
+               {"--block", "40", "--features", "blocks", "--classifiers", "j48", "--runs", "1", "--curve-steps", "0"});
+  ASSERT_TRUE(t.exited && t.status == 0) << portalsim::test::describe(t);
+  const auto from_table = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  EXPECT_EQ(from_table["classifiers"]["J48"]["trees"]["sim"], report["classifiers"]["J48"]["trees"]["sim"]);
+  EXPECT_EQ(from_table["classifiers"]["J48"]["sim"]["runs"], report["classifiers"]["J48"]["sim"]["runs"]);
+  fs::remove_all(d);
+}
+
 TEST(Validate, BadInputGetsAMessageAndNoReport) {
   const fs::path d = fresh_dir();
   fs::create_directories(d / "cap");

@@ -40,9 +40,12 @@ for c in names:
     curve = report["classifiers"][c].get("learning_curve")
     if curve:
         ax.plot([p["sim_added"] for p in curve], [p["percent_correct"] for p in curve], marker="o", label=c)
+if ax.lines:
+    ax.legend()
+else:
+    ax.text(0.5, 0.5, "no learning curve (--curve-steps 0)", ha="center", transform=ax.transAxes)
 ax.set_xlabel("simulated scenarios added to the real training folds")
 ax.set_ylabel("% correct on held-out real data")
-ax.legend()
 ax.set_title("Learning curve")
 fig.tight_layout()
 fig.savefig(folder + "/curve.png", dpi=100)
