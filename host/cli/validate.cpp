@@ -77,6 +77,12 @@ struct Table {
   std::set<std::string> classes;
 };
 
+std::vector<std::string> fields(const std::string& line) {
+  std::vector<std::string> f = split_commas(line);
+  for (auto& v : f) v = unquote(v);
+  return f;
+}
+
 void check_row(const std::string& path, int line, const Table& t, const std::vector<std::string>& f) {
   const std::string where = path + ":" + std::to_string(line);
   if (f.size() != t.names.size())
@@ -90,6 +96,14 @@ void check_row(const std::string& path, int line, const Table& t, const std::vec
       throw InputError(where + ": field '" + t.names[i] + "' is \"" + f[i] + "\", not a number");
   }
   if (f.back().empty() || f.back() == "?") throw InputError(where + ": field 'class' is missing");
+}
+
+// One data line, checked against the header and kept.
+void add_row(Table& t, int line, const std::string& text) {
+  std::vector<std::string> f = fields(text);
+  check_row(t.path, line, t, f);
+  t.classes.insert(f.back());
+  t.rows.push_back(std::move(f));
 }
 
 Table read_arff(const std::string& path) {
@@ -117,11 +131,7 @@ Table read_arff(const std::string& path) {
       continue;
     }
     if (t[0] == '{') throw InputError(path + ":" + std::to_string(n) + ": sparse instances are not supported");
-    std::vector<std::string> f = split_commas(t);
-    for (auto& v : f) v = unquote(v);
-    check_row(path, n, a, f);
-    a.classes.insert(f.back());
-    a.rows.push_back(std::move(f));
+    add_row(a, n, t);
   }
   if (!data) throw InputError(path + ": no @data section");
   return a;
@@ -139,17 +149,14 @@ Table read_csv(const std::string& path) {
     ++n;
     const std::string t = trim(line);
     if (t.empty()) continue;
-    std::vector<std::string> f = split_commas(t);
-    for (auto& v : f) v = unquote(v);
-    if (a.names.empty()) {
-      if (f.size() < 2) throw InputError(path + ":" + std::to_string(n) + ": needs at least one attribute and a class");
-      a.names = f;
-      a.name_lines.assign(f.size(), n);
+    if (!a.names.empty()) {
+      add_row(a, n, t);
       continue;
     }
-    check_row(path, n, a, f);
-    a.classes.insert(f.back());
-    a.rows.push_back(std::move(f));
+    a.names = fields(t);
+    a.name_lines.assign(a.names.size(), n);
+    if (a.names.size() < 2)
+      throw InputError(path + ":" + std::to_string(n) + ": needs at least one attribute and a class");
   }
   if (a.names.empty()) throw InputError(path + ": empty file, no header row");
   return a;
