@@ -179,8 +179,8 @@ TEST(Validate, ReadsCsvAndSelectsFeatureSets) {
   fs::remove_all(d);
 }
 
-// Folders of scenario folders become tables as `portalsim features` makes them; block 40 on
-// the 200x200 MMW views is the thesis's 5x5 grid, and its 69 attributes (appendix D.4).
+// Folders of scenario folders become tables as `portalsim features` makes them; --grid 5x5
+// (block 40 on the 200x200 MMW views) gives the thesis's 69 attributes (appendix D.4).
 TEST(Validate, ReadsScenarioFolders) {
   const fs::path d = fresh_dir();
   fs::create_directories(d / "cap");
@@ -195,7 +195,7 @@ TEST(Validate, ReadsScenarioFolders) {
   ASSERT_TRUE(f.exited && f.status == 0) << portalsim::test::describe(f);
   const auto r =
       validate(d, "set3/images", "set4/images",
-               {"--block", "40", "--features", "blocks", "--classifiers", "j48", "--runs", "1", "--curve-steps", "0"});
+               {"--grid", "5x5", "--features", "blocks", "--classifiers", "j48", "--runs", "1", "--curve-steps", "0"});
   ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
   const auto report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
   EXPECT_EQ(report["attributes"].get<int>(), 69);  // 2 views x 25 block means + 19 metal zones
@@ -210,6 +210,11 @@ TEST(Validate, ReadsScenarioFolders) {
   const auto from_table = nlohmann::json::parse(slurp(d / "out" / "report.json"));
   EXPECT_EQ(from_table["classifiers"]["J48"]["trees"]["sim"], report["classifiers"]["J48"]["trees"]["sim"]);
   EXPECT_EQ(from_table["classifiers"]["J48"]["sim"]["runs"], report["classifiers"]["J48"]["sim"]["runs"]);
+  fs::remove_all(d / "out");
+  const auto g = validate(d, "set3/images", "set4/images", {"--grid", "7x3"});
+  EXPECT_TRUE(g.exited && g.status != 0) << portalsim::test::describe(g);
+  EXPECT_NE(g.err.find("--grid: no square block cuts every pooled view into 7x3 blocks"), std::string::npos) << g.err;
+  EXPECT_FALSE(fs::exists(d / "out"));
   fs::remove_all(d);
 }
 

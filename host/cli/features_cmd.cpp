@@ -18,9 +18,11 @@ struct FeaturesOptions {
   std::vector<std::string> folders;
   std::string out, format;
   int block = 10;
+  std::string grid;
 };
 
 int features(FeaturesOptions& o) {
+  if (!o.grid.empty()) o.block = block_for_grid(o.grid, o.common.catalogue);
   std::string format = o.format;
   if (format.empty()) {
     format = std::filesystem::path(o.out).extension().string();
@@ -91,6 +93,21 @@ FeaturesCount write_features(const std::vector<std::string>& folder_args, const 
   return {folders.size(), positive};
 }
 
+int block_for_grid(const std::string& grid, const std::string& catalogue) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(grid.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 1 || h < 1)
+    throw InputError("--grid: \"" + grid + "\" is not WxH (for example 5x5)");
+  Session s;
+  CommonOptions common;
+  common.catalogue = catalogue;
+  open_catalogue(s, common);
+  const int block = FeatureLayout::block_for_grid(s.catalogue, w, h);
+  if (block == 0)
+    throw InputError("--grid: no square block cuts every pooled view into " + grid + " blocks; use --block");
+  return block;
+}
+
 std::function<int()> add_features(CLI::App& app) {
   auto o = std::make_shared<FeaturesOptions>();
   CLI::App* sub =
@@ -98,7 +115,9 @@ std::function<int()> add_features(CLI::App& app) {
   sub->add_option("folders", o->folders, "scenario folders, or folders holding them")->required();
   sub->add_option("--out", o->out, "output table: FILE.arff, FILE.csv or FILE.npy")->required();
   sub->add_option("--format", o->format, "arff, csv or npy (default: from --out's extension)");
-  sub->add_option("--block", o->block, "block side for the averaged features (default 10)");
+  auto* block = sub->add_option("--block", o->block, "block side for the averaged features (default 10)");
+  sub->add_option("--grid", o->grid, "WxH blocks per view instead of --block (5x5: the thesis's grid)")
+      ->excludes(block);
   sub->add_option("--catalogue", o->common.catalogue, "catalogue TOML file (its region rectangles are used)");
   return [o] { return features(*o); };
 }

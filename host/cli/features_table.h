@@ -16,4 +16,9 @@ struct FeaturesCount {
 FeaturesCount write_features(const std::vector<std::string>& folders, const std::string& out, const std::string& format,
                              int block, const std::string& catalogue);
 
+// The block side for `--grid WxH` ("5x5": the thesis's grid of block means per view) with
+// the views of `catalogue` (empty: the built-in one). Throws InputError naming --grid when
+// the text is not WxH or no square block cuts every pooled view into W x H blocks.
+int block_for_grid(const std::string& grid, const std::string& catalogue);
+
 }  // namespace portalsim::cli

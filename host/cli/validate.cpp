@@ -295,11 +295,12 @@ struct WorkDir {
 };
 
 struct Options {
-  std::string sim, real, out, features = "both", classifiers = "j48,mlp,svm", catalogue;
+  std::string sim, real, out, features = "both", classifiers = "j48,mlp,svm", catalogue, grid;
   int folds = 10, runs = 10, seed = 1, block = 10, curve_steps = 4;
 };
 
-int run_validate(const Options& o) {
+int run_validate(Options o) {
+  if (!o.grid.empty()) o.block = block_for_grid(o.grid, o.catalogue);
   const char* jar = "/usr/share/java/weka.jar";
   if (!fs::exists(jar)) throw EnvironmentError(std::string(jar) + " not found (apt-get install weka)");
   if (!on_path("java")) throw EnvironmentError("java not found on PATH (apt-get install default-jdk-headless)");
@@ -470,7 +471,9 @@ std::function<int()> add_validate(CLI::App& app) {
   cmd->add_option("--out", o->out, "Folder for report.md, report.json and the plots")->required();
   cmd->add_option("--features", o->features, "regions, blocks or both (default both)")
       ->check(CLI::IsMember({"regions", "blocks", "both"}));
-  cmd->add_option("--block", o->block, "Block side for folders turned into tables (default 10)");
+  auto* block = cmd->add_option("--block", o->block, "Block side for folders turned into tables (default 10)");
+  cmd->add_option("--grid", o->grid, "WxH blocks per view instead of --block (5x5: the thesis's grid)")
+      ->excludes(block);
   cmd->add_option("--catalogue", o->catalogue, "Catalogue TOML for folders turned into tables");
   cmd->add_option("--classifiers", o->classifiers, "Comma-separated: j48, mlp, svm (default all three)");
   cmd->add_option("--folds", o->folds, "Cross-validation folds (default 10)")->check(CLI::Range(2, 1000));
