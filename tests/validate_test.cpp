@@ -3,6 +3,7 @@
 // scipy, and bad input refused with a message naming the file.
 #include <nlohmann/json.hpp>
 #include <random>
+#include <tuple>
 
 #include "cli/validate_stats.h"
 #include "run_binary.h"
@@ -215,6 +216,32 @@ TEST(Validate, ReadsScenarioFolders) {
   EXPECT_TRUE(g.exited && g.status != 0) << portalsim::test::describe(g);
   EXPECT_NE(g.err.find("--grid: no square block cuts every pooled view into 7x3 blocks"), std::string::npos) << g.err;
   EXPECT_FALSE(fs::exists(d / "out"));
+  fs::remove_all(d);
+}
+
+// A real set labelled by another rule (iron rod AND metal plate, against gun) is told by a
+// far lower sim-to-real accuracy than one labelled by the same rule.
+TEST(Validate, AnotherRuleLowersSimToReal) {
+  const fs::path d = fresh_dir();
+  fs::create_directories(d / "cap");
+  const std::vector<std::tuple<std::string, std::string, std::string>> sets = {
+      {"sim", "1", "gun"}, {"same", "2", "gun"}, {"other", "3", "iron-rod & metal-plate"}};
+  for (const auto& [name, seed, rule] : sets) {
+    const auto g = finish(start(d / "cap", {"generate", "--count", "300", "--seed", seed, "--rule", rule, "--balance",
+                                            "--block", "40", "--out", (d / name).string()}));
+    ASSERT_TRUE(g.exited && g.status == 0) << portalsim::test::describe(g);
+  }
+  double accuracy[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    fs::remove_all(d / "out");
+    const auto r = validate(d, "sim/features.arff", k == 0 ? "same/features.arff" : "other/features.arff",
+                            {"--classifiers", "j48", "--runs", "1", "--curve-steps", "0"});
+    ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+    const auto report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+    accuracy[k] = report["classifiers"]["J48"]["sim_to_real"]["percent_correct"].get<double>();
+  }
+  EXPECT_GT(accuracy[0], 75);
+  EXPECT_LT(accuracy[1], accuracy[0] - 10) << "same rule " << accuracy[0] << "%, other rule " << accuracy[1] << "%";
   fs::remove_all(d);
 }
 
