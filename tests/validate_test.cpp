@@ -169,6 +169,8 @@ TEST(Validate, ReadsCsvAndSelectsFeatureSets) {
   ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
   auto report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
   EXPECT_EQ(report["attributes"].get<int>(), 3);  // two blocks and a zone; the region mean dropped
+  EXPECT_NE(slurp(d / "out" / "report.md").find("Not computed (`--curve-steps 0`)"), std::string::npos);
+  EXPECT_FALSE(report["classifiers"]["J48"].contains("learning_curve"));
   EXPECT_LT(report["classifiers"]["J48"]["real"]["mean_percent_correct"].get<double>(), 75);
   fs::remove_all(d / "out");
   r = validate(d, "sim.csv", "real.csv",

@@ -378,6 +378,7 @@ int run_validate(Options o) {
            << " stratified folds; simulated scenarios added to each training fold; % correct on the held-out real "
               "instances (seed "
            << o.seed << ").\n\n";
+  if (o.curve_steps == 0) curve_md << "Not computed (`--curve-steps 0`).\n\n";
 
   for (const auto& [key, label] : kClassifiers) {
     if (std::find(names.begin(), names.end(), key) == names.end()) continue;
