@@ -106,9 +106,14 @@ void add_row(Table& t, int line, const std::string& text) {
   t.rows.push_back(std::move(f));
 }
 
-Table read_arff(const std::string& path) {
+std::ifstream open_table(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open");
+  return in;
+}
+
+Table read_arff(const std::string& path) {
+  std::ifstream in = open_table(path);
   Table a;
   a.path = path;
   std::string line;
@@ -139,8 +144,7 @@ Table read_arff(const std::string& path) {
 
 // CSV with a header row; the last column is the class.
 Table read_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open");
+  std::ifstream in = open_table(path);
   Table a;
   a.path = path;
   std::string line;
