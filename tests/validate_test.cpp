@@ -1,8 +1,11 @@
-// `portalsim validate` as a user meets it: WEKA scores on small generated tables, and
-// bad input refused with a message naming the file.
+// `portalsim validate` as a user meets it: WEKA scores and t-tests on small generated
+// tables, WEKA's own command line as the reference for the folds, the t-tests against
+// scipy, and bad input refused with a message naming the file.
 #include <nlohmann/json.hpp>
 #include <random>
+#include <tuple>
 
+#include "cli/validate_stats.h"
 #include "run_binary.h"
 
 namespace {
@@ -34,36 +37,213 @@ std::string table(int n, unsigned seed, bool shuffled) {
   return s.str();
 }
 
-portalsim::test::Result validate(const fs::path& dir, const std::string& sim, const std::string& real) {
-  return finish(start(dir / "cap", {"validate", "--sim", (dir / sim).string(), "--real", (dir / real).string(), "--out",
-                                    (dir / "out").string(), "--folds", "5"}));
+portalsim::test::Result validate(const fs::path& dir, const std::string& sim, const std::string& real,
+                                 std::vector<std::string> more = {}) {
+  std::vector<std::string> args = {
+      "validate", "--sim", (dir / sim).string(), "--real", (dir / real).string(), "--out", (dir / "out").string(),
+      "--folds",  "5"};
+  args.insert(args.end(), more.begin(), more.end());
+  return finish(start(dir / "cap", args), 400);
 }
 
-TEST(Validate, ScoresAllThreeClassifiersAndShuffledLabelsFallToChance) {
+// scipy 1.10 (Debian python3-scipy):
+//   a=[80,90,85,70,75,95,88,82,79,91]; b=[78,85,80,72,70,90,84,75,80,86]
+//   stats.ttest_ind(a, b)  -> statistic=1.0991902374394489, pvalue=0.28617004408826807
+//   d=np.array(a)-np.array(b); t=d.mean()/np.sqrt((1/10+1/9)*d.var(ddof=1))
+//   t -> 2.612781159415557; 2*stats.t.sf(abs(t), 9) -> 0.028142110978438096
+TEST(Validate, TTestsAgreeWithScipy) {
+  const std::vector<double> a = {80, 90, 85, 70, 75, 95, 88, 82, 79, 91}, b = {78, 85, 80, 72, 70, 90, 84, 75, 80, 86};
+  const auto two = portalsim::cli::student_two_sample(a, b);
+  EXPECT_NEAR(two.t, 1.0991902374394489, 1e-12);
+  EXPECT_EQ(two.df, 18);
+  EXPECT_NEAR(two.p, 0.28617004408826807, 1e-10);
+  std::vector<double> d;
+  for (size_t i = 0; i < a.size(); ++i) d.push_back(a[i] - b[i]);
+  const auto corrected = portalsim::cli::corrected_resampled(d, 1.0 / 9);
+  EXPECT_NEAR(corrected.t, 2.612781159415557, 1e-12);
+  EXPECT_EQ(corrected.df, 9);
+  EXPECT_NEAR(corrected.p, 0.028142110978438096, 1e-10);
+  // No spread: equal means give P = 1, different ones P = 0.
+  EXPECT_EQ(portalsim::cli::student_two_sample({90, 90}, {90, 90}).p, 1);
+  EXPECT_EQ(portalsim::cli::corrected_resampled({5, 5, 5}, 0.1).p, 0);
+}
+
+TEST(Validate, SameSpecIsNotToldApartAndShuffledLabelsAre) {
   const fs::path d = fresh_dir();
   fs::create_directories(d / "cap");
   spit(d / "sim.arff", table(200, 1, false));
   spit(d / "real.arff", table(200, 2, false));
   spit(d / "shuffled.arff", table(200, 3, true));
-  auto r = validate(d, "sim.arff", "real.arff");
+  const std::vector<std::string> opts = {"--classifiers", "j48,svm", "--runs", "2", "--curve-steps", "2"};
+  auto r = validate(d, "sim.arff", "real.arff", opts);
   ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
   const auto same = nlohmann::json::parse(slurp(d / "out" / "report.json"));
-  for (const char* c : {"J48", "MultilayerPerceptron", "SMO"}) {
-    EXPECT_GT(same["classifiers"][c]["sim_to_real"]["percent_correct"].get<double>(), 85) << c;
-    EXPECT_GT(same["classifiers"][c]["real"]["percent_correct"].get<double>(), 85) << c;
+  for (const char* c : {"J48", "SMO"}) {
+    const auto& s = same["classifiers"][c];
+    EXPECT_GT(s["corrected_resampled_t_test"]["p"].get<double>(), 0.05) << c;
+    EXPECT_GT(s["sim_to_real"]["percent_correct"].get<double>(), 85) << c;
+    EXPECT_GT(s["real"]["mean_percent_correct"].get<double>(), 85) << c;
+    EXPECT_EQ(s["real"]["runs"].size(), 2u) << c;
+    EXPECT_EQ(s["real"]["runs"][0]["folds"].size(), 5u) << c;
+    EXPECT_EQ(s["learning_curve"].size(), 3u) << c;
+    EXPECT_EQ(s["learning_curve"][2]["sim_added"].get<int>(), 200) << c;
   }
-  EXPECT_NE(slurp(d / "out" / "report.md").find("| SMO |"), std::string::npos);
+  EXPECT_NE(same["classifiers"]["J48"]["trees"]["real"].get<std::string>().find("J48 pruned tree"), std::string::npos);
+  const std::string md = slurp(d / "out" / "report.md");
+  EXPECT_NE(md.find("| SMO |"), std::string::npos);
+  EXPECT_NE(md.find("(corrected resampled t-test, t = "), std::string::npos);
+  EXPECT_NE(md.find("(two-sample t-test)"), std::string::npos);
+  EXPECT_NE(md.find("J48 pruned tree"), std::string::npos);
+  EXPECT_GT(fs::file_size(d / "out" / "accuracy.png"), 1000u);
+  EXPECT_GT(fs::file_size(d / "out" / "curve.png"), 1000u);
   fs::remove_all(d / "out");
-  r = validate(d, "sim.arff", "shuffled.arff");
+
+  r = validate(d, "sim.arff", "shuffled.arff", opts);
   ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
   const auto shuffled = nlohmann::json::parse(slurp(d / "out" / "report.json"));
-  for (const char* c : {"J48", "MultilayerPerceptron", "SMO"}) {
-    const double acc = shuffled["classifiers"][c]["sim_to_real"]["percent_correct"].get<double>();
+  for (const char* c : {"J48", "SMO"}) {
+    const auto& s = shuffled["classifiers"][c];
+    EXPECT_LT(s["corrected_resampled_t_test"]["p"].get<double>(), 0.05) << c;
+    EXPECT_LT(s["two_sample_t_test"]["mean_p"].get<double>(), 0.05) << c;
+    const double acc = s["sim_to_real"]["percent_correct"].get<double>();
     EXPECT_GT(acc, 35) << c;
     EXPECT_LT(acc, 65) << c;
-    const long wrong = shuffled["classifiers"][c]["sim_to_real"]["misclassified"].get<long>();
+    const long wrong = s["sim_to_real"]["misclassified"].get<long>();
     EXPECT_NEAR(wrong, 200 * (100 - acc) / 100, 0.5) << c;
   }
+  fs::remove_all(d);
+}
+
+// The overall accuracy of the folds equals that of WEKA's own command line for the seed.
+TEST(Validate, FoldsAreWekasOwn) {
+  const fs::path d = fresh_dir();
+  fs::create_directories(d / "cap");
+  spit(d / "sim.arff", table(120, 4, false));
+  spit(d / "real.arff", table(120, 5, true));
+  auto r = validate(d, "sim.arff", "real.arff",
+                    {"--classifiers", "j48,svm", "--runs", "1", "--seed", "7", "--curve-steps", "0"});
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  const auto report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  for (const auto& [label, cls] : std::vector<std::pair<std::string, std::string>>{
+           {"J48", "weka.classifiers.trees.J48"}, {"SMO", "weka.classifiers.functions.SMO"}}) {
+    for (const char* set : {"real", "sim"}) {
+      const auto w =
+          finish(portalsim::test::start_program(d / "cap", "/usr/bin/env",
+                                                {"java", "-cp", "/usr/share/java/weka.jar", cls, "-o", "-t",
+                                                 (d / (std::string(set) + ".arff")).string(), "-x", "5", "-s", "7"}));
+      ASSERT_TRUE(w.exited && w.status == 0) << portalsim::test::describe(w);
+      const size_t at = w.out.find("Correctly Classified Instances", w.out.find("Stratified cross-validation"));
+      ASSERT_NE(at, std::string::npos) << w.out;
+      std::istringstream in(w.out.substr(at + 30));
+      long correct = -1;
+      in >> correct;
+      const auto& run = report["classifiers"][label][set]["runs"][0];
+      EXPECT_EQ(run["correct"].get<long>(), correct) << label << " " << set;
+      double sum = 0;
+      for (double f : run["folds"]) sum += f * 24 / 100;  // 120 instances, 5 stratified folds of 24
+      EXPECT_NEAR(sum, static_cast<double>(correct), 1e-6) << label << " " << set;
+    }
+  }
+  fs::remove_all(d);
+}
+
+TEST(Validate, ReadsCsvAndSelectsFeatureSets) {
+  const fs::path d = fresh_dir();
+  fs::create_directories(d / "cap");
+  auto csv = [](unsigned seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0, 0.3);
+    std::string s = "mmw_r0_c0,mmw_r0_c1,region1,zone1,class\n";
+    for (int i = 0; i < 60; ++i) {
+      const bool pos = i % 2;
+      s += std::to_string(noise(rng)) + "," + std::to_string(noise(rng)) + "," +
+           std::to_string((pos ? 2 : 0) + noise(rng)) + "," + std::to_string(noise(rng)) + "," +
+           (pos ? "positive" : "negative") + "\n";
+    }
+    return s;
+  };
+  spit(d / "sim.csv", csv(1));
+  spit(d / "real.csv", csv(2));
+  auto r = validate(d, "sim.csv", "real.csv",
+                    {"--classifiers", "j48", "--runs", "1", "--curve-steps", "0", "--features", "blocks"});
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  auto report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  EXPECT_EQ(report["attributes"].get<int>(), 3);  // two blocks and a zone; the region mean dropped
+  EXPECT_NE(slurp(d / "out" / "report.md").find("Not computed (`--curve-steps 0`)"), std::string::npos);
+  EXPECT_FALSE(report["classifiers"]["J48"].contains("learning_curve"));
+  EXPECT_LT(report["classifiers"]["J48"]["real"]["mean_percent_correct"].get<double>(), 75);
+  fs::remove_all(d / "out");
+  r = validate(d, "sim.csv", "real.csv",
+               {"--classifiers", "j48", "--runs", "1", "--curve-steps", "0", "--features", "regions"});
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  EXPECT_EQ(report["attributes"].get<int>(), 2);  // the region mean and a zone
+  EXPECT_GT(report["classifiers"]["J48"]["real"]["mean_percent_correct"].get<double>(), 90);
+  fs::remove_all(d);
+}
+
+// Folders of scenario folders become tables as `portalsim features` makes them; --grid 5x5
+// (block 40 on the 200x200 MMW views) gives the thesis's 69 attributes (appendix D.4).
+TEST(Validate, ReadsScenarioFolders) {
+  const fs::path d = fresh_dir();
+  fs::create_directories(d / "cap");
+  for (const char* seed : {"3", "4"}) {
+    const auto g = finish(
+        start(d / "cap", {"generate", "--spec", PORTALSIM_SOURCE_DIR "/scenarios/case2-rod-plate.toml", "--count", "30",
+                          "--seed", seed, "--what", "images", "--out", (d / (std::string("set") + seed)).string()}));
+    ASSERT_TRUE(g.exited && g.status == 0) << portalsim::test::describe(g);
+  }
+  const auto f = finish(start(
+      d / "cap", {"features", (d / "set3" / "images").string(), "--block", "40", "--out", (d / "set3.arff").string()}));
+  ASSERT_TRUE(f.exited && f.status == 0) << portalsim::test::describe(f);
+  const auto r =
+      validate(d, "set3/images", "set4/images",
+               {"--grid", "5x5", "--features", "blocks", "--classifiers", "j48", "--runs", "1", "--curve-steps", "0"});
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  const auto report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  EXPECT_EQ(report["attributes"].get<int>(), 69);  // 2 views x 25 block means + 19 metal zones
+  EXPECT_EQ(report["sim_instances"].get<int>(), 30);
+  EXPECT_EQ(report["real_instances"].get<int>(), 30);
+  // The same rows as `portalsim features` writes: J48 on the whole set gives the same tree.
+  fs::remove_all(d / "out");
+  const auto t =
+      validate(d, "set3.arff", "set4/images",
+               {"--block", "40", "--features", "blocks", "--classifiers", "j48", "--runs", "1", "--curve-steps", "0"});
+  ASSERT_TRUE(t.exited && t.status == 0) << portalsim::test::describe(t);
+  const auto from_table = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  EXPECT_EQ(from_table["classifiers"]["J48"]["trees"]["sim"], report["classifiers"]["J48"]["trees"]["sim"]);
+  EXPECT_EQ(from_table["classifiers"]["J48"]["sim"]["runs"], report["classifiers"]["J48"]["sim"]["runs"]);
+  fs::remove_all(d / "out");
+  const auto g = validate(d, "set3/images", "set4/images", {"--grid", "7x3"});
+  EXPECT_TRUE(g.exited && g.status != 0) << portalsim::test::describe(g);
+  EXPECT_NE(g.err.find("--grid: no square block cuts every pooled view into 7x3 blocks"), std::string::npos) << g.err;
+  EXPECT_FALSE(fs::exists(d / "out"));
+  fs::remove_all(d);
+}
+
+// A real set labelled by another rule (iron rod AND metal plate, against gun) is told by a
+// far lower sim-to-real accuracy than one labelled by the same rule.
+TEST(Validate, AnotherRuleLowersSimToReal) {
+  const fs::path d = fresh_dir();
+  fs::create_directories(d / "cap");
+  const std::vector<std::tuple<std::string, std::string, std::string>> sets = {
+      {"sim", "1", "gun"}, {"same", "2", "gun"}, {"other", "3", "iron-rod & metal-plate"}};
+  for (const auto& [name, seed, rule] : sets) {
+    const auto g = finish(start(d / "cap", {"generate", "--count", "300", "--seed", seed, "--rule", rule, "--balance",
+                                            "--block", "40", "--out", (d / name).string()}));
+    ASSERT_TRUE(g.exited && g.status == 0) << portalsim::test::describe(g);
+  }
+  double accuracy[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    fs::remove_all(d / "out");
+    const auto r = validate(d, "sim/features.arff", k == 0 ? "same/features.arff" : "other/features.arff",
+                            {"--classifiers", "j48", "--runs", "1", "--curve-steps", "0"});
+    ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+    const auto report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+    accuracy[k] = report["classifiers"]["J48"]["sim_to_real"]["percent_correct"].get<double>();
+  }
+  EXPECT_GT(accuracy[0], 75);
+  EXPECT_LT(accuracy[1], accuracy[0] - 10) << "same rule " << accuracy[0] << "%, other rule " << accuracy[1] << "%";
   fs::remove_all(d);
 }
 
@@ -79,10 +259,13 @@ TEST(Validate, BadInputGetsAMessageAndNoReport) {
   spit(d / "few.arff",
        "@relation t\n@attribute a numeric\n@attribute b numeric\n@attribute class {gun,none}\n"
        "@data\n1,2,gun\n2,3,none\n");
+  spit(d / "text.csv", "a,b,class\n1,2,gun\n1,x,none\n");
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {"other.arff", "other.arff:3: attribute '@attribute c numeric' differs"},
+      {"other.arff", "other.arff:3: attribute 'c' differs"},
       {"single.arff", "single value"},
       {"few.arff", "fewer than the 5 cross-validation folds"},
+      {"text.csv", "text.csv:3: field 'b' is \"x\", not a number"},
+      {"missing.arff", "missing.arff: no such file or folder"},
   };
   for (const auto& [file, message] : cases) {
     const auto r = validate(d, "ok.arff", file);
@@ -95,7 +278,7 @@ TEST(Validate, BadInputGetsAMessageAndNoReport) {
       d / "cap", "/usr/bin/env",
       {"PATH=/nonexistent", PORTALSIM_BINARY, "validate", "--sim", (d / "ok.arff").string(), "--real",
        (d / "ok.arff").string(), "--out", (d / "out").string(), "--folds", "5"}));
-  EXPECT_TRUE(r.exited && r.status != 0) << portalsim::test::describe(r);
+  EXPECT_TRUE(r.exited && r.status == 5) << portalsim::test::describe(r);  // 5: the machine's environment
   EXPECT_NE(r.err.find("java not found"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(d / "out"));
   fs::remove_all(d);

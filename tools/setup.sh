@@ -9,8 +9,9 @@ packages=(build-essential cmake pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
   libopenimageio-dev openimageio-tools
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
-  libxxhash-dev libgtest-dev libbenchmark-dev libcpp-httplib-dev libhdf5-dev
-  weka default-jre-headless python3 python3-matplotlib python3-h5py python3-numpy python3-torch clang-format
+  libxxhash-dev libgtest-dev libbenchmark-dev libcpp-httplib-dev libhdf5-dev libboost-dev
+  weka default-jdk-headless python3 python3-matplotlib python3-scipy python3-h5py python3-numpy python3-torch
+  clang-format
   clang libclang-rt-14-dev chromium)
 
 missing=()

@@ -1,5 +1,6 @@
 #include "plan/plan.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "base/error.h"
@@ -19,6 +20,19 @@ FeatureLayout FeatureLayout::of(const Catalogue& cat, int block) {
     f.blocks_y = (s.height + block - 1) / block;
   }
   return f;
+}
+
+int FeatureLayout::block_for_grid(const Catalogue& cat, int w, int h) {
+  int longest = 0;
+  for (const Sensor& s : cat.sensors)
+    if (s.pooled) longest = std::max({longest, s.width, s.height});
+  for (int block = 1; block <= longest; ++block) {
+    bool fits = true;
+    for (const Sensor& s : cat.sensors)
+      if (s.pooled && ((s.width + block - 1) / block != w || (s.height + block - 1) / block != h)) fits = false;
+    if (fits && longest > 0) return block;
+  }
+  return 0;
 }
 
 std::vector<std::string> FeatureLayout::names() const {

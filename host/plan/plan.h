@@ -94,6 +94,9 @@ struct FeatureLayout {
   int row_features() const { return image_features() + kZones; }
   std::vector<std::string> names() const;
   static FeatureLayout of(const Catalogue& cat, int block);
+  // The smallest square block side that cuts every pooled view into w x h blocks (5x5 on
+  // the 200x200 MMW views is block 40, the thesis's grid), or 0 when none does.
+  static int block_for_grid(const Catalogue& cat, int w, int h);
 };
 
 // Checks the plan's numbers; throws InputError naming the option.
