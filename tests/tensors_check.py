@@ -56,6 +56,7 @@ def main():
         expect(f.attrs["catalogue_hash"] == manifest["catalogue"]["hash"], "data.h5: catalogue_hash differs")
         expect(json.loads(f.attrs["spec"]) == manifest["spec"], "data.h5: attribute spec differs from the manifest")
         expect(list(f.attrs["class_names"]) == ["negative", "positive"], "data.h5: class_names")
+        expect(sorted(f.attrs["datasets"]) == sorted(f.keys()), "data.h5: attribute datasets does not list them")
         expect(len(f.attrs["region_names"]) == 13, "data.h5: region_names")
         drawings = list(f.attrs["object_drawings"])
         expect(len(drawings) == len(f.attrs["object_names"]), "data.h5: object_drawings and object_names differ")

@@ -13,6 +13,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "schedule/identity.h"
 #include "sink/output_folder.h"
 #include "sink/sinks.h"
 #include "sink/staging.h"
@@ -102,25 +103,6 @@ void draw_progress(uint64_t done, uint64_t total, double seconds) {
                static_cast<unsigned long long>(total), rate, static_cast<int>(eta / 3600),
                static_cast<int>(eta / 60) % 60, static_cast<int>(eta) % 60);
   std::fflush(stderr);
-}
-
-// "spec.seed (1 there, 2 now), spec.count (...)": every entry that differs, one level
-// into objects; empty when equal.
-std::string differing_keys(const json& was, const json& now, const std::string& prefix = "") {
-  if (!was.is_object()) return differing_keys(json::object(), now, prefix);
-  std::string out;
-  const auto add = [&](const std::string& k, const json& a, const json& b) {
-    if (a == b) return;
-    std::string d = a.is_object() && b.is_object() && prefix.empty()
-                        ? differing_keys(a, b, k + ".")
-                        : prefix + k + " (" + (a.is_null() ? "absent" : a.dump()) + " there, " +
-                              (b.is_null() ? "absent" : b.dump()) + " now)";
-    out += (out.empty() ? "" : ", ") + d;
-  };
-  for (const auto& [k, v] : now.items()) add(k, was.value(k, json()), v);
-  for (const auto& [k, v] : was.items())
-    if (!now.contains(k)) add(k, v, json());
-  return out;
 }
 
 }  // namespace

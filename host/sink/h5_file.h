@@ -1,0 +1,48 @@
+// data.h5 through libhdf5: built from per-tensor .npy files (by a run, or by a merge of
+// parts), and read back (a merge reads its parts' datasets and attributes). One writer,
+// so the bytes of data.h5 depend only on its contents and their order.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace portalsim {
+
+enum class TensorType { u8, i16, f32 };
+size_t type_size(TensorType t);
+const char* npy_descr(TensorType t);  // "|u1", "<i2", "<f4"
+
+// A dataset: name, element type, per-row shape (after N) and, for features, column names.
+struct H5Dataset {
+  std::string name;
+  TensorType type = TensorType::u8;
+  std::vector<uint64_t> dims;
+  std::vector<std::string> columns;  // the dataset's "columns" attribute; none when empty
+  size_t row_bytes() const;
+};
+
+// A root attribute of UTF-8 strings: one (scalar) or a 1-d array.
+struct H5Attribute {
+  std::string name;
+  std::vector<std::string> values;
+  bool scalar = true;
+};
+
+struct H5Layout {
+  uint64_t rows = 0;
+  bool compress = false;                // shuffle + gzip 4
+  std::vector<H5Attribute> attributes;  // written in name order, with "datasets" (their names, in order)
+  std::vector<H5Dataset> datasets;      // in the order written
+};
+
+// Writes dir/data.h5 (to data.h5.tmp, synced, then renamed). `npy_path(i)` is the .npy
+// file holding dataset i's rows; its header is skipped. Throws OutputError.
+void write_h5(const std::string& dir, const H5Layout& layout, const std::vector<std::string>& npy_paths);
+
+// The layout of a data.h5 this program wrote. Throws InputError naming the file.
+H5Layout read_h5_layout(const std::string& path);
+
+// Reads rows [first, first + n) of a dataset into `out` (n * row_bytes bytes).
+void read_h5_rows(const std::string& path, const H5Dataset& ds, uint64_t first, uint64_t n, char* out);
+
+}  // namespace portalsim
