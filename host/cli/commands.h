@@ -14,6 +14,11 @@ std::function<int()> add_tradeoff(CLI::App& app);
 std::function<int()> add_serve(CLI::App& app);
 std::function<int()> add_validate(CLI::App& app);
 std::function<int()> add_knobs(CLI::App& app);
+std::function<int()> add_merge(CLI::App& app);
+
+// Whether run() prints the error a command fails with (an MPI rank other than 0 does not:
+// rank 0 prints every rank's).
+void print_errors(bool on);
 
 // Parses argv and runs the chosen subcommand; prints errors, returns the exit status.
 int run(int argc, char** argv);

@@ -9,6 +9,7 @@
 #include "cli/common.h"
 #include "io/input_file.h"
 #include "schedule/pipeline.h"
+#include "schedule/ranked_run.h"
 
 namespace portalsim::cli {
 
@@ -30,6 +31,11 @@ struct GenerateOptions {
 
 int generate(GenerateOptions& o) {
   CLI::App& app = *o.app;
+  // Under an MPI launcher every rank runs this; rank 0 alone speaks.
+  std::unique_ptr<Ranks> alone;
+  Ranks* ranks = mpi_ranks();
+  if (!ranks) ranks = (alone = single_rank()).get();
+  if (ranks->rank() != 0) print_errors(false);
   RunSpec spec;
   if (!o.spec_file.empty()) read_spec_file(o.spec_file, spec);
   // Flags given on the command line override the spec file.
@@ -81,7 +87,8 @@ int generate(GenerateOptions& o) {
   popt.batch = static_cast<size_t>(std::max(0ll, o.batch));
   popt.threads = o.threads;
   popt.resume = o.resume;
-  popt.progress = !o.quiet && ::isatty(STDERR_FILENO);
+  const bool ranked = ranks->size() > 1 || has_ranked_parts(o.out);
+  popt.progress = !o.quiet && (::isatty(STDERR_FILENO) || (ranked && ranks->size() > 1));
   popt.stop = &g_stop;
   if (!o.shard.empty()) {
     const size_t slash = o.shard.find('/');
@@ -94,19 +101,22 @@ int generate(GenerateOptions& o) {
     throw InputError("--batch: " + std::to_string(o.batch) + " is not between 1 and 1000000");
 
   Session s;
-  open_catalogue(s, o.common);
-  {
+  // Together: a rank that cannot start stops them all, rather than leaving them waiting.
+  ranks->together([&] {
+    open_catalogue(s, o.common);
     // Check the generator's spec before any output exists.
     if (spec.scenarios.empty()) Generator check(s.catalogue, generator_spec(spec, s.catalogue), spec.seed);
     validate(spec.settings(), s.catalogue);
-  }
-  open_backend(s, o.common);
+    open_backend(s, o.common);
+  });
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  const PipelineResult r = run_pipeline(spec, s.catalogue, s.assets, *s.backend, o.out, popt);
+  const PipelineResult r = ranked ? run_ranked(spec, s.catalogue, s.assets, *s.backend, o.out, popt, *ranks)
+                                  : run_pipeline(spec, s.catalogue, s.assets, *s.backend, o.out, popt);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
+  if (ranks->rank() != 0) return r.interrupted ? 130 : 0;
 
   if (r.already_complete) {
     std::printf("%s: already complete (manifest.json present); nothing to do\n", o.out.c_str());
@@ -114,10 +124,11 @@ int generate(GenerateOptions& o) {
   }
   const double rate = r.seconds > 0 ? r.done / r.seconds : 0;
   std::printf(
-      "%s: %llu scenarios [%llu, %llu) in %.2f s, %.0f scenarios/s (%s backend, batch %zu); "
+      "%s: %llu scenarios [%llu, %llu) in %.2f s, %.0f scenarios/s (%s backend, batch %zu%s); "
       "positive %llu, negative %llu\n",
       o.out.c_str(), static_cast<unsigned long long>(r.done), static_cast<unsigned long long>(r.begin),
       static_cast<unsigned long long>(r.end), r.seconds, rate, s.backend->name().c_str(), r.batch,
+      ranked ? (", " + std::to_string(ranks->size()) + (ranks->size() == 1 ? " rank" : " ranks")).c_str() : "",
       static_cast<unsigned long long>(r.positive), static_cast<unsigned long long>(r.negative));
   if (o.common.timing)
     std::printf("timing: compute %.3f s (%.0f scenarios/s), waiting for the writer %.3f s%s\n", r.compute_seconds,

@@ -14,8 +14,10 @@ namespace {
 // values name the flag first.
 constexpr int kUsage = 2, kBadInput = 3, kOutput = 4, kEnvironment = 5, kInternal = 1;
 
+bool g_print_errors = true;
+
 int fail(const char* what, int code) {
-  std::fprintf(stderr, "portalsim: error: %s\n", what);
+  if (g_print_errors) std::fprintf(stderr, "portalsim: error: %s\n", what);
   return code;
 }
 
@@ -27,6 +29,8 @@ void check_values(const CLI::App& app) {
 }
 
 }  // namespace
+
+void print_errors(bool on) { g_print_errors = on; }
 
 int run(int argc, char** argv) {
   CLI::App app{"portalsim: simulated MMW, IR and metal detector outputs for security portal scenarios"};
@@ -41,6 +45,7 @@ int run(int argc, char** argv) {
   commands["serve"] = add_serve(app);
   commands["validate"] = add_validate(app);
   commands["knobs"] = add_knobs(app);
+  commands["merge"] = add_merge(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,132 @@
+#include "schedule/ranks.h"
+
+#include <cstdlib>
+
+#include "base/error.h"
+
+#ifdef PORTALSIM_MPI
+#include <mpi.h>
+#endif
+
+namespace portalsim {
+
+void Ranks::together(const std::function<void()>& f) {
+  std::exception_ptr error;
+  std::string mine;  // the error's kind (I, O, E, X), then its message
+  try {
+    f();
+  } catch (const InputError& e) {
+    error = std::current_exception();
+    mine = std::string("I") + e.what();
+  } catch (const OutputError& e) {
+    error = std::current_exception();
+    mine = std::string("O") + e.what();
+  } catch (const EnvironmentError& e) {
+    error = std::current_exception();
+    mine = std::string("E") + e.what();
+  } catch (const std::exception& e) {
+    error = std::current_exception();
+    mine = std::string("X") + e.what();
+  }
+  if (size() == 1) {
+    if (error) std::rethrow_exception(error);
+    return;
+  }
+  const std::vector<std::string> all = all_gather(mine);
+  std::string message;
+  char kind = 0;
+  for (size_t r = 0; r < all.size(); ++r) {
+    if (all[r].empty()) continue;
+    if (!kind) kind = all[r][0];
+    message += (message.empty() ? "" : "; ") + ("rank " + std::to_string(r) + ": ") + all[r].substr(1);
+  }
+  if (!kind) return;
+  if (kind == 'I') throw InputError(message);
+  if (kind == 'O') throw OutputError(message);
+  if (kind == 'E') throw EnvironmentError(message);
+  throw std::runtime_error(message);
+}
+
+namespace {
+
+// Set by Open MPI's mpirun, by PMIx launchers (srun --mpi=pmix) and by PMI-1/2 ones.
+bool launched_by_mpi() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK"})
+    if (std::getenv(v)) return true;
+  return false;
+}
+
+class SingleRank final : public Ranks {
+ public:
+  int rank() const override { return 0; }
+  int size() const override { return 1; }
+  std::vector<std::string> all_gather(const std::string& mine) override { return {mine}; }
+};
+
+#ifdef PORTALSIM_MPI
+class MpiRanks final : public Ranks {
+ public:
+  MpiRanks() {
+    int provided = 0;
+    // Only the main thread calls MPI; the writer and PoCL threads never do.
+    if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
+      throw EnvironmentError("MPI_Init_thread failed: the MPI launcher and this build's Open MPI do not agree");
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+    std::atexit([] {
+      int finalized = 0;
+      MPI_Finalized(&finalized);
+      if (!finalized) MPI_Finalize();
+    });
+  }
+  int rank() const override { return rank_; }
+  int size() const override { return size_; }
+  std::vector<std::string> all_gather(const std::string& mine) override {
+    const int n = static_cast<int>(mine.size());
+    std::vector<int> sizes(static_cast<size_t>(size_)), offsets(static_cast<size_t>(size_));
+    MPI_Allgather(&n, 1, MPI_INT, sizes.data(), 1, MPI_INT, MPI_COMM_WORLD);
+    int total = 0;
+    for (int r = 0; r < size_; ++r) {
+      offsets[static_cast<size_t>(r)] = total;
+      total += sizes[static_cast<size_t>(r)];
+    }
+    std::string all(static_cast<size_t>(total), '\0');
+    MPI_Allgatherv(mine.data(), n, MPI_CHAR, all.data(), sizes.data(), offsets.data(), MPI_CHAR, MPI_COMM_WORLD);
+    std::vector<std::string> out;
+    for (int r = 0; r < size_; ++r)
+      out.push_back(all.substr(static_cast<size_t>(offsets[static_cast<size_t>(r)]),
+                               static_cast<size_t>(sizes[static_cast<size_t>(r)])));
+    return out;
+  }
+
+ private:
+  int rank_ = 0, size_ = 1;
+};
+#endif
+
+}  // namespace
+
+std::unique_ptr<Ranks> single_rank() { return std::make_unique<SingleRank>(); }
+
+bool built_with_mpi() {
+#ifdef PORTALSIM_MPI
+  return true;
+#else
+  return false;
+#endif
+}
+
+Ranks* mpi_ranks() {
+  if (!launched_by_mpi()) return nullptr;
+#ifdef PORTALSIM_MPI
+  static MpiRanks ranks;
+  return &ranks;
+#else
+  // Each rank would run alone into the same folder: refuse rather than race.
+  throw EnvironmentError(
+      "started by an MPI launcher, but this portalsim was built without MPI: install libopenmpi-dev and build "
+      "again (CMake finds it), or run without mpirun");
+#endif
+}
+
+}  // namespace portalsim

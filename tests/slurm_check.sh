@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# ctest slurm.local: a one-node Slurm on this machine (tools/slurm/local_slurm.sh) runs
+# tools/slurm/generate.sbatch both ways, MPI (3 ranks under srun) and an array of 3
+# shards followed by a merge job; each data set must equal one process's, byte for byte.
+# Needs root (munged and slurmd), as CI runs.
+set -euo pipefail
+portalsim=$(realpath "${1:?usage: slurm_check.sh PORTALSIM WORKDIR}")
+work=$(realpath -m "${2:?usage: slurm_check.sh PORTALSIM WORKDIR}")
+here=$(cd "$(dirname "$0")/.." && pwd)
+slurm="$here/tools/slurm"
+
+"$slurm/local_slurm.sh" stop "$work/state" 2>/dev/null || true
+rm -rf "$work"
+mkdir -p "$work"
+trap '"$slurm/local_slurm.sh" stop "$work/state"' EXIT
+"$slurm/local_slurm.sh" start "$work/state" >/dev/null
+export SLURM_CONF=$work/state/slurm.conf PORTALSIM=$portalsim
+cd "$work"
+
+spec=(--count 900 --seed 11 --rule gun --what both --format arff,csv,npy,h5 --batch 64)
+"$portalsim" generate "${spec[@]}" --quiet --out "$work/one"
+
+# MPI: three ranks on two cores (--overcommit), started by srun inside the job.
+timeout 300 sbatch --wait --ntasks=3 --overcommit "$slurm/generate.sbatch" "$work/mpi" "${spec[@]}" >/dev/null
+# An array of three shards, then the merge once all three succeeded.
+id=$(sbatch --parsable --array=0-2 "$slurm/generate.sbatch" "$work/array" "${spec[@]}")
+timeout 300 sbatch --wait --dependency=afterok:"$id" "$slurm/generate.sbatch" --merge "$work/array" 3 >/dev/null
+
+status=0
+for d in mpi array; do
+  if diff -r "$work/one" "$work/$d" >/dev/null; then
+    echo "slurm.local: $d equals one process, byte for byte ($(find "$work/$d" -type f | wc -l) files)"
+  else
+    echo "slurm.local: $d differs from one process:" >&2
+    diff -rq "$work/one" "$work/$d" >&2 || true
+    status=1
+  fi
+done
+[ ! -e "$work/array.parts" ] || { echo "slurm.local: the merge job left array.parts behind" >&2; status=1; }
+if [ $status -ne 0 ]; then
+  echo "--- job logs ---" >&2
+  cat "$work"/portalsim-*.out >&2 || true
+fi
+exit $status
