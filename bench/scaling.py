@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Ranks against one process: generate's wall time for a features-only and an images data
-set, one process (2 threads) against mpirun -np 1 and -np 2, median of N runs, as a
+set, one process (2 threads) against mpirun -np 1 and -np 2 (--bind-to none: a rank
+threads over its node), median of N runs, as a
 Markdown table. Every ranked result is checked byte for byte against the one-process one.
 
   python3 bench/scaling.py --portalsim build/portalsim [--repetitions 3] [--work /tmp/scaling]
@@ -38,8 +39,8 @@ def main():
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     ways = {
         "one process, 2 threads": lambda out, spec: [exe, "generate", *spec, "--threads", "2", "--quiet", "--out", out],
-        "mpirun -np 1": lambda out, spec: ["mpirun", "-np", "1", exe, "generate", *spec, "--quiet", "--out", out],
-        "mpirun -np 2": lambda out, spec: ["mpirun", "--oversubscribe", "-np", "2", exe, "generate", *spec,
+        "mpirun -np 1": lambda out, spec: ["mpirun", "--bind-to", "none", "-np", "1", exe, "generate", *spec, "--quiet", "--out", out],
+        "mpirun -np 2": lambda out, spec: ["mpirun", "--bind-to", "none", "-np", "2", exe, "generate", *spec,
                                            "--quiet", "--out", out],
     }
     print(f"| data set | way | wall s (median of {a.repetitions}) | scenarios/s | vs one process |")
