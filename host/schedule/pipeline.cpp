@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -105,68 +107,64 @@ void draw_progress(uint64_t done, uint64_t total, double seconds) {
   std::fflush(stderr);
 }
 
-}  // namespace
-
-size_t default_batch(const Plan& plan, const Catalogue& cat) {
-  size_t bytes = 64 + kZones;
-  for (size_t k = 0; k < cat.sensors.size(); ++k)
-    if (plan.renders(cat.sensors[k], static_cast<int>(k))) bytes += cat.sensors[k].pixels();
-  if (plan.sparse_features()) bytes = 64 + kZones;  // no images, on the device either
-  if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
-  return std::clamp<size_t>((64u << 20) / bytes, 64, 16384);
-}
-
-PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const AssetSet& assets, Backend& backend,
-                            const std::string& dir, const PipelineOptions& opt) {
-  const auto t0 = Clock::now();
-  PipelineResult res;
-
-  // The scenario source.
-  std::optional<Generator> generator;
-  std::vector<Scenario> listed;
-  std::optional<ThreatRule> rule;
-  uint64_t total = spec.count;
-  if (!spec.rule.empty()) rule.emplace(cat, spec.rule, "--rule");  // listed scenarios' labels; region labels
-  if (!spec.scenarios.empty()) {
-    listed = read_scenario_file(cat, spec.scenarios);
-    total = listed.size();
-  } else {
-    generator.emplace(cat, generator_spec(spec, cat), spec.seed);
+// Where scenarios come from: the generator, or a listed file (a listed scenario without a
+// label takes the rule's). The rule also gives data.h5 its region labels.
+class ScenarioSource {
+ public:
+  ScenarioSource(const RunSpec& spec, const Catalogue& cat) {
+    if (!spec.rule.empty()) rule_.emplace(cat, spec.rule, "--rule");
+    if (!spec.scenarios.empty()) {
+      listed_ = read_scenario_file(cat, spec.scenarios);
+      total_ = listed_.size();
+    } else {
+      generator_.emplace(cat, generator_spec(spec, cat), spec.seed);
+      total_ = spec.count;
+    }
   }
-  if (opt.shards < 1 || opt.shard >= opt.shards) throw InputError("--shard: expected i/k with 0 <= i < k");
-  res.begin = total * opt.shard / opt.shards;
-  res.end = total * (opt.shard + 1) / opt.shards;
+  uint64_t total() const { return total_; }
+  const ThreatRule* rule() const { return rule_ ? &*rule_ : nullptr; }
+  Scenario operator()(uint64_t i) const {
+    if (generator_) return (*generator_)(i);
+    Scenario s = listed_[i];
+    if (s.label < 0) s.label = rule_ && (*rule_)(s) ? 1 : 0;
+    return s;
+  }
 
-  Plan plan = spec.settings();
-  plan.features = spec.wants_features();
-  plan.metal = true;
-  plan.images = spec.wants_images() ? kAllViews : 0;
-  validate(plan, cat);
-  res.batch = opt.batch ? opt.batch : default_batch(plan, cat);
-  const unsigned threads = opt.threads ? opt.threads : default_threads();
+ private:
+  std::optional<Generator> generator_;
+  std::vector<Scenario> listed_;
+  std::optional<ThreatRule> rule_;
+  uint64_t total_ = 0;
+};
 
+// What a run is, for its checkpoint, its manifest and a later --resume or merge.
+json run_identity(const RunSpec& spec, const Catalogue& cat, uint64_t total, const PipelineOptions& opt,
+                  const PipelineResult& res) {
   json identity;
   identity["portalsim"] = PORTALSIM_VERSION;
   identity["catalogue"] = {{"source", cat.source}, {"hash", cat.hash}};
   identity["spec"] = spec.to_json();
   if (!spec.scenarios.empty()) identity["spec"]["scenarios_count"] = total;
   identity["shard"] = {{"index", opt.shard}, {"count", opt.shards}, {"begin", res.begin}, {"end", res.end}};
+  return identity;
+}
 
-  // The output folder: new, or an interrupted run of the same identity to resume. The
-  // lock is taken before anything in it is read or changed.
-  const fs::path out(dir), state_dir = out / kStateDir, checkpoint_path = state_dir / "checkpoint.json",
-                           started_path = state_dir / "started";
-  std::error_code ec;
-  const bool created_dir = output_folder_state(dir) == FolderState::missing;
-  if (created_dir) {
-    fs::create_directories(out, ec);
-    if (ec) throw OutputError(dir + ": cannot create the output folder: " + ec.message());
-  }
-  const FolderLock lock(dir);
+struct FolderStart {
+  bool complete = false;  // a finished run of the same identity: --resume has nothing to do
+  bool resuming = false;  // an interrupted run of the same identity, to go on from `checkpoint`
   json checkpoint;
-  bool resuming = false;
+};
+
+// What the output folder holds, read with its lock held: new (or a run stopped before its
+// first checkpoint, whose files go), an interrupted run to resume, or a finished one.
+// Throws when the folder holds anything else, or a run with another identity.
+FolderStart examine_folder(const std::string& dir, const json& identity, bool resume) {
+  const fs::path out(dir), checkpoint_path = out / kStateDir / "checkpoint.json",
+                           started_path = out / kStateDir / "started";
+  std::error_code ec;
+  FolderStart start;
   if (fs::exists(out / "manifest.json", ec)) {
-    if (!opt.resume)
+    if (!resume)
       throw OutputError(dir +
                         ": is not empty: it holds a finished run (manifest.json); choose a new folder (--resume "
                         "only checks that it is complete)");
@@ -184,70 +182,45 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
     // Complete; a crash after the manifest was written may have left the checkpoint.
     fs::remove(checkpoint_path, ec);
     fs::remove(started_path, ec);
-    res.already_complete = true;
-    return res;
+    start.complete = true;
+    return start;
   }
-  if (opt.resume && fs::exists(checkpoint_path, ec)) {
+  if (resume && fs::exists(checkpoint_path, ec)) {
     try {
-      checkpoint = json::parse(read_file(checkpoint_path));
+      start.checkpoint = json::parse(read_file(checkpoint_path));
     } catch (const json::exception& e) {
       throw OutputError(checkpoint_path.string() + ": unreadable checkpoint: " + e.what());
     }
-    if (const std::string diff = differing_keys(checkpoint.value("identity", json::object()), identity); !diff.empty())
+    if (const std::string diff = differing_keys(start.checkpoint.value("identity", json::object()), identity);
+        !diff.empty())
       throw InputError("--resume: " + dir + " was made by a different run: " + diff +
                        "; give the same parameters, or another folder");
-    resuming = true;
+    start.resuming = true;
   } else if (fs::exists(started_path, ec) && !fs::exists(checkpoint_path, ec)) {
     // A run stopped before its first checkpoint: all that is here is its own; start again.
     for (const auto& entry : fs::directory_iterator(out, ec))
       if (entry.path().filename() != kStateDir) fs::remove_all(entry.path(), ec);
   } else if (output_folder_state(dir) == FolderState::has_files || fs::exists(checkpoint_path, ec)) {
-    throw OutputError(dir + (opt.resume ? ": holds no interrupted run to resume (no .portalsim/checkpoint.json); "
-                                          "choose a new folder"
-                                        : ": is not empty; use --resume to continue an interrupted run there, or "
-                                          "choose a new folder"));
+    throw OutputError(dir + (resume ? ": holds no interrupted run to resume (no .portalsim/checkpoint.json); "
+                                      "choose a new folder"
+                                    : ": is not empty; use --resume to continue an interrupted run there, or "
+                                      "choose a new folder"));
   }
-  // A fresh run that fails before any batch is written leaves nothing of its own
-  // behind; the folder was empty, or is one this run made.
-  struct Cleanup {
-    fs::path dir;
-    bool created, armed;
-    ~Cleanup() {
-      if (!armed) return;
-      std::error_code e;
-      if (created) {
-        fs::remove_all(dir, e);
-      } else {
-        for (const auto& entry : fs::directory_iterator(dir, e)) fs::remove_all(entry.path(), e);
-      }
-    }
-  } cleanup{out, created_dir, !resuming};
-  if (!resuming) write_text_atomic(started_path.string(), identity.dump() + "\n");
-  if (::access(state_dir.c_str(), W_OK) != 0) throw OutputError(dir + ": the output folder is not writable");
+  return start;
+}
 
-  const uint64_t start = resuming ? checkpoint["next"].get<uint64_t>() : res.begin;
-  if (resuming) {
-    res.positive = checkpoint["positive"].get<uint64_t>();
-    res.negative = checkpoint["negative"].get<uint64_t>();
-  }
-
-  // Sinks, each continuing from its checkpointed state on resume.
-  SinkContext ctx;
-  ctx.dir = dir;
-  ctx.cat = &cat;
-  ctx.assets = &assets;
-  ctx.layout = FeatureLayout::of(cat, plan.model.block);
-  ctx.rows = res.end - res.begin;
-  ctx.threads = threads;
-  ctx.image_format = spec.image_format;
+// The run's sinks, each continuing from its checkpointed state when resuming.
+std::vector<std::unique_ptr<Sink>> open_sinks(const RunSpec& spec, const Plan& plan, const SinkContext& ctx,
+                                              const ThreatRule* rule, const json& identity, const FolderStart& start,
+                                              uint64_t first) {
   std::map<std::string, FileState> saved;
-  if (resuming)
-    for (const json& f : checkpoint["files"])
+  if (start.resuming)
+    for (const json& f : start.checkpoint["files"])
       saved[f["name"]] = FileState{f["name"], f["bytes"].get<uint64_t>(), f["xxh3"].get<uint64_t>()};
   const auto resume_state = [&](const std::string& name) -> const FileState* {
-    if (!resuming) return nullptr;
+    if (!start.resuming) return nullptr;
     auto it = saved.find(name);
-    if (it == saved.end()) throw OutputError(checkpoint_path.string() + ": no state for " + name);
+    if (it == saved.end()) throw OutputError(ctx.dir + "/.portalsim/checkpoint.json: no state for " + name);
     return &it->second;
   };
   std::vector<std::unique_ptr<Sink>> sinks;
@@ -255,51 +228,42 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   if (plan.features)
     for (const std::string& f : spec.formats)
       if (f != "h5") sinks.push_back(make_table_sink(f, ctx, resume_state("features." + f)));
-  if (plan.images && !spec.image_tensors()) sinks.push_back(make_image_sink(ctx, resuming, start));
+  if (plan.images && !spec.image_tensors()) sinks.push_back(make_image_sink(ctx, start.resuming, first));
   TensorOptions topt;
-  topt.rule = rule ? &*rule : nullptr;
+  topt.rule = rule;
   topt.identity = identity;
   if (spec.has_format("h5")) {
     topt.h5 = true;
     topt.compress = spec.compress;
     topt.images = spec.wants_images();
     topt.features = spec.wants_features();
-    sinks.push_back(make_tensor_sink(ctx, topt, resuming ? &saved : nullptr));
+    sinks.push_back(make_tensor_sink(ctx, topt, start.resuming ? &saved : nullptr));
   }
   if (spec.npy_image_tensors()) {
     topt.h5 = false;
     topt.images = true;
-    sinks.push_back(make_tensor_sink(ctx, topt, resuming ? &saved : nullptr));
+    sinks.push_back(make_tensor_sink(ctx, topt, start.resuming ? &saved : nullptr));
   }
+  return sinks;
+}
 
-  const auto save_checkpoint = [&](uint64_t next) {
-    json c;
-    c["identity"] = identity;
-    c["next"] = next;
-    c["positive"] = res.positive;
-    c["negative"] = res.negative;
-    c["files"] = json::array();
-    for (const auto& s : sinks)
-      for (const FileState& f : s->files())
-        c["files"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"xxh3", f.xxh3}});
-    write_text_atomic(checkpoint_path.string(), c.dump(1) + "\n");
-  };
-  if (!resuming) {
-    save_checkpoint(start);
-    fs::remove(started_path, ec);
-  }
-
-  // Writer thread: sinks, then the checkpoint, batch after batch.
+// Generates, computes and writes scenarios [written, res.end) batch by batch: the main
+// thread generates and computes batch k while a writer thread writes batch k-1, records
+// `checkpoint(next)` and advances `written` (which an error leaves where it stood).
+void run_batches(const ScenarioSource& source, const Plan& plan, Backend& backend,
+                 std::vector<std::unique_ptr<Sink>>& sinks, unsigned threads, const PipelineOptions& opt,
+                 const std::function<void(uint64_t)>& checkpoint, PipelineResult& res, Clock::time_point t0,
+                 std::atomic<uint64_t>& written) {
+  const uint64_t first = written;
   Handover hand;
   std::exception_ptr writer_error;
-  std::atomic<uint64_t> written{start};
   std::thread writer([&] {
     try {
       while (std::unique_ptr<Job> job = hand.take()) {
         for (auto& s : sinks) s->write(job->scenes, job->out);
         for (uint8_t l : job->scenes.label) (l == 1 ? res.positive : res.negative)++;
         const uint64_t next = job->scenes.first_index + job->scenes.size();
-        save_checkpoint(next);
+        checkpoint(next);
         written = next;
         hand.recycle(std::move(job));
       }
@@ -312,23 +276,22 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   std::exception_ptr compute_error;
   double last_draw = -1;
   try {
-    for (uint64_t first = start; first < res.end; first += res.batch) {
+    for (uint64_t at = first; at < res.end; at += res.batch) {
       if (opt.stop && *opt.stop) {
         res.interrupted = true;
         break;
       }
       if (hand.failed()) break;
       std::unique_ptr<Job> job = hand.recycled();
-      const size_t n = static_cast<size_t>(std::min<uint64_t>(res.batch, res.end - first));
+      const size_t n = static_cast<size_t>(std::min<uint64_t>(res.batch, res.end - at));
       SceneBatch& b = job->scenes;
-      b.first_index = first;
+      b.first_index = at;
       b.subject.resize(n);
       b.objects.resize(n * kRegions);
       b.label.resize(n);
       parallel_for(n, n >= 1024 ? threads : 1, [&](size_t lo, size_t hi) {
         for (size_t i = lo; i < hi; ++i) {
-          Scenario s = generator ? (*generator)(first + i) : listed[first + i];
-          if (!generator && s.label < 0) s.label = rule && (*rule)(s) ? 1 : 0;
+          const Scenario s = source(at + i);
           b.subject[i] = static_cast<uint8_t>(s.subject);
           std::copy(s.objects.begin(), s.objects.end(), b.objects.begin() + i * kRegions);
           b.label[i] = static_cast<uint8_t>(s.label);
@@ -354,14 +317,13 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
     draw_progress(written - res.begin, res.end - res.begin, since(t0));
     std::fprintf(stderr, "\n");
   }
-  if (written > start || res.end == start) cleanup.armed = false;  // progress worth resuming
   if (compute_error) std::rethrow_exception(compute_error);
   if (writer_error) std::rethrow_exception(writer_error);
-  res.done = written - start;
-  res.seconds = since(t0);
-  if (res.interrupted) return res;
+}
 
-  // Complete: final names, then the manifest, then the checkpoint goes.
+// A finished run: every file gets its final name, then the manifest is written.
+void write_manifest(const std::string& dir, std::vector<std::unique_ptr<Sink>>& sinks, const json& identity,
+                    const PipelineResult& res, bool image_folders) {
   json manifest = identity;
   manifest["count"] = res.end - res.begin;
   manifest["classes"] = {{"positive", res.positive}, {"negative", res.negative}};
@@ -374,8 +336,118 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
       manifest["outputs"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"xxh3_64", hash}});
     }
   }
-  if (plan.images && !spec.image_tensors()) manifest["images"] = {{"folder", "images"}, {"count", res.end - res.begin}};
-  write_text_atomic((out / "manifest.json").string(), manifest.dump(2) + "\n");
+  if (image_folders) manifest["images"] = {{"folder", "images"}, {"count", res.end - res.begin}};
+  write_text_atomic((fs::path(dir) / "manifest.json").string(), manifest.dump(2) + "\n");
+}
+
+}  // namespace
+
+size_t default_batch(const Plan& plan, const Catalogue& cat) {
+  size_t bytes = 64 + kZones;
+  for (size_t k = 0; k < cat.sensors.size(); ++k)
+    if (plan.renders(cat.sensors[k], static_cast<int>(k))) bytes += cat.sensors[k].pixels();
+  if (plan.sparse_features()) bytes = 64 + kZones;  // no images, on the device either
+  if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
+  return std::clamp<size_t>((64u << 20) / bytes, 64, 16384);
+}
+
+PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const AssetSet& assets, Backend& backend,
+                            const std::string& dir, const PipelineOptions& opt) {
+  const auto t0 = Clock::now();
+  PipelineResult res;
+  const ScenarioSource source(spec, cat);
+  if (opt.shards < 1 || opt.shard >= opt.shards) throw InputError("--shard: expected i/k with 0 <= i < k");
+  res.begin = source.total() * opt.shard / opt.shards;
+  res.end = source.total() * (opt.shard + 1) / opt.shards;
+
+  Plan plan = spec.settings();
+  plan.features = spec.wants_features();
+  plan.metal = true;
+  plan.images = spec.wants_images() ? kAllViews : 0;
+  validate(plan, cat);
+  res.batch = opt.batch ? opt.batch : default_batch(plan, cat);
+  const unsigned threads = opt.threads ? opt.threads : default_threads();
+  const json identity = run_identity(spec, cat, source.total(), opt, res);
+
+  // The output folder: the lock is taken before anything in it is read or changed.
+  const fs::path out(dir), state_dir = out / kStateDir, checkpoint_path = state_dir / "checkpoint.json",
+                           started_path = state_dir / "started";
+  std::error_code ec;
+  const bool created_dir = output_folder_state(dir) == FolderState::missing;
+  if (created_dir) {
+    fs::create_directories(out, ec);
+    if (ec) throw OutputError(dir + ": cannot create the output folder: " + ec.message());
+  }
+  const FolderLock lock(dir);
+  const FolderStart start = examine_folder(dir, identity, opt.resume);
+  if (start.complete) {
+    res.already_complete = true;
+    return res;
+  }
+  // A fresh run that fails before any batch is written leaves nothing of its own
+  // behind; the folder was empty, or is one this run made.
+  struct Cleanup {
+    fs::path dir;
+    bool created, armed;
+    ~Cleanup() {
+      if (!armed) return;
+      std::error_code e;
+      if (created) {
+        fs::remove_all(dir, e);
+      } else {
+        for (const auto& entry : fs::directory_iterator(dir, e)) fs::remove_all(entry.path(), e);
+      }
+    }
+  } cleanup{out, created_dir, !start.resuming};
+  if (!start.resuming) write_text_atomic(started_path.string(), identity.dump() + "\n");
+  if (::access(state_dir.c_str(), W_OK) != 0) throw OutputError(dir + ": the output folder is not writable");
+
+  const uint64_t first = start.resuming ? start.checkpoint["next"].get<uint64_t>() : res.begin;
+  if (start.resuming) {
+    res.positive = start.checkpoint["positive"].get<uint64_t>();
+    res.negative = start.checkpoint["negative"].get<uint64_t>();
+  }
+  SinkContext ctx;
+  ctx.dir = dir;
+  ctx.cat = &cat;
+  ctx.assets = &assets;
+  ctx.layout = FeatureLayout::of(cat, plan.model.block);
+  ctx.rows = res.end - res.begin;
+  ctx.threads = threads;
+  ctx.image_format = spec.image_format;
+  std::vector<std::unique_ptr<Sink>> sinks = open_sinks(spec, plan, ctx, source.rule(), identity, start, first);
+
+  const auto checkpoint = [&](uint64_t next) {
+    json c;
+    c["identity"] = identity;
+    c["next"] = next;
+    c["positive"] = res.positive;
+    c["negative"] = res.negative;
+    c["files"] = json::array();
+    for (const auto& s : sinks)
+      for (const FileState& f : s->files())
+        c["files"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"xxh3", f.xxh3}});
+    write_text_atomic(checkpoint_path.string(), c.dump(1) + "\n");
+  };
+  if (!start.resuming) {
+    checkpoint(first);
+    fs::remove(started_path, ec);
+  }
+
+  std::atomic<uint64_t> written{first};
+  std::exception_ptr error;
+  try {
+    run_batches(source, plan, backend, sinks, threads, opt, checkpoint, res, t0, written);
+  } catch (...) {
+    error = std::current_exception();
+  }
+  if (written > first || res.end == first) cleanup.armed = false;  // progress worth resuming
+  if (error) std::rethrow_exception(error);
+  res.done = written - first;
+  res.seconds = since(t0);
+  if (res.interrupted) return res;
+
+  write_manifest(dir, sinks, identity, res, plan.images && !spec.image_tensors());
   fs::remove_all(state_dir, ec);
   res.seconds = since(t0);  // with the finishing work (data.h5 is built there)
   return res;
