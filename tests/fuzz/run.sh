@@ -8,7 +8,7 @@ cd "$(dirname "$0")/../.."
 seconds=${1:-50}
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPORTALSIM_FUZZ=ON \
   -DPORTALSIM_TESTS=OFF -DPORTALSIM_BENCH=OFF ${PORTALSIM_CMAKE_ARGS:-} >/dev/null
-cmake --build build-fuzz -j "$(nproc)"
+cmake --build build-fuzz -j "$(nproc)" --target fuzz_catalogue fuzz_spec fuzz_scenarios fuzz_feature_table fuzz_image
 for target in catalogue spec scenarios feature_table image; do
   work=build-fuzz/corpus/$target crashes=build-fuzz/crashes/$target
   rm -rf "$work" && mkdir -p "$work" "$crashes"
