@@ -2,6 +2,7 @@
 // as root with --allow-run-as-root, more ranks than cores with --oversubscribe). Every
 // check is byte for byte against one process making the whole data set.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <map>
 
@@ -130,6 +131,20 @@ TEST(Merge, RefusesPartsThatDoNotFit) {
   fs::copy(p1, t.w() / "cut", fs::copy_options::recursive);
   fs::resize_file(t.w() / "cut" / "features.csv", fs::file_size(t.w() / "cut" / "features.csv") - 10);
   ExpectRefused(ps(t, {"merge", p0, (t.w() / "cut").string(), p2, "--out", out.string()}), out, 3, {"cut"});
+  // A manifest naming an output outside the part, and a FIFO where a table should be:
+  // refused, never followed or waited on.
+  fs::copy(p1, t.w() / "evil", fs::copy_options::recursive);
+  std::string m = slurp(t.w() / "evil" / "manifest.json");
+  m.replace(m.find("\"features.csv\""), 14, "\"../escape.csv\"");
+  spit(t.w() / "evil" / "manifest.json", m);
+  ExpectRefused(ps(t, {"merge", p0, (t.w() / "evil").string(), p2, "--out", out.string()}), out, 3,
+                {"evil", "not a plain file name"});
+  EXPECT_FALSE(fs::exists(t.w() / "escape.csv.partial"));
+  fs::copy(p1, t.w() / "fifo", fs::copy_options::recursive);
+  fs::remove(t.w() / "fifo" / "features.csv");
+  ASSERT_EQ(::mkfifo((t.w() / "fifo" / "features.csv").c_str(), 0644), 0);
+  ExpectRefused(ps(t, {"merge", p0, (t.w() / "fifo").string(), p2, "--out", out.string()}), out, 3,
+                {"fifo", "features.csv"});
   // An output folder that holds something.
   fs::create_directories(t.w() / "full");
   spit(t.w() / "full" / "keep.txt", "mine");

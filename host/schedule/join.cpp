@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "base/error.h"
+#include "io/input_file.h"
 #include "schedule/identity.h"
 #include "sink/append_file.h"
 #include "sink/h5_file.h"
@@ -206,11 +207,13 @@ void copy_range(const std::string& src, const json& recorded, uint64_t from, uin
 void link_folder(const fs::path& src, const fs::path& dst) {
   const fs::path tmp = dst.string() + ".tmp";
   std::error_code ec;
+  if (fs::is_symlink(src, ec) || !fs::is_directory(src, ec))
+    throw InputError(src.string() + ": not a scenario folder portalsim wrote");
   fs::remove_all(tmp, ec);
   fs::create_directory(tmp, ec);
   if (ec) throw OutputError(tmp.string() + ": cannot create: " + ec.message());
   for (const auto& e : fs::directory_iterator(src)) {
-    if (!e.is_regular_file()) throw InputError(e.path().string() + ": not a file portalsim wrote");
+    if (e.is_symlink() || !e.is_regular_file()) throw InputError(e.path().string() + ": not a file portalsim wrote");
     const fs::path to = tmp / e.path().filename();
     fs::create_hard_link(e.path(), to, ec);
     if (ec) {
@@ -226,6 +229,50 @@ void link_folder(const fs::path& src, const fs::path& dst) {
 
 }  // namespace
 
+namespace {
+
+const json& field(const json& j, const char* key, const std::string& where) {
+  if (!j.is_object() || !j.contains(key)) throw InputError(where + key + ": missing");
+  return j[key];
+}
+
+uint64_t count_field(const json& j, const char* key, const std::string& where) {
+  const json& v = field(j, key, where);
+  if (!v.is_number_unsigned()) throw InputError(where + key + ": not a count");
+  return v.get<uint64_t>();
+}
+
+// Every field a join reads, checked before it is trusted: counts are counts, output
+// names are plain file names (no folder, nothing hidden), hashes are 16 hex digits.
+void check_manifest(const json& m) {
+  const uint64_t begin = count_field(field(m, "shard", ""), "begin", "shard."),
+                 end = count_field(m["shard"], "end", "shard."), count = count_field(m, "count", "");
+  if (end < begin || count != end - begin) throw InputError("shard: its range and count disagree");
+  const json& spec = field(m, "spec", "");
+  if (end > count_field(spec, spec.contains("scenarios_count") ? "scenarios_count" : "count", "spec."))
+    throw InputError("shard.end: past the spec's count");
+  const json& classes = field(m, "classes", "");
+  if (count_field(classes, "positive", "classes.") + count_field(classes, "negative", "classes.") != count)
+    throw InputError("classes: do not add up to count");
+  const json& outputs = field(m, "outputs", "");
+  if (!outputs.is_array() || outputs.size() > 64) throw InputError("outputs: not a list of outputs");
+  for (const json& o : outputs) {
+    const json& name = field(o, "name", "outputs[].");
+    if (!name.is_string()) throw InputError("outputs[].name: not a string");
+    const std::string n = name.get<std::string>();
+    if (n.empty() || n.size() > 255 || n[0] == '.' ||
+        n.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") != std::string::npos)
+      throw InputError("outputs[].name: \"" + n + "\" is not a plain file name");
+    count_field(o, "bytes", "outputs[].");
+    const json& h = field(o, "xxh3_64", "outputs[].");
+    if (!h.is_string() || h.get<std::string>().size() != 16 ||
+        h.get<std::string>().find_first_not_of("0123456789abcdef") != std::string::npos)
+      throw InputError("outputs[].xxh3_64: not 16 hexadecimal digits");
+  }
+}
+
+}  // namespace
+
 std::vector<Part> read_parts(const std::vector<std::string>& dirs) {
   if (dirs.empty()) throw InputError("merge: no parts given");
   std::vector<Part> parts;
@@ -237,13 +284,10 @@ std::vector<Part> read_parts(const std::vector<std::string>& dirs) {
     Part p;
     p.dir = d;
     try {
-      p.manifest = json::parse(read_whole(m));
-      p.begin = p.manifest.at("shard").at("begin").get<uint64_t>();
-      p.end = p.manifest.at("shard").at("end").get<uint64_t>();
-      (void)total_of(p.manifest.at("spec"));
-      if (p.end < p.begin || p.manifest.at("count").get<uint64_t>() != p.end - p.begin)
-        throw InputError("shard: its range and count disagree");
-      p.manifest.at("outputs").get<std::vector<json>>();
+      p.manifest = json::parse(io::read_text_file(m.string(), "manifest", io::Bom::refuse));
+      check_manifest(p.manifest);
+      p.begin = p.manifest["shard"]["begin"].get<uint64_t>();
+      p.end = p.manifest["shard"]["end"].get<uint64_t>();
     } catch (const json::exception& e) {
       throw InputError(m.string() + ": not a manifest portalsim wrote: " + e.what());
     } catch (const InputError& e) {
@@ -327,6 +371,17 @@ JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir
   std::vector<std::string> dataset_paths;
   H5Layout h5;
   bool has_h5 = false;
+  // A part's data.h5 must be what its manifest records before HDF5 opens it.
+  ranks.together([&] {
+    for (size_t k = 0; k < parts.size(); ++k)
+      if (mine(k))
+        for (const json& o : parts[k].manifest["outputs"])
+          if (o["name"] == "data.h5") {
+            io::check_regular_file((fs::path(parts[k].dir) / "data.h5").string(), "part's data.h5", SIZE_MAX);
+            const FileState f = hash_file(parts[k].dir, "data.h5");
+            check_recorded((fs::path(parts[k].dir) / "data.h5").string(), o, f.bytes, f.xxh3);
+          }
+  });
   ranks.together([&] {
     for (const json& o : first["outputs"]) {
       const std::string name = o.at("name").get<std::string>();
@@ -446,12 +501,6 @@ JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir
     }
   });
   ranks.together([&] {
-    if (has_h5)
-      for (size_t k = 0; k < parts.size(); ++k)
-        if (mine(k)) {
-          const FileState f = hash_file(parts[k].dir, "data.h5");
-          check_recorded((fs::path(parts[k].dir) / "data.h5").string(), recorded(k, "data.h5"), f.bytes, f.xxh3);
-        }
     std::vector<char> buf;
     for (Output& t : outputs) {
       RangeWriter w(t.path);
