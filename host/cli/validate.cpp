@@ -15,7 +15,6 @@
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -190,11 +189,26 @@ Table load(const std::string& path, const std::string& work, const std::string& 
 // "blocks" drops the region means (regionN); the metal zones and the class stay.
 void select_features(Table& t, const std::string& features) {
   if (features == "both") return;
-  static const std::regex block(R"(.+_r[0-9]+_c[0-9]+)"), region(R"(region[0-9]+)");
-  const std::regex& drop = features == "regions" ? block : region;
+  // "digits then `tail`" at the end of s, with at least one digit: returns where they start.
+  const auto digits_before = [](std::string_view s, size_t end) {
+    size_t b = end;
+    while (b > 0 && s[b - 1] >= '0' && s[b - 1] <= '9') --b;
+    return b < end ? b : std::string_view::npos;
+  };
+  const auto is_block = [&](std::string_view s) {  // .+_r[0-9]+_c[0-9]+
+    const size_t c = digits_before(s, s.size());
+    if (c == std::string_view::npos || c < 2 || s.substr(c - 2, 2) != "_c") return false;
+    const size_t r = digits_before(s, c - 2);
+    return r != std::string_view::npos && r >= 3 && s.substr(r - 2, 2) == "_r";
+  };
+  const auto is_region = [&](std::string_view s) {  // region[0-9]+
+    return s.starts_with("region") && s.size() > 6 && digits_before(s, s.size()) == 6;
+  };
   std::vector<size_t> keep;
-  for (size_t i = 0; i < t.names.size(); ++i)
-    if (i + 1 == t.names.size() || !std::regex_match(t.names[i], drop)) keep.push_back(i);
+  for (size_t i = 0; i < t.names.size(); ++i) {
+    const bool drop = features == "regions" ? is_block(t.names[i]) : is_region(t.names[i]);
+    if (i + 1 == t.names.size() || !drop) keep.push_back(i);
+  }
   auto pick = [&](auto& v) {
     std::remove_reference_t<decltype(v)> out;
     for (size_t i : keep) out.push_back(v[i]);
