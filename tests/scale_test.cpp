@@ -36,6 +36,12 @@ void ExpectOk(const Result& r) {
   EXPECT_EQ(r.err.find("error"), std::string::npos) << describe(r);
 }
 
+size_t occurrences(const std::string& text, const std::string& needle) {
+  size_t n = 0;
+  for (size_t p = text.find(needle); p != std::string::npos; p = text.find(needle, p + 1)) ++n;
+  return n;
+}
+
 // Every regular file under `dir` (hidden ones too): relative path -> bytes.
 std::map<std::string, std::string> tree(const fs::path& dir) {
   std::map<std::string, std::string> m;
@@ -162,11 +168,7 @@ TEST(Mpi, ThreeRanksEqualOneProcessInEveryFormat) {
     const Result r = finish(start_mpi(t, 3, gen(kSpecs[s], ranked)), 600);
     ExpectOk(r);
     // One summary for the whole job, from rank 0.
-    size_t lines = 0;
-    for (size_t p = r.out.find(ranked.string() + ":"); p != std::string::npos;
-         p = r.out.find(ranked.string() + ":", p + 1))
-      ++lines;
-    EXPECT_EQ(lines, 1u) << describe(r);
+    EXPECT_EQ(occurrences(r.out, ranked.string() + ":"), 1u) << describe(r);
     EXPECT_NE(r.out.find("3 ranks"), std::string::npos) << describe(r);
     ExpectSameBytes(whole, ranked);
   }
@@ -225,10 +227,7 @@ TEST(Mpi, AFailingRankStopsEveryRankAndIsNamed) {
   EXPECT_TRUE(r.exited && r.status == 4) << describe(r);
   EXPECT_NE(r.err.find("rank 2: "), std::string::npos) << describe(r);
   EXPECT_NE(r.err.find("2-of-3"), std::string::npos) << describe(r);
-  size_t errors = 0;
-  for (size_t p = r.err.find("portalsim: error:"); p != std::string::npos; p = r.err.find("portalsim: error:", p + 1))
-    ++errors;
-  EXPECT_EQ(errors, 1u) << "rank 0 alone reports\n" << describe(r);
+  EXPECT_EQ(occurrences(r.err, "portalsim: error:"), 1u) << "rank 0 alone reports\n" << describe(r);
   EXPECT_FALSE(fs::exists(dir / "manifest.json"));
 }
 

@@ -43,6 +43,12 @@ Knob choice(std::string key, std::vector<std::string> choices, std::string help,
 std::vector<Knob> declare() {
   std::vector<Knob> k;
   // The sensor model (README, "The model"); defaults are the thesis's.
+  k.push_back(choice(
+      "model", {"thesis", "physics"},
+      "the sensor model: the thesis's composite (its exact examples), or the physically based one (apparent "
+      "temperature, optics, raw grid, NETD; contact shadow in IR; coil fields and polarizability for metal)",
+      false, true, [](Plan& p, double v) { p.model.model = static_cast<Model>(v); },
+      [](const Plan& p) { return model_name(p.model.model); }));
   k.push_back(integer(
       "block", 1, 65536, "pixels", "side of the averaged pixel blocks of the features (thesis 5.6)",
       [](Plan& p, double v) { p.model.block = static_cast<int>(v); }, [](const Plan& p) { return p.model.block; }));

@@ -70,6 +70,7 @@ Tier parse_tier(const std::string& name, const std::string& where) {
   throw InputError(where + ": \"" + name + "\" is not a tier (fast, standard, exact)");
 }
 
+const char* model_name(Model m) { return m == Model::physics ? "physics" : "thesis"; }
 const char* tier_name(Tier t) { return t == Tier::fast ? "fast" : t == Tier::exact ? "exact" : "standard"; }
 const char* precision_name(Precision p) {
   return p == Precision::fp64 ? "fp64" : p == Precision::fixed16 ? "fixed16" : "fp32";

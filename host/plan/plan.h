@@ -9,9 +9,15 @@
 
 namespace portalsim {
 
+// Which sensor model renders a scenario: the thesis's composite, or the physically based
+// one (README, "The physics model"). Each camera view has a stage chain per model.
+enum class Model { thesis = 0, physics = 1 };
+const char* model_name(Model m);
+
 // The knobs of the sensor model (README, "The model"). Defaults are the thesis's.
 struct ModelSettings {
   uint64_t seed = 0;
+  Model model = Model::thesis;
   bool pattern_noise = true;  // thesis 4.2: one of the MMW noise patterns over each object
   double pixel_sigma = 0.0;   // per-pixel Gaussian sensor noise, gray levels (MMW and IR)
   int metal_noise = 0;        // detector noise: triangular integer noise, half-width in counts

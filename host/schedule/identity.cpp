@@ -21,4 +21,16 @@ std::string differing_keys(const json& was, const json& now, const std::string& 
   return out;
 }
 
+json run_manifest(const json& identity, uint64_t count, uint64_t positive, uint64_t negative,
+                  const std::vector<FileState>& outputs, bool image_folders) {
+  json manifest = identity;
+  manifest["count"] = count;
+  manifest["classes"] = {{"positive", positive}, {"negative", negative}};
+  manifest["outputs"] = json::array();
+  for (const FileState& f : outputs)
+    manifest["outputs"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"xxh3_64", xxh3_hex(f.xxh3)}});
+  if (image_folders) manifest["images"] = {{"folder", "images"}, {"count", count}};
+  return manifest;
+}
+
 }  // namespace portalsim

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include "base/error.h"
@@ -28,24 +29,13 @@ using nlohmann::json;
 
 namespace {
 
-std::string read_whole(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw InputError(p.string() + ": cannot read");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string read_whole(const fs::path& p) { return io::read_file(p.string(), "part file", io::kMaxTextBytes); }
 
 // The keys a part's manifest shares with every other part of the same data set.
 json shared_identity(const json& manifest) {
   json id = json::object();
   for (const char* k : {"portalsim", "catalogue", "spec"}) id[k] = manifest.value(k, json());
   return id;
-}
-
-uint64_t total_of(const json& spec) {
-  const json& n = spec.contains("scenarios_count") ? spec["scenarios_count"] : spec["count"];
-  return n.get<uint64_t>();
 }
 
 enum class Kind { text, npy, h5 };
@@ -134,9 +124,7 @@ void pwrite_all(int fd, const char* p, size_t n, uint64_t off, const std::string
 
 // A part's file must be what its manifest recorded: {"bytes": N, "xxh3_64": "hex"}.
 void check_recorded(const std::string& path, const json& recorded, uint64_t bytes, uint64_t hash) {
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
-  if (recorded.value("bytes", uint64_t(0)) != bytes || recorded.value("xxh3_64", std::string()) != hex)
+  if (recorded.value("bytes", uint64_t(0)) != bytes || recorded.value("xxh3_64", std::string()) != xxh3_hex(hash))
     throw InputError(path + ": its bytes are not those its manifest.json records (changed or damaged since)");
 }
 
@@ -172,24 +160,30 @@ class RangeWriter {
   int fd_;
 };
 
+using Xxh3 = std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)>;
+
+Xxh3 new_xxh3() {
+  Xxh3 h(XXH3_createState(), XXH3_freeState);
+  if (!h) throw std::bad_alloc();
+  XXH3_64bits_reset(h.get());
+  return h;
+}
+
 // Copies bytes [from, from + bytes) of `src` to `dst` at `to`, checking that the whole of
 // `src` is what its manifest says (size and XXH3-64); `written`, when given, takes the
 // bytes copied (a rank that writes a whole file in order hashes it on the way).
 void copy_range(const std::string& src, const json& recorded, uint64_t from, uint64_t bytes, RangeWriter& dst,
                 uint64_t to, XXH3_state_t* written) {
   std::ifstream in(src, std::ios::binary);
-  XXH3_state_t* h = XXH3_createState();
-  XXH3_64bits_reset(h);
+  const Xxh3 h = new_xxh3();
   std::vector<char> buf(16u << 20);
   uint64_t at = 0;
   const uint64_t end = from + bytes;
   while (at < end) {
     const size_t n = static_cast<size_t>(std::min<uint64_t>(end - at, buf.size()));
-    if (!in.read(buf.data(), static_cast<std::streamsize>(n))) {
-      XXH3_freeState(h);
+    if (!in.read(buf.data(), static_cast<std::streamsize>(n)))
       throw InputError(src + ": shorter than its manifest says");
-    }
-    XXH3_64bits_update(h, buf.data(), n);
+    XXH3_64bits_update(h.get(), buf.data(), n);
     const uint64_t skip = at < from ? std::min<uint64_t>(from - at, n) : 0;
     if (skip < n) {
       dst.write(buf.data() + skip, n - skip, to + (at + skip - from));
@@ -197,9 +191,7 @@ void copy_range(const std::string& src, const json& recorded, uint64_t from, uin
     }
     at += n;
   }
-  const uint64_t hash = XXH3_64bits_digest(h);
-  XXH3_freeState(h);
-  check_recorded(src, recorded, end, hash);
+  check_recorded(src, recorded, end, XXH3_64bits_digest(h.get()));
 }
 
 // dst/<name> from src/<name>, each file hard-linked (copied across filesystems), through
@@ -227,10 +219,6 @@ void link_folder(const fs::path& src, const fs::path& dst) {
   if (ec) throw OutputError(dst.string() + ": cannot move into place: " + ec.message());
 }
 
-}  // namespace
-
-namespace {
-
 const json& field(const json& j, const char* key, const std::string& where) {
   if (!j.is_object() || !j.contains(key)) throw InputError(where + key + ": missing");
   return j[key];
@@ -242,6 +230,11 @@ uint64_t count_field(const json& j, const char* key, const std::string& where) {
   return v.get<uint64_t>();
 }
 
+// The scenarios in the whole data set a spec describes.
+uint64_t total_of(const json& spec) {
+  return count_field(spec, spec.contains("scenarios_count") ? "scenarios_count" : "count", "spec.");
+}
+
 // Every field a join reads, checked before it is trusted: counts are counts, output
 // names are plain file names (no folder, nothing hidden), hashes are 16 hex digits.
 void check_manifest(const json& m) {
@@ -249,8 +242,7 @@ void check_manifest(const json& m) {
                  end = count_field(m["shard"], "end", "shard."), count = count_field(m, "count", "");
   if (end < begin || count != end - begin) throw InputError("shard: its range and count disagree");
   const json& spec = field(m, "spec", "");
-  if (end > count_field(spec, spec.contains("scenarios_count") ? "scenarios_count" : "count", "spec."))
-    throw InputError("shard.end: past the spec's count");
+  if (end > total_of(spec)) throw InputError("shard.end: past the spec's count");
   const json& classes = field(m, "classes", "");
   if (count_field(classes, "positive", "classes.") + count_field(classes, "negative", "classes.") != count)
     throw InputError("classes: do not add up to count");
@@ -505,17 +497,11 @@ JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir
     for (Output& t : outputs) {
       RangeWriter w(t.path);
       // Alone, this rank writes every byte in order: hash as it goes, saving a read.
-      XXH3_state_t* whole = size == 1 && t.dataset < 0 ? XXH3_createState() : nullptr;
-      if (whole) {
-        XXH3_64bits_reset(whole);
-        XXH3_64bits_update(whole, t.header.data(), t.header.size());
+      Xxh3 whole(nullptr, XXH3_freeState);
+      if (size == 1 && t.dataset < 0) {
+        whole = new_xxh3();
+        XXH3_64bits_update(whole.get(), t.header.data(), t.header.size());
       }
-      struct Free {
-        XXH3_state_t* s;
-        ~Free() {
-          if (s) XXH3_freeState(s);
-        }
-      } free_whole{whole};
       for (size_t k = 0; k < parts.size(); ++k) {
         if (!mine(k)) continue;
         const Piece& p = t.pieces[k];
@@ -529,11 +515,11 @@ JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir
             w.write(buf.data(), buf.size(), p.to + r * row);
           }
         } else {
-          copy_range(p.src, p.recorded, p.from, p.bytes, w, p.to, whole);
+          copy_range(p.src, p.recorded, p.from, p.bytes, w, p.to, whole.get());
         }
       }
       w.finish();
-      if (whole) written[t.name] = {t.bytes, XXH3_64bits_digest(whole)};
+      if (whole) written[t.name] = {t.bytes, XXH3_64bits_digest(whole.get())};
     }
     if (first.contains("images"))
       for (size_t k = 0; k < parts.size(); ++k) {
@@ -574,28 +560,23 @@ JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir
     for (const auto& [k, v] : theirs.items()) hashes[k] = v;
   }
 
+  std::vector<FileState> states;
+  for (const std::string& n : names) {
+    states.push_back(FileState{n, hashes.at(n)[0].get<uint64_t>(), hashes.at(n)[1].get<uint64_t>()});
+    res.bytes += states.back().bytes;
+  }
+
   ranks.together([&] {
     if (me != 0) return;
-    json manifest = identity;
-    manifest["count"] = total;
-    manifest["classes"] = {{"positive", res.positive}, {"negative", res.negative}};
-    manifest["outputs"] = json::array();
     for (const std::string& n : names) {
-      const uint64_t bytes = hashes.at(n)[0], xxh3 = hashes.at(n)[1];
-      char hash[17];
-      std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(xxh3));
-      manifest["outputs"].push_back({{"name", n}, {"bytes", bytes}, {"xxh3_64", hash}});
-      res.bytes += bytes;
       if (n == "data.h5") continue;
       std::error_code ec;
       fs::rename(out / (n + ".partial"), out / n, ec);
       if (ec) throw OutputError((out / n).string() + ": cannot move into place: " + ec.message());
     }
-    if (first.contains("images")) manifest["images"] = {{"folder", "images"}, {"count", total}};
+    const json manifest = run_manifest(identity, total, res.positive, res.negative, states, first.contains("images"));
     write_text_atomic((out / "manifest.json").string(), manifest.dump(2) + "\n");
   });
-  if (me != 0)
-    for (const std::string& n : names) res.bytes += hashes.at(n)[0].get<uint64_t>();
   return res;
 }
 

@@ -6,7 +6,6 @@
 #include <condition_variable>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -30,13 +29,6 @@ using nlohmann::json;
 namespace {
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 struct Job {
   SceneBatch scenes;
@@ -155,6 +147,30 @@ struct FolderStart {
   json checkpoint;
 };
 
+// Whether `dir` holds a finished run (a manifest.json). Throws when it does without
+// `resume`, or when that run's identity differs from `identity`, naming every key.
+bool finished_run_here(const std::string& dir, const json& identity, bool resume) {
+  const fs::path manifest_path = fs::path(dir) / "manifest.json";
+  std::error_code ec;
+  if (!fs::exists(manifest_path, ec)) return false;
+  if (!resume)
+    throw OutputError(dir +
+                      ": is not empty: it holds a finished run (manifest.json); choose a new folder (--resume "
+                      "only checks that it is complete)");
+  json manifest;
+  try {
+    manifest = json::parse(read_state_file(manifest_path.string()));
+  } catch (const json::exception& e) {
+    throw OutputError(dir + "/manifest.json: unreadable: " + e.what());
+  }
+  json was = json::object();
+  for (const auto& [k, v] : identity.items()) was[k] = manifest.value(k, json());
+  if (const std::string diff = differing_keys(was, identity); !diff.empty())
+    throw InputError("--resume: " + dir + " holds a finished run with other parameters: " + diff +
+                     "; give the same parameters, or another folder");
+  return true;
+}
+
 // What the output folder holds, read with its lock held: new (or a run stopped before its
 // first checkpoint, whose files go), an interrupted run to resume, or a finished one.
 // Throws when the folder holds anything else, or a run with another identity.
@@ -163,22 +179,7 @@ FolderStart examine_folder(const std::string& dir, const json& identity, bool re
                            started_path = out / kStateDir / "started";
   std::error_code ec;
   FolderStart start;
-  if (fs::exists(out / "manifest.json", ec)) {
-    if (!resume)
-      throw OutputError(dir +
-                        ": is not empty: it holds a finished run (manifest.json); choose a new folder (--resume "
-                        "only checks that it is complete)");
-    json manifest;
-    try {
-      manifest = json::parse(read_file(out / "manifest.json"));
-    } catch (const json::exception& e) {
-      throw OutputError(dir + "/manifest.json: unreadable: " + e.what());
-    }
-    json was = json::object();
-    for (const auto& [k, v] : identity.items()) was[k] = manifest.value(k, json());
-    if (const std::string diff = differing_keys(was, identity); !diff.empty())
-      throw InputError("--resume: " + dir + " holds a finished run with other parameters: " + diff +
-                       "; give the same parameters, or another folder");
+  if (finished_run_here(dir, identity, resume)) {
     // Complete; a crash after the manifest was written may have left the checkpoint.
     fs::remove(checkpoint_path, ec);
     fs::remove(started_path, ec);
@@ -187,7 +188,7 @@ FolderStart examine_folder(const std::string& dir, const json& identity, bool re
   }
   if (resume && fs::exists(checkpoint_path, ec)) {
     try {
-      start.checkpoint = json::parse(read_file(checkpoint_path));
+      start.checkpoint = json::parse(read_state_file(checkpoint_path.string()));
     } catch (const json::exception& e) {
       throw OutputError(checkpoint_path.string() + ": unreadable checkpoint: " + e.what());
     }
@@ -324,19 +325,12 @@ void run_batches(const ScenarioSource& source, const Plan& plan, Backend& backen
 // A finished run: every file gets its final name, then the manifest is written.
 void write_manifest(const std::string& dir, std::vector<std::unique_ptr<Sink>>& sinks, const json& identity,
                     const PipelineResult& res, bool image_folders) {
-  json manifest = identity;
-  manifest["count"] = res.end - res.begin;
-  manifest["classes"] = {{"positive", res.positive}, {"negative", res.negative}};
-  manifest["outputs"] = json::array();
+  std::vector<FileState> outputs;
   for (auto& s : sinks) {
     s->finish();  // before files(): data.h5 exists only once finished
-    for (const FileState& f : s->files()) {
-      char hash[17];
-      std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(f.xxh3));
-      manifest["outputs"].push_back({{"name", f.name}, {"bytes", f.bytes}, {"xxh3_64", hash}});
-    }
+    for (const FileState& f : s->files()) outputs.push_back(f);
   }
-  if (image_folders) manifest["images"] = {{"folder", "images"}, {"count", res.end - res.begin}};
+  const json manifest = run_manifest(identity, res.end - res.begin, res.positive, res.negative, outputs, image_folders);
   write_text_atomic((fs::path(dir) / "manifest.json").string(), manifest.dump(2) + "\n");
 }
 
@@ -349,6 +343,14 @@ size_t default_batch(const Plan& plan, const Catalogue& cat) {
   if (plan.sparse_features()) bytes = 64 + kZones;  // no images, on the device either
   if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
   return std::clamp<size_t>((64u << 20) / bytes, 64, 16384);
+}
+
+bool holds_finished_run(const RunSpec& spec, const Catalogue& cat, const std::string& dir, bool resume) {
+  std::error_code ec;
+  if (!fs::exists(fs::path(dir) / "manifest.json", ec)) return false;
+  PipelineResult whole;
+  whole.end = ScenarioSource(spec, cat).total();
+  return finished_run_here(dir, run_identity(spec, cat, whole.end, PipelineOptions{}, whole), resume);
 }
 
 PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const AssetSet& assets, Backend& backend,

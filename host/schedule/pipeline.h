@@ -34,6 +34,11 @@ struct PipelineResult {
 PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const AssetSet& assets, Backend& backend,
                             const std::string& dir, const PipelineOptions& options);
 
+// Whether `dir` holds the finished run of `spec`'s whole range, as run_pipeline and
+// run_ranked both make it. Throws when it does without `resume`, or when that run's
+// parameters differ (naming every key that does).
+bool holds_finished_run(const RunSpec& spec, const Catalogue& cat, const std::string& dir, bool resume);
+
 // Scenarios per batch for a plan: about 64 MiB of outputs, between 64 and 16384.
 size_t default_batch(const Plan& plan, const Catalogue& cat);
 

@@ -6,13 +6,10 @@
 #include <condition_variable>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <optional>
-#include <sstream>
 #include <thread>
 
 #include "base/error.h"
-#include "schedule/identity.h"
 #include "schedule/join.h"
 #include "sink/output_folder.h"
 #include "sink/staging.h"
@@ -31,12 +28,7 @@ fs::path part_dir(const std::string& dir, uint64_t p, uint64_t k) {
   return parts_dir(dir) / (std::to_string(p) + "-of-" + std::to_string(k));
 }
 
-json read_json(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return json::parse(s.str());
-}
+json read_json(const fs::path& p) { return json::parse(read_state_file(p.string())); }
 
 // Scenarios a part has written so far, from its checkpoint or manifest (0 when neither
 // can be read yet).
@@ -120,16 +112,7 @@ PipelineResult run_ranked(const RunSpec& spec, const Catalogue& cat, const Asset
   ranks.together([&] {
     if (ranks.rank() != 0) return;
     std::error_code ec;
-    if (fs::exists(out / "manifest.json", ec)) {
-      if (!opt.resume)
-        throw OutputError(dir + ": is not empty: it holds a finished run (manifest.json); choose a new folder");
-      const json m = read_json(out / "manifest.json");
-      json was = json::object(), now = {{"spec", spec.to_json()}, {"catalogue", cat.hash}};
-      was["spec"] = m.value("spec", json());
-      was["catalogue"] = m.value("catalogue", json::object()).value("hash", "");
-      if (!spec.scenarios.empty()) was["spec"].erase("scenarios_count");
-      if (const std::string diff = differing_keys(was, now); !diff.empty())
-        throw InputError("--resume: " + dir + " holds a finished run with other parameters: " + diff);
+    if (holds_finished_run(spec, cat, dir, opt.resume)) {
       complete = true;
       return;
     }

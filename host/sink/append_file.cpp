@@ -5,6 +5,7 @@
 #include <xxhash.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <vector>
@@ -16,6 +17,12 @@ namespace portalsim {
 namespace {
 XXH3_state_t* state_of(void* p) { return static_cast<XXH3_state_t*>(p); }
 }  // namespace
+
+std::string xxh3_hex(uint64_t hash) {
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return hex;
+}
 
 FileState hash_file(const std::string& dir, const std::string& name) {
   const std::string path = (std::filesystem::path(dir) / name).string();

@@ -13,6 +13,9 @@ struct FileState {
   uint64_t xxh3 = 0;  // XXH3-64 of the bytes so far
 };
 
+// 16 lower-case hexadecimal digits, as manifests record an XXH3-64.
+std::string xxh3_hex(uint64_t hash);
+
 // The state of a finished file dir/name (its size and XXH3-64). Throws OutputError.
 FileState hash_file(const std::string& dir, const std::string& name);
 

@@ -10,10 +10,19 @@
 #include <filesystem>
 
 #include "base/error.h"
+#include "io/input_file.h"
 
 namespace portalsim {
 
 namespace fs = std::filesystem;
+
+std::string read_state_file(const std::string& path) {
+  try {
+    return io::read_file(path, "run state", io::kMaxTextBytes);
+  } catch (const InputError& e) {
+    throw OutputError(e.what());
+  }
+}
 
 FolderState output_folder_state(const std::string& dir) {
   std::error_code ec;

@@ -11,6 +11,10 @@ inline constexpr const char* kStateDir = ".portalsim";
 
 enum class FolderState { missing, empty, has_files };
 
+// A file of a run's own state (checkpoint, manifest, job), read through the input layer's
+// checks; OutputError when it cannot be (the folder is the run's output).
+std::string read_state_file(const std::string& path);
+
 // What `dir` holds, not counting entries whose names start with ".portalsim" (the
 // state and staging folders of portalsim's own runs). Throws OutputError when `dir`
 // is a file, a dangling symlink or unreadable.
