@@ -10,11 +10,14 @@
 //   places:  int2 (x0, y0) per (view, variant, region), the sprite centred in its region
 //   records: the view's placement record per scenario (kernels/shared.h, PS_REC_*)
 //   field:   the view's values before display, n * height * width, at the build's precision
+//   phys:    the physics model's parameters (kernels/shared.h, PS_PHYS_*)
+//   raw:     physics: the MMW raw grid, n * raw_height * raw_width
+//   scratch: physics: a second field, for stages that cannot work in place
 #define VIEW_STAGE_ARGS                                                                                          \
   global const uchar *atlas, global const int *bases, global const int4 *sprites, global const int2 *places,     \
       global const int *noise_offsets, global const float *noise_gains, global const uchar *subject,             \
       global const short *objects, PsViewLaunch L, param alpha, param sigma, global int *records,                 \
-      global real *field, global uchar *out
+      global real *field, global uchar *out, global const param *phys, global real *raw, global real *scratch
 
 // The scenario and image row of a work-item (one per (scenario, row)).
 #define VIEW_STAGE_ROW                                           \
@@ -29,6 +32,19 @@
   (void)seed;                                                    \
   (void)index
 
+// The scenario and raw-grid row of a work-item (physics stages on the MMW raw grid, one
+// per (scenario, raw row)); r points at that raw row.
+#define RAW_STAGE_ROW                                                                   \
+  const size_t gid = get_global_id(0);                                                  \
+  const uint i = (uint)(gid / (size_t)L.raw_height);                                    \
+  const int j = (int)(gid % (size_t)L.raw_height);                                      \
+  if (i >= L.n) return;                                                                 \
+  const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);                                     \
+  const ulong index = upsample(L.first_hi, L.first_lo) + i;                             \
+  global preal* r = (global preal*)raw + ((size_t)i * L.raw_height + j) * L.raw_width;  \
+  (void)seed;                                                                           \
+  (void)index
+
 typedef struct {
   int count;
   int bilinear;
@@ -36,6 +52,7 @@ typedef struct {
   int voff[PS_MAX_LAYERS];    // the same row of the padded copy (integer placement)
   int x0[PS_MAX_LAYERS];
   int width[PS_MAX_LAYERS];
+  int variant[PS_MAX_LAYERS];
   // Bilinear placement: the second sprite row (-1 if outside), its weight, and the
   // sub-pixel x origin. offset[k] is -1 when only the second row is inside.
   int offset1[PS_MAX_LAYERS];
@@ -49,7 +66,8 @@ typedef struct {
 kernel void place_view(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
-  (void)atlas, (void)bases, (void)subject, (void)alpha, (void)sigma, (void)field, (void)out;
+  (void)atlas, (void)bases, (void)subject, (void)alpha, (void)sigma, (void)field, (void)out, (void)phys, (void)raw,
+      (void)scratch;
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
   const ulong index = upsample(L.first_hi, L.first_lo) + i;
   global const short* objs = objects + (size_t)i * PS_REGIONS;
@@ -80,6 +98,7 @@ kernel void place_view(VIEW_STAGE_ARGS) {
     ly[PS_LAYER_PADDED] = sp.w;
     ly[PS_LAYER_TILE_X0] = pl.x + (sp.y >> 1) - (L.tile_size >> 1);
     ly[PS_LAYER_TILE_Y0] = pl.y + (sp.z >> 1) - (L.tile_size >> 1);
+    ly[PS_LAYER_VARIANT] = v;
     ++count;
   }
   rec[PS_REC_COUNT] = count;
@@ -92,6 +111,7 @@ inline void composite_layers(Layers* Ly, global const int* rec, const PsViewLaun
   for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
     global const int* ly = rec + PS_REC_LAYERS + j * PS_LAYER_LEN;
     const int w = ly[PS_LAYER_W], h = ly[PS_LAYER_H];
+    Ly->variant[Ly->count] = ly[PS_LAYER_VARIANT];
     if (!Ly->bilinear) {
       const int y0 = ly[PS_LAYER_Y0];
       if (y < y0 || y >= y0 + h) continue;

@@ -101,3 +101,11 @@ inline uchar16 to_pixel16(real16 v) { return convert_uchar16(clamp(floor(v + 0.5
 inline real16 real16_zero(void) { return (float16)(0.0f); }
 #endif
 #endif
+
+// The physics model's values (kelvin, gray before rounding): double in fp64 builds, else
+// float, in every tier (8.8 fixed point cannot hold a temperature to a tenth of a gray).
+#if defined(PRECISION_FP64)
+typedef double preal;
+#else
+typedef float preal;
+#endif

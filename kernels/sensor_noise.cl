@@ -55,8 +55,8 @@ inline void philox16(uint16* c0, uint16* c1, uint16* c2, uint16* c3, uint2 k) {
 }
 
 #if defined(PRECISION_FP64)
-inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {
-  const uint4 r = draw(seed, index, PS_STREAM_PIXEL_NOISE, ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) | (uint)pair);
+inline greal2 gauss_pair_of(uint2 seed, ulong index, uint stream, int view, int pair) {
+  const uint4 r = draw(seed, index, stream, ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) | (uint)pair);
   const greal u1 = (greal)1 - (greal)(r.x >> 8) * ((greal)1 / (greal)16777216);
   const greal u2 = (greal)(r.y >> 8) * ((greal)1 / (greal)16777216);
   const greal rad = sqrt((greal)-2 * log(u1));
@@ -64,8 +64,8 @@ inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {
   return (greal2)(rad * cos(th), rad * sin(th));
 }
 #else
-inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {
-  const uint4 r = draw(seed, index, PS_STREAM_PIXEL_NOISE, ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) | (uint)pair);
+inline greal2 gauss_pair_of(uint2 seed, ulong index, uint stream, int view, int pair) {
+  const uint4 r = draw(seed, index, stream, ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) | (uint)pair);
   const float u1 = 1.0f - (float)(r.x >> 8) * (1.0f / 16777216.0f);
   const float u2 = (float)(r.y >> 8) * (1.0f / 16777216.0f);
   const float rad = sqrt(-2.0f * ln_poly(u1));
@@ -92,6 +92,11 @@ __attribute__((always_inline)) inline void gauss32(uint2 seed, ulong index, int 
   *g1 = shuffle2(c, s, (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
 }
 #endif
+
+// The Box-Muller pair of draws `pair` of a view's per-pixel noise stream.
+inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {
+  return gauss_pair_of(seed, index, PS_STREAM_PIXEL_NOISE, view, pair);
+}
 
 kernel void stage_sensor_noise(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;

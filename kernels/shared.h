@@ -18,6 +18,7 @@
 #define PS_STREAM_PIXEL_NOISE 3u   /* per-pixel sensor noise; element = view << 28 | pixel / 2 */
 #define PS_STREAM_BLOCK_NOISE 4u   /* block-mean noise model; element = feature */
 #define PS_STREAM_JITTER 5u        /* sprite placement jitter; element = region */
+#define PS_STREAM_RAW_NOISE 6u     /* physics: MMW noise per raw pixel; element = view << 28 | raw pixel / 2 */
 #define PS_STREAM_GENERATE 16u     /* scenario generators (host only) */
 #define PS_PIXEL_NOISE_VIEW_SHIFT 28
 
@@ -70,7 +71,23 @@ typedef struct {
   PS_I32 tile_size;          /* noise tile side */
   PS_I32 flags;              /* PS_FLAG_* */
   PS_F32 jitter_x, jitter_y; /* in this view's pixels */
+  /* The physics model: the raw grid, and where its parameters lie in `phys`. */
+  PS_I32 raw_width, raw_height;
+  PS_I32 psf_radius; /* taps either side of the centre */
+  PS_I32 subjects;   /* subjects in the catalogue (the layout of phys) */
 } PsViewLaunch;
+
+/* The physics model's parameters for one launch (kernels' `phys`, at the build's parameter
+ * precision): these scalars, then a (gain, offset) pair per subject turning its base
+ * image's gray into kelvin, then each variant's apparent temperature under clothing, then
+ * the PSF's 2 psf_radius + 1 normalised taps. */
+#define PS_PHYS_BACKGROUND 0 /* K */
+#define PS_PHYS_WINDOW_MIN 1 /* K shown as gray 0 */
+#define PS_PHYS_WINDOW_MAX 2 /* K shown as gray 255 */
+#define PS_PHYS_NETD 3       /* K rms per raw pixel */
+#define PS_PHYS_SUBJECTS 4
+#define PS_PHYS_VARIANTS(S) (PS_PHYS_SUBJECTS + 2 * (S))
+#define PS_PHYS_TAPS(S, V) (PS_PHYS_VARIANTS(S) + (V))
 
 /* A camera view's placement record per scenario, written by place_view and read by
  * every render stage: the objects it draws, in region order, and the noise pattern. */
@@ -87,7 +104,8 @@ typedef struct {
 #define PS_LAYER_PADDED 7  /* atlas offset of its padded copy */
 #define PS_LAYER_TILE_X0 8 /* the noise tile, centred on the unmoved sprite */
 #define PS_LAYER_TILE_Y0 9
-#define PS_LAYER_LEN 10
+#define PS_LAYER_VARIANT 10 /* the object drawing */
+#define PS_LAYER_LEN 11
 #define PS_REC_LEN (PS_REC_LAYERS + PS_MAX_LAYERS * PS_LAYER_LEN)
 
 /* The vector render path reads 16 pixels of a sprite or noise tile row at a time, so

@@ -29,6 +29,8 @@ Other other_value(const Knob& k, const Plan& defaults) {
       return {"2.5", "2.5"};
     case KnobKind::on_off:
       return d.get<bool>() ? Other{"off", "false"} : Other{"on", "true"};
+    case KnobKind::grid:
+      return {"16x12", "\"16x12\""};
     case KnobKind::choice:
       for (const std::string& c : k.choices)
         if (c != d.get<std::string>()) return {c, "\"" + c + "\""};

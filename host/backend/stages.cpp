@@ -5,11 +5,19 @@
 namespace portalsim {
 
 const std::vector<ViewStage>& view_stages() {
+  using K = StageItems;
   static const std::vector<ViewStage> stages = {
-      {"composite", reference::composite},
-      {"pattern_noise", reference::pattern_noise},
-      {"sensor_noise", reference::sensor_noise},
-      {"display", reference::display},
+      // The thesis model.
+      {"composite", reference::composite, {{"stage_composite", K::view_rows}}},
+      {"pattern_noise", reference::pattern_noise, {{"stage_pattern_noise", K::view_rows}}},
+      {"sensor_noise", reference::sensor_noise, {{"stage_sensor_noise", K::view_rows}}},
+      {"display", reference::display, {{"stage_display", K::view_rows}}, true},
+      // The physics model's MMW camera.
+      {"radiometry", reference::radiometry, {{"stage_radiometry", K::view_rows}}},
+      {"optics", reference::optics, {{"stage_optics_rows", K::view_rows}, {"stage_optics_columns", K::view_rows}}},
+      {"sample", reference::sample, {{"stage_sample", K::raw_rows}}},
+      {"netd", reference::netd, {{"stage_netd", K::raw_rows}}},
+      {"mmw_display", reference::mmw_display, {{"stage_mmw_display", K::view_rows}}, true},
   };
   return stages;
 }
@@ -20,9 +28,14 @@ const std::vector<std::string>& fused_chain() {
 }
 
 void check_chain(const Sensor& view) {
-  if (view.chain.empty() || view.chain.back() != "display")
-    throw std::logic_error("camera view " + view.name + ": its chain must end with display");
-  for (const std::string& name : view.chain) view_stage(name);
+  for (Model m : {Model::thesis, Model::physics}) {
+    const std::vector<std::string>& chain = view.chain_for(m);
+    for (size_t k = 0; k < chain.size(); ++k)
+      if (view_stage(chain[k]).makes_pixels != (k + 1 == chain.size()))
+        throw std::logic_error("camera view " + view.name + ": its " + model_name(m) +
+                               " chain must end with the one stage that makes pixels");
+    if (chain.empty()) throw std::logic_error("camera view " + view.name + ": empty chain");
+  }
 }
 
 const ViewStage& view_stage(std::string_view name) {

@@ -12,18 +12,29 @@
 
 namespace portalsim {
 
+// What one launch of a stage kernel covers: a work-item per (scenario, view row) or per
+// (scenario, raw-grid row).
+enum class StageItems { view_rows, raw_rows };
+
+struct StageKernel {
+  std::string_view kernel;
+  StageItems items;
+};
+
 struct ViewStage {
   std::string_view name;
   void (*reference)(const reference::ViewScene&, reference::Field&);
-  std::string kernel() const { return "stage_" + std::string(name); }
+  // Its kernels, launched in order; most stages have one, stage_<name>.
+  std::vector<StageKernel> kernels;
+  bool makes_pixels = false;  // the last stage of every chain: the stored 8-bit pixels
 };
 
 const std::vector<ViewStage>& view_stages();
 // The chain the fused render_view kernel implements (a declared fast path); views whose
 // chain differs run stage by stage.
 const std::vector<std::string>& fused_chain();
-// Throws std::logic_error unless every stage of the view's chain is registered and the
-// chain ends with display (the stage that makes pixels).
+// Throws std::logic_error unless every stage of each of the view's chains is registered
+// and each chain ends with a stage that makes pixels, and no other stage does.
 void check_chain(const Sensor& view);
 // Throws std::invalid_argument for a name no stage has.
 const ViewStage& view_stage(std::string_view name);

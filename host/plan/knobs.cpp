@@ -34,6 +34,12 @@ Knob on_off(std::string key, std::string help, bool fidelity, std::function<void
               std::move(set), std::move(get)};
 }
 
+Knob grid(std::string key, int lo, int hi, std::string unit, std::string help, std::function<void(Plan&, double)> set,
+          std::function<nlohmann::json(const Plan&)> get) {
+  return Knob{std::move(key), KnobKind::grid, double(lo),     double(hi),    {}, std::move(unit), std::move(help),
+              false,          true,           std::move(set), std::move(get)};
+}
+
 Knob choice(std::string key, std::vector<std::string> choices, std::string help, bool fidelity, bool identity,
             std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
   return Knob{std::move(key), KnobKind::choice, 0, 0, std::move(choices), "", std::move(help), fidelity, identity,
@@ -49,6 +55,24 @@ std::vector<Knob> declare() {
       "temperature, optics, raw grid, NETD; contact shadow in IR; coil fields and polarizability for metal)",
       false, true, [](Plan& p, double v) { p.model.model = static_cast<Model>(v); },
       [](const Plan& p) { return model_name(p.model.model); }));
+  k.push_back(number(
+      "illumination", 1, 1000, "K",
+      "physics: the temperature the scene reflects (the room indoors; about 50 K for a clear sky outdoors)",
+      [](Plan& p, double v) { p.model.illumination = v; }, [](const Plan& p) { return p.model.illumination; }));
+  k.push_back(number(
+      "netd", 0, 100, "K", "physics: MMW sensor noise, rms per raw pixel (Vela 125: 3 K)",
+      [](Plan& p, double v) { p.model.netd = v; }, [](const Plan& p) { return p.model.netd; }));
+  k.push_back(grid(
+      "mmw_raw", 1, 4096, "raw pixels", "physics: the MMW camera's raw grid over each view, at most the view's size",
+      [](Plan& p, double v) {
+        p.model.raw_width = static_cast<int>(v) / 65536;
+        p.model.raw_height = static_cast<int>(v) % 65536;
+      },
+      [](const Plan& p) { return std::to_string(p.model.raw_width) + "x" + std::to_string(p.model.raw_height); }));
+  k.push_back(number(
+      "worn_minutes", 0, 1440, "minutes",
+      "physics: how long the objects have been carried; they warm from the room towards the skin",
+      [](Plan& p, double v) { p.model.worn_minutes = v; }, [](const Plan& p) { return p.model.worn_minutes; }));
   k.push_back(integer(
       "block", 1, 65536, "pixels", "side of the averaged pixel blocks of the features (thesis 5.6)",
       [](Plan& p, double v) { p.model.block = static_cast<int>(v); }, [](const Plan& p) { return p.model.block; }));
@@ -112,6 +136,8 @@ std::string Knob::flag() const {
 }
 
 std::string Knob::values() const {
+  if (kind == KnobKind::grid)
+    return "WxH, each " + format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit);
   if (kind == KnobKind::integer || kind == KnobKind::number)
     return format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit);
   std::string s;
@@ -147,6 +173,17 @@ void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::
       if (text != "on" && text != "off") throw InputError(where + ": \"" + text + "\" is not on or off");
       v = text == "on";
       break;
+    case KnobKind::grid: {
+      const size_t x = text.find('x');
+      double w = 0, h = 0;
+      if (x == std::string::npos || !parse_number(text.substr(0, x), w) || !parse_number(text.substr(x + 1), h) ||
+          w != std::floor(w) || h != std::floor(h) || text.find_first_of(".eE+-") != std::string::npos)
+        throw InputError(where + ": \"" + text + "\" is not WxH (two whole numbers, such as 28x28)");
+      if (w < knob.min || w > knob.max || h < knob.min || h > knob.max)
+        throw InputError(where + ": " + text + " is out of range [" + knob.values() + "]");
+      v = w * 65536 + h;
+      break;
+    }
     case KnobKind::choice: {
       size_t i = 0;
       while (i < knob.choices.size() && knob.choices[i] != text) ++i;

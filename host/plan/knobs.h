@@ -12,18 +12,19 @@
 
 namespace portalsim {
 
-enum class KnobKind { integer, number, on_off, choice };
+enum class KnobKind { integer, number, on_off, choice, grid };
 
 struct Knob {
   std::string key;  // spec-file key and manifest entry; the flag is "--" + key with '-' for '_'
   KnobKind kind;
-  double min = 0, max = 0;           // integer and number
+  double min = 0, max = 0;           // integer and number; each side of a grid
   std::vector<std::string> choices;  // choice
   std::string unit;                  // integer and number, for the help and the README
   std::string help;
   bool fidelity = false;  // overrides the tier (its default comes from the tier)
   bool identity = true;   // part of a data set's identity (checked on --resume)
-  // Sets the knob from a checked value: the number, 0/1 for on_off, or the choice's index.
+  // Sets the knob from a checked value: the number, 0/1 for on_off, the choice's index, or
+  // width * 65536 + height for a grid ("WxH").
   std::function<void(Plan&, double)> set;
   // The knob's value in `plan`: a number, a bool (on_off) or the choice's name.
   std::function<nlohmann::json(const Plan&)> get;

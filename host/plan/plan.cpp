@@ -70,15 +70,26 @@ Tier parse_tier(const std::string& name, const std::string& where) {
   throw InputError(where + ": \"" + name + "\" is not a tier (fast, standard, exact)");
 }
 
-const char* model_name(Model m) { return m == Model::physics ? "physics" : "thesis"; }
 const char* tier_name(Tier t) { return t == Tier::fast ? "fast" : t == Tier::exact ? "exact" : "standard"; }
 const char* precision_name(Precision p) {
   return p == Precision::fp64 ? "fp64" : p == Precision::fixed16 ? "fixed16" : "fp32";
 }
 
 void validate(const Plan& plan, const Catalogue& cat) {
-  (void)cat;
   check_knobs(plan);
+  if (plan.model.model != Model::physics) return;
+  if (cat.materials.empty())
+    throw InputError("--model physics: the catalogue " + cat.source +
+                     " has no [[materials]] (emissivities and warming times); add them, as the built-in one has");
+  for (const Subject& s : cat.subjects)
+    if (s.mmw_level == cat.physics.base_background_gray)
+      throw InputError("--model physics: subject " + s.name + "'s mmw_level equals physics.base_background_gray (" +
+                       std::to_string(s.mmw_level) + "), so its base image cannot be read as kelvin");
+  for (const Sensor& s : cat.sensors)
+    if (s.camera == Camera::mmw && (plan.model.raw_width > s.width || plan.model.raw_height > s.height))
+      throw InputError("--mmw-raw: " + std::to_string(plan.model.raw_width) + "x" +
+                       std::to_string(plan.model.raw_height) + " is finer than the " + s.name + " view (" +
+                       std::to_string(s.width) + "x" + std::to_string(s.height) + ")");
 }
 
 }  // namespace portalsim

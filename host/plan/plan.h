@@ -9,11 +9,6 @@
 
 namespace portalsim {
 
-// Which sensor model renders a scenario: the thesis's composite, or the physically based
-// one (README, "The physics model"). Each camera view has a stage chain per model.
-enum class Model { thesis = 0, physics = 1 };
-const char* model_name(Model m);
-
 // The knobs of the sensor model (README, "The model"). Defaults are the thesis's.
 struct ModelSettings {
   uint64_t seed = 0;
@@ -27,6 +22,11 @@ struct ModelSettings {
   // sampling. The noise tiles stay where the unmoved sprite would be.
   bool bilinear = false;
   double jitter = 0.0;
+  // The physics model (README, "The physics model"); ignored by the thesis model.
+  double illumination = 293.0;          // K: what the body and objects reflect (the room, indoors)
+  double netd = 3.0;                    // K rms: MMW sensor noise per raw pixel
+  int raw_width = 28, raw_height = 28;  // the MMW camera's raw grid over each view
+  double worn_minutes = 5.0;            // how long the objects have been carried (their temperature)
   bool moves_sprites() const { return bilinear || jitter > 0; }
 };
 
@@ -80,8 +80,8 @@ struct Plan {
   // Features straight from precomputed tables, never materialising an image. Block sums
   // must stay exact in fp32 (255 * 256^2 < 2^24).
   bool sparse_features() const {
-    return features && images == 0 && fidelity.pooling == Pooling::sparse && !pixel_noise_per_pixel() &&
-           model.block <= 256 && !model.moves_sprites();
+    return features && images == 0 && model.model == Model::thesis && fidelity.pooling == Pooling::sparse &&
+           !pixel_noise_per_pixel() && model.block <= 256 && !model.moves_sprites();
   }
 };
 

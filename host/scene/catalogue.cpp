@@ -184,8 +184,9 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
                           const std::string& assets_dir) {
   Reader rd{source_name, base_dir, assets_dir};
   const toml::table root = io::parse_toml(text, source_name);
-  io::reject_unknown_keys(root, {"format", "images", "metal", "subjects", "regions", "objects", "noise"}, source_name,
-                          "");
+  io::reject_unknown_keys(
+      root, {"format", "images", "metal", "subjects", "regions", "objects", "noise", "physics", "materials"},
+      source_name, "");
   Catalogue cat;
   cat.source = source_name;
   cat.hash = fnv1a_hex(text);
@@ -295,6 +296,50 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     r.ir = rd.rect(t, "ir", f, ic.ir_width, ic.ir_height);
   }
 
+  // [physics] and [[materials]]: optional; the physics model needs them.
+  if (const toml::node* pn = root.get("physics")) {
+    const toml::table* pt = pn->as_table();
+    if (!pt) rd.fail(pn, "physics", "expected a table");
+    io::reject_unknown_keys(*pt,
+                            {"frequency_ghz", "aperture_m", "fov_rad", "range_m", "skin_emissivity", "skin_temperature",
+                             "clothing_transmission", "clothing_temperature", "background_temperature",
+                             "room_temperature", "base_background_gray", "display_min", "display_max"},
+                            source_name, "physics");
+    PhysicsConfig& pc = cat.physics;
+    pc.frequency_ghz = rd.number(*pt, "frequency_ghz", "physics", 1.0, 10000.0, pc.frequency_ghz);
+    pc.aperture_m = rd.number(*pt, "aperture_m", "physics", 1e-3, 100.0, pc.aperture_m);
+    pc.fov_rad = rd.number(*pt, "fov_rad", "physics", 1e-3, 3.0, pc.fov_rad);
+    pc.range_m = rd.number(*pt, "range_m", "physics", 0.01, 1000.0, pc.range_m);
+    pc.skin_emissivity = rd.number(*pt, "skin_emissivity", "physics", 0.0, 1.0, pc.skin_emissivity);
+    pc.skin_temperature = rd.number(*pt, "skin_temperature", "physics", 1.0, 1000.0, pc.skin_temperature);
+    pc.clothing_transmission = rd.number(*pt, "clothing_transmission", "physics", 0.0, 1.0, pc.clothing_transmission);
+    pc.clothing_temperature = rd.number(*pt, "clothing_temperature", "physics", 1.0, 1000.0, pc.clothing_temperature);
+    pc.background_temperature =
+        rd.number(*pt, "background_temperature", "physics", 1.0, 1000.0, pc.background_temperature);
+    pc.room_temperature = rd.number(*pt, "room_temperature", "physics", 1.0, 1000.0, pc.room_temperature);
+    pc.base_background_gray = rd.integer(*pt, "base_background_gray", "physics", 0, 254, pc.base_background_gray);
+    pc.display_min = rd.number(*pt, "display_min", "physics", 0.0, 1000.0, pc.display_min);
+    pc.display_max = rd.number(*pt, "display_max", "physics", 0.0, 1000.0, pc.display_max);
+    if (pc.display_max <= pc.display_min) rd.fail(pt, "physics.display_max", "must be above physics.display_min");
+  }
+  if (root.get("materials")) {
+    const toml::array& mats = rd.array_of_tables(root, "materials");
+    if (mats.size() > 1000) rd.fail(&mats, "materials", "expected at most 1000 materials");
+    for (size_t i = 0; i < mats.size(); ++i) {
+      const toml::table& t = *mats.get(i)->as_table();
+      const std::string f = "materials[" + std::to_string(i + 1) + "]";
+      io::reject_unknown_keys(t, {"name", "emissivity", "warm_minutes", "source"}, source_name, f);
+      Material m;
+      m.name = rd.string(t, "name", f);
+      for (const Material& other : cat.materials)
+        if (other.name == m.name) rd.fail(t.get("name"), f + ".name", "\"" + m.name + "\" is named twice");
+      m.emissivity = rd.number(t, "emissivity", f, 0.0, 1.0);
+      m.warm_minutes = rd.number(t, "warm_minutes", f, 1e-3, 1e6);
+      rd.string(t, "source", f);  // every value says where it comes from
+      cat.materials.push_back(m);
+    }
+  }
+
   // [[objects]]
   const toml::array& objects = rd.array_of_tables(root, "objects");
   if (objects.empty() || objects.size() > 1000) rd.fail(&objects, "objects", "expected 1 to 1000 objects");
@@ -326,6 +371,13 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
         rd.fail(&t, f + ".name", "\"" + n + "\" already names " + cat.objects[cat.find_object(n)].name);
     }
     o.material = rd.string(t, "material", f, "");
+    if (!cat.materials.empty()) {
+      for (size_t m = 0; m < cat.materials.size(); ++m)
+        if (cat.materials[m].name == o.material) o.material_id = static_cast<int>(m);
+      if (o.material_id < 0)
+        rd.fail(t.get("material") ? t.get("material") : &t, f + ".material",
+                "\"" + o.material + "\" is not one of the catalogue's [[materials]]");
+    }
     const std::string metal_name = rd.string(t, "metal", f);
     o.metal = -1;
     for (size_t c = 0; c < cat.metal_categories.size(); ++c)

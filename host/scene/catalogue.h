@@ -44,11 +44,35 @@ struct Variant {
   ImageSource mmw, ir;
 };
 
+// A material of the physics model (README, "The physics model"): its emissivity at 94 GHz
+// and how fast it warms on the body. The catalogue gives each value's source.
+struct Material {
+  std::string name;
+  double emissivity = 0;    // at 94 GHz; 1 - reflectivity
+  double warm_minutes = 1;  // time constant of warming from the room to the skin
+};
+
+// The physics model's scene and sensor parameters ([physics] in the catalogue).
+struct PhysicsConfig {
+  // The MMW camera (thesis appendix A: Millivision Vela 125).
+  double frequency_ghz = 94.0, aperture_m = 0.125, fov_rad = 0.43, range_m = 2.0;
+  // The scene: skin seen at 94 GHz through clothing, the room behind the subject.
+  double skin_emissivity = 0.39, skin_temperature = 306.0;
+  double clothing_transmission = 0.9, clothing_temperature = 303.0;
+  double background_temperature = 293.0, room_temperature = 293.0;
+  // The subject's base image as kelvin: its background gray is background_temperature,
+  // the subject's mmw_level is bare body (through clothing); linear in between and beyond.
+  int base_background_gray = 25;
+  // Display window: these temperatures map to gray 0 and 255.
+  double display_min = 283.0, display_max = 313.0;
+};
+
 struct Object {
   std::string name;
   std::vector<std::string> aliases;
   std::string material;
-  int metal = 0;  // index into Catalogue::metal_categories
+  int material_id = -1;  // index into Catalogue::materials, -1 where the catalogue has none
+  int metal = 0;         // index into Catalogue::metal_categories
   std::string shape;
   int width = 0, height = 0;  // MMW sprite of the horizontal drawing
   int mmw_level = 0, ir_level = 0;
@@ -83,6 +107,8 @@ struct Catalogue {
   std::array<Region, kRegions> regions;
   std::vector<Object> objects;
   std::vector<NoisePattern> noise;
+  std::vector<Material> materials;
+  PhysicsConfig physics;
   std::vector<std::string> metal_categories;
   // influence[category][region][zone]
   std::vector<std::array<std::array<int, kZones>, kRegions>> influence;

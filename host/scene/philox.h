@@ -36,6 +36,7 @@ enum Stream : uint32_t {
   kStreamPixelNoise = PS_STREAM_PIXEL_NOISE,
   kStreamBlockNoise = PS_STREAM_BLOCK_NOISE,
   kStreamJitter = PS_STREAM_JITTER,
+  kStreamRawNoise = PS_STREAM_RAW_NOISE,
   kStreamGenerate = PS_STREAM_GENERATE,
 };
 

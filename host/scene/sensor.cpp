@@ -4,6 +4,8 @@
 
 namespace portalsim {
 
+const char* model_name(Model m) { return m == Model::physics ? "physics" : "thesis"; }
+
 std::vector<Sensor> camera_sensors(const Catalogue& cat) {
   const ImagesConfig& ic = cat.images;
   std::vector<Sensor> out;
@@ -21,6 +23,7 @@ std::vector<Sensor> camera_sensors(const Catalogue& cat) {
       }
     s.pattern_noise = true;
     s.pooled = true;
+    s.physics_chain = {"radiometry", "optics", "sample", "netd", "mmw_display"};
     out.push_back(s);
   }
   // The IR camera sees the whole body at its own scale: the two MMW views stacked.

@@ -21,6 +21,10 @@ struct Rect {
 
 // Which sprites and palette a view uses: the camera it belongs to.
 enum class Camera : int { mmw = 0, ir = 1 };
+// Which sensor model renders a scenario: the thesis's composite, or the physically based
+// one (README, "The physics model"). Each camera view has a stage chain per model.
+enum class Model { thesis = 0, physics = 1 };
+const char* model_name(Model m);
 constexpr int kCameras = 2;
 inline const char* camera_name(Camera c) { return c == Camera::ir ? "ir" : "mmw"; }
 
@@ -37,8 +41,11 @@ struct Sensor {
   bool palette = false;        // stored as a temperature index, written through the palette
   // Jitter is given in MMW pixels; this view's pixels per MMW pixel.
   double jitter_scale_x = 1.0, jitter_scale_y = 1.0;
-  // The stages of its chain, in order (names registered in backend/stages.cpp).
+  // The stages of its chain under each model, in order (names registered in
+  // backend/stages.cpp).
   std::vector<std::string> chain{"composite", "pattern_noise", "sensor_noise", "display"};
+  std::vector<std::string> physics_chain = chain;
+  const std::vector<std::string>& chain_for(Model m) const { return m == Model::physics ? physics_chain : chain; }
 
   bool sees(int region) const { return (region_mask >> region) & 1u; }
   size_t pixels() const { return static_cast<size_t>(width) * height; }

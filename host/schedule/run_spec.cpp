@@ -109,6 +109,7 @@ std::string knob_value(const Knob& k, const toml::node& n, const std::string& at
     case KnobKind::on_off:
       if (!n.is_boolean()) throw InputError(at + ": expected true or false");
       return n.as_boolean()->get() ? "on" : "off";
+    case KnobKind::grid:
     case KnobKind::choice:
       if (!n.is_string()) throw InputError(at + ": expected a string (" + k.values() + ")");
       return n.as_string()->get();

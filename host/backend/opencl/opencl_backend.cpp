@@ -262,9 +262,18 @@ class OpenCLBackend final : public Backend {
               (plan.pixel_noise_per_pixel() ? PS_FLAG_PIXEL_NOISE : 0) | (plan.model.bilinear ? PS_FLAG_BILINEAR : 0);
     L.jitter_x = static_cast<float>(plan.model.jitter * s.jitter_scale_x);
     L.jitter_y = static_cast<float>(plan.model.jitter * s.jitter_scale_y);
-    const bool fused = plan.fidelity.fused && s.chain == fused_chain();
-    cl::Buffer field = fused ? dst : field_.at_least(rt_->context(), n * s.pixels() * K.real_bytes);
-    cl::Buffer& records = records_.at_least(rt_->context(), n * PS_REC_LEN * sizeof(cl_int));
+    L.raw_width = plan.model.raw_width;
+    L.raw_height = plan.model.raw_height;
+    L.subjects = static_cast<int32_t>(cat_.subjects.size());
+    const std::vector<std::string>& chain = s.chain_for(plan.model.model);
+    const bool fused = plan.fidelity.fused && chain == fused_chain();
+    cl::Context& ctx = rt_->context();
+    cl::Buffer field = fused ? dst : field_.at_least(ctx, n * s.pixels() * K.real_bytes);
+    cl::Buffer& records = records_.at_least(ctx, n * PS_REC_LEN * sizeof(cl_int));
+    cl::Buffer phys = physics_params(K, plan, s, L.psf_radius);
+    const bool physics = plan.model.model == Model::physics;
+    cl::Buffer& raw = raw_.at_least(ctx, physics ? n * plan.model.raw_width * plan.model.raw_height * K.real_bytes : 1);
+    cl::Buffer& scratch = view_scratch_.at_least(ctx, physics ? n * s.pixels() * K.real_bytes : 1);
     const auto launch = [&](cl::Kernel& k, size_t items) {
       int a = 0;
       k.setArg(a++, atlas_);
@@ -281,6 +290,9 @@ class OpenCLBackend final : public Backend {
       k.setArg(a++, records);
       k.setArg(a++, field);
       k.setArg(a++, dst);
+      k.setArg(a++, phys);
+      k.setArg(a++, raw);
+      k.setArg(a++, scratch);
       rt_->queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(items)), cl::NDRange(kLocalSize));
     };
     launch(K.place, n);  // one placement record per scenario, read by every row below
@@ -288,12 +300,58 @@ class OpenCLBackend final : public Backend {
       launch(K.render, n * s.height);
       return;
     }
-    for (const std::string& name : s.chain) {
-      const std::string kernel = view_stage(name).kernel();
-      auto it = K.stages.find(kernel);
-      if (it == K.stages.end()) it = K.stages.emplace(kernel, cl::Kernel(K.program, kernel.c_str())).first;
-      launch(it->second, n * s.height);
+    for (const std::string& name : chain)
+      for (const StageKernel& sk : view_stage(name).kernels) {
+        const std::string kernel(sk.kernel);
+        auto it = K.stages.find(kernel);
+        if (it == K.stages.end()) it = K.stages.emplace(kernel, cl::Kernel(K.program, kernel.c_str())).first;
+        launch(it->second, n * (sk.items == StageItems::raw_rows ? plan.model.raw_height : s.height));
+      }
+  }
+
+  // The physics model's parameters for a view's launch (kernels/shared.h, PS_PHYS_*), at the
+  // kernels' parameter precision; `radius` gets the PSF's half-width in taps. The same
+  // formulas as the reference's, written again here: the two never share code.
+  cl::Buffer physics_params(const Kernels& K, const Plan& plan, const Sensor& view, int32_t& radius) {
+    radius = 0;
+    if (plan.model.model != Model::physics) return physics_none_.at_least(rt_->context(), 16);
+    const PhysicsConfig& pc = cat_.physics;
+    const ModelSettings& m = plan.model;
+    const auto seen = [&](double e, double t) {
+      return pc.clothing_transmission * (e * t + (1 - e) * m.illumination) +
+             (1 - pc.clothing_transmission) * pc.clothing_temperature;
+    };
+    std::vector<double> p(PS_PHYS_SUBJECTS, 0.0);
+    p[PS_PHYS_BACKGROUND] = pc.background_temperature;
+    p[PS_PHYS_WINDOW_MIN] = pc.display_min;
+    p[PS_PHYS_WINDOW_MAX] = pc.display_max;
+    p[PS_PHYS_NETD] = m.netd;
+    const double body = seen(pc.skin_emissivity, pc.skin_temperature);
+    for (const Subject& s : cat_.subjects) {
+      const double gain = (body - pc.background_temperature) / (s.mmw_level - pc.base_background_gray);
+      p.push_back(gain);
+      p.push_back(pc.background_temperature - gain * pc.base_background_gray);
     }
+    for (size_t v = 0; v < cat_.variant_list.size(); ++v) {
+      const Material& mat = cat_.materials.at(cat_.object_of(static_cast<int>(v)).material_id);
+      const double rise = (pc.skin_temperature - pc.room_temperature) * std::exp(-m.worn_minutes / mat.warm_minutes);
+      p.push_back(seen(mat.emissivity, pc.skin_temperature - rise));
+    }
+    // The Airy core's FWHM, 1.02 lambda / D at the range, in this view's pixels; a
+    // Gaussian of that FWHM over +-4 sigma.
+    const double lambda = 299792458.0 / (pc.frequency_ghz * 1e9);
+    const double fwhm = 1.02 * lambda / pc.aperture_m * view.width / (2.0 * std::tan(pc.fov_rad / 2.0));
+    const double sigma = fwhm / 2.3548200450309493;
+    radius = static_cast<int32_t>(std::ceil(4.0 * sigma));
+    double total = 0;
+    const size_t taps = p.size();
+    for (int d = -radius; d <= radius; ++d) {
+      p.push_back(std::exp(-0.5 * d * d / (sigma * sigma)));
+      total += p.back();
+    }
+    for (size_t k = taps; k < p.size(); ++k) p[k] /= total;
+    if (K.fp64) return constant(rt_->context(), p);
+    return constant(rt_->context(), std::vector<cl_float>(p.begin(), p.end()));
   }
 
   // Block and region means of one pooled view into its columns of the feature rows.
@@ -554,7 +612,7 @@ class OpenCLBackend final : public Backend {
   cl::Buffer atlas_, bases_, sprites_, places_, noise_offsets_, noise_gains_, pooled_, region_slot_, region_rects_,
       influence_, categories_, base_zones_;
   std::vector<cl::Buffer> view_rects_;  // per view: int4 per region
-  Grown subject_, objects_, metal_out_, features_, field_, records_;
+  Grown subject_, objects_, metal_out_, features_, field_, records_, raw_, view_scratch_, physics_none_;
   std::vector<Grown> scratch_;  // per view: images only pooled
 };
 

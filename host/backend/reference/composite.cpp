@@ -23,23 +23,14 @@ ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSe
       dx = m.jitter * sensor.jitter_scale_x * (2.0 * uniform24(q[0]) - 1.0);
       dy = m.jitter * sensor.jitter_scale_y * (2.0 * uniform24(q[1]) - 1.0);
     }
-    vs.placed.push_back({&sp, x0, y0, dx, dy});
+    vs.placed.push_back({&sp, x0, y0, dx, dy, v});
   }
   return vs;
 }
 
-// Thesis algorithm step 8: v = a s + (1 - a) v, a = alpha coverage / 255, objects in
-// region order over the subject's base image.
-void composite(const ViewScene& vs, Field& f) {
-  const Image& base = vs.assets.bases[vs.scenario.subject][vs.view];
-  const int W = base.width, H = base.height;
-  const double alpha = vs.cat.images.alpha;
-  f.width = W;
-  f.height = H;
-  f.v.assign(static_cast<size_t>(W) * H, 0.0);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) f.at(x, y) = base.at(x, y);
-
+void lay_objects(const ViewScene& vs, Field& f, double alpha,
+                 double (*value)(const ViewScene&, const Placed&, int, int)) {
+  const int W = f.width, H = f.height;
   for (const Placed& p : vs.placed) {
     const Image& sp = *p.sprite;
     if (!vs.model.bilinear) {
@@ -51,7 +42,7 @@ void composite(const ViewScene& vs, Field& f) {
           if (x < 0 || y < 0 || x >= W || y >= H) continue;
           const double a = alpha * sp.at(sx, sy, 1) / 255.0;
           double& v = f.at(x, y);
-          v = a * sp.at(sx, sy, 0) + (1.0 - a) * v;
+          v = a * value(vs, p, sx, sy) + (1.0 - a) * v;
         }
       continue;
     }
@@ -60,7 +51,7 @@ void composite(const ViewScene& vs, Field& f) {
     const auto texel = [&](int i, int j, double& pv, double& c) {
       if (i < 0 || j < 0 || i >= sp.width || j >= sp.height) return;
       const double cov = sp.at(i, j, 1) / 255.0;
-      pv = cov * sp.at(i, j, 0);
+      pv = cov * value(vs, p, i, j);
       c = cov;
     };
     for (int y = std::max(0, static_cast<int>(std::floor(fy)) - 1);
@@ -84,6 +75,20 @@ void composite(const ViewScene& vs, Field& f) {
         v = (1.0 - alpha * c) * v + alpha * pv;
       }
   }
+}
+
+// Thesis algorithm step 8: v = a s + (1 - a) v, a = alpha coverage / 255, objects in
+// region order over the subject's base image.
+void composite(const ViewScene& vs, Field& f) {
+  const Image& base = vs.assets.bases[vs.scenario.subject][vs.view];
+  const int W = base.width, H = base.height;
+  f.width = W;
+  f.height = H;
+  f.v.assign(static_cast<size_t>(W) * H, 0.0);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) f.at(x, y) = base.at(x, y);
+  lay_objects(vs, f, vs.cat.images.alpha,
+              [](const ViewScene&, const Placed& p, int sx, int sy) { return double(p.sprite->at(sx, sy, 0)); });
 }
 
 }  // namespace portalsim::reference

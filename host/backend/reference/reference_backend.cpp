@@ -29,7 +29,7 @@ class ReferenceBackend final : public Backend {
         const Sensor& sensor = cat_.sensors[k];
         if (!plan.renders(sensor, k)) continue;
         const reference::ViewScene vs = reference::view_scene(cat_, assets_, plan.model, k, s, index);
-        for (const std::string& stage : sensor.chain) view_stage(stage).reference(vs, field);
+        for (const std::string& stage : sensor.chain_for(plan.model.model)) view_stage(stage).reference(vs, field);
         images[k].assign(field.v.begin(), field.v.end());  // display left whole numbers 0..255
         if (plan.image(k))
           std::copy(images[k].begin(), images[k].end(), out.views[k].pixels.begin() + i * sensor.pixels());

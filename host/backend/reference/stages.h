@@ -17,6 +17,7 @@ struct Field {
   int width = 0, height = 0;
   std::vector<double> v;
   double& at(int x, int y) { return v[static_cast<size_t>(y) * width + x]; }
+  double at(int x, int y) const { return v[static_cast<size_t>(y) * width + x]; }
 };
 
 // One object drawn in a view: its sprite, where it sits centred in its region (the noise
@@ -25,6 +26,7 @@ struct Placed {
   const Image* sprite;
   int x0, y0;
   double dx, dy;
+  int variant;  // the object drawing
 };
 
 // Everything a stage of one camera view reads for one scenario.
@@ -42,11 +44,28 @@ struct ViewScene {
 ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSettings& model, int view,
                      const Scenario& s, uint64_t index);
 
+// Lays each placed object over `f` in region order, at its whole-pixel or sub-pixel place:
+// v = a s + (1 - a) v, a = alpha * coverage, s = value(object, sprite x, sprite y).
+void lay_objects(const ViewScene& vs, Field& f, double alpha,
+                 double (*value)(const ViewScene&, const Placed&, int, int));
+
 // The view's chain (thesis model), in order. Each transforms the field in place.
 void composite(const ViewScene& vs, Field& f);      // base image, then sprites in region order
 void pattern_noise(const ViewScene& vs, Field& f);  // the scenario's MMW noise tile over each object
 void sensor_noise(const ViewScene& vs, Field& f);   // per-pixel Gaussian noise, Box-Muller
 void display(const ViewScene& vs, Field& f);        // round half up, clamp to 0..255
+
+// The physics model's MMW chain (README, "The physics model"), in order.
+void radiometry(const ViewScene& vs, Field& f);   // apparent temperature, K, objects under clothing
+void optics(const ViewScene& vs, Field& f);       // Gaussian PSF of the Airy core's FWHM, edges held
+void sample(const ViewScene& vs, Field& f);       // integrate onto the raw grid (the field shrinks)
+void netd(const ViewScene& vs, Field& f);         // Gaussian noise per raw pixel, NETD kelvin rms
+void mmw_display(const ViewScene& vs, Field& f);  // bilinear to the view, window to gray, round
+
+// The physics model's quantities, from the catalogue and the knobs.
+double body_temperature(const Catalogue& cat, const ModelSettings& m);                 // bare body under clothing, K
+double object_temperature(const Catalogue& cat, const ModelSettings& m, int variant);  // apparent, under clothing
+double psf_fwhm_pixels(const Catalogue& cat, const Sensor& view);  // the Airy core's FWHM in view pixels
 
 // Block means of each pooled view, then each region's mean (thesis 5.6); `views` holds the
 // displayed images of every camera view (empty where not rendered).

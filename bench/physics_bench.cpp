@@ -1,0 +1,65 @@
+// The physics model against the thesis model, per scenario, in the same run:
+//   ./build/portalsim_bench --benchmark_filter=Model --benchmark_repetitions=3
+// Args: batch size, model (0 thesis, 1 physics), NETD in kelvin (physics only).
+#include <benchmark/benchmark.h>
+
+#include "fixture.h"
+
+namespace portalsim {
+namespace {
+using bench::fx;
+using bench::make_batch;
+
+Plan model_plan(const benchmark::State& state, bool images) {
+  Plan p;
+  p.model.model = state.range(1) == 1 ? Model::physics : Model::thesis;
+  p.model.netd = static_cast<double>(state.range(2));
+  if (images)
+    p.features = false;
+  else
+    p.images = 0;
+  return p;
+}
+
+void run_model(benchmark::State& state, Backend& backend, bool images) {
+  const size_t n = static_cast<size_t>(state.range(0));
+  const Plan plan = model_plan(state, images);
+  state.SetLabel(std::string(model_name(plan.model.model)) + (images ? " images" : " features"));
+  const SceneBatch batch = make_batch(n);
+  BatchOutput out;
+  backend.run(batch, plan, out);  // warm: work-group compilation
+  for (auto _ : state) {
+    backend.run(batch, plan, out);
+    benchmark::DoNotOptimize(out.metal.data());
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+}
+
+void BM_ModelOpenCL(benchmark::State& state, bool images) {
+  auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+  run_model(state, *b, images);
+}
+void BM_ModelReference(benchmark::State& state, bool images) {
+  auto b = make_reference_backend(fx().cat, fx().assets);
+  run_model(state, *b, images);
+}
+
+BENCHMARK_CAPTURE(BM_ModelOpenCL, images, true)
+    ->Args({1024, 0, 0})
+    ->Args({1024, 1, 0})
+    ->Args({1024, 1, 3})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ModelOpenCL, features, false)
+    ->Args({4096, 0, 0})
+    ->Args({4096, 1, 3})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ModelReference, images, true)
+    ->Args({16, 0, 0})
+    ->Args({16, 1, 3})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+}  // namespace portalsim

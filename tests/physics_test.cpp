@@ -1,0 +1,444 @@
+// The physics model (--model physics): parity of the MMW chain's kernels with the fp64
+// reference, and the physical invariants that fail when the physics is wrong: the PSF's
+// width, the noise level through the display, no detail finer than the raw grid, the sign
+// and size of metal's contrast, and the extremes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <numbers>
+
+#include "assets/image_io.h"
+#include "backend/compare.h"
+#include "backend/reference/stages.h"
+#include "backend/stages.h"
+#include "base/error.h"
+#include "plan/knobs.h"
+#include "run_binary.h"
+#include "support.h"
+
+namespace portalsim::embedded {
+extern const std::string_view default_catalogue;
+}
+
+namespace portalsim {
+namespace {
+
+using test::assets;
+using test::catalogue;
+
+Plan physics_plan(uint64_t seed = 7) {
+  Plan p;
+  p.model.model = Model::physics;
+  p.model.seed = seed;
+  return p;
+}
+
+std::vector<Scenario> scenes(size_t n) {
+  std::vector<Scenario> v;
+  for (size_t k = 0; k < n; ++k) v.push_back(test::random_scenario(catalogue(), k, 6));
+  return v;
+}
+
+int variant_of(const Catalogue& cat, const std::string& object) {
+  const int o = cat.find_object(object);
+  EXPECT_GE(o, 0) << object;
+  return cat.objects[o].first_variant;
+}
+
+// The Airy core's FWHM in view pixels, from the catalogue's camera, written out here.
+double fwhm_formula(const Catalogue& cat, int width) {
+  const PhysicsConfig& pc = cat.physics;
+  const double lambda = 299792458.0 / (pc.frequency_ghz * 1e9);
+  return 1.02 * lambda / pc.aperture_m * pc.range_m / (2 * pc.range_m * std::tan(pc.fov_rad / 2) / width);
+}
+
+TEST(Physics, KernelsMatchTheReferenceInEveryTier) {
+  const SceneBatch batch = test::batch_of(scenes(48));
+  auto ref = make_reference_backend(catalogue(), assets());
+  auto cl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  struct Case {
+    const char* name;
+    Tier tier;
+    double jitter;
+    bool bilinear;
+    int raw;
+  };
+  for (const Case& c : {Case{"standard", Tier::standard, 0, false, 28}, Case{"exact", Tier::exact, 0, false, 28},
+                        Case{"fast", Tier::fast, 0, false, 28}, Case{"jitter", Tier::standard, 6, false, 28},
+                        Case{"bilinear", Tier::standard, 6, true, 28}, Case{"raw 200", Tier::standard, 0, false, 200},
+                        Case{"raw 1", Tier::standard, 0, false, 1}, Case{"raw 37x13", Tier::standard, 0, false, -1}}) {
+    SCOPED_TRACE(c.name);
+    Plan plan = physics_plan();
+    plan.fidelity = tier_fidelity(c.tier);
+    plan.model.jitter = c.jitter;
+    plan.model.bilinear = c.bilinear;
+    plan.model.raw_width = c.raw > 0 ? c.raw : 37;
+    plan.model.raw_height = c.raw > 0 ? c.raw : 13;
+    BatchOutput r, k;
+    ref->run(batch, plan, r);
+    cl->run(batch, plan, k);
+    const OutputDiff d = compare_outputs(k, r);
+    // Stated tolerance: MMW pixels within 1 gray level, at most 0.5% of them off by one;
+    // features within 1; metal zones exact.
+    EXPECT_LE(d.mmw.max_abs, 1);
+    EXPECT_LE(d.mmw.share_differing, 0.005);
+    EXPECT_LE(d.feature_max_abs, 1.0);
+    EXPECT_EQ(d.metal_exact, 1.0);
+  }
+}
+
+// Each stage of the chain changes the image, in both backends alike.
+TEST(Physics, EachStageOfTheChainDoesSomethingInBothBackends) {
+  const SceneBatch batch = test::batch_of(scenes(16));
+  Plan plan = physics_plan();
+  plan.fidelity.fused = false;
+  BatchOutput whole;
+  make_reference_backend(catalogue(), assets())->run(batch, plan, whole);
+  for (const std::string dropped : {"optics", "netd"}) {
+    SCOPED_TRACE(dropped);
+    Catalogue cat = catalogue();
+    for (Sensor& s : cat.sensors)
+      if (s.camera == Camera::mmw) std::erase(s.physics_chain, dropped);
+    BatchOutput r, k;
+    make_reference_backend(cat, assets())->run(batch, plan, r);
+    make_opencl_backend(cat, assets(), test::runtime())->run(batch, plan, k);
+    const OutputDiff d = compare_outputs(k, r);
+    EXPECT_LE(d.mmw.max_abs, 1);
+    EXPECT_NE(r.view("upper").pixels, whole.view("upper").pixels) << "the stage changes nothing";
+  }
+}
+
+TEST(Physics, TheModelKnobSwitchesTheMmwChainOnly) {
+  const SceneBatch batch = test::batch_of(scenes(8));
+  auto cl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  BatchOutput thesis, physics;
+  cl->run(batch, Plan{}, thesis);
+  cl->run(batch, physics_plan(0), physics);
+  EXPECT_NE(thesis.view("upper").pixels, physics.view("upper").pixels);
+  EXPECT_NE(thesis.view("lower").pixels, physics.view("lower").pixels);
+}
+
+TEST(Physics, OutputDoesNotDependOnTheBatch) {
+  const std::vector<Scenario> all = scenes(40);
+  auto cl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  const Plan plan = physics_plan(3);
+  BatchOutput whole, a, b;
+  cl->run(test::batch_of(all), plan, whole);
+  cl->run(test::batch_of({all.begin(), all.begin() + 17}), plan, a);
+  cl->run(test::batch_of({all.begin() + 17, all.end()}, 17), plan, b);
+  append_output(a, b);
+  EXPECT_EQ(whole.view("upper").pixels, a.view("upper").pixels);
+  EXPECT_EQ(whole.features, a.features);
+}
+
+// The PSF's FWHM, measured on a point source through the reference's optics stage, is
+// the Airy core's 1.02 lambda / D within 5%.
+TEST(Physics, PointSpreadFunctionWidthMatchesTheFormula) {
+  const Catalogue& cat = catalogue();
+  const Plan plan = physics_plan();
+  const Sensor& upper = cat.sensors[0];
+  const double expected = fwhm_formula(cat, upper.width);
+  EXPECT_NEAR(reference::psf_fwhm_pixels(cat, upper), expected, 1e-9 * expected);
+  // Vela 125: about 2 raw pixels of 28 (the figure).
+  EXPECT_NEAR(expected / (upper.width / 28.0), 1.7, 0.2);
+  Scenario s;
+  const reference::ViewScene vs = reference::view_scene(cat, assets(), plan.model, 0, s, 0);
+  reference::Field f;
+  f.width = upper.width;
+  f.height = upper.height;
+  f.v.assign(upper.pixels(), 0.0);
+  f.at(100, 100) = 1.0;
+  reference::optics(vs, f);
+  const double peak = f.at(100, 100);
+  int x = 100;
+  while (f.at(x + 1, 100) >= peak / 2) ++x;
+  const double right = x + (f.at(x, 100) - peak / 2) / (f.at(x, 100) - f.at(x + 1, 100));
+  const double measured = 2 * (right - 100);
+  EXPECT_NEAR(measured, expected, 0.05 * expected);
+}
+
+// Sum of the squared bilinear weights of view pixel x on a raw axis (the display's).
+double weight_squares(int x, int size, int raw) {
+  const double u = std::clamp((x + 0.5) * raw / size - 0.5, 0.0, raw - 1.0);
+  const double t = u - std::floor(u);
+  return (1 - t) * (1 - t) + t * t;
+}
+
+// On the same scene, two seeds' images differ by the noise alone: their variance matches
+// NETD through the display (window scale and bilinear weights) within 5%.
+TEST(Physics, NoiseMatchesTheNetdThroughTheDisplay) {
+  const Catalogue& cat = catalogue();
+  auto cl = make_opencl_backend(cat, assets(), test::runtime());
+  const std::vector<Scenario> scene(1, test::random_scenario(cat, 3, 2));
+  const double scale = 255.0 / (cat.physics.display_max - cat.physics.display_min);
+  for (int raw : {28, 200}) {
+    SCOPED_TRACE(raw);
+    double measured = 0, expected = 0;
+    const int pairs = 8;
+    for (int k = 0; k < pairs; ++k) {
+      BatchOutput a, b;
+      Plan plan = physics_plan(100 + 2 * k);
+      plan.model.netd = 1.0;
+      plan.model.raw_width = plan.model.raw_height = raw;
+      cl->run(test::batch_of(scene), plan, a);
+      plan.model.seed += 1;
+      cl->run(test::batch_of(scene), plan, b);
+      for (const char* view : {"upper", "lower"}) {
+        const ViewImages& va = a.view(view);
+        const ViewImages& vb = b.view(view);
+        for (int y = 0; y < va.height; ++y)
+          for (int x = 0; x < va.width; ++x) {
+            const double d = double(va.pixels[y * va.width + x]) - vb.pixels[y * va.width + x];
+            measured += d * d / 2;
+            // Rounding adds 1/12 of a gray level squared per image.
+            expected += scale * scale * weight_squares(x, va.width, raw) * weight_squares(y, va.height, raw) + 1.0 / 12;
+          }
+      }
+    }
+    EXPECT_NEAR(measured / expected, 1.0, 0.05);
+  }
+}
+
+// The DFT power of an image above a raw grid's Nyquist limit, as a share of all but DC.
+double share_above_nyquist(const std::vector<double>& img, int w, int h, int raw_w, int raw_h) {
+  std::vector<std::complex<double>> a(img.size());
+  double mean = 0;
+  for (double v : img) mean += v;
+  mean /= img.size();
+  for (size_t k = 0; k < img.size(); ++k) a[k] = img[k] - mean;
+  const auto dft = [](std::vector<std::complex<double>>& line) {
+    const size_t n = line.size();
+    std::vector<std::complex<double>> out(n);
+    for (size_t k = 0; k < n; ++k)
+      for (size_t j = 0; j < n; ++j) out[k] += line[j] * std::polar(1.0, -2 * std::numbers::pi * double(k * j % n) / n);
+    line = out;
+  };
+  for (int y = 0; y < h; ++y) {
+    std::vector<std::complex<double>> row(a.begin() + y * w, a.begin() + (y + 1) * w);
+    dft(row);
+    std::copy(row.begin(), row.end(), a.begin() + y * w);
+  }
+  for (int x = 0; x < w; ++x) {
+    std::vector<std::complex<double>> col(h);
+    for (int y = 0; y < h; ++y) col[y] = a[y * w + x];
+    dft(col);
+    for (int y = 0; y < h; ++y) a[y * w + x] = col[y];
+  }
+  double above = 0, total = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int fx = std::min(x, w - x), fy = std::min(y, h - y);  // cycles per view
+      const double p = std::norm(a[y * w + x]);
+      total += p;
+      if (2 * fx > raw_w || 2 * fy > raw_h) above += p;
+    }
+  return above / total;
+}
+
+// No detail finer than the raw grid. Before sampling, the PSF has already removed what
+// lies above the raw grid's Nyquist limit (at most 1% of the power is left there, so the
+// raw grid carries the whole signal). After display, what lies above it comes from the
+// bilinear interpolation alone: the stored image has the share the interpolated raw grid
+// has, within 0.5 points (rounding), stated as at most 6%.
+TEST(Physics, NoDetailFinerThanTheRawGrid) {
+  const Catalogue& cat = catalogue();
+  const Scenario s = test::random_scenario(cat, 5, 4);
+  const Plan plan = physics_plan();
+  const reference::ViewScene vs = reference::view_scene(cat, assets(), plan.model, 0, s, 0);
+  reference::Field f;
+  reference::radiometry(vs, f);
+  const double sharp = share_above_nyquist(f.v, f.width, f.height, 28, 28);
+  reference::optics(vs, f);
+  const double blurred = share_above_nyquist(f.v, f.width, f.height, 28, 28);
+  reference::sample(vs, f);
+  reference::netd(vs, f);
+  // The display's bilinear interpolation alone, in gray levels but unrounded.
+  const PhysicsConfig& pc = cat.physics;
+  const double scale = 255.0 / (pc.display_max - pc.display_min);
+  std::vector<double> interpolated(200 * 200);
+  const auto coord = [](int x, int size, int raw) { return std::clamp((x + 0.5) * raw / size - 0.5, 0.0, raw - 1.0); };
+  for (int y = 0; y < 200; ++y)
+    for (int x = 0; x < 200; ++x) {
+      const double u = coord(x, 200, 28), v = coord(y, 200, 28);
+      const int c0 = int(u), r0 = int(v), c1 = std::min(c0 + 1, 27), r1 = std::min(r0 + 1, 27);
+      const double tx = u - c0, ty = v - r0;
+      const double t =
+          (1 - ty) * ((1 - tx) * f.at(c0, r0) + tx * f.at(c1, r0)) + ty * ((1 - tx) * f.at(c0, r1) + tx * f.at(c1, r1));
+      interpolated[y * 200 + x] = (t - pc.display_min) * scale;
+    }
+  reference::Field shown = f;
+  reference::mmw_display(vs, shown);
+  const double image = share_above_nyquist(shown.v, shown.width, shown.height, 28, 28);
+  const double interpolation = share_above_nyquist(interpolated, 200, 200, 28, 28);
+  RecordProperty("share_sharp", std::to_string(sharp));
+  RecordProperty("share_blurred", std::to_string(blurred));
+  RecordProperty("share_image", std::to_string(image));
+  EXPECT_GT(sharp, 3 * blurred) << "the scene before optics has fine detail";
+  EXPECT_LE(blurred, 0.01);
+  EXPECT_NEAR(image, interpolation, 0.005);
+  EXPECT_LE(image, 0.06);
+}
+
+// A catalogue whose subject-1 has a flat upper body image (gray = its mmw_level: bare body
+// everywhere), a 120 x 120 metal plate, and a wide display window.
+struct FlatWorld {
+  test::TempDir dir;
+  Catalogue cat;
+  AssetSet assets;
+  explicit FlatWorld(const std::string& edit_from = "", const std::string& edit_to = "") {
+    write_image((dir.w() / "flat.png").string(), Image(200, 200, 1, 150));
+    std::string text(embedded::default_catalogue);
+    const auto replace = [&](const std::string& from, const std::string& to) {
+      const size_t at = text.find(from);
+      ASSERT_NE(at, std::string::npos) << from;
+      text.replace(at, from.size(), to);
+    };
+    replace("name = \"subject-1\"\n", "name = \"subject-1\"\nmmw_upper = \"flat.png\"\n");
+    replace("shape = \"plate\"\nsize = [32, 40]", "shape = \"plate\"\nsize = [120, 120]");
+    replace("display_min = 285.0", "display_min = 270.0");
+    replace("display_max = 305.0", "display_max = 350.0");
+    if (!edit_from.empty()) replace(edit_from, edit_to);
+    cat = parse_catalogue(text, "flat.toml", dir.w().string(), "");
+    assets = build_assets(cat);
+  }
+};
+
+// The raw grid of the upper view, before display (reference stages).
+reference::Field raw_grid(const FlatWorld& w, const ModelSettings& m, const Scenario& s) {
+  const reference::ViewScene vs = reference::view_scene(w.cat, w.assets, m, 0, s, 0);
+  reference::Field f;
+  for (const char* stage : {"radiometry", "optics", "sample"}) view_stage(stage).reference(vs, f);
+  return f;
+}
+
+// Metal reads darker than the body at 293 K illumination and brighter at 330 K, by the
+// radiometric formula within 0.5 gray level before rounding (the reference's raw grid) and
+// within 1 after (the kernels' image, two rounded values).
+TEST(Physics, MetalContrastFollowsTheRadiometricFormula) {
+  for (const char* emissivity : {"0.0055", "0.0", "1.0"}) {
+    SCOPED_TRACE(emissivity);
+    const FlatWorld w("emissivity = 0.0055", std::string("emissivity = ") + emissivity);
+    const PhysicsConfig& pc = w.cat.physics;
+    const double scale = 255.0 / (pc.display_max - pc.display_min);
+    Scenario bare, plate;
+    plate.objects[1] = static_cast<int16_t>(variant_of(w.cat, "metal-plate"));  // region 2, centre (100, 75)
+    auto cl = make_opencl_backend(w.cat, w.assets, test::runtime());
+    for (double illumination : {293.0, 330.0}) {
+      SCOPED_TRACE(illumination);
+      Plan plan = physics_plan();
+      plan.model.illumination = illumination;
+      plan.model.netd = 0;
+      const double e = std::stod(emissivity), tc = pc.clothing_transmission;
+      const double t_metal = pc.skin_temperature - (pc.skin_temperature - pc.room_temperature) *
+                                                       std::exp(-plan.model.worn_minutes / 15.0);  // steel
+      const double contrast_k =
+          tc * ((e * t_metal + (1 - e) * illumination) -
+                (pc.skin_emissivity * pc.skin_temperature + (1 - pc.skin_emissivity) * illumination));
+      const reference::Field with = raw_grid(w, plan.model, plate), without = raw_grid(w, plan.model, bare);
+      const double raw_contrast = with.at(14, 10) - without.at(14, 10);
+      EXPECT_NEAR(raw_contrast * scale, contrast_k * scale, 0.5);
+      BatchOutput a, b;
+      cl->run(test::batch_of({plate}), plan, a);
+      cl->run(test::batch_of({bare}), plan, b);
+      const double seen = double(a.view("upper").pixels[75 * 200 + 100]) - b.view("upper").pixels[75 * 200 + 100];
+      EXPECT_NEAR(seen, contrast_k * scale, 1.0);
+      if (e < 0.1) {
+        if (illumination < 300)
+          EXPECT_LT(seen, -2) << "metal reflects the cooler room: darker than the body";
+        else
+          EXPECT_GT(seen, 2) << "metal reflects the hotter surroundings: brighter than the body";
+      }
+    }
+  }
+}
+
+// Illumination at body temperature, objects warmed to it: no contrast at all.
+TEST(Physics, NoContrastWhenEverythingIsAtBodyTemperature) {
+  const FlatWorld w;
+  Scenario bare, plate;
+  plate.objects[1] = static_cast<int16_t>(variant_of(w.cat, "metal-plate"));
+  Plan plan = physics_plan();
+  plan.model.illumination = w.cat.physics.skin_temperature;
+  plan.model.worn_minutes = 1440;
+  plan.model.netd = 0;
+  auto cl = make_opencl_backend(w.cat, w.assets, test::runtime());
+  BatchOutput a, b;
+  cl->run(test::batch_of({plate}), plan, a);
+  cl->run(test::batch_of({bare}), plan, b);
+  int worst = 0;
+  for (size_t k = 0; k < a.view("upper").pixels.size(); ++k)
+    worst = std::max(worst, std::abs(int(a.view("upper").pixels[k]) - int(b.view("upper").pixels[k])));
+  EXPECT_LE(worst, 1);
+}
+
+TEST(Physics, Extremes) {
+  const SceneBatch batch = test::batch_of(scenes(4));
+  auto cl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  // NETD 0: no noise, whatever the seed.
+  BatchOutput a, b;
+  Plan quiet = physics_plan(1);
+  quiet.model.netd = 0;
+  cl->run(batch, quiet, a);
+  quiet.model.seed = 2;
+  cl->run(batch, quiet, b);
+  EXPECT_EQ(a.view("upper").pixels, b.view("upper").pixels);
+  // A 1x1 raw grid: one value over the whole view.
+  Plan one = physics_plan();
+  one.model.raw_width = one.model.raw_height = 1;
+  BatchOutput c;
+  cl->run(batch, one, c);
+  const std::vector<uint8_t>& px = c.view("upper").pixels;
+  for (size_t i = 0; i < 4; ++i)
+    EXPECT_TRUE(std::all_of(px.begin() + i * 40000, px.begin() + (i + 1) * 40000,
+                            [&](uint8_t v) { return v == px[i * 40000]; }));
+  // A PSF wider than the view (a 2 mm aperture): nearly uniform, and the backends agree.
+  const FlatWorld w("aperture_m = 0.125", "aperture_m = 0.002");
+  EXPECT_GT(reference::psf_fwhm_pixels(w.cat, w.cat.sensors[0]), 200.0);
+  Plan wide = physics_plan();
+  wide.model.netd = 0;
+  BatchOutput r, k;
+  Scenario plate;
+  plate.objects[1] = static_cast<int16_t>(variant_of(w.cat, "metal-plate"));
+  make_reference_backend(w.cat, w.assets)->run(test::batch_of({plate}), wide, r);
+  make_opencl_backend(w.cat, w.assets, test::runtime())->run(test::batch_of({plate}), wide, k);
+  EXPECT_LE(compare_outputs(k, r).mmw.max_abs, 1);
+  const auto [lo, hi] = std::minmax_element(k.view("upper").pixels.begin(), k.view("upper").pixels.end());
+  EXPECT_LE(*hi - *lo, 20);
+}
+
+TEST(Physics, BadSettingsAreRefused) {
+  Plan p = physics_plan();
+  p.model.raw_width = 201;
+  EXPECT_THROW(validate(p, catalogue()), InputError);
+  Plan q;
+  const Knob& raw = *find_knob("mmw_raw");
+  for (const char* bad : {"28", "28x", "x28", "0x28", "28x5000", "2.5x3", "-3x4", "28x28x2", "1e1x10", ""})
+    EXPECT_THROW(set_knob(q, raw, bad, "--mmw-raw"), InputError) << bad;
+  set_knob(q, raw, "40x30", "--mmw-raw");
+  EXPECT_EQ(q.model.raw_width, 40);
+  EXPECT_EQ(q.model.raw_height, 30);
+  // A catalogue without [[materials]] cannot run the physics model.
+  std::string text(embedded::default_catalogue);
+  text = text.substr(0, text.find("[[materials]]")) + text.substr(text.find("# --- Subjects:"));
+  const Catalogue bare = parse_catalogue(text, "bare.toml", "", "");
+  EXPECT_TRUE(bare.materials.empty());
+  EXPECT_THROW(validate(p, bare), InputError);
+  EXPECT_NO_THROW(validate(Plan{}, bare)) << "the thesis model needs no materials";
+  // An object naming no known material, a NaN emissivity.
+  std::string unknown(embedded::default_catalogue);
+  unknown.replace(unknown.find("material = \"cd\""), 14, "material = \"xx\"");
+  EXPECT_THROW(parse_catalogue(unknown, "u.toml", "", ""), InputError);
+  std::string nan(embedded::default_catalogue);
+  nan.replace(nan.find("emissivity = 0.0055"), 19, "emissivity = nan");
+  try {
+    parse_catalogue(nan, "n.toml", "", "");
+    ADD_FAILURE() << "NaN emissivity accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("n.toml:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("materials[1].emissivity"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace portalsim
