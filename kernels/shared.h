@@ -75,6 +75,11 @@ typedef struct {
   PS_I32 raw_width, raw_height;
   PS_I32 psf_radius; /* taps either side of the centre */
   PS_I32 subjects;   /* subjects in the catalogue (the layout of phys) */
+  /* The physics fast path's tables in phys: the raw grid's weights of each view column
+   * (raw_width x width) and row (raw_height x height), optics and sampling folded in; the
+   * first and last raw column of each view column and raw row of each view row (2 per);
+   * and each subject's bare raw grid (subjects x raw_height x raw_width). */
+  PS_I32 phys_wx, phys_wy, phys_cband, phys_rband, phys_base;
 } PsViewLaunch;
 
 /* The physics model's parameters for one launch (kernels' `phys`, at the build's parameter

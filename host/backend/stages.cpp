@@ -27,6 +27,11 @@ const std::vector<std::string>& fused_chain() {
   return chain;
 }
 
+const std::vector<std::string>& physics_fused_chain() {
+  static const std::vector<std::string> chain = {"radiometry", "optics", "sample", "netd", "mmw_display"};
+  return chain;
+}
+
 void check_chain(const Sensor& view) {
   for (Model m : {Model::thesis, Model::physics}) {
     const std::vector<std::string>& chain = view.chain_for(m);

@@ -33,6 +33,8 @@ const std::vector<ViewStage>& view_stages();
 // The chain the fused render_view kernel implements (a declared fast path); views whose
 // chain differs run stage by stage.
 const std::vector<std::string>& fused_chain();
+// The physics MMW chain the physics_raw fast path (then mmw_display) implements.
+const std::vector<std::string>& physics_fused_chain();
 // Throws std::logic_error unless every stage of each of the view's chains is registered
 // and each chain ends with a stage that makes pixels, and no other stage does.
 void check_chain(const Sensor& view);

@@ -224,7 +224,7 @@ class OpenCLBackend final : public Backend {
     cl::Program program;
     cl::Kernel place, render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, features_sparse,
         analytic_noise;
-    std::map<std::string, cl::Kernel> stages;  // stage_<name>, made on first use
+    std::map<std::string, cl::Kernel> stages;  // stage kernels and fast paths, made on first use
     SparseTables tables;
     bool fp64 = false;  // alpha and sigma are passed as double
     size_t real_bytes = sizeof(cl_float);
@@ -267,10 +267,11 @@ class OpenCLBackend final : public Backend {
     L.subjects = static_cast<int32_t>(cat_.subjects.size());
     const std::vector<std::string>& chain = s.chain_for(plan.model.model);
     const bool fused = plan.fidelity.fused && chain == fused_chain();
+    const bool physics_fast = plan.fidelity.fused && chain == physics_fused_chain();
     cl::Context& ctx = rt_->context();
-    cl::Buffer field = fused ? dst : field_.at_least(ctx, n * s.pixels() * K.real_bytes);
+    cl::Buffer field = fused || physics_fast ? dst : field_.at_least(ctx, n * s.pixels() * K.real_bytes);
     cl::Buffer& records = records_.at_least(ctx, n * PS_REC_LEN * sizeof(cl_int));
-    cl::Buffer phys = physics_params(K, plan, s, L.psf_radius);
+    cl::Buffer phys = physics_params(K, plan, view, L);
     const bool physics = plan.model.model == Model::physics;
     cl::Buffer& raw = raw_.at_least(ctx, physics ? n * plan.model.raw_width * plan.model.raw_height * K.real_bytes : 1);
     cl::Buffer& scratch = view_scratch_.at_least(ctx, physics ? n * s.pixels() * K.real_bytes : 1);
@@ -300,35 +301,95 @@ class OpenCLBackend final : public Backend {
       launch(K.render, n * s.height);
       return;
     }
+    if (physics_fast) {
+      launch(stage_kernel(K, "physics_raw"), n);
+      launch(stage_kernel(K, "stage_mmw_display"), n * s.height);
+      return;
+    }
     for (const std::string& name : chain)
-      for (const StageKernel& sk : view_stage(name).kernels) {
-        const std::string kernel(sk.kernel);
-        auto it = K.stages.find(kernel);
-        if (it == K.stages.end()) it = K.stages.emplace(kernel, cl::Kernel(K.program, kernel.c_str())).first;
-        launch(it->second, n * (sk.items == StageItems::raw_rows ? plan.model.raw_height : s.height));
-      }
+      for (const StageKernel& sk : view_stage(name).kernels)
+        launch(stage_kernel(K, sk.kernel), n * (sk.items == StageItems::raw_rows ? plan.model.raw_height : s.height));
+  }
+
+  static cl::Kernel& stage_kernel(Kernels& K, std::string_view name) {
+    const std::string kernel(name);
+    auto it = K.stages.find(kernel);
+    if (it == K.stages.end()) it = K.stages.emplace(kernel, cl::Kernel(K.program, kernel.c_str())).first;
+    return it->second;
   }
 
   // The physics model's parameters for a view's launch (kernels/shared.h, PS_PHYS_*), at the
-  // kernels' parameter precision; `radius` gets the PSF's half-width in taps. The same
-  // formulas as the reference's, written again here: the two never share code.
-  cl::Buffer physics_params(const Kernels& K, const Plan& plan, const Sensor& view, int32_t& radius) {
-    radius = 0;
+  // kernels' parameter precision, with the fast path's tables; fills L's offsets into them.
+  // The same formulas as the reference's, written again here: the two never share code.
+  // Kept per (view, knobs, precision): the bare raw grids cost a few milliseconds.
+  cl::Buffer physics_params(const Kernels& K, const Plan& plan, int view, PsViewLaunch& L) {
+    L.psf_radius = L.phys_wx = L.phys_wy = L.phys_cband = L.phys_rband = L.phys_base = 0;
     if (plan.model.model != Model::physics) return physics_none_.at_least(rt_->context(), 16);
+    const ModelSettings& m = plan.model;
+    char key[160];
+    std::snprintf(key, sizeof key, "%d %d %a %a %a %d %d", view, int(K.fp64), m.illumination, m.netd, m.worn_minutes,
+                  m.raw_width, m.raw_height);
+    PhysicsTables& t = physics_tables_[key];
+    if (t.values.empty()) t = physics_tables(plan, cat_.sensors[view], view);
+    L.psf_radius = t.radius;
+    L.phys_wx = t.wx;
+    L.phys_wy = t.wy;
+    L.phys_cband = t.cband;
+    L.phys_rband = t.rband;
+    L.phys_base = t.base;
+    if (!t.buffer()) {
+      t.buffer = K.fp64 ? constant(rt_->context(), t.values)
+                        : constant(rt_->context(), std::vector<cl_float>(t.values.begin(), t.values.end()));
+    }
+    return t.buffer;
+  }
+
+  struct PhysicsTables {
+    std::vector<double> values;
+    int32_t radius = 0, wx = 0, wy = 0, cband = 0, rband = 0, base = 0;
+    cl::Buffer buffer;
+  };
+
+  // The raw grid's weight of each view pixel along one axis (size pixels, raw cells): the
+  // PSF's taps (edges held) folded into each cell's box over size / raw pixels; then the
+  // first and last cell each pixel reaches.
+  static void axis_weights(int size, int raw, const std::vector<double>& taps, int radius, std::vector<double>& w,
+                           std::vector<double>& band) {
+    w.assign(static_cast<size_t>(raw) * size, 0.0);
+    const double step = double(size) / raw;
+    for (int c = 0; c < raw; ++c)
+      for (int x = static_cast<int>(std::floor(c * step)); x < std::min(size, int(std::ceil((c + 1) * step))); ++x) {
+        const double share = (std::min(x + 1.0, (c + 1) * step) - std::max(double(x), c * step)) / step;
+        for (int d = -radius; d <= radius; ++d)
+          w[size_t(c) * size + std::clamp(x + d, 0, size - 1)] += share * taps[d + radius];
+      }
+    band.assign(2 * static_cast<size_t>(size), 0.0);
+    for (int x = 0; x < size; ++x) {
+      int lo = raw, hi = -1;
+      for (int c = 0; c < raw; ++c)
+        if (w[size_t(c) * size + x] != 0) lo = std::min(lo, c), hi = std::max(hi, c);
+      band[2 * x] = lo;
+      band[2 * x + 1] = hi;
+    }
+  }
+
+  PhysicsTables physics_tables(const Plan& plan, const Sensor& s, int view) const {
     const PhysicsConfig& pc = cat_.physics;
     const ModelSettings& m = plan.model;
     const auto seen = [&](double e, double t) {
       return pc.clothing_transmission * (e * t + (1 - e) * m.illumination) +
              (1 - pc.clothing_transmission) * pc.clothing_temperature;
     };
-    std::vector<double> p(PS_PHYS_SUBJECTS, 0.0);
+    PhysicsTables t;
+    std::vector<double>& p = t.values;
+    p.assign(PS_PHYS_SUBJECTS, 0.0);
     p[PS_PHYS_BACKGROUND] = pc.background_temperature;
     p[PS_PHYS_WINDOW_MIN] = pc.display_min;
     p[PS_PHYS_WINDOW_MAX] = pc.display_max;
     p[PS_PHYS_NETD] = m.netd;
     const double body = seen(pc.skin_emissivity, pc.skin_temperature);
-    for (const Subject& s : cat_.subjects) {
-      const double gain = (body - pc.background_temperature) / (s.mmw_level - pc.base_background_gray);
+    for (const Subject& subj : cat_.subjects) {
+      const double gain = (body - pc.background_temperature) / (subj.mmw_level - pc.base_background_gray);
       p.push_back(gain);
       p.push_back(pc.background_temperature - gain * pc.base_background_gray);
     }
@@ -340,18 +401,48 @@ class OpenCLBackend final : public Backend {
     // The Airy core's FWHM, 1.02 lambda / D at the range, in this view's pixels; a
     // Gaussian of that FWHM over +-4 sigma.
     const double lambda = 299792458.0 / (pc.frequency_ghz * 1e9);
-    const double fwhm = 1.02 * lambda / pc.aperture_m * view.width / (2.0 * std::tan(pc.fov_rad / 2.0));
+    const double fwhm = 1.02 * lambda / pc.aperture_m * s.width / (2.0 * std::tan(pc.fov_rad / 2.0));
     const double sigma = fwhm / 2.3548200450309493;
-    radius = static_cast<int32_t>(std::ceil(4.0 * sigma));
+    t.radius = static_cast<int32_t>(std::ceil(4.0 * sigma));
+    std::vector<double> taps;
     double total = 0;
-    const size_t taps = p.size();
-    for (int d = -radius; d <= radius; ++d) {
-      p.push_back(std::exp(-0.5 * d * d / (sigma * sigma)));
-      total += p.back();
+    for (int d = -t.radius; d <= t.radius; ++d) total += taps.emplace_back(std::exp(-0.5 * d * d / (sigma * sigma)));
+    for (double& tap : taps) tap /= total;
+    p.insert(p.end(), taps.begin(), taps.end());
+    // The fast path's tables.
+    const int W = s.width, H = s.height, RW = m.raw_width, RH = m.raw_height;
+    std::vector<double> wx, wy, cband, rband;
+    axis_weights(W, RW, taps, t.radius, wx, cband);
+    axis_weights(H, RH, taps, t.radius, wy, rband);
+    const auto append = [&](const std::vector<double>& v) {
+      if (p.size() + v.size() > 0x7fffffffu) throw std::runtime_error("physics tables exceed 2^31 values");
+      const int32_t at = static_cast<int32_t>(p.size());
+      p.insert(p.end(), v.begin(), v.end());
+      return at;
+    };
+    t.wx = append(wx);
+    t.wy = append(wy);
+    t.cband = append(cband);
+    t.rband = append(rband);
+    // Each subject's bare raw grid: wy . T . wx^T over its base image in kelvin.
+    std::vector<double> bare(cat_.subjects.size() * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
+    for (size_t subj = 0; subj < cat_.subjects.size(); ++subj) {
+      const Image& base = assets_.bases[subj][view];
+      const double gain = p[PS_PHYS_SUBJECTS + 2 * subj], offset = p[PS_PHYS_SUBJECTS + 2 * subj + 1];
+      std::fill(rows.begin(), rows.end(), 0.0);
+      for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+          const double kelvin = gain * base.at(x, y) + offset;
+          for (int c = int(cband[2 * x]); c <= int(cband[2 * x + 1]); ++c)
+            rows[size_t(y) * RW + c] += wx[size_t(c) * W + x] * kelvin;
+        }
+      double* out = &bare[subj * size_t(RW) * RH];
+      for (int y = 0; y < H; ++y)
+        for (int r = int(rband[2 * y]); r <= int(rband[2 * y + 1]); ++r)
+          for (int c = 0; c < RW; ++c) out[size_t(r) * RW + c] += wy[size_t(r) * H + y] * rows[size_t(y) * RW + c];
     }
-    for (size_t k = taps; k < p.size(); ++k) p[k] /= total;
-    if (K.fp64) return constant(rt_->context(), p);
-    return constant(rt_->context(), std::vector<cl_float>(p.begin(), p.end()));
+    t.base = append(bare);
+    return t;
   }
 
   // Block and region means of one pooled view into its columns of the feature rows.
@@ -613,6 +704,7 @@ class OpenCLBackend final : public Backend {
       influence_, categories_, base_zones_;
   std::vector<cl::Buffer> view_rects_;  // per view: int4 per region
   Grown subject_, objects_, metal_out_, features_, field_, records_, raw_, view_scratch_, physics_none_;
+  std::map<std::string, PhysicsTables> physics_tables_;
   std::vector<Grown> scratch_;  // per view: images only pooled
 };
 

@@ -1,0 +1,94 @@
+// The physics MMW camera's declared fast path: radiometry -> optics -> sample -> netd in one
+// work-item per scenario, writing the raw grid that stage_mmw_display then shows. All of
+// optics and sampling is linear, so the raw grid is the subject's bare raw grid (a table)
+// plus, for each view row an object crosses, that row's change (composite minus bare, in
+// kelvin) projected through the folded weights: raw[r][c] += wy[r][y] sum_x wx[c][x] d(x, y).
+// Tested against the chain of stage kernels and the reference (tests/physics_test.cpp).
+kernel void physics_raw(VIEW_STAGE_ARGS) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= L.n) return;
+  (void)bases, (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha,
+      (void)sigma, (void)field, (void)out;
+  const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
+  const ulong index = upsample(L.first_hi, L.first_lo) + i;
+  global const int* rec = records + (size_t)i * PS_REC_LEN;
+  const int W = L.width, H = L.height, RW = L.raw_width, RH = L.raw_height, cells = RW * RH;
+  global preal* r = (global preal*)raw + (size_t)i * cells;
+  global preal* acc = (global preal*)scratch + (size_t)i * RW;  // one view row's change per raw column
+  const int s = subject[i];
+  global const param* bare = phys + L.phys_base + (size_t)s * cells;
+  for (int k = 0; k < cells; ++k) r[k] = (preal)bare[k];
+
+  // The view rows any object can touch.
+  int y_lo = H, y_hi = 0;
+  const int bilinear = (L.flags & PS_FLAG_BILINEAR) != 0;
+  for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
+    global const int* ly = rec + PS_REC_LAYERS + j * PS_LAYER_LEN;
+    const int top = bilinear ? (int)floor(as_float(ly[PS_LAYER_FY])) - 1 : ly[PS_LAYER_Y0];
+    y_lo = min(y_lo, max(top, 0));
+    y_hi = max(y_hi, min(top + ly[PS_LAYER_H] + 2, H));
+  }
+  const preal gain = (preal)phys[PS_PHYS_SUBJECTS + 2 * s], offset = (preal)phys[PS_PHYS_SUBJECTS + 2 * s + 1];
+  global const param* object_t = phys + PS_PHYS_VARIANTS(L.subjects);
+  global const param* wx = phys + L.phys_wx;
+  global const param* wy = phys + L.phys_wy;
+  global const param* cband = phys + L.phys_cband;
+  global const param* rband = phys + L.phys_rband;
+  for (int y = y_lo; y < y_hi; ++y) {
+    Layers Ly;
+    composite_layers(&Ly, rec, &L, y);
+    if (Ly.count == 0) continue;
+    int x_lo = W, x_hi = 0;
+    for (int k = 0; k < Ly.count; ++k) {
+      x_lo = min(x_lo, max(Ly.x0[k], 0));
+      x_hi = max(x_hi, min(Ly.x0[k] + Ly.width[k], W));
+    }
+    global const uchar* base = base_row(atlas, bases, subject, &L, i, y);
+    int c_lo = RW, c_hi = -1;
+    for (int c = 0; c < RW; ++c) acc[c] = 0;
+    for (int x = x_lo; x < x_hi; ++x) {
+      const preal t0 = gain * (preal)base[x] + offset;
+      preal v = t0;
+      for (int k = 0; k < Ly.count; ++k) {
+        const int sx = x - Ly.x0[k];
+        if (sx < 0 || sx >= Ly.width[k]) continue;
+        preal c;
+        if (Ly.bilinear) {
+          greal pv, cov;
+          bilinear_sample(&Ly, k, atlas, x, &pv, &cov);
+          c = (preal)cov;
+        } else {
+          c = (preal)atlas[Ly.offset[k] + 2 * sx + 1] * ((preal)1 / (preal)255);
+        }
+        v = c * (preal)object_t[Ly.variant[k]] + ((preal)1 - c) * v;
+      }
+      const preal d = v - t0;
+      if (d == 0) continue;
+      const int c0 = (int)cband[2 * x], c1 = (int)cband[2 * x + 1];
+      for (int c = c0; c <= c1; ++c) acc[c] += (preal)wx[(size_t)c * W + x] * d;
+      c_lo = min(c_lo, c0);
+      c_hi = max(c_hi, c1);
+    }
+    for (int rr = (int)rband[2 * y]; rr <= (int)rband[2 * y + 1]; ++rr) {
+      const preal w = (preal)wy[(size_t)rr * H + y];
+      for (int c = c_lo; c <= c_hi; ++c) r[rr * RW + c] += w * acc[c];
+    }
+  }
+
+  const preal sd = (preal)phys[PS_PHYS_NETD];
+  if (sd <= 0) return;
+  int p = 0;
+#if !defined(PRECISION_FP64)
+  for (; p + 32 <= cells; p += 32) {  // 16 Box-Muller pairs at once (kernels/sensor_noise.cl)
+    float16 g0, g1;
+    gauss32_of(seed, index, PS_STREAM_RAW_NOISE, L.view, p >> 1, &g0, &g1);
+    vstore16(vload16(0, r + p) + sd * g0, 0, r + p);
+    vstore16(vload16(0, r + p + 16) + sd * g1, 0, r + p + 16);
+  }
+#endif
+  for (; p < cells; p += 2) {
+    const greal2 g = gauss_pair_of(seed, index, PS_STREAM_RAW_NOISE, L.view, p >> 1);
+    r[p] += sd * (preal)g.x;
+    if (p + 1 < cells) r[p + 1] += sd * (preal)g.y;
+  }
+}
