@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <complex>
+#include <filesystem>
 #include <numbers>
 
 #include "assets/image_io.h"
@@ -23,6 +24,8 @@ extern const std::string_view default_catalogue;
 
 namespace portalsim {
 namespace {
+
+namespace fs = std::filesystem;
 
 using test::assets;
 using test::catalogue;
@@ -428,6 +431,26 @@ TEST(Physics, Extremes) {
   EXPECT_LE(compare_outputs(k, r).mmw.max_abs, 1);
   const auto [lo, hi] = std::minmax_element(k.view("upper").pixels.begin(), k.view("upper").pixels.end());
   EXPECT_LE(*hi - *lo, 20);
+}
+
+// simulate --stages: every stage's field of each view, shaped as the stage leaves it.
+TEST(Physics, SimulateWritesEveryStageField) {
+  test::TempDir t;
+  const auto out = t.w() / "gun";
+  const test::Result r =
+      test::finish(test::start(t.cap(), {"simulate", "--model", "physics", "--mmw-raw", "28x20", "--stages", "none",
+                                         "none", "none", "gun", "--out", out.string()}));
+  ASSERT_TRUE(r.exited && r.status == 0) << test::describe(r);
+  for (const char* view : {"upper", "lower"}) {
+    SCOPED_TRACE(view);
+    const std::string v(view);
+    EXPECT_NE(test::slurp(out / "stages" / (v + ".1.radiometry.npy")).find("'shape': (200, 200,)"), std::string::npos);
+    EXPECT_NE(test::slurp(out / "stages" / (v + ".3.sample.npy")).find("'shape': (20, 28,)"), std::string::npos);
+    const std::string shown = test::slurp(out / "stages" / (v + ".5.mmw_display.npy"));
+    ASSERT_EQ(shown.size(), 128u + 200 * 200 * 8);
+  }
+  EXPECT_TRUE(fs::exists(out / "stages" / "ir.1.composite.npy"));
+  EXPECT_TRUE(fs::exists(out / "upper.png"));
 }
 
 TEST(Physics, BadSettingsAreRefused) {

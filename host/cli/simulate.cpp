@@ -18,6 +18,7 @@ struct SimulateOptions {
   std::string rule, threat, out = "portalsim-out", image_format = "png";
   std::vector<std::string> objects;
   std::string tier = "standard";
+  bool stages = false;
   std::map<std::string, std::string> knobs;
   CLI::App* app = nullptr;
 };
@@ -42,8 +43,9 @@ int simulate(SimulateOptions& o) {
 
   open_backend(s, o.common);
   BatchOutput out;
-  const OneScenarioTimes t =
-      write_one_scenario(o.out, *s.backend, scene, plan, s.assets.palette, FolderOptions{o.image_format}, out);
+  const StageFieldsRequest fields{cat, s.assets};
+  const OneScenarioTimes t = write_one_scenario(o.out, *s.backend, scene, plan, s.assets.palette,
+                                                FolderOptions{o.image_format}, out, o.stages ? &fields : nullptr);
   const double run_seconds = t.run_seconds, write_seconds = t.write_seconds;
 
   std::printf("%s: subject %d, threat %s, metal", o.out.c_str(), o.subject, scene.label ? "yes" : "no");
@@ -72,6 +74,9 @@ std::function<int()> add_simulate(CLI::App& app) {
   sub->add_option("--threat", o->threat, "label the scenario yes or no")->check(CLI::IsMember({"yes", "no"}));
   sub->add_option("--out", o->out, "output folder (default portalsim-out)");
   sub->add_option("--image-format", o->image_format, "png or jpg")->check(CLI::IsMember({"png", "jpg"}));
+  sub->add_flag("--stages", o->stages,
+                "also write every stage's field of each view, as the reference computes it, to OUT/stages/"
+                "<view>.<k>.<stage>.npy (float64)");
   add_knob_options(*sub, o->tier, o->knobs);
   o->app = sub;
   return [o] { return simulate(*o); };

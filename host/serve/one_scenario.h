@@ -28,9 +28,16 @@ struct OneScenarioTimes {
   double run_seconds = 0, write_seconds = 0;
 };
 
+// What `simulate --stages` adds: every stage's field under dir/stages (sink/stage_fields.h).
+struct StageFieldsRequest {
+  const Catalogue& cat;
+  const AssetSet& assets;
+};
+
 // Runs `scene` on `backend` and writes its folder to `dir` all or nothing. `out` keeps
 // the backend's outputs (metal zones etc.) for the caller.
 OneScenarioTimes write_one_scenario(const std::string& dir, Backend& backend, const Scenario& scene, const Plan& plan,
-                                    const Palette& palette, const FolderOptions& opt, BatchOutput& out);
+                                    const Palette& palette, const FolderOptions& opt, BatchOutput& out,
+                                    const StageFieldsRequest* stages = nullptr);
 
 }  // namespace portalsim
