@@ -77,8 +77,10 @@ const char* precision_name(Precision p) {
 }
 
 void validate(const Plan& plan, const Catalogue& cat) {
-  (void)cat;
   check_knobs(plan);
+  if (plan.model.model == Model::physics && plan.metal && !cat.metal_physics.present)
+    throw InputError("--model physics: the catalogue " + cat.source +
+                     " has no [metal.physics] section (the metal detector's coil model)");
 }
 
 }  // namespace portalsim
