@@ -10,7 +10,7 @@ namespace {
 using bench::fx;
 using bench::make_batch;
 
-enum Path { kFeaturesSparse, kFeaturesDense, kImages, kMetal };
+enum Path { kFeaturesSparse, kFeaturesDense, kImages, kMetal, kMetalPhysics };
 
 Plan plan_for(Path path, int block) {
   Plan p;
@@ -29,6 +29,11 @@ Plan plan_for(Path path, int block) {
     case kMetal:
       p.images = 0;
       p.features = false;
+      break;
+    case kMetalPhysics:  // the coil model (README, "Metal detector physics")
+      p.images = 0;
+      p.features = false;
+      p.model.model = Model::physics;
       break;
   }
   return p;
@@ -87,6 +92,10 @@ BENCHMARK_CAPTURE(BM_OpenCL, metal, kMetal)
     ->ArgsProduct({{65536}, {10}, {1, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK_CAPTURE(BM_OpenCL, metal_physics, kMetalPhysics)
+    ->ArgsProduct({{65536}, {10}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Tier, features, kFeaturesSparse)
     ->ArgsProduct({{16384}, {10}, {0, 1, 2}})
     ->Unit(benchmark::kMillisecond)
@@ -105,6 +114,10 @@ BENCHMARK_CAPTURE(BM_Reference, images, kImages)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Reference, metal, kMetal)
     ->ArgsProduct({{65536}, {10}, {1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Reference, metal_physics, kMetalPhysics)
+    ->ArgsProduct({{4096}, {10}, {1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

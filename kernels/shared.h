@@ -11,6 +11,26 @@
 /* Most sprites one camera view draws: one per region. */
 #define PS_MAX_LAYERS PS_REGIONS
 
+/* The metal detector under --model physics (README, "Metal detector physics"). */
+#define PS_METAL_PANEL_A_ZONES 9     /* zones 1..9 transmit from panel A (x < 0), the rest from B */
+#define PS_METAL_MAX_DEDUCTION 199   /* most one zone's response takes off its base value */
+#define PS_METAL_FOUR_PI 12.566370614359172 /* 4 pi, the dipole field's denominator */
+/* Record of one zone's coils, doubles: transmit and receive coil position (x, z, metres;
+ * y = 0) and moment (along x, A m^2), then the zone's gain. */
+#define PS_MZ_TX_X 0
+#define PS_MZ_TX_Z 1
+#define PS_MZ_TX_M 2
+#define PS_MZ_RX_X 3
+#define PS_MZ_RX_Z 4
+#define PS_MZ_RX_M 5
+#define PS_MZ_GAIN 6
+#define PS_MZ_LEN 8
+/* Record of one region, doubles: its rectangle's centre in its MMW view (column, and row
+ * counted from the top of the upper view: the two views stacked). */
+#define PS_MR_COL 0
+#define PS_MR_ROW 1
+#define PS_MR_LEN 2
+
 /* Random streams of the counter generator: each kind of draw has its own, so adding one
  * never shifts another. element = the index within the stream named beside it. */
 #define PS_STREAM_NOISE_PATTERN 1u /* which MMW noise pattern a scenario gets; element 0 */

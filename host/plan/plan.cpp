@@ -78,6 +78,9 @@ const char* precision_name(Precision p) {
 void validate(const Plan& plan, const Catalogue& cat) {
   check_knobs(plan);
   if (plan.model.model != Model::physics) return;
+  if (plan.metal && !cat.metal_physics.present)
+    throw InputError("--model physics: the catalogue " + cat.source +
+                     " has no [metal.physics] section (the metal detector's coil model)");
   if (cat.materials.empty())
     throw InputError("--model physics: the catalogue " + cat.source +
                      " has no [[materials]] (emissivities and warming times); add them, as the built-in one has");

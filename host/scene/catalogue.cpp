@@ -66,6 +66,9 @@ struct Reader {
       if (dflt) return *dflt;
       fail(&t, f, "missing");
     }
+    return number(n, f, lo, hi);
+  }
+  double number(const toml::node* n, const std::string& f, double lo, double hi) const {
     double v;
     if (n->is_integer())
       v = static_cast<double>(n->as_integer()->get());
@@ -101,6 +104,18 @@ struct Reader {
     std::vector<int> out;
     for (size_t i = 0; i < a->size(); ++i)
       out.push_back(static_cast<int>(integer(a->get(i), field + "[" + std::to_string(i) + "]", lo, hi)));
+    return out;
+  }
+
+  template <size_t N>
+  std::array<double, N> numbers(const toml::table& t, const std::string& key, const std::string& field, double lo,
+                                double hi) const {
+    const std::string f = field + "." + key;
+    const toml::node* n = need(t, key, f);
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != N) fail(n, f, "expected an array of " + std::to_string(N) + " numbers");
+    std::array<double, N> out{};
+    for (size_t i = 0; i < N; ++i) out[i] = number(a->get(i), f + "[" + std::to_string(i) + "]", lo, hi);
     return out;
   }
 
@@ -154,7 +169,50 @@ std::string fnv1a_hex(std::string_view text) {
   return buf;
 }
 
+// [metal.physics]: the coil model of --model physics. Ranges keep every value physical
+// and every computed signal finite.
+void read_metal_physics(const Reader& rd, const toml::node* node, Catalogue& cat) {
+  const std::string f = "metal.physics";
+  const toml::table* t = node->as_table();
+  if (!t) rd.fail(node, f, "expected a table");
+  io::reject_unknown_keys(
+      *t,
+      {"body_height", "panel_separation", "tx_moment", "rx_moment", "tx_height", "rx_height", "gain", "polarizability"},
+      rd.file, f);
+  MetalPhysics& mp = cat.metal_physics;
+  mp.present = true;
+  mp.body_height = rd.number(*t, "body_height", f, 0.5, 3.0);
+  mp.panel_separation = rd.number(*t, "panel_separation", f, 0.2, 5.0);
+  mp.tx_moment = rd.number(*t, "tx_moment", f, 1e-6, 1e6);
+  mp.rx_moment = rd.number(*t, "rx_moment", f, 1e-6, 1e6);
+  mp.tx_height = rd.numbers<kZones>(*t, "tx_height", f, 0.0, 5.0);
+  mp.rx_height = rd.numbers<kZones>(*t, "rx_height", f, 0.0, 5.0);
+  mp.gain = rd.numbers<2>(*t, "gain", f, 0.0, 1e12);
+  const toml::node* pn = rd.need(*t, "polarizability", f + ".polarizability");
+  const toml::table* pol = pn->as_table();
+  if (!pol) rd.fail(pn, f + ".polarizability", "expected a table of category = cm^3");
+  for (const auto& [key, value] : *pol) {
+    bool known = false;
+    for (const std::string& c : cat.metal_categories) known |= (c == key.str());
+    if (!known) rd.fail(&value, f + ".polarizability." + std::string(key.str()), "not one of metal.categories");
+  }
+  for (const std::string& c : cat.metal_categories)
+    mp.polarizability.push_back(rd.number(*pol, c, f + ".polarizability", 0.0, 1e6));
+}
+
 }  // namespace
+
+std::array<double, 9> Catalogue::polarizability(int variant_id) const {
+  const Object& o = object_of(variant_id);
+  const double m = metal_physics.polarizability.empty() ? 0.0 : metal_physics.polarizability[o.metal];
+  const double a = o.metal_anisotropy;
+  const int axis = variant(variant_id).code == "v" ? 2 : 0;
+  std::array<double, 9> t{};
+  const double across = m * 3.0 / (a + 2.0);
+  for (int i = 0; i < 3; ++i) t[i * 3 + i] = across;
+  t[axis * 3 + axis] = across * a;
+  return t;
+}
 
 std::string normalise_name(std::string_view name) {
   std::string out;
@@ -211,7 +269,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   const toml::node* metal_node = rd.need(root, "metal", "metal");
   const toml::table* metal = metal_node->as_table();
   if (!metal) rd.fail(metal_node, "metal", "expected a table");
-  io::reject_unknown_keys(*metal, {"categories", "influence"}, source_name, "metal");
+  io::reject_unknown_keys(*metal, {"categories", "influence", "physics"}, source_name, "metal");
   {
     const toml::node* cn = rd.need(*metal, "categories", "metal.categories");
     const toml::array* ca = cn->as_array();
@@ -242,6 +300,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
       }
       cat.influence.push_back(table);
     }
+    if (const toml::node* pn = metal->get("physics")) read_metal_physics(rd, pn, cat);
   }
 
   // [[subjects]]
@@ -348,7 +407,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     const std::string f = "objects[" + std::to_string(i + 1) + "]";
     io::reject_unknown_keys(t,
                             {"name", "aliases", "material", "metal", "shape", "size", "mmw_level", "ir_level",
-                             "variants", "mmw", "ir", "mmw_h", "mmw_v", "ir_h", "ir_v"},
+                             "variants", "mmw", "ir", "mmw_h", "mmw_v", "ir_h", "ir_v", "metal_anisotropy"},
                             source_name, f);
     Object o;
     o.name = rd.string(t, "name", f);
@@ -387,6 +446,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     const std::vector<int> size = rd.ints(rd.need(t, "size", f + ".size"), f + ".size", 2, 1, 4096);
     o.width = size[0];
     o.height = size[1];
+    o.metal_anisotropy = rd.number(t, "metal_anisotropy", f, 1.0, 1000.0, 1.0);
     o.mmw_level = rd.integer(t, "mmw_level", f, 0, 255);
     o.ir_level = rd.integer(t, "ir_level", f, 0, 255);
     std::vector<std::string> codes;

@@ -76,6 +76,8 @@ struct Object {
   std::string shape;
   int width = 0, height = 0;  // MMW sprite of the horizontal drawing
   int mmw_level = 0, ir_level = 0;
+  // --model physics: polarizability along the drawing's long axis over across it (1: isotropic).
+  double metal_anisotropy = 1.0;
   std::vector<Variant> variants;
   int first_variant = 0;  // index of variants[0] in Catalogue::variant_list
 };
@@ -91,6 +93,18 @@ struct ImagesConfig {
   int ir_width = 100, ir_height = 200;
   double alpha = 0.9;
   int noise_size = 64;
+};
+
+// The walk-through metal detector under --model physics ([metal.physics]; README, "Metal
+// detector physics"). Zones 1..PS_METAL_PANEL_A_ZONES transmit from panel A (x < 0, the
+// subject's right), the others from panel B; each receives on the other panel.
+struct MetalPhysics {
+  bool present = false;                                 // the catalogue has [metal.physics]
+  double body_height = 1.75, panel_separation = 0.76;   // m
+  double tx_moment = 1.0, rx_moment = 1.0;              // A m^2
+  std::array<double, kZones> tx_height{}, rx_height{};  // m above the floor
+  std::array<double, 2> gain{};                         // counts per unit signal, panels A and B
+  std::vector<double> polarizability;                   // cm^3 per metal category
 };
 
 // A drawable thing: one variant of one object. Scenes refer to these by index.
@@ -114,12 +128,17 @@ struct Catalogue {
   std::vector<std::array<std::array<int, kZones>, kRegions>> influence;
   std::vector<VariantRef> variant_list;
   std::vector<Sensor> sensors;  // the camera views (scene/sensor.h)
+  MetalPhysics metal_physics;
 
   const Object& object_of(int variant_id) const { return objects[variant_list[variant_id].object]; }
   const Variant& variant(int variant_id) const {
     const VariantRef& r = variant_list[variant_id];
     return objects[r.object].variants[r.variant];
   }
+  // A variant's magnetic polarizability tensor, cm^3, row-major 3x3 in portal axes (x
+  // across, y along the walk, z up): m (I + (a - 1) u u^T) 3 / (a + 2), mean m of its metal
+  // category, anisotropy a along its long axis u (z for a "v" drawing, else x).
+  std::array<double, 9> polarizability(int variant_id) const;
   // "gun:v" for display; "gun" where the object has one drawing.
   std::string variant_name(int variant_id) const;
   // Finds an object by name or alias, ignoring case and punctuation ("Iron Rod",

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "backend/stages.h"
+#include "base/error.h"
 
 namespace portalsim {
 
@@ -143,6 +144,7 @@ class OpenCLBackend final : public Backend {
     for (size_t k = 0; k < views; ++k)
       view_rects_.push_back(constant(
           ctx, std::vector<cl_int4>(view_rects.begin() + k * kRegions, view_rects.begin() + (k + 1) * kRegions)));
+    if (cat.metal_physics.present) metal_physics_tables(ctx);
     influence_ = constant(ctx, influence);
     categories_ = constant(ctx, categories);
     base_zones_ = constant(ctx, base_zones);
@@ -193,7 +195,9 @@ class OpenCLBackend final : public Backend {
     }
     for (size_t k = 0; k < cat_.sensors.size(); ++k)
       if (plan.image(static_cast<int>(k))) sync(rendered[k], out.views[k].pixels);
-    if (plan.metal) {
+    if (plan.metal && plan.model.model == Model::physics) {
+      metal_physics(K, plan, n, subject, objects, seed, first, out);
+    } else if (plan.metal) {
       cl::Buffer& metal = metal_out_.at_least(ctx, n * kZones);
       int a = 0;
       K.metal.setArg(a++, influence_);
@@ -224,11 +228,80 @@ class OpenCLBackend final : public Backend {
     cl::Program program;
     cl::Kernel place, render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, features_sparse,
         analytic_noise;
+    cl::Kernel metal_physics;                  // made on first use: needs cl_khr_fp64
     std::map<std::string, cl::Kernel> stages;  // stage kernels and fast paths, made on first use
     SparseTables tables;
     bool fp64 = false;  // alpha and sigma are passed as double
     size_t real_bytes = sizeof(cl_float);
   };
+
+  // The coil model's tables (kernels/shared.h, PS_MZ_* and PS_MR_*) and each variant's
+  // polarizability tensor, as the reference computes them.
+  void metal_physics_tables(cl::Context& ctx) {
+    const MetalPhysics& mp = cat_.metal_physics;
+    std::vector<cl_double> zones(kZones * PS_MZ_LEN, 0.0), regions(kRegions * PS_MR_LEN, 0.0), tensors;
+    for (int z = 0; z < kZones; ++z) {
+      const double side = z < PS_METAL_PANEL_A_ZONES ? -1.0 : 1.0;
+      cl_double* rec = &zones[z * PS_MZ_LEN];
+      rec[PS_MZ_TX_X] = side * mp.panel_separation / 2.0;
+      rec[PS_MZ_TX_Z] = mp.tx_height[z];
+      rec[PS_MZ_TX_M] = -side * mp.tx_moment;
+      rec[PS_MZ_RX_X] = -side * mp.panel_separation / 2.0;
+      rec[PS_MZ_RX_Z] = mp.rx_height[z];
+      rec[PS_MZ_RX_M] = side * mp.rx_moment;
+      rec[PS_MZ_GAIN] = mp.gain[z < PS_METAL_PANEL_A_ZONES ? 0 : 1];
+    }
+    double row_offset = 0;  // the MMW views stacked, the first on top
+    for (const Sensor& s : cat_.sensors) {
+      if (s.camera != Camera::mmw) continue;
+      if (!metal_view_) metal_view_ = &s;
+      for (int r = 0; r < kRegions; ++r)
+        if (s.sees(r)) {
+          regions[r * PS_MR_LEN + PS_MR_COL] = s.rects[r].x + s.rects[r].w / 2.0;
+          regions[r * PS_MR_LEN + PS_MR_ROW] = row_offset + s.rects[r].y + s.rects[r].h / 2.0;
+        }
+      row_offset += s.height;
+    }
+    for (size_t v = 0; v < cat_.variant_list.size(); ++v)
+      for (double e : cat_.polarizability(static_cast<int>(v))) tensors.push_back(e);
+    metal_zone_rec_ = constant(ctx, zones);
+    metal_region_rec_ = constant(ctx, regions);
+    metal_tensors_ = constant(ctx, tensors);
+  }
+
+  void metal_physics(Kernels& K, const Plan& plan, size_t n, cl::Buffer& subject, cl::Buffer& objects, cl_uint2 seed,
+                     cl_uint2 first, BatchOutput& out) {
+    if (!rt_->has_fp64())
+      throw EnvironmentError("--model physics computes metal zones in fp64, and " + rt_->device_name() +
+                             " has no cl_khr_fp64; --backend reference works without it");
+    if (!cat_.metal_physics.present || !metal_view_)
+      throw InputError("--model physics: the catalogue has no [metal.physics] section");
+    if (!K.metal_physics()) K.metal_physics = cl::Kernel(K.program, "metal_physics");
+    cl::Kernel& k = K.metal_physics;
+    const MetalPhysics& mp = cat_.metal_physics;
+    cl::Buffer& metal = metal_out_.at_least(rt_->context(), n * kZones);
+    int a = 0;
+    k.setArg(a++, metal_zone_rec_);
+    k.setArg(a++, metal_region_rec_);
+    k.setArg(a++, metal_tensors_);
+    k.setArg(a++, base_zones_);
+    k.setArg(a++, subject);
+    k.setArg(a++, objects);
+    k.setArg(a++, static_cast<cl_uint>(n));
+    k.setArg(a++, seed);
+    k.setArg(a++, first);
+    k.setArg(a++, static_cast<cl_int>(plan.model.metal_noise));
+    // The reference's jitter, (jitter * scale) * (2u - 1), in the MMW views' pixels.
+    k.setArg(a++, static_cast<cl_double>(plan.model.jitter * metal_view_->jitter_scale_x));
+    k.setArg(a++, static_cast<cl_double>(plan.model.jitter * metal_view_->jitter_scale_y));
+    k.setArg(a++, static_cast<cl_double>(metal_view_->width / 2.0));
+    k.setArg(a++, static_cast<cl_double>(mp.body_height / (2.0 * cat_.images.mmw_height)));
+    k.setArg(a++, static_cast<cl_double>(mp.body_height));
+    k.setArg(a++, metal);
+    cl::CommandQueue& q = rt_->queue();
+    q.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
+    q.enqueueReadBuffer(metal, CL_FALSE, 0, n * kZones, out.metal.data());
+  }
 
   // A model parameter at the kernels' parameter precision (see kernels/precision.cl).
   static void set_param(const Kernels& K, cl::Kernel& k, int index, double v) {
@@ -701,7 +774,8 @@ class OpenCLBackend final : public Backend {
   std::vector<cl_int> sprite_offsets_;  // atlas offset of each variant's MMW sprite
   std::map<std::string, Kernels> variants_;
   cl::Buffer atlas_, bases_, sprites_, places_, noise_offsets_, noise_gains_, pooled_, region_slot_, region_rects_,
-      influence_, categories_, base_zones_;
+      influence_, categories_, base_zones_, metal_zone_rec_, metal_region_rec_, metal_tensors_;
+  const Sensor* metal_view_ = nullptr;  // the first MMW view: the metal model's pixel scale
   std::vector<cl::Buffer> view_rects_;  // per view: int4 per region
   Grown subject_, objects_, metal_out_, features_, field_, records_, raw_, view_scratch_, physics_none_;
   std::map<std::string, PhysicsTables> physics_tables_;

@@ -110,11 +110,14 @@ void OpenCLRuntime::build_failed(const cl::Program& p, const std::string& option
   throw std::runtime_error(what + ":\n" + log);
 }
 
+bool OpenCLRuntime::has_fp64() const {
+  return device_.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
+}
+
 cl::Program& OpenCLRuntime::program(const std::string& options) {
   auto it = variants_.find(options);
   if (it != variants_.end()) return it->second;
-  if (options.find("PRECISION_FP64") != std::string::npos &&
-      device_.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") == std::string::npos)
+  if (options.find("PRECISION_FP64") != std::string::npos && !has_fp64())
     throw EnvironmentError("the exact tier needs fp64, and " + device_name_ + " has no cl_khr_fp64");
   cl::Program p(context_, source());
   try {

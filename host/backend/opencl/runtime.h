@@ -24,6 +24,7 @@ class OpenCLRuntime {
   // built once and kept.
   cl::Program& program(const std::string& options);
   const std::string& device_name() const { return device_name_; }
+  bool has_fp64() const;  // the device offers cl_khr_fp64
   double build_seconds() const { return build_seconds_; }
   static std::string source();  // kernels/shared.h and the kernels/ files, in CMakeLists.txt's order
 

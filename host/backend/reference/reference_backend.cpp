@@ -35,7 +35,10 @@ class ReferenceBackend final : public Backend {
           std::copy(images[k].begin(), images[k].end(), out.views[k].pixels.begin() + i * sensor.pixels());
       }
       if (plan.features) reference::pool(cat_, images, out.layout, &out.features[i * out.layout.image_features()]);
-      if (plan.metal) reference::metal(cat_, plan.model, s, index, &out.metal[i * kZones]);
+      if (plan.metal && plan.model.model == Model::physics)
+        reference::metal_physics(cat_, assets_, plan.model, s, index, &out.metal[i * kZones]);
+      else if (plan.metal)
+        reference::metal(cat_, plan.model, s, index, &out.metal[i * kZones]);
     }
   }
 

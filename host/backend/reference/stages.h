@@ -3,6 +3,7 @@
 // same name as its kernel in kernels/ and its entry in backend/stages.h. They share
 // nothing with kernels/ except the random generator (scene/philox.h) and the catalogue.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -73,5 +74,21 @@ void pool(const Catalogue& cat, const std::vector<std::vector<uint8_t>>& views, 
           float* row);
 // Metal zones (thesis algorithm step 2): base minus every object's influence, clamped.
 void metal(const Catalogue& cat, const ModelSettings& m, const Scenario& s, uint64_t index, uint8_t* zones);
+
+// Metal zones under --model physics (metal_physics.cpp): base minus round(gain |sum of
+// H_R^T M H_T|), at most 199, detector noise as the thesis model's, clamped to [1, 200].
+void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m, const Scenario& s,
+                   uint64_t index, uint8_t* zones);
+// A metal object as the coils see it: polarizability tensor (cm^3) and position (metres,
+// x across the portal, z up; y = 0), its region's centre in the stacked MMW views plus
+// the composite's placement jitter.
+struct MetalObject {
+  std::array<double, 9> tensor;
+  double x, z;
+};
+std::vector<MetalObject> metal_objects(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m,
+                                       const Scenario& s, uint64_t index);
+// One object's H_R^T M H_T in zone `zone` (0-based), before the gain.
+double zone_signal(const MetalPhysics& mp, int zone, const MetalObject& o);
 
 }  // namespace portalsim::reference

@@ -1,0 +1,90 @@
+// Metal zones under --model physics (README, "Metal detector physics"): each zone is a
+// transmit coil on its own panel and a receive coil on the other, both magnetic dipoles;
+// an object at p with polarizability tensor M gives H_R(p)^T M H_T(p) (Marsh et al. 2014),
+// and the objects' signals add. Plain double precision, one zone and object at a time.
+#include <algorithm>
+#include <cmath>
+
+#include "backend/reference/stages.h"
+#include "scene/philox.h"
+
+namespace portalsim::reference {
+
+namespace {
+
+struct Vec {
+  double x, y, z;
+};
+
+// Field of a dipole of moment m at c, seen at p: (3 (m.r) r / |r|^2 - m) / (4 pi |r|^3).
+Vec dipole(Vec m, Vec c, Vec p) {
+  const Vec r{p.x - c.x, p.y - c.y, p.z - c.z};
+  const double d2 = r.x * r.x + r.y * r.y + r.z * r.z;
+  const double d = std::sqrt(d2);
+  const double k = 3.0 * (m.x * r.x + m.y * r.y + m.z * r.z) / d2;
+  const double den = PS_METAL_FOUR_PI * d2 * d;
+  return {(k * r.x - m.x) / den, (k * r.y - m.y) / den, (k * r.z - m.z) / den};
+}
+
+}  // namespace
+
+std::vector<MetalObject> metal_objects(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m,
+                                       const Scenario& s, uint64_t index) {
+  const MetalPhysics& mp = cat.metal_physics;
+  const double scale = mp.body_height / (2.0 * cat.images.mmw_height);  // metres per MMW pixel
+  std::vector<MetalObject> out;
+  double row_offset = 0;  // the MMW views stacked, the first on top
+  for (int k = 0; k < static_cast<int>(cat.sensors.size()); ++k) {
+    const Sensor& sensor = cat.sensors[k];
+    if (sensor.camera != Camera::mmw) continue;
+    // The placement jitter is the composite's: its sprites, in region order.
+    const ViewScene vs = view_scene(cat, assets, m, k, s, index);
+    size_t next = 0;
+    for (int r = 0; r < kRegions; ++r) {
+      if (s.objects[r] == kNoObject || !sensor.sees(r)) continue;
+      const Placed& p = vs.placed[next++];
+      const Rect& rc = sensor.rects[r];
+      const double col = rc.x + rc.w / 2.0, row = row_offset + rc.y + rc.h / 2.0;
+      out.push_back({cat.polarizability(s.objects[r]), (col + p.dx - sensor.width / 2.0) * scale,
+                     mp.body_height - (row + p.dy) * scale});
+    }
+    row_offset += sensor.height;
+  }
+  return out;
+}
+
+double zone_signal(const MetalPhysics& mp, int zone, const MetalObject& o) {
+  const double side = zone < PS_METAL_PANEL_A_ZONES ? -1.0 : 1.0;
+  const Vec tx{side * mp.panel_separation / 2.0, 0.0, mp.tx_height[zone]};
+  const Vec rx{-side * mp.panel_separation / 2.0, 0.0, mp.rx_height[zone]};
+  const Vec p{o.x, 0.0, o.z};
+  // Both coils' moments point into the portal.
+  const Vec ht = dipole({-side * mp.tx_moment, 0.0, 0.0}, tx, p);
+  const Vec hr = dipole({side * mp.rx_moment, 0.0, 0.0}, rx, p);
+  const std::array<double, 9>& M = o.tensor;
+  const double v0 = M[0] * ht.x + M[1] * ht.y + M[2] * ht.z;
+  const double v1 = M[3] * ht.x + M[4] * ht.y + M[5] * ht.z;
+  const double v2 = M[6] * ht.x + M[7] * ht.y + M[8] * ht.z;
+  return hr.x * v0 + hr.y * v1 + hr.z * v2;
+}
+
+void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m, const Scenario& s,
+                   uint64_t index, uint8_t* zones) {
+  const MetalPhysics& mp = cat.metal_physics;
+  const std::vector<MetalObject> objects = metal_objects(cat, assets, m, s, index);
+  for (int z = 0; z < kZones; ++z) {
+    double signal = 0;
+    for (const MetalObject& o : objects) signal += zone_signal(mp, z, o);
+    // Rounded half up; anything at or past the cap (or not finite, an object on a coil) is the cap.
+    const double t = mp.gain[z < PS_METAL_PANEL_A_ZONES ? 0 : 1] * std::fabs(signal);
+    const int deduction = t < PS_METAL_MAX_DEDUCTION ? static_cast<int>(std::floor(t + 0.5)) : PS_METAL_MAX_DEDUCTION;
+    int value = cat.subjects[s.subject].base_zones[z] - deduction;
+    if (m.metal_noise > 0 && deduction > 0) {
+      const Philox4 r = draw(m.seed, index, kStreamMetalNoise, static_cast<uint32_t>(z));
+      value += static_cast<int>(below(r[0], m.metal_noise + 1)) - static_cast<int>(below(r[1], m.metal_noise + 1));
+    }
+    zones[z] = static_cast<uint8_t>(std::clamp(value, 1, 200));
+  }
+}
+
+}  // namespace portalsim::reference

@@ -1,0 +1,68 @@
+// Metal zones under --model physics: the coil model of the reference
+// (host/backend/reference/metal_physics.cpp), in fp64 with the reference's operations in
+// the reference's order and no contraction into fma, so the integer zones match it
+// exactly. One work-item per scenario. Needs cl_khr_fp64; the host checks for it.
+#if defined(cl_khr_fp64)
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+#pragma OPENCL FP_CONTRACT OFF
+
+// Field of a dipole of moment (mx, 0, 0) at (cx, 0, cz), seen at (px, 0, pz).
+inline double3 metal_dipole(double mx, double cx, double cz, double px, double pz) {
+  const double rx = px - cx, ry = 0.0 - 0.0, rz = pz - cz;
+  const double d2 = rx * rx + ry * ry + rz * rz;
+  const double d = sqrt(d2);
+  const double k = 3.0 * (mx * rx + 0.0 * ry + 0.0 * rz) / d2;
+  const double den = PS_METAL_FOUR_PI * d2 * d;
+  return (double3)((k * rx - mx) / den, (k * ry - 0.0) / den, (k * rz - 0.0) / den);
+}
+
+kernel void metal_physics(global const double* zone_rec, global const double* region_rec,
+                          global const double* tensors, global const uchar* base_zones, global const uchar* subject,
+                          global const short* objects, uint n, uint2 seed, uint2 first, int noise, double jitter_x,
+                          double jitter_y, double half_width, double scale, double body_height, global uchar* out) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= n) return;
+  const ulong index = upsample(first.y, first.x) + i;
+  // Objects' positions (metres) and tensors, in region order as the reference.
+  double px[PS_REGIONS], pz[PS_REGIONS];
+  int variant[PS_REGIONS];
+  int count = 0;
+  for (int r = 0; r < PS_REGIONS; ++r) {
+    const int v = objects[(size_t)i * PS_REGIONS + r];
+    if (v < 0) continue;
+    double dx = 0.0, dy = 0.0;
+    if (jitter_x > 0.0 || jitter_y > 0.0) {
+      const uint4 q = draw(seed, index, PS_STREAM_JITTER, (uint)r);
+      dx = jitter_x * (2.0 * ((double)(q.x >> 8) * (1.0 / 16777216.0)) - 1.0);
+      dy = jitter_y * (2.0 * ((double)(q.y >> 8) * (1.0 / 16777216.0)) - 1.0);
+    }
+    const double col = region_rec[r * PS_MR_LEN + PS_MR_COL], row = region_rec[r * PS_MR_LEN + PS_MR_ROW];
+    px[count] = (col + dx - half_width) * scale;
+    pz[count] = body_height - (row + dy) * scale;
+    variant[count] = v;
+    ++count;
+  }
+  global const uchar* base = base_zones + (size_t)subject[i] * PS_ZONES;
+  for (int z = 0; z < PS_ZONES; ++z) {
+    global const double* zr = zone_rec + z * PS_MZ_LEN;
+    double signal = 0.0;
+    for (int o = 0; o < count; ++o) {
+      const double3 ht = metal_dipole(zr[PS_MZ_TX_M], zr[PS_MZ_TX_X], zr[PS_MZ_TX_Z], px[o], pz[o]);
+      const double3 hr = metal_dipole(zr[PS_MZ_RX_M], zr[PS_MZ_RX_X], zr[PS_MZ_RX_Z], px[o], pz[o]);
+      global const double* M = tensors + (size_t)variant[o] * 9;
+      const double v0 = M[0] * ht.x + M[1] * ht.y + M[2] * ht.z;
+      const double v1 = M[3] * ht.x + M[4] * ht.y + M[5] * ht.z;
+      const double v2 = M[6] * ht.x + M[7] * ht.y + M[8] * ht.z;
+      signal += hr.x * v0 + hr.y * v1 + hr.z * v2;
+    }
+    const double t = zr[PS_MZ_GAIN] * fabs(signal);
+    const int deduction = t < PS_METAL_MAX_DEDUCTION ? (int)floor(t + 0.5) : PS_METAL_MAX_DEDUCTION;
+    int value = (int)base[z] - deduction;
+    if (noise > 0 && deduction > 0) {
+      const uint4 r = draw(seed, index, PS_STREAM_METAL_NOISE, (uint)z);
+      value += (int)below(r.x, (uint)noise + 1u) - (int)below(r.y, (uint)noise + 1u);
+    }
+    out[(size_t)i * PS_ZONES + z] = (uchar)clamp(value, 1, 200);
+  }
+}
+#endif
