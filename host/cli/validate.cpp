@@ -426,7 +426,7 @@ FeatureSet feature_set(const std::string& key) {
   return {"all attributes", {}};
 }
 
-const char* kSets[3] = {"real", "sim", "combined"};
+constexpr const char* kSets[3] = {"real", "sim", "combined"};
 
 // All the WEKA work of one analysis in one JVM; returns WekaValidate's JSON.
 nlohmann::json run_weka(const Options& o, const std::string& classifiers, const std::string& work,
