@@ -78,8 +78,9 @@ TEST(Validate, SameSpecIsNotToldApartAndShuffledLabelsAre) {
   auto r = validate(d, "sim.arff", "real.arff", opts);
   ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
   const auto same = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  EXPECT_EQ(same["analyses"].size(), 1u);  // no region or block columns: one analysis of all
   for (const char* c : {"J48", "SMO"}) {
-    const auto& s = same["classifiers"][c];
+    const auto& s = same["analyses"]["all"]["classifiers"][c];
     EXPECT_GT(s["corrected_resampled_t_test"]["p"].get<double>(), 0.05) << c;
     EXPECT_GT(s["sim_to_real"]["percent_correct"].get<double>(), 85) << c;
     EXPECT_GT(s["real"]["mean_percent_correct"].get<double>(), 85) << c;
@@ -88,7 +89,8 @@ TEST(Validate, SameSpecIsNotToldApartAndShuffledLabelsAre) {
     EXPECT_EQ(s["learning_curve"].size(), 3u) << c;
     EXPECT_EQ(s["learning_curve"][2]["sim_added"].get<int>(), 200) << c;
   }
-  EXPECT_NE(same["classifiers"]["J48"]["trees"]["real"].get<std::string>().find("J48 pruned tree"), std::string::npos);
+  EXPECT_NE(same["analyses"]["all"]["classifiers"]["J48"]["trees"]["real"].get<std::string>().find("J48 pruned tree"),
+            std::string::npos);
   const std::string md = slurp(d / "out" / "report.md");
   EXPECT_NE(md.find("| SMO |"), std::string::npos);
   EXPECT_NE(md.find("(corrected resampled t-test, t = "), std::string::npos);
@@ -102,7 +104,7 @@ TEST(Validate, SameSpecIsNotToldApartAndShuffledLabelsAre) {
   ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
   const auto shuffled = nlohmann::json::parse(slurp(d / "out" / "report.json"));
   for (const char* c : {"J48", "SMO"}) {
-    const auto& s = shuffled["classifiers"][c];
+    const auto& s = shuffled["analyses"]["all"]["classifiers"][c];
     EXPECT_LT(s["corrected_resampled_t_test"]["p"].get<double>(), 0.05) << c;
     EXPECT_LT(s["two_sample_t_test"]["mean_p"].get<double>(), 0.05) << c;
     const double acc = s["sim_to_real"]["percent_correct"].get<double>();
@@ -137,7 +139,7 @@ TEST(Validate, FoldsAreWekasOwn) {
       std::istringstream in(w.out.substr(at + 30));
       long correct = -1;
       in >> correct;
-      const auto& run = report["classifiers"][label][set]["runs"][0];
+      const auto& run = report["analyses"]["all"]["classifiers"][label][set]["runs"][0];
       EXPECT_EQ(run["correct"].get<long>(), correct) << label << " " << set;
       double sum = 0;
       for (double f : run["folds"]) sum += f * 24 / 100;  // 120 instances, 5 stratified folds of 24
@@ -164,21 +166,63 @@ TEST(Validate, ReadsCsvAndSelectsFeatureSets) {
   };
   spit(d / "sim.csv", csv(1));
   spit(d / "real.csv", csv(2));
-  auto r = validate(d, "sim.csv", "real.csv",
-                    {"--classifiers", "j48", "--runs", "1", "--curve-steps", "0", "--features", "blocks"});
+  const std::vector<std::string> opts = {"--classifiers", "j48", "--runs", "1", "--curve-steps", "0", "--features"};
+  auto with = [&](const char* features) {
+    auto v = opts;
+    v.push_back(features);
+    return v;
+  };
+  auto r = validate(d, "sim.csv", "real.csv", with("blocks"));
   ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
   auto report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
-  EXPECT_EQ(report["attributes"].get<int>(), 3);  // two blocks and a zone; the region mean dropped
+  ASSERT_EQ(report["analyses"].size(), 1u);
+  const auto blocks = report["analyses"]["blocks"];
+  EXPECT_EQ(blocks["attributes"].get<int>(), 3);  // two blocks and a zone; the region mean dropped
+  EXPECT_EQ(blocks["thesis_tables"], nlohmann::json({"6.2", "6.4", "6.6"}));
   EXPECT_NE(slurp(d / "out" / "report.md").find("Not computed (`--curve-steps 0`)"), std::string::npos);
-  EXPECT_FALSE(report["classifiers"]["J48"].contains("learning_curve"));
-  EXPECT_LT(report["classifiers"]["J48"]["real"]["mean_percent_correct"].get<double>(), 75);
+  EXPECT_FALSE(blocks["classifiers"]["J48"].contains("learning_curve"));
+  EXPECT_LT(blocks["classifiers"]["J48"]["real"]["mean_percent_correct"].get<double>(), 75);
   fs::remove_all(d / "out");
-  r = validate(d, "sim.csv", "real.csv",
-               {"--classifiers", "j48", "--runs", "1", "--curve-steps", "0", "--features", "regions"});
+  r = validate(d, "sim.csv", "real.csv", with("regions"));
   ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
   report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
-  EXPECT_EQ(report["attributes"].get<int>(), 2);  // the region mean and a zone
-  EXPECT_GT(report["classifiers"]["J48"]["real"]["mean_percent_correct"].get<double>(), 90);
+  const auto regions = report["analyses"]["regions"];
+  EXPECT_EQ(regions["attributes"].get<int>(), 2);  // the region mean and a zone
+  EXPECT_GT(regions["classifiers"]["J48"]["real"]["mean_percent_correct"].get<double>(), 90);
+  fs::remove_all(d / "out");
+
+  // both: the two analyses side by side, as the thesis's tables 6.1-6.6; each equals its own run.
+  r = validate(d, "sim.csv", "real.csv", with("both"));
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  ASSERT_EQ(report["analyses"].size(), 2u);
+  EXPECT_EQ(report["analyses"]["regions"], regions);
+  EXPECT_EQ(report["analyses"]["blocks"], blocks);
+  const std::string md = slurp(d / "out" / "report.md");
+  size_t at = 0;
+  for (const char* table :
+       {"### Real data, region means (as thesis table 6.1)", "### Real data, block means (as thesis table 6.2)",
+        "### Simulated data, region means (as thesis table 6.3)",
+        "### Simulated data, block means (as thesis table 6.4)",
+        "### Combined data, region means (as thesis table 6.5)",
+        "### Combined data, block means (as thesis table 6.6)"}) {
+    const size_t next = md.find(table, at);
+    EXPECT_NE(next, std::string::npos) << table << " (in this order)\n" << md;
+    if (next != std::string::npos) at = next;
+  }
+  EXPECT_NE(md.find("| J48 | region means | P = "), std::string::npos);
+  EXPECT_NE(md.find("| J48 | block means | P = "), std::string::npos);
+  EXPECT_NE(md.find("## J48 trees, region means"), std::string::npos);
+  EXPECT_NE(md.find("## J48 trees, block means"), std::string::npos);
+  fs::remove_all(d / "out");
+
+  // A table without block means cannot give a blocks analysis.
+  spit(d / "plain.csv", "a,b,class\n1,2,gun\n2,3,none\n");
+  r = finish(start(d / "cap", {"validate", "--sim", (d / "plain.csv").string(), "--real", (d / "plain.csv").string(),
+                               "--out", (d / "out").string(), "--features", "blocks"}));
+  EXPECT_TRUE(r.exited && r.status == 3) << portalsim::test::describe(r);
+  EXPECT_NE(r.err.find("plain.csv: --features blocks: no block-mean attributes"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "out"));
   fs::remove_all(d);
 }
 
@@ -201,7 +245,7 @@ TEST(Validate, ReadsScenarioFolders) {
                {"--grid", "5x5", "--features", "blocks", "--classifiers", "j48", "--runs", "1", "--curve-steps", "0"});
   ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
   const auto report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
-  EXPECT_EQ(report["attributes"].get<int>(), 69);  // 2 views x 25 block means + 19 metal zones
+  EXPECT_EQ(report["analyses"]["blocks"]["attributes"].get<int>(), 69);  // 2 views x 25 block means + 19 zones
   EXPECT_EQ(report["sim_instances"].get<int>(), 30);
   EXPECT_EQ(report["real_instances"].get<int>(), 30);
   // The same rows as `portalsim features` writes: J48 on the whole set gives the same tree.
@@ -211,8 +255,10 @@ TEST(Validate, ReadsScenarioFolders) {
                {"--block", "40", "--features", "blocks", "--classifiers", "j48", "--runs", "1", "--curve-steps", "0"});
   ASSERT_TRUE(t.exited && t.status == 0) << portalsim::test::describe(t);
   const auto from_table = nlohmann::json::parse(slurp(d / "out" / "report.json"));
-  EXPECT_EQ(from_table["classifiers"]["J48"]["trees"]["sim"], report["classifiers"]["J48"]["trees"]["sim"]);
-  EXPECT_EQ(from_table["classifiers"]["J48"]["sim"]["runs"], report["classifiers"]["J48"]["sim"]["runs"]);
+  const auto& a = from_table["analyses"]["blocks"]["classifiers"]["J48"];
+  const auto& b = report["analyses"]["blocks"]["classifiers"]["J48"];
+  EXPECT_EQ(a["trees"]["sim"], b["trees"]["sim"]);
+  EXPECT_EQ(a["sim"]["runs"], b["sim"]["runs"]);
   fs::remove_all(d / "out");
   const auto g = validate(d, "set3/images", "set4/images", {"--grid", "7x3"});
   EXPECT_TRUE(g.exited && g.status != 0) << portalsim::test::describe(g);
@@ -237,13 +283,153 @@ TEST(Validate, AnotherRuleLowersSimToReal) {
   for (int k = 0; k < 2; ++k) {
     fs::remove_all(d / "out");
     const auto r = validate(d, "sim/features.arff", k == 0 ? "same/features.arff" : "other/features.arff",
-                            {"--classifiers", "j48", "--runs", "1", "--curve-steps", "0"});
+                            {"--classifiers", "j48", "--runs", "1", "--curve-steps", "0", "--features", "blocks"});
     ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
     const auto report = nlohmann::json::parse(slurp(d / "out" / "report.json"));
-    accuracy[k] = report["classifiers"]["J48"]["sim_to_real"]["percent_correct"].get<double>();
+    accuracy[k] = report["analyses"]["blocks"]["classifiers"]["J48"]["sim_to_real"]["percent_correct"].get<double>();
   }
   EXPECT_GT(accuracy[0], 75);
   EXPECT_LT(accuracy[1], accuracy[0] - 10) << "same rule " << accuracy[0] << "%, other rule " << accuracy[1] << "%";
+  fs::remove_all(d);
+}
+
+// A data.h5 of `generate --format h5` is read as the same run's ARFF: the same report.
+TEST(Validate, ReadsH5AsTheSameRunsArff) {
+  const fs::path d = fresh_dir();
+  fs::create_directories(d / "cap");
+  for (const char* seed : {"5", "6"}) {
+    const auto g =
+        finish(start(d / "cap", {"generate", "--spec", PORTALSIM_SOURCE_DIR "/scenarios/case2-rod-plate.toml",
+                                 "--count", "120", "--seed", seed, "--block", "40", "--format", "arff,h5", "--out",
+                                 (d / (std::string("g") + seed)).string()}));
+    ASSERT_TRUE(g.exited && g.status == 0) << portalsim::test::describe(g);
+  }
+  const std::vector<std::string> opts = {"--classifiers", "j48", "--runs", "2", "--curve-steps", "1"};
+  nlohmann::json reports[2];
+  for (int k = 0; k < 2; ++k) {
+    fs::remove_all(d / "out");
+    const std::string file = k == 0 ? "features.arff" : "data.h5";
+    const auto r = validate(d, "g5/" + file, "g6/" + file, opts);
+    ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+    reports[k] = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  }
+  EXPECT_EQ(reports[1]["sim_instances"].get<int>(), 120);
+  EXPECT_EQ(reports[1]["analyses"].size(), 2u);
+  EXPECT_EQ(reports[1]["analyses"]["blocks"]["attributes"].get<int>(), 69);
+  EXPECT_EQ(reports[1]["analyses"]["regions"]["attributes"].get<int>(), 32);
+  EXPECT_EQ(reports[0]["analyses"], reports[1]["analyses"]);  // every fold, tree and P value
+
+  // An h5 that is not HDF5, and one without features (--what images), are refused.
+  spit(d / "bad.h5", "not an HDF5 file\n");
+  const auto g = finish(start(
+      d / "cap", {"generate", "--count", "10", "--what", "images", "--format", "h5", "--out", (d / "imgs").string()}));
+  ASSERT_TRUE(g.exited && g.status == 0) << portalsim::test::describe(g);
+  for (const auto& [file, message] : std::vector<std::pair<std::string, std::string>>{
+           {"bad.h5", "bad.h5: not an HDF5 file"}, {"imgs/data.h5", "imgs/data.h5: has no \"features\" dataset"}}) {
+    fs::remove_all(d / "out");
+    const auto r = validate(d, "g5/data.h5", file);
+    EXPECT_TRUE(r.exited && r.status == 3) << portalsim::test::describe(r);
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(d / "out")) << file;
+  }
+  fs::remove_all(d);
+}
+
+double mean_of(const std::string& arff, const std::string& column) {
+  std::istringstream in(arff);
+  std::string line;
+  int index = -1, n = 0, count = 0;
+  double sum = 0;
+  bool data = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("@attribute ", 0) == 0) {
+      if (line.substr(11, column.size() + 1) == column + " ") index = n;
+      ++n;
+    } else if (line.rfind("@data", 0) == 0) {
+      data = true;
+    } else if (data && !line.empty() && index >= 0) {
+      std::istringstream row(line);
+      std::string v;
+      for (int i = 0; i <= index; ++i) std::getline(row, v, ',');
+      sum += std::stod(v);
+      ++count;
+    }
+  }
+  return count ? sum / count : -1;
+}
+
+// --demo: the simulated set is `generate`'s own, the "real" one comes through a catalogue of
+// altered image files, and the report has both feature sets' tables with sane numbers.
+TEST(Validate, DemoMakesBothSetsAndTheReport) {
+  const fs::path d = fresh_dir();
+  fs::create_directories(d / "cap");
+  const auto r = finish(start(d / "cap", {"validate", "--demo", "--demo-count", "100", "--runs", "2", "--seed", "3",
+                                          "--out", (d / "out").string()}),
+                        400);
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  const fs::path out = d / "out";
+  const auto report = nlohmann::json::parse(slurp(out / "report.json"));
+  EXPECT_EQ(report["sim_instances"].get<int>(), 100);
+  EXPECT_EQ(report["real_instances"].get<int>(), 100);
+  EXPECT_EQ(report["demo"]["block"].get<int>(), 40);  // the thesis's 5x5 grid
+  ASSERT_EQ(report["analyses"].size(), 2u);
+  EXPECT_EQ(report["analyses"]["regions"]["attributes"].get<int>(), 32);
+  EXPECT_EQ(report["analyses"]["blocks"]["attributes"].get<int>(), 69);
+  for (const char* key : {"regions", "blocks"}) {
+    const auto& c = report["analyses"][key]["classifiers"];
+    ASSERT_EQ(c.size(), 1u) << key;  // J48 alone by default
+    const auto& j48 = c["J48"];
+    for (const char* set : {"real", "sim", "combined"}) {
+      const double pct = j48[set]["mean_percent_correct"].get<double>();
+      const double n = std::string(set) == "combined" ? 200 : 100;
+      EXPECT_GT(pct, 60) << key << " " << set;  // case 2 is learnable, far above chance
+      EXPECT_LE(pct, 100) << key << " " << set;
+      EXPECT_NEAR(j48[set]["mean_misclassified"].get<double>(), n * (100 - pct) / 100, 1e-6) << key << " " << set;
+    }
+    EXPECT_GT(j48["sim_to_real"]["percent_correct"].get<double>(), 60) << key;
+    for (const double p :
+         {j48["two_sample_t_test"]["mean_p"].get<double>(), j48["corrected_resampled_t_test"]["p"].get<double>()}) {
+      EXPECT_GE(p, 0) << key;
+      EXPECT_LE(p, 1) << key;
+    }
+  }
+  const std::string md = slurp(out / "report.md");
+  for (const char* table : {"(as thesis table 6.1)", "(as thesis table 6.2)", "(as thesis table 6.5)",
+                            "(as thesis table 6.6)", "## Sim-to-real", "(corrected resampled t-test, t = "})
+    EXPECT_NE(md.find(table), std::string::npos) << table;
+  EXPECT_GT(fs::file_size(out / "accuracy.png"), 1000u);
+  EXPECT_GT(fs::file_size(out / "curve.png"), 1000u);
+
+  // The real set comes through the user-image route: a catalogue naming altered images.
+  const std::string catalogue = slurp(out / "demo" / "catalogue.toml");
+  EXPECT_NE(catalogue.find("mmw_upper = \"images/subject1_mmw_upper.png\""), std::string::npos);
+  EXPECT_NE(catalogue.find("mmw_lower = \"images/subject5_mmw_lower.png\""), std::string::npos);
+  EXPECT_GT(fs::file_size(out / "demo" / "images" / "subject5_mmw_lower.png"), 1000u);
+  const std::string sim = slurp(out / "demo" / "sim.arff"), real = slurp(out / "demo" / "real.arff");
+  // The offset of +20 (gain 0.85) lifts the dark background of the altered views.
+  EXPECT_GT(mean_of(real, "upper_r0_c0"), mean_of(sim, "upper_r0_c0") + 5);
+  // The simulated set is exactly what generate makes of thesis case 2 with that seed.
+  const auto g = finish(
+      start(d / "cap", {"generate", "--spec", PORTALSIM_SOURCE_DIR "/scenarios/case2-rod-plate.toml", "--count", "100",
+                        "--seed", "3", "--block", "40", "--format", "arff", "--out", (d / "g").string()}));
+  ASSERT_TRUE(g.exited && g.status == 0) << portalsim::test::describe(g);
+  EXPECT_EQ(sim, slurp(d / "g" / "features.arff"));
+  // The "real" set is what generate makes of the same spec through the demo's catalogue.
+  const auto h =
+      finish(start(d / "cap", {"generate", "--spec", PORTALSIM_SOURCE_DIR "/scenarios/case2-rod-plate.toml",
+                               "--catalogue", (out / "demo" / "catalogue.toml").string(), "--count", "100", "--seed",
+                               "4", "--block", "40", "--format", "arff", "--out", (d / "h").string()}));
+  ASSERT_TRUE(h.exited && h.status == 0) << portalsim::test::describe(h);
+  EXPECT_EQ(real, slurp(d / "h" / "features.arff"));
+
+  // --demo makes its own inputs; --sim or --real with it, or neither without it, is refused.
+  const auto both = finish(start(d / "cap", {"validate", "--demo", "--sim", "x.arff", "--out", (d / "o2").string()}));
+  EXPECT_TRUE(both.exited && both.status != 0) << portalsim::test::describe(both);
+  EXPECT_NE(both.err.find("--sim excludes --demo"), std::string::npos) << both.err;
+  const auto none = finish(start(d / "cap", {"validate", "--out", (d / "o2").string()}));
+  EXPECT_TRUE(none.exited && none.status == 3) << portalsim::test::describe(none);
+  EXPECT_NE(none.err.find("--sim and --real are both needed"), std::string::npos) << none.err;
+  EXPECT_FALSE(fs::exists(d / "o2"));
   fs::remove_all(d);
 }
 

@@ -39,29 +39,36 @@ int list(CatalogueOptions& o) {
   }
   if (!o.images.empty()) {
     StagedFolder folder(o.images);
-    for (size_t i = 0; i < s.assets.bases.size(); ++i) {
-      const std::string p = "subject" + std::to_string(i + 1);
-      for (size_t k = 0; k < c.sensors.size(); ++k) {
-        const Image& img = s.assets.bases[i][k];
-        write_image(folder.path(p + "_" + c.sensors[k].asset_key + ".png"),
-                    c.sensors[k].palette ? colourise(img, s.assets.palette) : img);
-      }
-    }
-    for (size_t v = 0; v < c.variant_list.size(); ++v) {
-      std::string n = c.variant_name(static_cast<int>(v));
-      for (char& ch : n)
-        if (ch == ':') ch = '_';
-      for (Camera cam : {Camera::mmw, Camera::ir})
-        write_image(folder.path(n + "_" + camera_name(cam) + ".png"), s.assets.sprite(cam, static_cast<int>(v)));
-    }
-    for (size_t k = 0; k < s.assets.noise.size(); ++k)
-      write_image(folder.path("noise" + std::to_string(k + 1) + "_" + c.noise[k].name + ".png"), s.assets.noise[k]);
+    write_catalogue_images(s, folder);
     folder.commit();
     std::printf("\nimages written to %s\n", o.images.c_str());
   }
   return 0;
 }
 }  // namespace
+
+void write_catalogue_images(const Session& s, StagedFolder& folder) {
+  const Catalogue& c = s.catalogue;
+  for (size_t i = 0; i < s.assets.bases.size(); ++i)
+    for (size_t k = 0; k < c.sensors.size(); ++k) {
+      const Image& img = s.assets.bases[i][k];
+      write_image(folder.path(subject_image_name(i, c.sensors[k])),
+                  c.sensors[k].palette ? colourise(img, s.assets.palette) : img);
+    }
+  for (size_t v = 0; v < c.variant_list.size(); ++v) {
+    std::string n = c.variant_name(static_cast<int>(v));
+    for (char& ch : n)
+      if (ch == ':') ch = '_';
+    for (Camera cam : {Camera::mmw, Camera::ir})
+      write_image(folder.path(n + "_" + camera_name(cam) + ".png"), s.assets.sprite(cam, static_cast<int>(v)));
+  }
+  for (size_t k = 0; k < s.assets.noise.size(); ++k)
+    write_image(folder.path("noise" + std::to_string(k + 1) + "_" + c.noise[k].name + ".png"), s.assets.noise[k]);
+}
+
+std::string subject_image_name(size_t subject, const Sensor& view) {
+  return "subject" + std::to_string(subject + 1) + "_" + view.asset_key + ".png";
+}
 
 std::function<int()> add_catalogue(CLI::App& app) {
   auto o = std::make_shared<CatalogueOptions>();

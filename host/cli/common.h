@@ -11,6 +11,7 @@
 #include "backend/backend.h"
 #include "backend/opencl/runtime.h"
 #include "scene/catalogue.h"
+#include "sink/staging.h"
 
 namespace portalsim::cli {
 
@@ -41,5 +42,12 @@ Session open_session(const CommonOptions& o);
 // Catalogue and assets only (no backend yet): lets a command check its arguments first.
 void open_catalogue(Session& s, const CommonOptions& o);
 void open_backend(Session& s, const CommonOptions& o);
+
+// Every base image, sprite and noise pattern of the session, as `portalsim catalogue
+// --images` writes them; a subject's view is named by subject_image_name.
+void write_catalogue_images(const Session& s, StagedFolder& folder);
+// "subject1_mmw_upper.png": subject (0-based) and view; the view's asset key is also the
+// subject's catalogue field that can name the file.
+std::string subject_image_name(size_t subject, const Sensor& view);
 
 }  // namespace portalsim::cli

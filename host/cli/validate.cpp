@@ -1,10 +1,9 @@
 // `portalsim validate`: the thesis's chapter 6 on a simulated and a real data set. Each is a
-// feature table (ARFF or CSV) or a folder of scenario folders (turned into a table by the
-// code of `portalsim features`). WEKA's J48, MultilayerPerceptron and SMO (default settings)
-// are scored in one JVM (tools/WekaValidate.java, embedded) by cross-validation on real,
-// simulated and combined data over several runs, trained on simulated data and tested on real
-// data, and along a learning curve; the fold accuracies are compared by the thesis's t-test
-// and by the corrected resampled t-test.
+// feature table (ARFF, CSV or a data.h5 of `generate --format h5`) or a folder of scenario
+// folders (turned into a table by the code of `portalsim features`). WEKA's J48, MultilayerPerceptron and SMO (default
+// settings) are scored in one JVM (tools/WekaValidate.java, embedded) by cross-validation on real, simulated and
+// combined data over several runs, trained on simulated data and tested on real data, and along a learning curve; the
+// fold accuracies are compared by the thesis's t-test and by the corrected resampled t-test.
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,7 +21,10 @@
 #include "base/error.h"
 #include "cli/commands.h"
 #include "cli/features_table.h"
+#include "cli/validate_demo.h"
 #include "cli/validate_stats.h"
+#include "sink/feature_rows.h"
+#include "sink/h5_file.h"
 #include "sink/staging.h"
 
 namespace portalsim::embedded {
@@ -165,6 +167,68 @@ Table read_csv(const std::string& path) {
   return a;
 }
 
+// A data.h5 of `generate --format h5`: the "features" columns, the metal zones and the
+// label as class. Numbers are written as the ARFF sink writes them, so an h5 run and the
+// same run's ARFF give the same table.
+Table read_h5_table(const std::string& path) {
+  const H5Layout layout = read_h5_layout(path);
+  const auto find = [&](const std::string& name, TensorType type, size_t rank) -> const H5Dataset& {
+    for (const H5Dataset& d : layout.datasets)
+      if (d.name == name) {
+        if (d.type != type || d.dims.size() != rank)
+          throw InputError(path + ": dataset " + name + " does not have the type and shape generate writes");
+        return d;
+      }
+    throw InputError(path + ": has no \"" + name + "\" dataset" +
+                     (name == "features" ? " (write one with generate --what features|both --format h5)" : ""));
+  };
+  const H5Dataset& features = find("features", TensorType::f32, 1);
+  const H5Dataset& metal = find("metal", TensorType::u8, 1);
+  const H5Dataset& label = find("label", TensorType::u8, 0);
+  if (features.columns.size() != features.dims[0])
+    throw InputError(path + ": dataset features: attribute 'columns' names " + std::to_string(features.columns.size()) +
+                     " columns, the dataset has " + std::to_string(features.dims[0]));
+  std::vector<std::string> classes = {"negative", "positive"};
+  for (const H5Attribute& a : layout.attributes)
+    if (a.name == "class_names") classes = a.values;
+  Table t;
+  t.path = path;
+  t.names = features.columns;
+  for (uint64_t z = 1; z <= metal.dims[0]; ++z) t.names.push_back("zone" + std::to_string(z));
+  t.names.push_back("class");
+  t.name_lines.assign(t.names.size(), 0);
+  const size_t nf = features.dims[0], nz = metal.dims[0];
+  const uint64_t block = 4096;
+  std::vector<float> f;
+  std::vector<uint8_t> m, l;
+  for (uint64_t first = 0; first < layout.rows; first += block) {
+    const uint64_t n = std::min(block, layout.rows - first);
+    f.resize(n * nf);
+    m.resize(n * nz);
+    l.resize(n);
+    read_h5_rows(path, features, first, n, reinterpret_cast<char*>(f.data()));
+    read_h5_rows(path, metal, first, n, reinterpret_cast<char*>(m.data()));
+    read_h5_rows(path, label, first, n, reinterpret_cast<char*>(l.data()));
+    for (uint64_t i = 0; i < n; ++i) {
+      std::vector<std::string> row;
+      row.reserve(t.names.size());
+      for (size_t k = 0; k < nf; ++k) {
+        std::string v;
+        append_number(v, f[i * nf + k]);
+        row.push_back(std::move(v));
+      }
+      for (size_t z = 0; z < nz; ++z) row.push_back(std::to_string(m[i * nz + z]));
+      if (l[i] >= classes.size())
+        throw InputError(path + ": dataset label, row " + std::to_string(first + i) + ": " + std::to_string(l[i]) +
+                         " is not an index into attribute class_names");
+      row.push_back(classes[l[i]]);
+      t.classes.insert(row.back());
+      t.rows.push_back(std::move(row));
+    }
+  }
+  return t;
+}
+
 // A table file, or a folder of scenario folders made into one (in `work`) as `portalsim
 // features` makes it.
 Table load(const std::string& path, const std::string& work, const std::string& tag, int block,
@@ -182,41 +246,71 @@ Table load(const std::string& path, const std::string& work, const std::string& 
   const std::string ext = lower(fs::path(path).extension().string());
   if (ext == ".arff") return read_arff(path);
   if (ext == ".csv") return read_csv(path);
-  throw InputError(path + ": a feature table must be .arff or .csv, or a folder of scenario folders");
+  if (ext == ".h5") return read_h5_table(path);
+  throw InputError(path + ": a feature table must be .arff, .csv or .h5, or a folder of scenario folders");
 }
 
-// Keeps the columns `features` asks for: "regions" drops the block means (VIEW_rY_cX),
-// "blocks" drops the region means (regionN); the metal zones and the class stay.
-void select_features(Table& t, const std::string& features) {
-  if (features == "both") return;
-  // "digits then `tail`" at the end of s, with at least one digit: returns where they start.
-  const auto digits_before = [](std::string_view s, size_t end) {
-    size_t b = end;
-    while (b > 0 && s[b - 1] >= '0' && s[b - 1] <= '9') --b;
-    return b < end ? b : std::string_view::npos;
-  };
-  const auto is_block = [&](std::string_view s) {  // .+_r[0-9]+_c[0-9]+
-    const size_t c = digits_before(s, s.size());
-    if (c == std::string_view::npos || c < 2 || s.substr(c - 2, 2) != "_c") return false;
-    const size_t r = digits_before(s, c - 2);
-    return r != std::string_view::npos && r >= 3 && s.substr(r - 2, 2) == "_r";
-  };
-  const auto is_region = [&](std::string_view s) {  // region[0-9]+
-    return s.starts_with("region") && s.size() > 6 && digits_before(s, s.size()) == 6;
-  };
+// The two feature sets of the thesis (tables 6.1/6.3/6.5 and 6.2/6.4/6.6): region means
+// (regionN) and block means (VIEW_rY_cX). Other columns (the metal zones) are in both.
+// "digits then `tail`" at the end of s, with at least one digit: returns where they start.
+size_t digits_before(std::string_view s, size_t end) {
+  size_t b = end;
+  while (b > 0 && s[b - 1] >= '0' && s[b - 1] <= '9') --b;
+  return b < end ? b : std::string_view::npos;
+}
+
+bool is_block(std::string_view s) {  // .+_r[0-9]+_c[0-9]+
+  const size_t c = digits_before(s, s.size());
+  if (c == std::string_view::npos || c < 2 || s.substr(c - 2, 2) != "_c") return false;
+  const size_t r = digits_before(s, c - 2);
+  return r != std::string_view::npos && r >= 3 && s.substr(r - 2, 2) == "_r";
+}
+
+bool is_region(std::string_view s) {  // region[0-9]+
+  return s.starts_with("region") && s.size() > 6 && digits_before(s, s.size()) == 6;
+}
+
+bool has_column(const Table& t, bool (*kind)(std::string_view)) {
+  return std::any_of(t.names.begin(), t.names.end(), [&](const std::string& n) { return kind(n); });
+}
+
+// The table with the columns of one analysis: "regions" drops the block means, "blocks"
+// the region means, "all" nothing; the class stays last.
+Table select_features(const Table& t, const std::string& set) {
+  if (set == "all") return t;
   std::vector<size_t> keep;
   for (size_t i = 0; i < t.names.size(); ++i) {
-    const bool drop = features == "regions" ? is_block(t.names[i]) : is_region(t.names[i]);
+    const bool drop = set == "regions" ? is_block(t.names[i]) : is_region(t.names[i]);
     if (i + 1 == t.names.size() || !drop) keep.push_back(i);
   }
-  auto pick = [&](auto& v) {
-    std::remove_reference_t<decltype(v)> out;
-    for (size_t i : keep) out.push_back(v[i]);
-    v = std::move(out);
-  };
-  pick(t.names);
-  pick(t.name_lines);
-  for (auto& r : t.rows) pick(r);
+  Table out;
+  out.path = t.path;
+  out.classes = t.classes;
+  for (size_t i : keep) {
+    out.names.push_back(t.names[i]);
+    out.name_lines.push_back(t.name_lines[i]);
+  }
+  out.rows.reserve(t.rows.size());
+  for (const auto& r : t.rows) {
+    std::vector<std::string> row;
+    row.reserve(keep.size());
+    for (size_t i : keep) row.push_back(r[i]);
+    out.rows.push_back(std::move(row));
+  }
+  return out;
+}
+
+// The analyses `--features` asks for. "both" is the regions and the blocks analyses, as the
+// thesis ran them; a table without both kinds of column gets one analysis of all columns.
+std::vector<std::string> analyses_for(const std::string& features, const Table& sim) {
+  const bool regions = has_column(sim, is_region), blocks = has_column(sim, is_block);
+  if (features == "both")
+    return regions && blocks ? std::vector<std::string>{"regions", "blocks"} : std::vector<std::string>{"all"};
+  if (features == "regions" && !regions)
+    throw InputError(sim.path + ": --features regions: no region-mean attributes (region1, region2, ...)");
+  if (features == "blocks" && !blocks)
+    throw InputError(sim.path + ": --features blocks: no block-mean attributes (VIEW_rY_cX)");
+  return {features};
 }
 
 void check_usable(const Table& a, int folds) {
@@ -315,154 +409,238 @@ struct WorkDir {
 struct Options {
   std::string sim, real, out, features = "both", classifiers = "j48,mlp,svm", catalogue, grid;
   int folds = 10, runs = 10, seed = 1, block = 10, curve_steps = 4;
+  bool demo = false;
+  uint64_t demo_count = kDemoCount;
 };
+
+// What the report calls an analysis, and the thesis tables of its real, simulated and
+// combined data.
+struct FeatureSet {
+  std::string title;
+  std::vector<std::string> tables;
+};
+
+FeatureSet feature_set(const std::string& key) {
+  if (key == "regions") return {"region means", {"6.1", "6.3", "6.5"}};
+  if (key == "blocks") return {"block means", {"6.2", "6.4", "6.6"}};
+  return {"all attributes", {}};
+}
+
+constexpr const char* kSets[3] = {"real", "sim", "combined"};
+
+// All the WEKA work of one analysis in one JVM; returns WekaValidate's JSON.
+nlohmann::json run_weka(const Options& o, const std::string& classifiers, const std::string& work,
+                        const std::string& key, const Table& sim, const Table& real) {
+  std::set<std::string> classes = sim.classes;
+  classes.insert(real.classes.begin(), real.classes.end());
+  const std::string sim_arff = (fs::path(work) / (".sim-" + key + ".arff")).string();
+  const std::string real_arff = (fs::path(work) / (".real-" + key + ".arff")).string();
+  write_arff(sim, classes, sim_arff);
+  write_arff(real, classes, real_arff);
+  const std::string program = (fs::path(work) / "WekaValidate.java").string();
+  const std::string weka_out = (fs::path(work) / (".weka-" + key + ".json")).string();
+  write_text_atomic(program, std::string(embedded::weka_validate));
+  std::fprintf(stderr, "validate: %s (%s, %zu attributes)\n", key.c_str(), feature_set(key).title.c_str(),
+               sim.names.size() - 1);
+  const std::string cmd = "java -Xmx2g -cp /usr/share/java/weka.jar " + shell_quote(program) + " --real " +
+                          shell_quote(real_arff) + " --sim " + shell_quote(sim_arff) + " --folds " +
+                          std::to_string(o.folds) + " --runs " + std::to_string(o.runs) + " --seed " +
+                          std::to_string(o.seed) + " --classifiers " + classifiers + " --curve-steps " +
+                          std::to_string(o.curve_steps) + " > " + shell_quote(weka_out);
+  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("WEKA failed (its messages are above)");
+  std::ifstream in(weka_out);
+  return nlohmann::json::parse(in);
+}
+
+// One classifier's scores in one analysis: means over runs, both t-tests, sim-to-real, the
+// learning curve and the combined-data claim.
+nlohmann::json score(const Options& o, const nlohmann::json& w) {
+  nlohmann::json c;
+  double wrong[3] = {0, 0, 0};
+  for (int s = 0; s < 3; ++s) {
+    double pct = 0;
+    for (const auto& run : w[kSets[s]]) {
+      pct += run["percent_correct"].get<double>() / o.runs;
+      wrong[s] += run["misclassified"].get<double>() / o.runs;
+    }
+    c[kSets[s]] = {{"runs", w[kSets[s]]}, {"mean_percent_correct", pct}, {"mean_misclassified", wrong[s]}};
+  }
+  // The thesis's test per run, averaged; the corrected test over all runs x folds.
+  double p_sum = 0;
+  std::vector<double> differences;
+  nlohmann::json per_run = nlohmann::json::array();
+  for (int r = 0; r < o.runs; ++r) {
+    const auto a = w["real"][r]["folds"].get<std::vector<double>>();
+    const auto b = w["sim"][r]["folds"].get<std::vector<double>>();
+    const TTest t = student_two_sample(a, b);
+    p_sum += t.p;
+    per_run.push_back({{"t", t.t}, {"df", t.df}, {"p", t.p}});
+    for (size_t i = 0; i < a.size(); ++i) differences.push_back(a[i] - b[i]);
+  }
+  const TTest corrected = corrected_resampled(differences, 1.0 / (o.folds - 1));
+  c["two_sample_t_test"] = {{"test", "Student two-sample t-test, pooled variance, two-tailed (thesis table 6.8)"},
+                            {"per_run", per_run},
+                            {"mean_p", p_sum / o.runs}};
+  c["corrected_resampled_t_test"] = {{"test", "corrected resampled t-test (Nadeau & Bengio 2003)"},
+                                     {"t", corrected.t},
+                                     {"df", corrected.df},
+                                     {"p", corrected.p}};
+  c["sim_to_real"] = w["sim_to_real"];
+  if (w.contains("curve")) c["learning_curve"] = w["curve"];
+  if (w.contains("trees")) c["trees"] = w["trees"];
+  const double together = wrong[0] + wrong[1];
+  c["combined_claim"] = {
+      {"real_plus_sim_misclassified", together}, {"combined_misclassified", wrong[2]}, {"holds", wrong[2] < together}};
+  return c;
+}
+
+// The analyses in the thesis's order (regions before blocks); JSON objects sort by key.
+std::vector<std::pair<std::string, nlohmann::json>> in_order(const nlohmann::json& analyses) {
+  std::vector<std::pair<std::string, nlohmann::json>> v;
+  for (const char* key : {"regions", "blocks", "all"})
+    if (analyses.contains(key)) v.emplace_back(key, analyses[key]);
+  return v;
+}
+
+// report.md from report.json: the thesis's tables 6.1-6.6 (one per data set and feature
+// set), then sim-to-real, the t-tests (table 6.8), the combined claim, curves and trees.
+std::string markdown(const Options& o, const nlohmann::json& report) {
+  const auto& analyses = report["analyses"];
+  const auto title = [](const std::string& key) { return feature_set(key).title; };
+  std::ostringstream md;
+  md << "# portalsim validate\n\nSimulated: `" << report["sim"].get<std::string>() << "` ("
+     << report["sim_instances"].get<size_t>() << " instances), real: `" << report["real"].get<std::string>() << "` ("
+     << report["real_instances"].get<size_t>() << " instances); " << o.folds
+     << "-fold stratified cross-validation as WEKA's `-x " << o.folds << " -s SEED`, " << o.runs
+     << " run(s) with seeds " << o.seed << ".." << o.seed + o.runs - 1 << ". Feature sets (`--features " << o.features
+     << "`): ";
+  std::string sets;
+  for (const auto& [key, a] : in_order(analyses))
+    sets += (sets.empty() ? "" : "; ") + title(key) + " (" + std::to_string(a["attributes"].get<size_t>()) +
+            " attributes and the class)";
+  md << sets << ".\n\n## Data and features (thesis tables 6.1-6.6 layout; mean over runs)\n\n";
+  const char* set_names[3] = {"Real data", "Simulated data", "Combined data"};
+  for (int s = 0; s < 3; ++s)
+    for (const auto& [key, a] : in_order(analyses)) {
+      const FeatureSet f = feature_set(key);
+      md << "### " << set_names[s] << ", " << f.title;
+      if (!f.tables.empty()) md << " (as thesis table " << f.tables[s] << ")";
+      md << "\n\n| Classification algorithm | Classification accuracy (%) | Misclassified instances |\n|---|---|---|\n";
+      for (const auto& [label, c] : a["classifiers"].items())
+        md << "| " << label << " | " << fmt(c[kSets[s]]["mean_percent_correct"].get<double>()) << " | "
+           << fmt(c[kSets[s]]["mean_misclassified"].get<double>(), 1) << " |\n";
+      md << "\n";
+    }
+  md << "## Sim-to-real: trained on simulated data, tested on real data\n\n"
+     << "| Classifier | Feature set | % correct | Misclassified |\n|---|---|---|---|\n";
+  for (const auto& [key, a] : in_order(analyses))
+    for (const auto& [label, c] : a["classifiers"].items())
+      md << "| " << label << " | " << title(key) << " | " << fmt(c["sim_to_real"]["percent_correct"].get<double>())
+         << " | " << c["sim_to_real"]["misclassified"].get<long>() << " |\n";
+  md << "\n## Real against simulated fold accuracies\n\n"
+     << "| Classifier | Feature set | Two-sample t-test (Student, pooled variance, two-tailed; thesis table 6.8), "
+        "mean P over runs | Corrected resampled t-test (Nadeau & Bengio 2003, as WEKA's Experimenter), P |\n"
+     << "|---|---|---|---|\n";
+  for (const auto& [key, a] : in_order(analyses))
+    for (const auto& [label, c] : a["classifiers"].items()) {
+      const auto& t = c["corrected_resampled_t_test"];
+      md << "| " << label << " | " << title(key) << " | P = " << fmt_p(c["two_sample_t_test"]["mean_p"].get<double>())
+         << " (two-sample t-test) | P = " << fmt_p(t["p"].get<double>())
+         << " (corrected resampled t-test, t = " << fmt(t["t"].get<double>(), 3) << ", df = " << t["df"].get<double>()
+         << ") |\n";
+    }
+  md << "\nP > 0.05: the fold accuracies do not tell real from simulated data.\n\n"
+     << "## The thesis's combined-data claim\n\nThe thesis claims that combined (real + simulated) data has fewer "
+        "misclassifications than real and simulated data together (sum of their misclassified counts).\n\n"
+     << "| Classifier | Feature set | Real + simulated misclassified | Combined misclassified | Claim holds |\n"
+     << "|---|---|---|---|---|\n";
+  for (const auto& [key, a] : in_order(analyses))
+    for (const auto& [label, c] : a["classifiers"].items()) {
+      const auto& cl = c["combined_claim"];
+      md << "| " << label << " | " << title(key) << " | " << fmt(cl["real_plus_sim_misclassified"].get<double>(), 1)
+         << " | " << fmt(cl["combined_misclassified"].get<double>(), 1) << " | "
+         << (cl["holds"].get<bool>() ? "yes" : "no") << " |\n";
+    }
+  md << "\n## Learning curve\n\nReal data in " << o.folds
+     << " stratified folds; simulated scenarios added to each training fold; % correct on the held-out real "
+        "instances (seed "
+     << o.seed << ").\n\n";
+  if (o.curve_steps == 0) md << "Not computed (`--curve-steps 0`).\n\n";
+  for (const auto& [key, a] : in_order(analyses))
+    for (const auto& [label, c] : a["classifiers"].items()) {
+      if (!c.contains("learning_curve")) continue;
+      md << "| " << label << ", " << title(key) << " | sim added | % correct |\n|---|---|---|\n";
+      for (const auto& p : c["learning_curve"])
+        md << "| | " << p["sim_added"].get<long>() << " | " << fmt(p["percent_correct"].get<double>()) << " |\n";
+      md << "\n";
+    }
+  for (const auto& [key, a] : in_order(analyses))
+    for (const auto& [label, c] : a["classifiers"].items()) {
+      if (!c.contains("trees")) continue;
+      md << "## J48 trees, " << title(key) << " (thesis figures 6.10-6.12)\n\n";
+      for (const char* s : kSets) md << "### " << s << "\n\n```\n" << c["trees"][s].get<std::string>() << "```\n\n";
+    }
+  md << "## Plots\n\n![accuracy](accuracy.png)\n\n![learning curve](curve.png)\n";
+  return md.str();
+}
 
 int run_validate(Options o) {
   if (!o.grid.empty()) o.block = block_for_grid(o.grid, o.catalogue);
   const char* jar = "/usr/share/java/weka.jar";
   if (!fs::exists(jar)) throw EnvironmentError(std::string(jar) + " not found (apt-get install weka)");
   if (!on_path("java")) throw EnvironmentError("java not found on PATH (apt-get install default-jdk-headless)");
-  std::vector<std::string> names;
+  std::string classifiers;
   for (const std::string& c : split_commas(lower(o.classifiers))) {
     if (std::none_of(kClassifiers.begin(), kClassifiers.end(), [&](const auto& k) { return k.first == c; }))
       throw InputError("--classifiers: unknown classifier '" + c + "' (j48, mlp or svm)");
-    names.push_back(c);
+    classifiers += (classifiers.empty() ? "" : ",") + c;
   }
 
   const WorkDir scratch;
   const std::string& work = scratch.path;
-  Table sim = load(o.sim, work, "sim", o.block, o.catalogue);
-  Table real = load(o.real, work, "real", o.block, o.catalogue);
-  select_features(sim, o.features);
-  select_features(real, o.features);
-  check_same_attributes(sim, real);
-  check_usable(sim, o.folds);
-  check_usable(real, o.folds);
-  std::set<std::string> classes = sim.classes;
-  classes.insert(real.classes.begin(), real.classes.end());
-  const std::string sim_arff = (fs::path(work) / ".sim.arff").string();
-  const std::string real_arff = (fs::path(work) / ".real.arff").string();
-  write_arff(sim, classes, sim_arff);
-  write_arff(real, classes, real_arff);
-
-  // All the WEKA work in one JVM.
-  const std::string program = (fs::path(work) / "WekaValidate.java").string();
-  const std::string weka_out = (fs::path(work) / ".weka.json").string();
-  write_text_atomic(program, std::string(embedded::weka_validate));
-  std::string classifiers;
-  for (const auto& n : names) classifiers += (classifiers.empty() ? "" : ",") + n;
-  const std::string cmd = "java -Xmx2g -cp " + std::string(jar) + " " + shell_quote(program) + " --real " +
-                          shell_quote(real_arff) + " --sim " + shell_quote(sim_arff) + " --folds " +
-                          std::to_string(o.folds) + " --runs " + std::to_string(o.runs) + " --seed " +
-                          std::to_string(o.seed) + " --classifiers " + classifiers + " --curve-steps " +
-                          std::to_string(o.curve_steps) + " > " + shell_quote(weka_out);
-  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("WEKA failed (its messages are above)");
-  nlohmann::json weka;
-  {
-    std::ifstream in(weka_out);
-    weka = nlohmann::json::parse(in);
-  }
-
   StagedFolder folder(o.out);
+  std::string sim_path = o.sim, real_path = o.real;
+  nlohmann::json demo;
+  if (o.demo) {
+    // The inputs are made here and kept beside the report, under demo/.
+    const std::string demo_dir = folder.path("demo");
+    demo = make_demo_sets(demo_dir, o.demo_count, static_cast<uint64_t>(o.seed), o.block);
+    sim_path = demo["sim"].get<std::string>();
+    real_path = demo["real"].get<std::string>();
+    o.sim = (fs::path(o.out) / "demo" / fs::path(sim_path).filename()).string();
+    o.real = (fs::path(o.out) / "demo" / fs::path(real_path).filename()).string();
+  }
+  const Table sim = load(sim_path, work, "sim", o.block, o.catalogue);
+  const Table real = load(real_path, work, "real", o.block, o.catalogue);
+
   nlohmann::json report = {{"sim", o.sim},
                            {"real", o.real},
                            {"folds", o.folds},
                            {"runs", o.runs},
                            {"seed", o.seed},
                            {"features", o.features},
-                           {"attributes", sim.names.size() - 1},
                            {"sim_instances", sim.rows.size()},
                            {"real_instances", real.rows.size()}};
-  std::ostringstream md, trees, tests;
-  md << "# portalsim validate\n\nSimulated: `" << o.sim << "` (" << sim.rows.size() << " instances), real: `" << o.real
-     << "` (" << real.rows.size() << " instances); " << sim.names.size() - 1 << " attributes and the class ("
-     << o.features << " features); " << o.folds << "-fold stratified cross-validation as WEKA's `-x " << o.folds
-     << " -s SEED`, " << o.runs << " run(s) with seeds " << o.seed << ".." << o.seed + o.runs - 1 << ".\n\n"
-     << "## Accuracy (thesis tables 6.1-6.7 layout; mean over runs)\n\n"
-     << "| Classifier | Real: % correct | Real: misclassified | Simulated: % correct | Simulated: misclassified | "
-        "Combined: % correct | Combined: misclassified | Sim-to-real: % correct | Sim-to-real: misclassified |\n"
-     << "|---|---|---|---|---|---|---|---|---|\n";
-  tests << "## Real against simulated fold accuracies\n\n"
-        << "| Classifier | Two-sample t-test (Student, pooled variance, two-tailed; thesis table 6.8), mean P over "
-           "runs | Corrected resampled t-test (Nadeau & Bengio 2003, as WEKA's Experimenter), P |\n"
-        << "|---|---|---|\n";
-  std::ostringstream claim;
-  claim
-      << "## The thesis's combined-data claim\n\nThe thesis claims that combined (real + simulated) data has fewer "
-         "misclassifications than real and simulated data together (sum of their misclassified counts).\n\n"
-      << "| Classifier | Real + simulated misclassified | Combined misclassified | Claim holds |\n|---|---|---|---|\n";
-  std::ostringstream curve_md;
-  curve_md << "## Learning curve\n\nReal data in " << o.folds
-           << " stratified folds; simulated scenarios added to each training fold; % correct on the held-out real "
-              "instances (seed "
-           << o.seed << ").\n\n";
-  if (o.curve_steps == 0) curve_md << "Not computed (`--curve-steps 0`).\n\n";
-
-  for (const auto& [key, label] : kClassifiers) {
-    if (std::find(names.begin(), names.end(), key) == names.end()) continue;
-    const auto& w = weka["classifiers"][key];
-    nlohmann::json c;
-    double mean_pct[3] = {0, 0, 0}, mean_wrong[3] = {0, 0, 0};
-    const char* sets[3] = {"real", "sim", "combined"};
-    for (int s = 0; s < 3; ++s) {
-      for (const auto& run : w[sets[s]]) {
-        mean_pct[s] += run["percent_correct"].get<double>() / o.runs;
-        mean_wrong[s] += run["misclassified"].get<double>() / o.runs;
-      }
-      c[sets[s]] = {{"runs", w[sets[s]]}, {"mean_percent_correct", mean_pct[s]}, {"mean_misclassified", mean_wrong[s]}};
-    }
-    // The thesis's test per run, averaged; the corrected test over all runs x folds.
-    double p_sum = 0;
-    std::vector<double> differences;
-    nlohmann::json per_run = nlohmann::json::array();
-    for (int r = 0; r < o.runs; ++r) {
-      const auto a = w["real"][r]["folds"].get<std::vector<double>>();
-      const auto b = w["sim"][r]["folds"].get<std::vector<double>>();
-      const TTest t = student_two_sample(a, b);
-      p_sum += t.p;
-      per_run.push_back({{"t", t.t}, {"df", t.df}, {"p", t.p}});
-      for (size_t i = 0; i < a.size(); ++i) differences.push_back(a[i] - b[i]);
-    }
-    const TTest corrected = corrected_resampled(differences, 1.0 / (o.folds - 1));
-    c["two_sample_t_test"] = {{"test", "Student two-sample t-test, pooled variance, two-tailed (thesis table 6.8)"},
-                              {"per_run", per_run},
-                              {"mean_p", p_sum / o.runs}};
-    c["corrected_resampled_t_test"] = {{"test", "corrected resampled t-test (Nadeau & Bengio 2003)"},
-                                       {"t", corrected.t},
-                                       {"df", corrected.df},
-                                       {"p", corrected.p}};
-    c["sim_to_real"] = w["sim_to_real"];
-    if (w.contains("curve")) c["learning_curve"] = w["curve"];
-    const double together = mean_wrong[0] + mean_wrong[1];
-    c["combined_claim"] = {{"real_plus_sim_misclassified", together},
-                           {"combined_misclassified", mean_wrong[2]},
-                           {"holds", mean_wrong[2] < together}};
-    md << "| " << label << " | " << fmt(mean_pct[0]) << " | " << fmt(mean_wrong[0], 1) << " | " << fmt(mean_pct[1])
-       << " | " << fmt(mean_wrong[1], 1) << " | " << fmt(mean_pct[2]) << " | " << fmt(mean_wrong[2], 1) << " | "
-       << fmt(w["sim_to_real"]["percent_correct"].get<double>()) << " | "
-       << w["sim_to_real"]["misclassified"].get<long>() << " |\n";
-    tests << "| " << label << " | P = " << fmt_p(p_sum / o.runs) << " (two-sample t-test) | P = " << fmt_p(corrected.p)
-          << " (corrected resampled t-test, t = " << fmt(corrected.t, 3) << ", df = " << corrected.df << ") |\n";
-    claim << "| " << label << " | " << fmt(together, 1) << " | " << fmt(mean_wrong[2], 1) << " | "
-          << (mean_wrong[2] < together ? "yes" : "no") << " |\n";
-    if (w.contains("curve")) {
-      curve_md << "| " << label << " | sim added | % correct |\n|---|---|---|\n";
-      for (const auto& p : w["curve"])
-        curve_md << "| | " << p["sim_added"].get<long>() << " | " << fmt(p["percent_correct"].get<double>()) << " |\n";
-      curve_md << "\n";
-    }
-    if (w.contains("trees")) {
-      c["trees"] = w["trees"];
-      trees << "## J48 trees (thesis figures 6.10-6.12)\n\n";
-      for (const char* s : sets) trees << "### " << s << "\n\n```\n" << w["trees"][s].get<std::string>() << "```\n\n";
-    }
-    report["classifiers"][label] = c;
+  if (o.demo) report["demo"] = demo["about"];
+  // Check every analysis before the slow part starts.
+  std::vector<std::pair<std::string, std::pair<Table, Table>>> sets;
+  for (const std::string& key : analyses_for(o.features, sim)) {
+    Table s = select_features(sim, key), r = select_features(real, key);
+    check_same_attributes(s, r);
+    check_usable(s, o.folds);
+    check_usable(r, o.folds);
+    sets.emplace_back(key, std::make_pair(std::move(s), std::move(r)));
   }
-  md << "\n"
-     << tests.str() << "\nP > 0.05: the fold accuracies do not tell real from simulated data.\n\n"
-     << claim.str() << "\n"
-     << curve_md.str() << trees.str() << "## Plots\n\n![accuracy](accuracy.png)\n\n![learning curve](curve.png)\n";
-  write_text_atomic(folder.path("report.md"), md.str());
+  for (const auto& [key, tables] : sets) {
+    const nlohmann::json weka = run_weka(o, classifiers, work, key, tables.first, tables.second);
+    nlohmann::json a = {{"feature_set", feature_set(key).title}, {"attributes", tables.first.names.size() - 1}};
+    if (!feature_set(key).tables.empty()) a["thesis_tables"] = feature_set(key).tables;
+    for (const auto& [name, label] : kClassifiers)
+      if (weka["classifiers"].contains(name)) a["classifiers"][label] = score(o, weka["classifiers"][name]);
+    report["analyses"][key] = a;
+  }
+  const std::string md = markdown(o, report);
+  write_text_atomic(folder.path("report.md"), md);
   write_text_atomic(folder.path("report.json"), report.dump(2) + "\n");
 
   // The plots, drawn by the embedded matplotlib script from report.json in the staging folder.
@@ -474,7 +652,7 @@ int run_validate(Options o) {
   folder.path("accuracy.png");
   folder.path("curve.png");
   folder.commit();
-  std::printf("%s", md.str().c_str());
+  std::printf("%s", md.c_str());
   return 0;
 }
 
@@ -483,10 +661,19 @@ int run_validate(Options o) {
 std::function<int()> add_validate(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("validate", "Score simulated against real data with WEKA (thesis ch. 6)");
-  cmd->add_option("--sim", o->sim, "Simulated data: feature table (ARFF or CSV) or folder of scenario folders")
-      ->required();
-  cmd->add_option("--real", o->real, "Real data: feature table (ARFF or CSV) or folder of scenario folders")
-      ->required();
+  auto* sim = cmd->add_option("--sim", o->sim,
+                              "Simulated data: feature table (ARFF, CSV or data.h5) or folder of scenario folders");
+  auto* real = cmd->add_option("--real", o->real,
+                               "Real data: feature table (ARFF, CSV or data.h5) or folder of scenario folders");
+  auto* demo = cmd->add_flag("--demo", o->demo,
+                             "No real data to hand: make a simulated and an altered-image \"real\" set (thesis case "
+                             "2) and validate them; both are kept under OUT/demo/")
+                   ->excludes(sim)
+                   ->excludes(real);
+  cmd->add_option("--demo-count", o->demo_count,
+                  "Scenarios per --demo set (default " + std::to_string(kDemoCount) + ")")
+      ->check(CLI::Range(uint64_t{20}, uint64_t{100000}))
+      ->needs(demo);
   cmd->add_option("--out", o->out, "Folder for report.md, report.json and the plots")->required();
   cmd->add_option("--features", o->features, "regions, blocks or both (default both)")
       ->check(CLI::IsMember({"regions", "blocks", "both"}));
@@ -501,7 +688,15 @@ std::function<int()> add_validate(CLI::App& app) {
   cmd->add_option("--seed", o->seed, "Seed of the first run (default 1)");
   cmd->add_option("--curve-steps", o->curve_steps, "Learning-curve points after the first; 0: none (default 4)")
       ->check(CLI::Range(0, 100));
-  return [o]() { return run_validate(*o); };
+  return [o, cmd]() {
+    if (!o->demo && (o->sim.empty() || o->real.empty()))
+      throw InputError("validate: --sim and --real are both needed (or --demo, to see a report without real data)");
+    // The demo's default keeps it short: J48 alone (MultilayerPerceptron takes minutes).
+    if (o->demo && cmd->get_option("--classifiers")->count() == 0) o->classifiers = "j48";
+    // and the thesis's 5x5 grid of block means (appendix D.4) unless --block or --grid says otherwise.
+    if (o->demo && cmd->get_option("--block")->count() == 0 && o->grid.empty()) o->grid = "5x5";
+    return run_validate(*o);
+  };
 }
 
 }  // namespace portalsim::cli
