@@ -133,6 +133,30 @@ TEST(Annotations, MasksAndBoxesAgreeWithTheReferenceComposite) {
   EXPECT_EQ(checked, 2 * 3 * 40 * static_cast<int>(cat.sensors.size()));
 }
 
+// annotate() clears a reused buffer only where it painted before: batches of other sizes
+// and scenes through one buffer must give what fresh buffers give.
+TEST(Annotations, ReusedBuffersGiveWhatFreshOnesGive) {
+  const Catalogue& cat = test::catalogue();
+  ModelSettings m;
+  m.jitter = 20;
+  std::vector<ViewAnnotations> reused;
+  size_t compared = 0;
+  for (const auto& [first, n] : std::vector<std::pair<uint64_t, size_t>>{{0, 50}, {300, 20}, {900, 70}, {40, 70}}) {
+    std::vector<Scenario> scenes;
+    for (uint64_t k = 0; k < n; ++k) scenes.push_back(test::random_scenario(cat, first + k));
+    const SceneBatch b = test::batch_of(scenes, first);
+    std::vector<ViewAnnotations> fresh;
+    annotate(cat, test::assets(), m, b, fresh, 2);
+    annotate(cat, test::assets(), m, b, reused, 2);
+    for (size_t k = 0; k < fresh.size(); ++k) {
+      ASSERT_EQ(fresh[k].masks, reused[k].masks) << "batch at " << first << " view " << k;
+      EXPECT_EQ(fresh[k].first, reused[k].first);
+      compared += fresh[k].items.size();
+    }
+  }
+  EXPECT_GT(compared, 300u);
+}
+
 // The kernels' images of white sprites on black: a pixel is lit exactly where the mask
 // has an object (integer placement, no noise; coverage >= 1/255 at alpha 0.9 displays >= 1).
 TEST(Annotations, MasksAgreeWithTheKernelsPixels) {

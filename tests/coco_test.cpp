@@ -2,6 +2,8 @@
 // (cocodataset.org/#format-data) by this test's own reader, the RLE decoded back onto the
 // mask images, YOLO lines checked against the boxes, masks in data.h5, byte identity
 // across --batch and --threads, exact resume after kill -9, and what merge does.
+#include "sink/coco.h"
+
 #include <gtest/gtest.h>
 #include <hdf5.h>
 #include <sys/wait.h>
@@ -20,6 +22,7 @@
 
 #include "assets/image_io.h"
 #include "run_binary.h"
+#include "scene/philox.h"
 
 namespace {
 
@@ -193,6 +196,43 @@ TEST(Coco, ValidAndAgreesWithMasksAndYolo) {
           << view << " " << i;
     }
   }
+}
+
+// The RLE visits only the object's box; it must equal a plain run-length pass over every
+// pixel, whatever the box touches (the view's edges, full columns, one pixel).
+TEST(Coco, RleOfTheBoxEqualsAPlainPassOverTheImage) {
+  int cases = 0;
+  for (uint64_t k = 0; k < 4000; ++k) {
+    const portalsim::Philox4 r = portalsim::draw(3, k, 0, 0);
+    const int W = 1 + static_cast<int>(r[0] % 9), H = 1 + static_cast<int>(r[1] % 9);
+    const int bx = static_cast<int>(r[2] % W), by = static_cast<int>(r[3] % H);
+    const portalsim::Philox4 q = portalsim::draw(3, k, 1, 0);
+    const int bw = 1 + static_cast<int>(q[0] % (W - bx)), bh = 1 + static_cast<int>(q[1] % (H - by));
+    std::vector<uint8_t> mask(static_cast<size_t>(W) * H, 0);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const uint32_t u = portalsim::draw(3, k, 2, static_cast<uint32_t>(y * W + x))[0];
+        const bool in_box = x >= bx && x < bx + bw && y >= by && y < by + bh;
+        mask[static_cast<size_t>(y) * W + x] = in_box ? (u % 3 ? 5 : 2) : (u % 2 ? 7 : 0);  // id 5 only in the box
+      }
+    std::vector<uint32_t> plain;
+    bool on = false;
+    uint32_t run = 0;
+    for (int x = 0; x < W; ++x)
+      for (int y = 0; y < H; ++y) {
+        if ((mask[static_cast<size_t>(y) * W + x] == 5) != on) {
+          plain.push_back(run);
+          run = 0;
+          on = !on;
+        }
+        ++run;
+      }
+    plain.push_back(run);
+    ASSERT_EQ(portalsim::coco_rle(mask.data(), W, H, 5, bx, by, bw, bh), plain)
+        << W << "x" << H << " box " << bx << "," << by << " " << bw << "x" << bh;
+    ++cases;
+  }
+  EXPECT_EQ(cases, 4000);
 }
 
 TEST(Coco, ByteIdenticalForAnyBatchAndThreads) {

@@ -10,6 +10,7 @@
 // holds that region's number (1..13), 0 for none. An object with no visible pixel (out of
 // the view, or covered whole) has no annotation.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -35,6 +36,14 @@ struct ViewAnnotations {
   std::vector<Annotation> items;  // by scenario, then region
   std::vector<uint32_t> first;    // n + 1: scenario i's items are [first[i], first[i + 1])
   const uint8_t* mask_of(size_t i) const { return masks.data() + i * static_cast<size_t>(width) * height; }
+
+  // Where annotate() painted each mask, so that a reused buffer is cleared there only
+  // rather than whole; a size that differs from the masks' count means "clear all".
+  struct Painted {
+    int count = 0;
+    std::array<std::array<int16_t, 4>, kRegions> box{};  // x0, y0, x1, y1 inclusive
+  };
+  std::vector<Painted> painted;
 };
 
 // One ViewAnnotations per camera view (Catalogue::sensors order) for the batch.

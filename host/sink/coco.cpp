@@ -1,11 +1,13 @@
 #include "sink/coco.h"
 
+#include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 
 #include "base/error.h"
+#include "base/parallel.h"
 #include "sink/output_folder.h"
 
 namespace portalsim {
@@ -16,21 +18,26 @@ using nlohmann::json;
 uint64_t coco_image_id(uint64_t index, size_t views, size_t view) { return index * views + view + 1; }
 uint64_t coco_annotation_id(uint64_t image_id, int region) { return image_id * 16 + static_cast<uint64_t>(region); }
 
-std::vector<uint32_t> coco_rle(const uint8_t* mask, int width, int height, uint8_t id) {
+std::vector<uint32_t> coco_rle(const uint8_t* mask, int width, int height, uint8_t id, int bx, int by, int bw, int bh) {
+  // Runs change only inside the box and where it meets the pixels around it; the
+  // positions between are counted, not visited.
   std::vector<uint32_t> counts;
   bool inside = false;
-  uint32_t run = 0;
-  for (int x = 0; x < width; ++x)
-    for (int y = 0; y < height; ++y) {
-      const bool on = mask[static_cast<size_t>(y) * width + x] == id;
-      if (on != inside) {
-        counts.push_back(run);
-        run = 0;
-        inside = on;
-      }
-      ++run;
-    }
-  counts.push_back(run);
+  uint64_t last = 0;  // column-major position where the current run began
+  const auto turn = [&](uint64_t at) {
+    counts.push_back(static_cast<uint32_t>(at - last));
+    last = at;
+    inside = !inside;
+  };
+  const uint64_t H = static_cast<uint64_t>(height);
+  for (int x = bx; x < bx + bw; ++x) {
+    if (inside && by > 0) turn(x * H);  // the column's top, above the box, is off
+    for (int y = by; y < by + bh; ++y)
+      if ((mask[static_cast<size_t>(y) * width + x] == id) != inside) turn(x * H + static_cast<uint64_t>(y));
+    if (inside && by + bh < height) turn(x * H + static_cast<uint64_t>(by + bh));
+  }
+  if (inside && bx + bw < width) turn(static_cast<uint64_t>(bx + bw) * H);
+  counts.push_back(static_cast<uint32_t>(static_cast<uint64_t>(width) * H - last));
   return counts;
 }
 
@@ -70,40 +77,17 @@ class CocoSink final : public Sink {
   }
 
   void write(const SceneBatch& scenes, const BatchOutput& out) override {
-    const Catalogue& cat = *ctx_.cat;
-    const size_t views = cat.sensors.size();
-    std::string im, an;
-    for (size_t i = 0; i < scenes.size(); ++i) {
-      const uint64_t index = scenes.first_index + i;
-      for (size_t k = 0; k < views; ++k) {
-        const ViewAnnotations& a = out.annotations[k];
-        const Sensor& s = cat.sensors[k];
-        const uint64_t image_id = coco_image_id(index, views, k);
-        json e = {{"id", image_id},    {"file_name", file_name(index, s.name)},
-                  {"width", s.width},  {"height", s.height},
-                  {"scenario", index}, {"view", s.name}};
-        record(im, images_->state().bytes, e);
-        for (uint32_t t = a.first[i]; t < a.first[i + 1]; ++t) {
-          const Annotation& x = a.items[t];
-          json r = {{"id", coco_annotation_id(image_id, x.region)},
-                    {"image_id", image_id},
-                    {"category_id", x.object + 1},
-                    {"bbox", {x.x, x.y, x.w, x.h}},
-                    {"area", x.area},
-                    {"iscrowd", 0},
-                    {"segmentation",
-                     {{"counts", coco_rle(a.mask_of(i), a.width, a.height, static_cast<uint8_t>(x.region + 1))},
-                      {"size", {a.height, a.width}}}},
-                    {"region", x.region + 1},
-                    {"orientation", cat.objects[x.object].variants[x.drawing].code},
-                    {"dx", x.dx},
-                    {"dy", x.dy}};
-          record(an, annotations_->state().bytes, r);
-        }
-      }
-    }
-    images_->append(im);
-    annotations_->append(an);
+    // Records formatted in parallel chunks, each record after ",\n"; the file's very
+    // first loses its comma.
+    const size_t n = scenes.size();
+    const unsigned parts = std::min<unsigned>(ctx_.threads, static_cast<unsigned>(std::max<size_t>(1, n / 64)));
+    std::vector<std::string> im(std::max(1u, parts)), an(im.size());
+    parallel_for(im.size(), parts, [&](size_t b, size_t e) {
+      for (size_t c = b; c < e; ++c)
+        for (size_t i = n * c / im.size(); i < n * (c + 1) / im.size(); ++i) records(scenes, out, i, im[c], an[c]);
+    });
+    append(*images_, im);
+    append(*annotations_, an);
   }
 
   std::vector<FileState> files() const override {
@@ -141,10 +125,74 @@ class CocoSink final : public Sink {
   std::unique_ptr<AppendFile> images_, annotations_;
   std::optional<FileState> final_;
 
-  // Records are separated by commas: none before a file's first.
-  static void record(std::string& buf, uint64_t bytes_before, const json& r) {
-    buf += bytes_before == 0 && buf.empty() ? "\n" : ",\n";
-    buf += r.dump();
+  static void append(AppendFile& f, std::vector<std::string>& chunks) {
+    bool first = f.state().bytes == 0;
+    for (std::string& c : chunks) {
+      if (c.empty()) continue;
+      f.append(first ? std::string_view(c).substr(1) : std::string_view(c));
+      first = false;
+    }
+  }
+
+  // Scenario i's image entries and annotations, as JSON text (portalsim's own keys last).
+  void records(const SceneBatch& scenes, const BatchOutput& out, size_t i, std::string& im, std::string& an) const {
+    const Catalogue& cat = *ctx_.cat;
+    const size_t views = cat.sensors.size();
+    const uint64_t index = scenes.first_index + i;
+    const auto num = [](std::string& s, auto v) {
+      char b[32];
+      const auto r = std::to_chars(b, b + sizeof b, v);
+      s.append(b, r.ptr);
+    };
+    for (size_t k = 0; k < views; ++k) {
+      const ViewAnnotations& a = out.annotations[k];
+      const Sensor& s = cat.sensors[k];
+      const uint64_t image_id = coco_image_id(index, views, k);
+      im += ",\n{\"id\":";
+      num(im, image_id);
+      im += ",\"file_name\":" + json(file_name(index, s.name)).dump() + ",\"width\":";
+      num(im, s.width);
+      im += ",\"height\":";
+      num(im, s.height);
+      im += ",\"scenario\":";
+      num(im, index);
+      im += ",\"view\":" + json(s.name).dump() + "}";
+      for (uint32_t t = a.first[i]; t < a.first[i + 1]; ++t) {
+        const Annotation& x = a.items[t];
+        an += ",\n{\"id\":";
+        num(an, coco_annotation_id(image_id, x.region));
+        an += ",\"image_id\":";
+        num(an, image_id);
+        an += ",\"category_id\":";
+        num(an, x.object + 1);
+        an += ",\"bbox\":[";
+        for (int v : {x.x, x.y, x.w, x.h}) {
+          num(an, v);
+          an += ',';
+        }
+        an.back() = ']';
+        an += ",\"area\":";
+        num(an, x.area);
+        an += ",\"iscrowd\":0,\"segmentation\":{\"counts\":[";
+        for (uint32_t c :
+             coco_rle(a.mask_of(i), a.width, a.height, static_cast<uint8_t>(x.region + 1), x.x, x.y, x.w, x.h)) {
+          num(an, c);
+          an += ',';
+        }
+        an.back() = ']';
+        an += ",\"size\":[";
+        num(an, a.height);
+        an += ',';
+        num(an, a.width);
+        an += "]},\"region\":";
+        num(an, x.region + 1);
+        an += ",\"orientation\":" + json(cat.objects[x.object].variants[x.drawing].code).dump() + ",\"dx\":";
+        num(an, x.dx);
+        an += ",\"dy\":";
+        num(an, x.dy);
+        an += '}';
+      }
+    }
   }
   std::string file_name(uint64_t index, const std::string& view) const {
     if (!opt_.image_folder_ext.empty())

@@ -31,8 +31,9 @@ uint64_t coco_image_id(uint64_t index, size_t views, size_t view);
 uint64_t coco_annotation_id(uint64_t image_id, int region);
 
 // COCO's uncompressed RLE of the pixels of `mask` (row-major, width x height) equal to
-// `id`: run lengths in column-major order, starting with a run of others (maybe 0).
-std::vector<uint32_t> coco_rle(const uint8_t* mask, int width, int height, uint8_t id);
+// `id`, all inside the box (bx, by, bw, bh): run lengths in column-major order, starting
+// with a run of others (maybe 0).
+std::vector<uint32_t> coco_rle(const uint8_t* mask, int width, int height, uint8_t id, int bx, int by, int bw, int bh);
 
 // One YOLO line per annotation: "class cx cy w h", class = object index (COCO's category
 // id - 1), the box's centre and size divided by the image's width and height.
