@@ -309,4 +309,17 @@ TEST(Coco, AnnotationsWithoutImagesAreRefused) {
   EXPECT_FALSE(fs::exists(t.w() / "x"));
 }
 
+TEST(Coco, SpecFileKeyTurnsThemOnAndIsCheckedThere) {
+  portalsim::test::TempDir t;
+  const fs::path good = t.w() / "good.toml", bad = t.w() / "bad.toml";
+  portalsim::test::spit(good, "count = 4\nwhat = \"images\"\nannotations = true\n");
+  portalsim::test::spit(bad, "count = 4\nannotations = true\n");
+  ExpectOk(run(t, {"--spec", good.string()}, t.w() / "a"));
+  EXPECT_TRUE(fs::exists(t.w() / "a" / "annotations.json"));
+  const portalsim::test::Result r = run(t, {"--spec", bad.string()}, t.w() / "b");
+  EXPECT_TRUE(r.exited && r.status == 3) << "a bad spec file exits 3: " << portalsim::test::describe(r);
+  EXPECT_NE(r.err.find(bad.string() + ":2"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("needs images"), std::string::npos) << r.err;
+}
+
 }  // namespace
