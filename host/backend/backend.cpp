@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "base/parallel.h"
+
 namespace portalsim {
 
 void prepare_output(BatchOutput& out, const Catalogue& cat, const Plan& plan, size_t n) {
@@ -22,6 +24,14 @@ void prepare_output(BatchOutput& out, const Catalogue& cat, const Plan& plan, si
   out.features.resize(plan.features ? n * out.layout.image_features() : 0);
 }
 
+void Backend::annotations(const Catalogue& cat, const AssetSet& assets, const SceneBatch& batch, const Plan& plan,
+                          BatchOutput& out) {
+  if (plan.annotations)
+    annotate(cat, assets, plan.model, batch, out.annotations, default_threads());
+  else
+    out.annotations.clear();
+}
+
 const ViewImages& BatchOutput::view(std::string_view name) const {
   for (const ViewImages& v : views)
     if (v.name == name) return v;
@@ -40,6 +50,22 @@ void append_output(BatchOutput& all, const BatchOutput& part) {
   }
   all.metal.insert(all.metal.end(), part.metal.begin(), part.metal.end());
   all.features.insert(all.features.end(), part.features.begin(), part.features.end());
+  all.annotations.resize(part.annotations.size());
+  for (size_t k = 0; k < part.annotations.size(); ++k) {
+    ViewAnnotations& a = all.annotations[k];
+    const ViewAnnotations& p = part.annotations[k];
+    const uint32_t scenarios = a.first.empty() ? 0 : static_cast<uint32_t>(a.first.size() - 1);
+    const uint32_t items = static_cast<uint32_t>(a.items.size());
+    a.width = p.width;
+    a.height = p.height;
+    a.masks.insert(a.masks.end(), p.masks.begin(), p.masks.end());
+    if (!a.first.empty()) a.first.pop_back();
+    for (uint32_t f : p.first) a.first.push_back(f + items);
+    for (Annotation x : p.items) {
+      x.scenario += scenarios;
+      a.items.push_back(x);
+    }
+  }
 }
 
 }  // namespace portalsim

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "assets/assets.h"
+#include "backend/annotate.h"
 #include "plan/plan.h"
 #include "scene/scene.h"
 
@@ -32,6 +33,9 @@ struct BatchOutput {
   std::vector<uint8_t> metal;     // n * 19
   FeatureLayout layout;
   std::vector<float> features;  // n * layout.image_features()
+  // Per camera view, boxes and instance masks (backend/annotate.h); empty unless the plan
+  // asks for annotations.
+  std::vector<ViewAnnotations> annotations;
 
   // The view called `name` ("upper", "lower", "ir"); throws std::out_of_range if none is.
   const ViewImages& view(std::string_view name) const;
@@ -52,6 +56,11 @@ class Backend {
   virtual std::string name() const = 0;
   // Fills `out` with what `plan` asks for; `out`'s buffers are reused across calls.
   virtual void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) = 0;
+
+ protected:
+  // The annotations `plan` asks for (the same function for every backend), or none.
+  static void annotations(const Catalogue& cat, const AssetSet& assets, const SceneBatch& batch, const Plan& plan,
+                          BatchOutput& out);
 };
 
 std::unique_ptr<Backend> make_reference_backend(const Catalogue& cat, const AssetSet& assets);

@@ -74,6 +74,7 @@ int generate(GenerateOptions& o) {
   if (given("--format")) spec.formats = split_list(o.formats);
   if (given("--image-format")) spec.image_format = o.spec.image_format;
   if (given("--compress")) spec.compress = o.spec.compress;
+  if (given("--annotations")) spec.annotations = o.spec.annotations;
   if (given("--scenarios")) spec.scenarios = o.spec.scenarios;
   if (given("--tier")) spec.tier = o.spec.tier;
   for (const auto& [key, text] : given_knobs(app, o.knobs)) {
@@ -162,6 +163,8 @@ std::function<int()> add_generate(CLI::App& app) {
                   "arff,csv,npy feature tables; h5: data.h5 with image tensors and labels; npy with --what images: "
                   "image tensors as .npy (default arff)");
   sub->add_flag("--compress", o->spec.compress, "gzip data.h5's datasets (--format h5)");
+  sub->add_flag("--annotations", o->spec.annotations,
+                "per-object boxes and instance masks: annotations.json (COCO), YOLO .txt and mask images");
   sub->add_option("--image-format", o->spec.image_format, "png or jpg (default png)");
   sub->add_option("--scenarios", o->spec.scenarios, "explicit scenario list (CSV: subject, region1..13, label)");
   add_knob_options(*sub, o->spec.tier, o->knobs);

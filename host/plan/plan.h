@@ -66,6 +66,7 @@ struct Plan {
   uint32_t images = kAllViews;  // which camera views' images the caller keeps
   bool metal = true;            // metal zones
   bool features = true;         // block and region means of the pooled views
+  bool annotations = false;     // per-object boxes and instance masks (backend/annotate.h)
   ModelSettings model;
   Fidelity fidelity;
 

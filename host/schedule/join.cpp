@@ -42,6 +42,10 @@ enum class Kind { text, npy, h5 };
 
 Kind kind_of(const std::string& name, const std::string& part) {
   if (name == "data.h5") return Kind::h5;
+  if (name == "annotations.json")
+    throw InputError(part +
+                     "/manifest.json: outputs: annotations.json (generate --annotations): merge cannot join "
+                     "COCO annotations yet; make the data set in one run (--batch and --threads never change it)");
   const auto ends = [&](const char* e) { return name.size() > std::strlen(e) && name.ends_with(e); };
   if (ends(".npy")) return Kind::npy;
   if (ends(".csv") || ends(".arff")) return Kind::text;

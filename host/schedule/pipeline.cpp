@@ -15,6 +15,7 @@
 #include "base/error.h"
 #include "base/parallel.h"
 #include "schedule/identity.h"
+#include "sink/coco.h"
 #include "sink/output_folder.h"
 #include "sink/sinks.h"
 #include "sink/staging.h"
@@ -233,6 +234,7 @@ std::vector<std::unique_ptr<Sink>> open_sinks(const RunSpec& spec, const Plan& p
   TensorOptions topt;
   topt.rule = rule;
   topt.identity = identity;
+  topt.annotations = plan.annotations;
   if (spec.has_format("h5")) {
     topt.h5 = true;
     topt.compress = spec.compress;
@@ -244,6 +246,16 @@ std::vector<std::unique_ptr<Sink>> open_sinks(const RunSpec& spec, const Plan& p
     topt.h5 = false;
     topt.images = true;
     sinks.push_back(make_tensor_sink(ctx, topt, start.resuming ? &saved : nullptr));
+  }
+  if (plan.annotations) {
+    CocoOptions copt;
+    if (!spec.image_tensors()) copt.image_folder_ext = spec.image_format;
+    if (spec.has_format("h5")) copt.tensor_file = "data.h5";
+    copt.info = {{"description", "portalsim"},
+                 {"version", identity["portalsim"]},
+                 {"catalogue_hash", identity["catalogue"]["hash"]},
+                 {"spec", identity["spec"]}};
+    sinks.push_back(make_coco_sink(ctx, copt, start.resuming ? &saved : nullptr));
   }
   return sinks;
 }
@@ -366,6 +378,7 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   plan.features = spec.wants_features();
   plan.metal = true;
   plan.images = spec.wants_images() ? kAllViews : 0;
+  plan.annotations = spec.annotations;
   validate(plan, cat);
   res.batch = opt.batch ? opt.batch : default_batch(plan, cat);
   const unsigned threads = opt.threads ? opt.threads : default_threads();

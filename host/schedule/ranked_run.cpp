@@ -101,6 +101,8 @@ PipelineResult run_ranked(const RunSpec& spec, const Catalogue& cat, const Asset
                           const std::string& dir, const PipelineOptions& opt, Ranks& ranks) {
   const auto t0 = Clock::now();
   if (opt.shards != 1) throw InputError("--shard: not with an MPI launch; the ranks split the range among them");
+  if (spec.annotations)
+    throw InputError("--annotations: not with an MPI launch: merge cannot join annotations.json yet; run on one rank");
   const fs::path out(dir), job = parts_dir(dir) / "job.json";
   PipelineResult res;
   res.end = spec.scenarios.empty() ? spec.count : 0;

@@ -24,6 +24,7 @@ nlohmann::json RunSpec::to_json() const {
   j["format"] = formats;
   j["image_format"] = image_format;
   j["compress"] = compress;
+  if (annotations) j["annotations"] = true;  // absent when off: older runs keep their identity
   // The fidelity changes the numbers (within its tier's tolerance), so it is part of
   // the identity; knobs that never change a bit (pooling) are not.
   const Plan p = settings();
@@ -60,6 +61,7 @@ void RunSpec::validate() const {
       if (formats[j] == formats[i]) throw InputError(where("format") + ": \"" + formats[i] + "\" given twice");
   }
   if (compress && !has_format("h5")) throw InputError(where("compress") + ": only applies to --format h5");
+  if (annotations && !wants_images()) throw InputError(where("annotations") + ": needs images (--what images or both)");
   if (image_format != "png" && image_format != "jpg")
     throw InputError(where("image_format") + ": \"" + image_format + "\" is not png or jpg");
   if (balance && rule.empty()) throw InputError(where("balance") + ": needs a threat rule (--rule)");
@@ -192,6 +194,8 @@ void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
       spec.image_format = string(node, key);
     } else if (key == "compress") {
       spec.compress = boolean(node, key);
+    } else if (key == "annotations") {
+      spec.annotations = boolean(node, key);
     } else if (key == "tier") {
       spec.tier = string(node, key);
     } else if (key == "scenarios") {
@@ -201,7 +205,8 @@ void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
       spec.set_knob_text(key, knob_value(*knob, node, at(node, key)), at(node, key));
     } else {
       std::string known =
-          "count, seed, rule, pool, objects, subjects, balance, what, format, image_format, compress, scenarios, tier";
+          "count, seed, rule, pool, objects, subjects, balance, what, format, image_format, compress, annotations, "
+          "scenarios, tier";
       for (const Knob& k : portalsim::knobs()) known += ", " + k.key;
       throw InputError(at(node, key) + ": unknown key (" + known + ")");
     }

@@ -26,6 +26,7 @@ struct RunSpec {
   std::vector<std::string> formats{"arff"};
   std::string image_format = "png";
   bool compress = false;                     // gzip data.h5's datasets (--format h5)
+  bool annotations = false;                  // boxes and masks: annotations.json, YOLO, mask images
   std::string tier = "standard";             // fast | standard | exact; fidelity knobs override it
   std::map<std::string, std::string> knobs;  // the knobs given (plan/knobs.h), by key, as text
   // The model and fidelity: the tier's, then every given knob; the model's seed is `seed`.

@@ -4,6 +4,7 @@
 
 #include "assets/image_io.h"
 #include "base/error.h"
+#include "sink/coco.h"
 #include "sink/feature_rows.h"
 #include "sink/staging.h"
 
@@ -32,6 +33,12 @@ void write_scenario_folder(const PathOf& path_of, const BatchOutput& b, size_t i
     if (v.empty()) continue;
     const Image img = gray(v.of(i), v.width, v.height);
     write(path_of(v.name + ext), v.palette ? colourise(img, palette) : img);
+  }
+  // Annotations: the instance mask (region numbers, always PNG) and the YOLO boxes.
+  for (size_t k = 0; k < b.annotations.size(); ++k) {
+    const ViewAnnotations& a = b.annotations[k];
+    write(path_of("mask_" + b.views[k].name + ".png"), gray(a.mask_of(i), a.width, a.height));
+    write_text_atomic(path_of(b.views[k].name + ".txt"), yolo_lines(a, i));
   }
   if (!b.metal.empty()) {
     std::string m;

@@ -1,6 +1,6 @@
 // One scenario's outputs as a folder, the layout of thesis appendix D.2 step 7:
 // upper.png, lower.png (MMW), ir.png (IR through the palette), metal.txt, threat.txt,
-// features.csv.
+// features.csv; with annotations, mask_<view>.png (instance mask) and <view>.txt (YOLO).
 #pragma once
 #include <functional>
 #include <string>

@@ -74,6 +74,14 @@ class TensorSink final : public Sink {
           });
         }
       }
+    if (opt.annotations)
+      for (size_t k = 0; k < cat.sensors.size(); ++k) {
+        const Sensor& s = cat.sensors[k];
+        add("mask_" + s.name, TensorType::u8, {static_cast<uint64_t>(s.height), static_cast<uint64_t>(s.width)},
+            [k](const SceneBatch&, const BatchOutput& o, std::string& buf) {
+              buf.assign(reinterpret_cast<const char*>(o.annotations[k].masks.data()), o.annotations[k].masks.size());
+            });
+      }
     if (opt.features)
       add("features", TensorType::f32, {static_cast<uint64_t>(ctx.layout.image_features())},
           [](const SceneBatch&, const BatchOutput& o, std::string& buf) {

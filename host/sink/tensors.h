@@ -8,7 +8,8 @@
 // palette) and ir_index uint8 NxHxW (temperature index); metal uint8 Nx19; features
 // float32 NxF (image features, when computed); label, subject uint8 N; region_object,
 // region_orientation int16 Nx13 (object and drawing index, -1 for none); region_label
-// uint8 Nx13 (the rule applied to each region's object on its own).
+// uint8 Nx13 (the rule applied to each region's object on its own); with annotations,
+// mask_<view> uint8 NxHxW (instance masks: the region number, 0 none).
 #pragma once
 #include <map>
 #include <memory>
@@ -27,6 +28,7 @@ struct TensorOptions {
   bool images = false;               // the camera views
   bool features = false;             // the image features
   bool scenario = true;              // label, subject, metal, region_* (always in h5)
+  bool annotations = false;          // mask_<view>: uint8 NxHxW instance masks
   const ThreatRule* rule = nullptr;  // for region_label; null = every region 0
   nlohmann::json identity;           // the run's identity (version, catalogue, spec): HDF5 attributes
 };

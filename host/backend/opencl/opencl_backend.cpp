@@ -156,6 +156,7 @@ class OpenCLBackend final : public Backend {
   void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) override {
     const size_t n = batch.size();
     prepare_output(out, cat_, plan, n);
+    annotations(cat_, assets_, batch, plan, out);
     if (n == 0) return;
     const FeatureLayout& lay = out.layout;
     const int row_len = lay.image_features();

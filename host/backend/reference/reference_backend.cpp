@@ -19,6 +19,7 @@ class ReferenceBackend final : public Backend {
   void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) override {
     const size_t n = batch.size();
     prepare_output(out, cat_, plan, n);
+    annotations(cat_, assets_, batch, plan, out);
     const int views = static_cast<int>(cat_.sensors.size());
     std::vector<std::vector<uint8_t>> images(views);
     reference::Field field;
