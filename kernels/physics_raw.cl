@@ -48,20 +48,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     for (int c = 0; c < RW; ++c) acc[c] = 0;
     for (int x = x_lo; x < x_hi; ++x) {
       const preal t0 = gain * (preal)base[x] + offset;
-      preal v = t0;
-      for (int k = 0; k < Ly.count; ++k) {
-        const int sx = x - Ly.x0[k];
-        if (sx < 0 || sx >= Ly.width[k]) continue;
-        preal c;
-        if (Ly.bilinear) {
-          greal pv, cov;
-          bilinear_sample(&Ly, k, atlas, x, &pv, &cov);
-          c = (preal)cov;
-        } else {
-          c = (preal)atlas[Ly.offset[k] + 2 * sx + 1] * ((preal)1 / (preal)255);
-        }
-        v = c * (preal)object_t[Ly.variant[k]] + ((preal)1 - c) * v;
-      }
+      const preal v = lay_kelvin(&Ly, atlas, object_t, t0, x);
       const preal d = v - t0;
       if (d == 0) continue;
       const int c0 = (int)cband[2 * x], c1 = (int)cband[2 * x + 1];
