@@ -42,8 +42,8 @@ int simulate(SimulateOptions& o) {
 
   open_backend(s, o.common);
   BatchOutput out;
-  const OneScenarioTimes t =
-      write_one_scenario(o.out, *s.backend, scene, plan, s.assets.palette, FolderOptions{o.image_format}, out);
+  const OneScenarioTimes t = write_one_scenario(o.out, *s.backend, scene, plan, procedural::ir_palette(plan.palette),
+                                                FolderOptions{o.image_format}, out);
   const double run_seconds = t.run_seconds, write_seconds = t.write_seconds;
 
   std::printf("%s: subject %d, threat %s, metal", o.out.c_str(), o.subject, scene.label ? "yes" : "no");

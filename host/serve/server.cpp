@@ -179,7 +179,7 @@ struct Server::Impl {
   std::vector<int> run(const Request& r, const Scenario& scene, const std::string& dir) {
     BatchOutput out;
     std::lock_guard<std::mutex> lock(backend_mutex);
-    write_one_scenario(dir, backend, scene, r.plan, assets.palette, FolderOptions{}, out);
+    write_one_scenario(dir, backend, scene, r.plan, procedural::ir_palette(r.plan.palette), FolderOptions{}, out);
     return std::vector<int>(out.metal_of(0), out.metal_of(0) + kZones);
   }
 

@@ -310,48 +310,66 @@ class OpenCLBackend final : public Backend {
   }
 
   // The physics model's parameters for a view's launch (kernels/shared.h, PS_PHYS_*), at the
-  // kernels' parameter precision; `radius` gets the PSF's half-width in taps. The same
-  // formulas as the reference's, written again here: the two never share code.
+  // kernels' parameter precision; `radius` gets the Gaussian's half-width in taps (MMW: the
+  // PSF; IR: heat spreading). The same formulas as the reference's, written again here: the
+  // two never share code.
   cl::Buffer physics_params(const Kernels& K, const Plan& plan, const Sensor& view, int32_t& radius) {
     radius = 0;
     if (plan.model.model != Model::physics) return physics_none_.at_least(rt_->context(), 16);
     const PhysicsConfig& pc = cat_.physics;
     const ModelSettings& m = plan.model;
+    const bool ir = view.camera == Camera::ir;
     const auto seen = [&](double e, double t) {
       return pc.clothing_transmission * (e * t + (1 - e) * m.illumination) +
              (1 - pc.clothing_transmission) * pc.clothing_temperature;
     };
     std::vector<double> p(PS_PHYS_SUBJECTS, 0.0);
     p[PS_PHYS_BACKGROUND] = pc.background_temperature;
-    p[PS_PHYS_WINDOW_MIN] = pc.display_min;
-    p[PS_PHYS_WINDOW_MAX] = pc.display_max;
-    p[PS_PHYS_NETD] = m.netd;
+    p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : pc.display_min;
+    p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : pc.display_max;
+    p[PS_PHYS_NETD] = ir ? m.ir_netd : m.netd;
+    // Per subject, its base image's value to kelvin: the IR index map, or the MMW's gray
+    // between the room behind and the bare body.
     const double body = seen(pc.skin_emissivity, pc.skin_temperature);
     for (const Subject& s : cat_.subjects) {
-      const double gain = (body - pc.background_temperature) / (s.mmw_level - pc.base_background_gray);
+      const double gain = ir ? (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0
+                             : (body - pc.background_temperature) / (s.mmw_level - pc.base_background_gray);
       p.push_back(gain);
-      p.push_back(pc.background_temperature - gain * pc.base_background_gray);
+      p.push_back(ir ? pc.ir_index_min_k : pc.background_temperature - gain * pc.base_background_gray);
     }
+    // Per variant: the IR surface's contact shadow, or the MMW apparent temperature.
     for (size_t v = 0; v < cat_.variant_list.size(); ++v) {
       const Material& mat = cat_.materials.at(cat_.object_of(static_cast<int>(v)).material_id);
-      const double rise = (pc.skin_temperature - pc.room_temperature) * std::exp(-m.worn_minutes / mat.warm_minutes);
-      p.push_back(seen(mat.emissivity, pc.skin_temperature - rise));
+      const double t = worn_temperature(pc, mat, m.worn_minutes);
+      p.push_back(ir ? -pc.ir_coupling * (pc.skin_temperature - t) : seen(mat.emissivity, t));
     }
-    // The Airy core's FWHM, 1.02 lambda / D at the range, in this view's pixels; a
-    // Gaussian of that FWHM over +-4 sigma.
+    // MMW: the Airy core's FWHM, 1.02 lambda / D at the range, in this view's pixels, as a
+    // Gaussian of that FWHM. IR: ir_spread_mm over the view's pixel (as wide as an MMW view).
+    const double span_m = 2.0 * pc.range_m * std::tan(pc.fov_rad / 2.0);
     const double lambda = 299792458.0 / (pc.frequency_ghz * 1e9);
-    const double fwhm = 1.02 * lambda / pc.aperture_m * view.width / (2.0 * std::tan(pc.fov_rad / 2.0));
-    const double sigma = fwhm / 2.3548200450309493;
-    radius = static_cast<int32_t>(std::ceil(4.0 * sigma));
-    double total = 0;
-    const size_t taps = p.size();
-    for (int d = -radius; d <= radius; ++d) {
-      p.push_back(std::exp(-0.5 * d * d / (sigma * sigma)));
-      total += p.back();
-    }
-    for (size_t k = taps; k < p.size(); ++k) p[k] /= total;
+    const double sigma = ir ? pc.ir_spread_mm / (1000.0 * span_m / view.width)
+                            : 1.02 * lambda / pc.aperture_m * pc.range_m / (span_m / view.width) / 2.3548200450309493;
+    append_gaussian_taps(p, sigma, radius);
     if (K.fp64) return constant(rt_->context(), p);
     return constant(rt_->context(), std::vector<cl_float>(p.begin(), p.end()));
+  }
+
+  // An object's physical temperature after `worn` minutes on the body: from the room towards
+  // the skin with its material's time constant.
+  static double worn_temperature(const PhysicsConfig& pc, const Material& mat, double worn) {
+    return pc.skin_temperature - (pc.skin_temperature - pc.room_temperature) * std::exp(-worn / mat.warm_minutes);
+  }
+
+  // A Gaussian of `sigma` taps over +-4 sigma, normalised; sigma 0 is the single tap 1.
+  static void append_gaussian_taps(std::vector<double>& p, double sigma, int32_t& radius) {
+    radius = sigma > 0 ? static_cast<int32_t>(std::ceil(4.0 * sigma)) : 0;
+    double total = 0;
+    const size_t first = p.size();
+    for (int d = -radius; d <= radius; ++d) {
+      p.push_back(sigma > 0 ? std::exp(-0.5 * d * d / (sigma * sigma)) : 1.0);
+      total += p.back();
+    }
+    for (size_t k = first; k < p.size(); ++k) p[k] /= total;
   }
 
   // Block and region means of one pooled view into its columns of the feature rows.
