@@ -164,6 +164,7 @@ struct Server::Impl {
     knob("pattern_noise", field<bool>(j, "pattern_noise", true) ? "on" : "off");
     knob("pixel_noise", knob_text(field<double>(j, "pixel_noise", 0.0)));
     knob("placement", field<std::string>(j, "placement", "integer"));
+    knob("palette", field<std::string>(j, "palette", "ironbow"));
     if (r.in.objects.size() > static_cast<size_t>(kRegions))
       throw InputError("objects: " + std::to_string(r.in.objects.size()) + " given, at most 13 regions");
     r.plan.model.seed = io::parse_u64(r.seed, "--seed");
