@@ -74,12 +74,13 @@ inline greal2 gauss_pair_of(uint2 seed, ulong index, uint stream, int view, int 
   return (float2)(rad * c, rad * s);
 }
 
-// The draws of pixels 2 pair .. 2 pair + 31: 16 Box-Muller pairs, interleaved, the first
-// 16 pixels in *g0 and the next 16 in *g1.
-__attribute__((always_inline)) inline void gauss32(uint2 seed, ulong index, int view, int pair, float16* g0, float16* g1) {
+// The draws of pixels 2 pair .. 2 pair + 31 of a stream: 16 Box-Muller pairs, interleaved,
+// the first 16 pixels in *g0 and the next 16 in *g1.
+__attribute__((always_inline)) inline void gauss32(uint2 seed, ulong index, uint stream, int view, int pair,
+                                                   float16* g0, float16* g1) {
   uint16 c0 = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
               ((uint)pair + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
-  uint16 c1 = (uint16)(PS_STREAM_PIXEL_NOISE), c2 = (uint16)((uint)index), c3 = (uint16)((uint)(index >> 32));
+  uint16 c1 = (uint16)(stream), c2 = (uint16)((uint)index), c3 = (uint16)((uint)(index >> 32));
   philox16(&c0, &c1, &c2, &c3, seed);
   const float16 u1 = 1.0f - convert_float16(c0 >> 8) * (1.0f / 16777216.0f);
   const float16 u2 = convert_float16(c1 >> 8) * (1.0f / 16777216.0f);
