@@ -1,8 +1,11 @@
 // The physics model against the thesis model, per scenario, in the same run:
 //   ./build/portalsim_bench --benchmark_filter=Model --benchmark_repetitions=3
 // Args: batch size, model (0 thesis, 1 physics), NETD in kelvin (physics only).
+// The IR camera alone, and its physics chain cut after each stage:
+//   ./build/portalsim_bench --benchmark_filter='Ir' --benchmark_repetitions=3
 #include <benchmark/benchmark.h>
 
+#include "backend/stages.h"
 #include "fixture.h"
 
 namespace portalsim {
@@ -60,6 +63,55 @@ BENCHMARK_CAPTURE(BM_ModelReference, images, true)
     ->Args({16, 1, 3})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// The IR view's images only. Args: model (0 thesis, 1 physics), IR NETD in mK (physics).
+void BM_IrImages(benchmark::State& state) {
+  auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+  Plan p;
+  p.model.model = state.range(0) == 1 ? Model::physics : Model::thesis;
+  p.model.ir_netd = static_cast<double>(state.range(1)) / 1000.0;
+  p.images = 1u << fx().cat.sensor_index("ir");
+  p.features = false;
+  p.metal = false;
+  state.SetLabel(std::string(model_name(p.model.model)) + " IR images");
+  const size_t n = 1024;
+  const SceneBatch batch = make_batch(n);
+  BatchOutput out;
+  b->run(batch, p, out);
+  for (auto _ : state) {
+    b->run(batch, p, out);
+    benchmark::DoNotOptimize(out.views.data());
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+}
+
+// The IR physics chain's first `range(0)` stages, then ir_display: a stage's cost is the
+// difference from the prefix before it.
+void BM_IrPhysicsStages(benchmark::State& state) {
+  Catalogue cat = fx().cat;
+  std::vector<std::string>& chain = cat.sensors[cat.sensor_index("ir")].physics_chain;
+  chain.resize(static_cast<size_t>(state.range(0)));
+  chain.push_back("ir_display");
+  auto b = make_opencl_backend(cat, fx().assets, fx().rt);
+  Plan p;
+  p.model.model = Model::physics;
+  p.images = 1u << cat.sensor_index("ir");
+  p.features = false;
+  p.metal = false;
+  state.SetLabel(chain[chain.size() - 2]);
+  const size_t n = 1024;
+  const SceneBatch batch = make_batch(n);
+  BatchOutput out;
+  b->run(batch, p, out);
+  for (auto _ : state) {
+    b->run(batch, p, out);
+    benchmark::DoNotOptimize(out.views.data());
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+}
+
+BENCHMARK(BM_IrImages)->Args({0, 0})->Args({1, 0})->Args({1, 50})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_IrPhysicsStages)->DenseRange(1, 4)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace portalsim

@@ -7,6 +7,13 @@ inline preal raw_coordinate(int x, preal step, int raw) {
   return fmin(fmax(((preal)x + (preal)0.5) * step - (preal)0.5, (preal)0), (preal)(raw - 1));
 }
 
+// Kelvin t through the launch's display window to a level 0..255, rounded half up, clamped.
+inline uchar window_level(preal t, global const param* phys) {
+  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
+  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
+  return (uchar)clamp(floor((t - lo) * scale + (preal)0.5), (preal)0, (preal)255);
+}
+
 kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;
   const int RW = L.raw_width, RH = L.raw_height;
@@ -16,11 +23,11 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
   const preal ty = v - (preal)j0;
   global const preal* top = grid + j0 * RW;
   global const preal* bottom = grid + j1 * RW;
-  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
-  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
   const preal step = (preal)RW / (preal)L.width;
   int x = 0;
 #if !defined(PRECISION_FP64)
+  const float lo = (float)phys[PS_PHYS_WINDOW_MIN];
+  const float scale = 255.0f / ((float)phys[PS_PHYS_WINDOW_MAX] - lo);
   // Each raw column c adds its row value times its hat max(0, 1 - |u - c|) to the pixels
   // it reaches: the bilinear weights, no gathers. A run of 16 pixels meets the columns
   // from floor(u) of its first to floor(u) + 1 of its last.
@@ -43,7 +50,6 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
     const preal tx = u - (preal)i0;
     const preal t0 = top[i0] + tx * (top[i1] - top[i0]);
     const preal t1 = bottom[i0] + tx * (bottom[i1] - bottom[i0]);
-    const preal gray = ((t0 + ty * (t1 - t0)) - lo) * scale + (preal)0.5;
-    out[row0 + x] = (uchar)(int)fmin(fmax(gray, (preal)0), (preal)255);
+    out[row0 + x] = window_level(t0 + ty * (t1 - t0), phys);
   }
 }

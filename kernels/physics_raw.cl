@@ -48,7 +48,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     for (int c = 0; c < RW; ++c) acc[c] = 0;
     for (int x = x_lo; x < x_hi; ++x) {
       const preal t0 = gain * (preal)base[x] + offset;
-      const preal v = lay_kelvin(&Ly, atlas, object_t, t0, x);
+      const preal v = lay_values(&Ly, atlas, x, object_t, t0);
       const preal d = v - t0;
       if (d == 0) continue;
       const int c0 = (int)cband[2 * x], c1 = (int)cband[2 * x + 1];
@@ -68,7 +68,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
 #if !defined(PRECISION_FP64)
   for (; p + 32 <= cells; p += 32) {  // 16 Box-Muller pairs at once (kernels/sensor_noise.cl)
     float16 g0, g1;
-    gauss32_of(seed, index, PS_STREAM_RAW_NOISE, L.view, p >> 1, &g0, &g1);
+    gauss32(seed, index, PS_STREAM_RAW_NOISE, L.view, p >> 1, &g0, &g1);
     vstore16(vload16(0, r + p) + sd * g0, 0, r + p);
     vstore16(vload16(0, r + p + 16) + sd * g1, 0, r + p + 16);
   }

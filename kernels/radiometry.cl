@@ -2,9 +2,9 @@
 // subject's base image turns into kelvin through its subject's (gain, offset); each object,
 // in region order, covers it by its sprite's coverage c: v = c T_object + (1 - c) v, where
 // T_object is the variant's apparent temperature under clothing (host: PS_PHYS_VARIANTS).
-// Pixel x under the layers crossing its row, over v kelvin: each object's apparent
-// temperature laid on by its coverage (the fast path in physics_raw.cl shares it).
-inline preal lay_kelvin(const Layers* Ly, global const uchar* atlas, global const param* object_t, preal v, int x) {
+
+// Lays a row's objects over v at column x, each by its coverage, with its variant's value.
+inline preal lay_values(const Layers* Ly, global const uchar* atlas, int x, global const param* value, preal v) {
   for (int k = 0; k < Ly->count; ++k) {
     const int sx = x - Ly->x0[k];
     if (sx < 0 || sx >= Ly->width[k]) continue;
@@ -16,7 +16,7 @@ inline preal lay_kelvin(const Layers* Ly, global const uchar* atlas, global cons
     } else {
       c = (preal)atlas[Ly->offset[k] + 2 * sx + 1] * ((preal)1 / (preal)255);
     }
-    v = c * (preal)object_t[Ly->variant[k]] + ((preal)1 - c) * v;
+    v = c * (preal)value[Ly->variant[k]] + ((preal)1 - c) * v;
   }
   return v;
 }
@@ -30,5 +30,5 @@ kernel void stage_radiometry(VIEW_STAGE_ARGS) {
   global const param* object_t = phys + PS_PHYS_VARIANTS(L.subjects);
   Layers Ly;
   composite_layers(&Ly, rec, &L, y);
-  for (int x = 0; x < L.width; ++x) T[x] = lay_kelvin(&Ly, atlas, object_t, gain * (preal)base[x] + offset, x);
+  for (int x = 0; x < L.width; ++x) T[x] = lay_values(&Ly, atlas, x, object_t, gain * (preal)base[x] + offset);
 }

@@ -67,7 +67,7 @@ kernel void render_view(VIEW_STAGE_ARGS) {
     for (int xc = 0; xc < W; xc += 32) {
       const int x = min(xc, W - 32);
       float16 g0, g1;
-      gauss32(seed, index, L.view, (y * W + x) >> 1, &g0, &g1);
+      gauss32(seed, index, PS_STREAM_PIXEL_NOISE, L.view, (y * W + x) >> 1, &g0, &g1);
       render_chunk16(atlas, base, row, x, &Ly, &T, tile_size, gain, alpha, sigma, 1, g0);
       render_chunk16(atlas, base, row, x + 16, &Ly, &T, tile_size, gain, alpha, sigma, 1, g1);
     }

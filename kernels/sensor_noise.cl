@@ -74,10 +74,10 @@ inline greal2 gauss_pair_of(uint2 seed, ulong index, uint stream, int view, int 
   return (float2)(rad * c, rad * s);
 }
 
-// The draws of pixels 2 pair .. 2 pair + 31: 16 Box-Muller pairs, interleaved, the first
-// 16 pixels in *g0 and the next 16 in *g1.
-__attribute__((always_inline)) inline void gauss32_of(uint2 seed, ulong index, uint stream, int view, int pair,
-                                                      float16* g0, float16* g1) {
+// The draws of pixels 2 pair .. 2 pair + 31 of a stream: 16 Box-Muller pairs, interleaved,
+// the first 16 pixels in *g0 and the next 16 in *g1.
+__attribute__((always_inline)) inline void gauss32(uint2 seed, ulong index, uint stream, int view, int pair,
+                                                   float16* g0, float16* g1) {
   uint16 c0 = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
               ((uint)pair + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
   uint16 c1 = (uint16)(stream), c2 = (uint16)((uint)index), c3 = (uint16)((uint)(index >> 32));
@@ -91,9 +91,6 @@ __attribute__((always_inline)) inline void gauss32_of(uint2 seed, ulong index, u
   s *= rad;
   *g0 = shuffle2(c, s, (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23));
   *g1 = shuffle2(c, s, (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
-}
-__attribute__((always_inline)) inline void gauss32(uint2 seed, ulong index, int view, int pair, float16* g0, float16* g1) {
-  gauss32_of(seed, index, PS_STREAM_PIXEL_NOISE, view, pair, g0, g1);
 }
 #endif
 

@@ -39,6 +39,7 @@
 #define PS_STREAM_BLOCK_NOISE 4u   /* block-mean noise model; element = feature */
 #define PS_STREAM_JITTER 5u        /* sprite placement jitter; element = region */
 #define PS_STREAM_RAW_NOISE 6u     /* physics: MMW noise per raw pixel; element = view << 28 | raw pixel / 2 */
+#define PS_STREAM_IR_NOISE 7u      /* physics: IR noise per pixel; element = view << 28 | pixel / 2 */
 #define PS_STREAM_GENERATE 16u     /* scenario generators (host only) */
 #define PS_PIXEL_NOISE_VIEW_SHIFT 28
 

@@ -135,7 +135,7 @@ TEST(Physics, EachStageOfTheChainDoesSomethingInBothBackends) {
   }
 }
 
-TEST(Physics, TheModelKnobSwitchesTheMmwChainOnly) {
+TEST(Physics, TheModelKnobSwitchesEveryCamerasChain) {
   const SceneBatch batch = test::batch_of(scenes(8));
   auto cl = make_opencl_backend(catalogue(), assets(), test::runtime());
   BatchOutput thesis, physics;
@@ -143,6 +143,7 @@ TEST(Physics, TheModelKnobSwitchesTheMmwChainOnly) {
   cl->run(batch, physics_plan(0), physics);
   EXPECT_NE(thesis.view("upper").pixels, physics.view("upper").pixels);
   EXPECT_NE(thesis.view("lower").pixels, physics.view("lower").pixels);
+  EXPECT_NE(thesis.view("ir").pixels, physics.view("ir").pixels);
 }
 
 TEST(Physics, OutputDoesNotDependOnTheBatch) {
@@ -449,7 +450,8 @@ TEST(Physics, SimulateWritesEveryStageField) {
     const std::string shown = test::slurp(out / "stages" / (v + ".5.mmw_display.npy"));
     ASSERT_EQ(shown.size(), 128u + 200 * 200 * 8);
   }
-  EXPECT_TRUE(fs::exists(out / "stages" / "ir.1.composite.npy"));
+  EXPECT_TRUE(fs::exists(out / "stages" / "ir.1.contact_shadow.npy"));
+  EXPECT_TRUE(fs::exists(out / "stages" / "ir.5.ir_display.npy"));
   EXPECT_TRUE(fs::exists(out / "upper.png"));
 }
 

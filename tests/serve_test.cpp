@@ -91,6 +91,19 @@ TEST_F(Serve, RenderGivesTheThesisGunExample) {
   EXPECT_EQ(j["upper"].get<std::string>().rfind("data:image/png;base64,iVBORw0KGgo", 0), 0u);
 }
 
+// The page's IR palette changes the IR image, not the MMW views.
+TEST_F(Serve, PaletteChangesTheIrImageOnly) {
+  std::map<std::string, json> got;
+  for (const char* palette : {"ironbow", "gray"}) {
+    auto r = post("/api/render", {{"objects", kGun}, {"palette", palette}});
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 200) << r->body;
+    got[palette] = json::parse(r->body);
+  }
+  EXPECT_EQ(got["ironbow"]["upper"], got["gray"]["upper"]);
+  EXPECT_NE(got["ironbow"]["ir"], got["gray"]["ir"]);
+}
+
 // Each bad input gets HTTP 400 and the message simulate prints for the same input.
 TEST_F(Serve, BadInputsGet400WithTheCommandLinesMessage) {
   struct Case {
@@ -104,6 +117,7 @@ TEST_F(Serve, BadInputsGet400WithTheCommandLinesMessage) {
       {{{"objects", kGun}, {"seed", "12x"}}, {"none", "none", "none", "gun", "--seed", "12x"}},
       {{{"objects", kGun}, {"tier", "turbo"}}, {"none", "none", "none", "gun", "--tier", "turbo"}},
       {{{"objects", kGun}, {"placement", "cubic"}}, {"none", "none", "none", "gun", "--placement", "cubic"}},
+      {{{"objects", kGun}, {"palette", "jet"}}, {"none", "none", "none", "gun", "--palette", "jet"}},
       {{{"objects", kGun}, {"threat", "maybe"}}, {"none", "none", "none", "gun", "--threat", "maybe"}},
       {{{"objects", kGun}, {"rule", "gun"}, {"threat", "yes"}},
        {"none", "none", "none", "gun", "--rule", "gun", "--threat", "yes"}},

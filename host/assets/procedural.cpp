@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -660,6 +661,10 @@ struct Stop {
 };
 constexpr Stop kIron[] = {{0, 0, 0, 0},       {36, 22, 0, 92},    {78, 92, 0, 150},    {118, 168, 6, 140},
                           {152, 218, 38, 64}, {186, 246, 108, 0}, {222, 255, 196, 24}, {255, 255, 252, 236}};
+constexpr Stop kGray[] = {{0, 0, 0, 0}, {255, 255, 255, 255}};  // white hot
+// Rainbow: blue (cold), cyan, green, yellow, red, white (hot).
+constexpr Stop kRainbow[] = {{0, 0, 0, 128},     {40, 0, 0, 255},   {92, 0, 224, 255},   {140, 0, 224, 0},
+                             {184, 255, 240, 0}, {228, 255, 32, 0}, {255, 255, 255, 255}};
 
 }  // namespace
 
@@ -840,14 +845,21 @@ Image noise_pattern(int k, int size) {
   return img;
 }
 
-std::array<std::array<uint8_t, 3>, 256> ir_palette() {
+const char* palette_name(PaletteName p) {
+  return p == PaletteName::gray ? "gray" : p == PaletteName::rainbow ? "rainbow" : "ironbow";
+}
+
+std::array<std::array<uint8_t, 3>, 256> ir_palette(PaletteName which) {
+  const std::span<const Stop> stops = which == PaletteName::gray      ? std::span<const Stop>(kGray)
+                                      : which == PaletteName::rainbow ? std::span<const Stop>(kRainbow)
+                                                                      : std::span<const Stop>(kIron);
   std::array<std::array<uint8_t, 3>, 256> pal{};
-  constexpr int n = sizeof(kIron) / sizeof(kIron[0]);
+  const size_t n = stops.size();
   for (int i = 0; i < 256; ++i) {
-    int k = 0;
-    while (k + 2 < n && i > kIron[k + 1].at) ++k;
-    const Stop& a = kIron[k];
-    const Stop& b = kIron[k + 1];
+    size_t k = 0;
+    while (k + 2 < n && i > stops[k + 1].at) ++k;
+    const Stop& a = stops[k];
+    const Stop& b = stops[k + 1];
     const double t = static_cast<double>(i - a.at) / (b.at - a.at);
     pal[i] = {to_u8(lerp(a.r, b.r, t)), to_u8(lerp(a.g, b.g, t)), to_u8(lerp(a.b, b.b, t))};
   }

@@ -42,8 +42,11 @@ Image sprite(const std::string& shape, bool vertical, int width, int height, int
 // to the image. Its amplitude falls to 0 at the tile's border, so it stays local.
 Image noise_pattern(int k, int size);
 
-// 256-entry RGB palette for IR temperature indices, like the thesis's figure 4.13:
-// black, blue, magenta, red, orange, yellow, white.
-std::array<std::array<uint8_t, 3>, 256> ir_palette();
+// 256-entry RGB palettes for IR temperature indices: ironbow, like the thesis's figure 4.13
+// (black, blue, magenta, red, orange, yellow, white; also how RGB captures are read), gray
+// (white hot), rainbow (blue cold to red and white hot).
+enum class PaletteName { ironbow = 0, gray = 1, rainbow = 2 };
+const char* palette_name(PaletteName p);
+std::array<std::array<uint8_t, 3>, 256> ir_palette(PaletteName which = PaletteName::ironbow);
 
 }  // namespace portalsim::procedural

@@ -18,6 +18,15 @@ const std::vector<ViewStage>& view_stages() {
       {"sample", reference::sample, {{"stage_sample", K::raw_rows}}},
       {"netd", reference::netd, {{"stage_netd", K::raw_rows}}},
       {"mmw_display", reference::mmw_display, {{"stage_mmw_display", K::view_rows}}, true},
+      // The physics model's IR camera. Heat spreading is the PSF's separable Gaussian
+      // kernels over the taps its launch passes.
+      {"contact_shadow", reference::contact_shadow, {{"stage_contact_shadow", K::view_rows}}},
+      {"heat_spread",
+       reference::heat_spread,
+       {{"stage_optics_rows", K::view_rows}, {"stage_optics_columns", K::view_rows}}},
+      {"ir_surface", reference::ir_surface, {{"stage_ir_surface", K::view_rows}}},
+      {"ir_netd", reference::ir_netd, {{"stage_ir_netd", K::view_rows}}},
+      {"ir_display", reference::ir_display, {{"stage_ir_display", K::view_rows}}, true},
   };
   return stages;
 }

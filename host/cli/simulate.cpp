@@ -44,7 +44,7 @@ int simulate(SimulateOptions& o) {
   open_backend(s, o.common);
   BatchOutput out;
   const StageFieldsRequest fields{cat, s.assets};
-  const OneScenarioTimes t = write_one_scenario(o.out, *s.backend, scene, plan, s.assets.palette,
+  const OneScenarioTimes t = write_one_scenario(o.out, *s.backend, scene, plan, procedural::ir_palette(plan.palette),
                                                 FolderOptions{o.image_format}, out, o.stages ? &fields : nullptr);
   const double run_seconds = t.run_seconds, write_seconds = t.write_seconds;
 

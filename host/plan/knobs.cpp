@@ -73,6 +73,9 @@ std::vector<Knob> declare() {
       "worn_minutes", 0, 1440, "minutes",
       "physics: how long the objects have been carried; they warm from the room towards the skin",
       [](Plan& p, double v) { p.model.worn_minutes = v; }, [](const Plan& p) { return p.model.worn_minutes; }));
+  k.push_back(number(
+      "ir_netd", 0, 10, "K", "physics: IR sensor noise, rms per pixel (thermal cameras: about 0.05 K)",
+      [](Plan& p, double v) { p.model.ir_netd = v; }, [](const Plan& p) { return p.model.ir_netd; }));
   k.push_back(integer(
       "block", 1, 65536, "pixels", "side of the averaged pixel blocks of the features (thesis 5.6)",
       [](Plan& p, double v) { p.model.block = static_cast<int>(v); }, [](const Plan& p) { return p.model.block; }));
@@ -93,6 +96,12 @@ std::vector<Knob> declare() {
   k.push_back(number(
       "jitter", 0, 1000, "pixels", "move each object by up to this much in x and y",
       [](Plan& p, double v) { p.model.jitter = v; }, [](const Plan& p) { return p.model.jitter; }));
+  k.push_back(choice(
+      "palette", {"ironbow", "gray", "rainbow"},
+      "how the IR temperature index is written as RGB: ironbow (the thesis's), gray (white hot), rainbow; "
+      "the index itself is unchanged",
+      false, true, [](Plan& p, double v) { p.palette = static_cast<procedural::PaletteName>(v); },
+      [](const Plan& p) { return procedural::palette_name(p.palette); }));
   // The fidelity tiers' knobs (README, "Fidelity tiers"): each overrides --tier.
   k.push_back(choice(
       "precision", {"fp32", "fp64", "fixed16"},

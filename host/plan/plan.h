@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "assets/procedural.h"
 #include "scene/catalogue.h"
 
 namespace portalsim {
@@ -27,6 +28,7 @@ struct ModelSettings {
   double netd = 3.0;                    // K rms: MMW sensor noise per raw pixel
   int raw_width = 28, raw_height = 28;  // the MMW camera's raw grid over each view
   double worn_minutes = 5.0;            // how long the objects have been carried (their temperature)
+  double ir_netd = 0.05;                // K rms: IR sensor noise per pixel
   bool moves_sprites() const { return bilinear || jitter > 0; }
 };
 
@@ -69,6 +71,9 @@ struct Plan {
   bool annotations = false;     // per-object boxes and instance masks (backend/annotate.h)
   ModelSettings model;
   Fidelity fidelity;
+  // How the IR temperature index is written as RGB (images, h5 `ir`, serve); not part of
+  // either model: the stored index is the same.
+  procedural::PaletteName palette = procedural::PaletteName::ironbow;
 
   bool image(int view) const { return (images >> view) & 1u; }
   // A view is rendered when its images are kept or it is pooled into features; views

@@ -65,6 +65,12 @@ struct PhysicsConfig {
   int base_background_gray = 25;
   // Display window: these temperatures map to gray 0 and 255.
   double display_min = 283.0, display_max = 313.0;
+  // The IR camera: the base image's temperature index 0 and 255 in kelvin (linear); how much
+  // of an object's coolness reaches the clothing surface; the Gaussian heat spreading in the
+  // fabric (sigma, mm); the display window in kelvin shown as index 0 and 255.
+  double ir_index_min_k = 290.5, ir_index_max_k = 308.9;
+  double ir_coupling = 0.8, ir_spread_mm = 10.0;
+  double ir_display_min = 290.5, ir_display_max = 308.9;
 };
 
 struct Object {

@@ -37,6 +37,7 @@ enum Stream : uint32_t {
   kStreamBlockNoise = PS_STREAM_BLOCK_NOISE,
   kStreamJitter = PS_STREAM_JITTER,
   kStreamRawNoise = PS_STREAM_RAW_NOISE,
+  kStreamIrNoise = PS_STREAM_IR_NOISE,
   kStreamGenerate = PS_STREAM_GENERATE,
 };
 

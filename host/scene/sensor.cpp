@@ -38,6 +38,7 @@ std::vector<Sensor> camera_sensors(const Catalogue& cat) {
     ir.region_mask |= 1u << (r.id - 1);
   }
   ir.palette = true;
+  ir.physics_chain = {"contact_shadow", "heat_spread", "ir_surface", "ir_netd", "ir_display"};
   ir.jitter_scale_x = static_cast<double>(ic.ir_width) / ic.mmw_width;
   ir.jitter_scale_y = static_cast<double>(ic.ir_height) / (2.0 * ic.mmw_height);
   out.push_back(ir);

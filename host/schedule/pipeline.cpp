@@ -430,6 +430,7 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   ctx.rows = res.end - res.begin;
   ctx.threads = threads;
   ctx.image_format = spec.image_format;
+  ctx.palette = procedural::ir_palette(plan.palette);
   std::vector<std::unique_ptr<Sink>> sinks = open_sinks(spec, plan, ctx, source.rule(), identity, start, first);
 
   const auto checkpoint = [&](uint64_t next) {

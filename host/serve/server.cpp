@@ -164,6 +164,7 @@ struct Server::Impl {
     knob("pattern_noise", field<bool>(j, "pattern_noise", true) ? "on" : "off");
     knob("pixel_noise", knob_text(field<double>(j, "pixel_noise", 0.0)));
     knob("placement", field<std::string>(j, "placement", "integer"));
+    knob("palette", field<std::string>(j, "palette", "ironbow"));
     if (r.in.objects.size() > static_cast<size_t>(kRegions))
       throw InputError("objects: " + std::to_string(r.in.objects.size()) + " given, at most 13 regions");
     r.plan.model.seed = io::parse_u64(r.seed, "--seed");
@@ -179,7 +180,7 @@ struct Server::Impl {
   std::vector<int> run(const Request& r, const Scenario& scene, const std::string& dir) {
     BatchOutput out;
     std::lock_guard<std::mutex> lock(backend_mutex);
-    write_one_scenario(dir, backend, scene, r.plan, assets.palette, FolderOptions{}, out);
+    write_one_scenario(dir, backend, scene, r.plan, procedural::ir_palette(r.plan.palette), FolderOptions{}, out);
     return std::vector<int>(out.metal_of(0), out.metal_of(0) + kZones);
   }
 

@@ -162,7 +162,7 @@ class ImageSink final : public Sink {
         fs::create_directory(tmp, ec);
         if (ec) throw OutputError(tmp.string() + ": cannot create: " + ec.message());
         write_scenario_folder([&](const std::string& f) { return (tmp / f).string(); }, out, i, scenes.label[i] == 1,
-                              ctx_.assets->palette, FolderOptions{ctx_.image_format});
+                              ctx_.palette, FolderOptions{ctx_.image_format});
         const fs::path final_path = fs::path(root_) / name;
         fs::remove_all(final_path, ec);
         fs::rename(tmp, final_path, ec);

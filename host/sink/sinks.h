@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "assets/procedural.h"
 #include "backend/backend.h"
 #include "sink/append_file.h"
 
@@ -31,6 +32,7 @@ struct SinkContext {
   uint64_t rows = 0;  // rows the finished table will hold (the npy header needs it)
   unsigned threads = 1;
   std::string image_format = "png";
+  Palette palette = procedural::ir_palette();  // the IR index as RGB (Plan::palette)
 };
 
 // format: arff, csv or npy; the file is ctx.dir/name (default "features.<format>"; an npy

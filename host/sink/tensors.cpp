@@ -62,7 +62,7 @@ class TensorSink final : public Sink {
                 const size_t px = v.pixels_per_image();
                 buf.resize(b.size() * px * 3);
                 for (size_t i = 0; i < b.size() * px; ++i)
-                  std::memcpy(&buf[i * 3], ctx_.assets->palette[v.pixels[i]].data(), 3);
+                  std::memcpy(&buf[i * 3], ctx_.palette[v.pixels[i]].data(), 3);
               });
           add(s.name + "_index", TensorType::u8, {h, w},
               [k](const SceneBatch&, const BatchOutput& o, std::string& buf) {

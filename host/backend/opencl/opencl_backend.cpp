@@ -393,16 +393,16 @@ class OpenCLBackend final : public Backend {
   }
 
   // The physics model's parameters for a view's launch (kernels/shared.h, PS_PHYS_*), at the
-  // kernels' parameter precision, with the fast path's tables; fills L's offsets into them.
-  // The same formulas as the reference's, written again here: the two never share code.
-  // Kept per (view, knobs, precision): the bare raw grids cost a few milliseconds.
+  // kernels' parameter precision, with the MMW fast path's tables; fills L's offsets into
+  // them. The same formulas as the reference's, written again here: the two never share
+  // code. Kept per (view, knobs, precision): the bare raw grids cost a few milliseconds.
   cl::Buffer physics_params(const Kernels& K, const Plan& plan, int view, PsViewLaunch& L) {
     L.psf_radius = L.phys_wx = L.phys_wy = L.phys_cband = L.phys_rband = L.phys_base = 0;
     if (plan.model.model != Model::physics) return physics_none_.at_least(rt_->context(), 16);
     const ModelSettings& m = plan.model;
-    char key[160];
-    std::snprintf(key, sizeof key, "%d %d %a %a %a %d %d", view, int(K.fp64), m.illumination, m.netd, m.worn_minutes,
-                  m.raw_width, m.raw_height);
+    char key[200];
+    std::snprintf(key, sizeof key, "%d %d %a %a %a %a %d %d", view, int(K.fp64), m.illumination, m.netd, m.ir_netd,
+                  m.worn_minutes, m.raw_width, m.raw_height);
     PhysicsTables& t = physics_tables_[key];
     if (t.values.empty()) t = physics_tables(plan, cat_.sensors[view], view);
     L.psf_radius = t.radius;
@@ -424,10 +424,28 @@ class OpenCLBackend final : public Backend {
     cl::Buffer buffer;
   };
 
+  // An object's physical temperature after `worn` minutes on the body: from the room towards
+  // the skin with its material's time constant.
+  static double worn_temperature(const PhysicsConfig& pc, const Material& mat, double worn) {
+    return pc.skin_temperature - (pc.skin_temperature - pc.room_temperature) * std::exp(-worn / mat.warm_minutes);
+  }
+
+  // A Gaussian of `sigma` taps over +-4 sigma, normalised; sigma 0 is the single tap 1.
+  static void append_gaussian_taps(std::vector<double>& p, double sigma, int32_t& radius) {
+    radius = sigma > 0 ? static_cast<int32_t>(std::ceil(4.0 * sigma)) : 0;
+    double total = 0;
+    const size_t first = p.size();
+    for (int d = -radius; d <= radius; ++d) {
+      p.push_back(sigma > 0 ? std::exp(-0.5 * d * d / (sigma * sigma)) : 1.0);
+      total += p.back();
+    }
+    for (size_t k = first; k < p.size(); ++k) p[k] /= total;
+  }
+
   // The raw grid's weight of each view pixel along one axis (size pixels, raw cells): the
   // PSF's taps (edges held) folded into each cell's box over size / raw pixels; then the
   // first and last cell each pixel reaches.
-  static void axis_weights(int size, int raw, const std::vector<double>& taps, int radius, std::vector<double>& w,
+  static void axis_weights(int size, int raw, const double* taps, int radius, std::vector<double>& w,
                            std::vector<double>& band) {
     w.assign(static_cast<size_t>(raw) * size, 0.0);
     const double step = double(size) / raw;
@@ -450,6 +468,7 @@ class OpenCLBackend final : public Backend {
   PhysicsTables physics_tables(const Plan& plan, const Sensor& s, int view) const {
     const PhysicsConfig& pc = cat_.physics;
     const ModelSettings& m = plan.model;
+    const bool ir = s.camera == Camera::ir;
     const auto seen = [&](double e, double t) {
       return pc.clothing_transmission * (e * t + (1 - e) * m.illumination) +
              (1 - pc.clothing_transmission) * pc.clothing_temperature;
@@ -458,36 +477,39 @@ class OpenCLBackend final : public Backend {
     std::vector<double>& p = t.values;
     p.assign(PS_PHYS_SUBJECTS, 0.0);
     p[PS_PHYS_BACKGROUND] = pc.background_temperature;
-    p[PS_PHYS_WINDOW_MIN] = pc.display_min;
-    p[PS_PHYS_WINDOW_MAX] = pc.display_max;
-    p[PS_PHYS_NETD] = m.netd;
+    p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : pc.display_min;
+    p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : pc.display_max;
+    p[PS_PHYS_NETD] = ir ? m.ir_netd : m.netd;
+    // Per subject, its base image's value to kelvin: the IR index map, or the MMW's gray
+    // between the room behind and the bare body.
     const double body = seen(pc.skin_emissivity, pc.skin_temperature);
     for (const Subject& subj : cat_.subjects) {
-      const double gain = (body - pc.background_temperature) / (subj.mmw_level - pc.base_background_gray);
+      const double gain = ir ? (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0
+                             : (body - pc.background_temperature) / (subj.mmw_level - pc.base_background_gray);
       p.push_back(gain);
-      p.push_back(pc.background_temperature - gain * pc.base_background_gray);
+      p.push_back(ir ? pc.ir_index_min_k : pc.background_temperature - gain * pc.base_background_gray);
     }
+    // Per variant: the IR surface's contact shadow, or the MMW apparent temperature.
     for (size_t v = 0; v < cat_.variant_list.size(); ++v) {
       const Material& mat = cat_.materials.at(cat_.object_of(static_cast<int>(v)).material_id);
-      const double rise = (pc.skin_temperature - pc.room_temperature) * std::exp(-m.worn_minutes / mat.warm_minutes);
-      p.push_back(seen(mat.emissivity, pc.skin_temperature - rise));
+      const double worn = worn_temperature(pc, mat, m.worn_minutes);
+      p.push_back(ir ? -pc.ir_coupling * (pc.skin_temperature - worn) : seen(mat.emissivity, worn));
     }
-    // The Airy core's FWHM, 1.02 lambda / D at the range, in this view's pixels; a
-    // Gaussian of that FWHM over +-4 sigma.
+    // MMW: the Airy core's FWHM, 1.02 lambda / D at the range, in this view's pixels, as a
+    // Gaussian of that FWHM. IR: ir_spread_mm over the view's pixel (as wide as an MMW view).
+    const double span_m = 2.0 * pc.range_m * std::tan(pc.fov_rad / 2.0);
     const double lambda = 299792458.0 / (pc.frequency_ghz * 1e9);
-    const double fwhm = 1.02 * lambda / pc.aperture_m * s.width / (2.0 * std::tan(pc.fov_rad / 2.0));
-    const double sigma = fwhm / 2.3548200450309493;
-    t.radius = static_cast<int32_t>(std::ceil(4.0 * sigma));
-    std::vector<double> taps;
-    double total = 0;
-    for (int d = -t.radius; d <= t.radius; ++d) total += taps.emplace_back(std::exp(-0.5 * d * d / (sigma * sigma)));
-    for (double& tap : taps) tap /= total;
-    p.insert(p.end(), taps.begin(), taps.end());
-    // The fast path's tables.
+    const double sigma = ir ? pc.ir_spread_mm / (1000.0 * span_m / s.width)
+                            : 1.02 * lambda / pc.aperture_m * pc.range_m / (span_m / s.width) / 2.3548200450309493;
+    const size_t taps = p.size();
+    append_gaussian_taps(p, sigma, t.radius);
+    if (ir) return t;
+    // The MMW fast path's tables (kernels/physics_raw.cl).
     const int W = s.width, H = s.height, RW = m.raw_width, RH = m.raw_height;
+    const std::vector<double> psf(p.begin() + static_cast<std::ptrdiff_t>(taps), p.end());
     std::vector<double> wx, wy, cband, rband;
-    axis_weights(W, RW, taps, t.radius, wx, cband);
-    axis_weights(H, RH, taps, t.radius, wy, rband);
+    axis_weights(W, RW, psf.data(), t.radius, wx, cband);
+    axis_weights(H, RH, psf.data(), t.radius, wy, rband);
     const auto append = [&](const std::vector<double>& v) {
       if (p.size() + v.size() > 0x7fffffffu) throw std::runtime_error("physics tables exceed 2^31 values");
       const int32_t at = static_cast<int32_t>(p.size());

@@ -15,10 +15,10 @@ double psf_fwhm_pixels(const Catalogue& cat, const Sensor& view) {
   return fwhm_m / pixel_m;
 }
 
-// A Gaussian of that FWHM, truncated at 4 sigma and normalised, along x then along y;
-// pixels past the edge repeat the edge pixel.
-void optics(const ViewScene& vs, Field& f) {
-  const double sigma = psf_fwhm_pixels(vs.cat, vs.sensor) / (2.0 * std::sqrt(2.0 * std::log(2.0)));
+// A Gaussian of standard deviation `sigma` pixels, truncated at 4 sigma and normalised,
+// along x then along y; pixels past the edge repeat the edge pixel. sigma 0 changes nothing.
+void gaussian_blur(Field& f, double sigma) {
+  if (sigma <= 0) return;
   const int R = static_cast<int>(std::ceil(4.0 * sigma));
   std::vector<double> taps(2 * R + 1);
   double total = 0;
@@ -39,5 +39,20 @@ void optics(const ViewScene& vs, Field& f) {
       f.at(x, y) = acc;
     }
 }
+
+// A Gaussian of the Airy core's FWHM.
+void optics(const ViewScene& vs, Field& f) {
+  gaussian_blur(f, psf_fwhm_pixels(vs.cat, vs.sensor) / (2.0 * std::sqrt(2.0 * std::log(2.0))));
+}
+
+// The IR view is as wide as an MMW view: 2 R tan(fov / 2) metres over its width.
+double ir_spread_pixels(const Catalogue& cat, const Sensor& view) {
+  const PhysicsConfig& pc = cat.physics;
+  const double pixel_mm = 1000.0 * 2.0 * pc.range_m * std::tan(pc.fov_rad / 2.0) / view.width;
+  return pc.ir_spread_mm / pixel_mm;
+}
+
+// Heat spreading sideways in the fabric: a Gaussian of ir_spread_mm over the shadow field.
+void heat_spread(const ViewScene& vs, Field& f) { gaussian_blur(f, ir_spread_pixels(vs.cat, vs.sensor)); }
 
 }  // namespace portalsim::reference

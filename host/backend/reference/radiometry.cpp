@@ -23,12 +23,16 @@ double body_temperature(const Catalogue& cat, const ModelSettings& m) {
 
 // The object has warmed from the room towards the skin for worn_minutes, with its
 // material's time constant.
-double object_temperature(const Catalogue& cat, const ModelSettings& m, int variant) {
+double worn_temperature(const Catalogue& cat, const ModelSettings& m, int variant) {
   const PhysicsConfig& pc = cat.physics;
   const Material& mat = cat.materials.at(cat.object_of(variant).material_id);
-  const double t =
-      pc.skin_temperature - (pc.skin_temperature - pc.room_temperature) * std::exp(-m.worn_minutes / mat.warm_minutes);
-  return under_clothing(pc, m, mat.emissivity, t);
+  return pc.skin_temperature -
+         (pc.skin_temperature - pc.room_temperature) * std::exp(-m.worn_minutes / mat.warm_minutes);
+}
+
+double object_temperature(const Catalogue& cat, const ModelSettings& m, int variant) {
+  const Material& mat = cat.materials.at(cat.object_of(variant).material_id);
+  return under_clothing(cat.physics, m, mat.emissivity, worn_temperature(cat, m, variant));
 }
 
 // The subject's base image in kelvin: its background gray is the room behind the subject,

@@ -63,10 +63,21 @@ void sample(const ViewScene& vs, Field& f);       // integrate onto the raw grid
 void netd(const ViewScene& vs, Field& f);         // Gaussian noise per raw pixel, NETD kelvin rms
 void mmw_display(const ViewScene& vs, Field& f);  // bilinear to the view, window to gray, round
 
+// The physics model's IR chain (README, "The physics model: IR camera"), in order.
+void contact_shadow(const ViewScene& vs, Field& f);  // dT of objects under clothing, K, alone
+void heat_spread(const ViewScene& vs, Field& f);     // Gaussian of ir_spread_mm over the shadow
+void ir_surface(const ViewScene& vs, Field& f);      // plus the bare body's surface, K
+void ir_netd(const ViewScene& vs, Field& f);         // Gaussian noise per pixel, ir_netd kelvin rms
+void ir_display(const ViewScene& vs, Field& f);      // window to temperature index, round
+
 // The physics model's quantities, from the catalogue and the knobs.
-double body_temperature(const Catalogue& cat, const ModelSettings& m);                 // bare body under clothing, K
-double object_temperature(const Catalogue& cat, const ModelSettings& m, int variant);  // apparent, under clothing
-double psf_fwhm_pixels(const Catalogue& cat, const Sensor& view);  // the Airy core's FWHM in view pixels
+double body_temperature(const Catalogue& cat, const ModelSettings& m);               // bare body under clothing, K
+double worn_temperature(const Catalogue& cat, const ModelSettings& m, int variant);  // physical, K, warmed on the body
+double object_temperature(const Catalogue& cat, const ModelSettings& m, int variant);     // apparent, under clothing
+double contact_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant);  // IR surface dT, full cover
+double ir_spread_pixels(const Catalogue& cat, const Sensor& view);  // heat spreading's sigma in IR view pixels
+void gaussian_blur(Field& f, double sigma);                         // separable, edges held; sigma in pixels
+double psf_fwhm_pixels(const Catalogue& cat, const Sensor& view);   // the Airy core's FWHM in view pixels
 
 // Block means of each pooled view, then each region's mean (thesis 5.6); `views` holds the
 // displayed images of every camera view (empty where not rendered).

@@ -10,6 +10,7 @@ function settings() {
   for (let r = 1; r <= cat.regions.length; ++r) objects.push($("region" + r).value);
   return {
     subject: Number($("subject").value), seed: $("seed").value, tier: $("tier").value, placement: $("placement").value,
+    palette: $("palette").value,
     pattern_noise: $("pattern-noise").checked, pixel_noise: Number($("pixel-noise").value),
     rule: $("rule").value.trim(), threat: $("threat").value, objects,
   };
@@ -106,7 +107,7 @@ async function init() {
     row.innerHTML = '<span class="name">' + z + '</span><div class="bar"><div></div></div><span class="value"></span>';
     $(z <= 9 ? "panel-a" : "panel-b").appendChild(row);
   }
-  for (const id of ["subject", "seed", "tier", "placement", "pattern-noise", "pixel-noise", "rule", "threat"])
+  for (const id of ["subject", "seed", "tier", "placement", "palette", "pattern-noise", "pixel-noise", "rule", "threat"])
     $(id).addEventListener("change", render);
   $("save").addEventListener("click", save);
   $("generate").addEventListener("click", generate);

@@ -1,0 +1,57 @@
+// The physics model's IR camera, which sees the clothing surface. Stage "contact_shadow":
+// the field is each object's surface dT alone (host: PS_PHYS_VARIANTS, -coupling (skin -
+// object)), laid by its IR sprite's coverage over 0 K; "heat_spread" then blurs it with
+// the optics kernels. Stage "ir_surface": plus the bare body's surface temperature, the
+// base image's index read as kelvin through the subject's (gain, offset).
+kernel void stage_contact_shadow(VIEW_STAGE_ARGS) {
+  VIEW_STAGE_ROW;
+  global preal* dT = (global preal*)field + row0;
+  global const param* shadow = phys + PS_PHYS_VARIANTS(L.subjects);
+  Layers Ly;
+  composite_layers(&Ly, rec, &L, y);
+  for (int x = 0; x < L.width; ++x) dT[x] = lay_values(&Ly, atlas, x, shadow, (preal)0);
+}
+
+kernel void stage_ir_surface(VIEW_STAGE_ARGS) {
+  VIEW_STAGE_ROW;
+  global const uchar* base = base_row(atlas, bases, subject, &L, i, y);
+  global preal* T = (global preal*)field + row0;
+  const int s = subject[i];
+  const preal gain = (preal)phys[PS_PHYS_SUBJECTS + 2 * s], offset = (preal)phys[PS_PHYS_SUBJECTS + 2 * s + 1];
+  for (int x = 0; x < L.width; ++x) T[x] += gain * (preal)base[x] + offset;
+}
+
+// Stage "ir_netd": Gaussian noise of the IR NETD (kelvin rms) on every view pixel, from
+// the counter generator (PS_STREAM_IR_NOISE; Box-Muller pairs of pixels 2k, 2k + 1). fp32
+// and fixed16 builds draw 32 pixels at a time (gauss32), fp64 builds a pair at a time.
+kernel void stage_ir_netd(VIEW_STAGE_ARGS) {
+  VIEW_STAGE_ROW;
+  const preal sd = (preal)phys[PS_PHYS_NETD];
+  if (sd <= 0) return;
+  global preal* T = (global preal*)field + row0;
+  const int p0 = y * L.width, p1 = p0 + L.width;
+#if defined(PRECISION_FP64)
+  for (int p = p0 & ~1; p < p1; p += 2) {
+    const greal2 g = gauss_pair_of(seed, index, PS_STREAM_IR_NOISE, L.view, p >> 1);
+    if (p >= p0) T[p - p0] += sd * (preal)g.x;
+    if (p + 1 < p1) T[p + 1 - p0] += sd * (preal)g.y;
+  }
+#else
+  for (int p = p0 & ~1; p < p1; p += 32) {
+    float16 g0, g1;
+    gauss32(seed, index, PS_STREAM_IR_NOISE, L.view, p >> 1, &g0, &g1);
+    float g[32];
+    vstore16(g0, 0, g);
+    vstore16(g1, 1, g);
+    const int lo = max(p0 - p, 0), hi = min(p1 - p, 32);
+    for (int j = lo; j < hi; ++j) T[p + j - p0] += sd * g[j];
+  }
+#endif
+}
+
+// Stage "ir_display": the IR display window, kelvin to temperature index 0..255.
+kernel void stage_ir_display(VIEW_STAGE_ARGS) {
+  VIEW_STAGE_ROW;
+  global const preal* T = (global const preal*)field + row0;
+  for (int x = 0; x < L.width; ++x) out[row0 + x] = window_level(T[x], phys);
+}
