@@ -1,5 +1,6 @@
 // portalsim tradeoff: one scenario set through every fidelity tier and the fp64
-// reference; throughput, error and the effect on a classifier, as JSON, CSV and a plot.
+// reference of each sensor model; throughput, error and the effect on a classifier, as
+// JSON, CSV and a plot.
 #include <unistd.h>
 
 #include <chrono>
@@ -7,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <utility>
 
 #include "backend/compare.h"
 #include "backend/opencl/opencl_backend.h"
@@ -15,6 +18,7 @@
 #include "cli/common.h"
 #include "cli/weka.h"
 #include "io/input_file.h"
+#include "plan/knobs.h"
 #include "scene/generator.h"
 #include "sink/sinks.h"
 #include "sink/staging.h"
@@ -36,6 +40,7 @@ struct TradeoffOptions {
   uint64_t count = 2000;
   std::string out = "tradeoff";
   ModelSettings model;
+  std::string models = "thesis,physics";
   bool classifier = true;
 };
 
@@ -106,121 +111,222 @@ void write_arff(const std::string& dir, const std::string& name, const SceneBatc
   sink->finish();
 }
 
+// "thesis,physics": each name a choice of the --model knob, none twice.
+std::vector<Model> parse_models(const std::string& text) {
+  const Knob* knob = find_knob("model");
+  std::vector<Model> models;
+  for (size_t start = 0;;) {
+    const size_t comma = text.find(',', start);
+    const std::string name = text.substr(start, comma == std::string::npos ? comma : comma - start);
+    Plan p;
+    set_knob(p, *knob, name, "--models");
+    if (std::find(models.begin(), models.end(), p.model.model) != models.end())
+      throw InputError("--models: \"" + name + "\" is listed twice");
+    models.push_back(p.model.model);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return models;
+}
+
+// The thesis's experimental cases as scenarios/case1-gun.toml and case2-rod-plate.toml
+// draw them: balanced, 0 to 4 objects; case 1 from every object, case 2 from its six.
+SceneBatch thesis_case(const Catalogue& cat, int which, uint64_t seed, uint64_t count) {
+  GeneratorSpec gs;
+  gs.balance = true;
+  if (which == 1) {
+    gs.rule = "gun";
+  } else {
+    gs.rule = "iron-rod & metal-plate";
+    for (const char* name :
+         {"metal-plate", "iron-rod", "compact-disk", "cement-tile", "ceramic-plate", "mobile-phone"}) {
+      const int o = cat.find_object(name);
+      if (o < 0) throw InputError(std::string("thesis case 2 needs the catalogue object \"") + name + "\"");
+      gs.pool.push_back(o);
+    }
+  }
+  Generator gen(cat, gs, seed);
+  SceneBatch batch;
+  for (uint64_t i = 0; i < count; ++i) batch.push(gen(i));
+  return batch;
+}
+
 int tradeoff(TradeoffOptions& o) {
   if (o.count < 10 || o.count > 1000000) throw InputError("--count: must be between 10 and 1000000");
   if (o.out.empty()) throw InputError("--out: empty folder name");
+  const std::vector<Model> models = parse_models(o.models);
   Session s;
   open_catalogue(s, o.common);
   const Catalogue& cat = s.catalogue;
-  ModelSettings model = o.model;
-  model.seed = io::parse_u64(o.common.seed, "--seed");
-  Plan check = images_plan(model);
-  validate(check, cat);
+  ModelSettings base = o.model;
+  base.seed = io::parse_u64(o.common.seed, "--seed");
+  for (Model m : models) {
+    Plan check = images_plan(base);
+    check.model.model = m;
+    validate(check, cat);
+  }
   std::error_code ec;
   if (std::filesystem::exists(o.out, ec) && !std::filesystem::is_empty(o.out, ec))
     throw OutputError(o.out + ": is not empty; choose a new folder");
+  // Case 2 is drawn first: it checks the catalogue before anything is written.
+  const SceneBatch case2 = o.classifier ? thesis_case(cat, 2, base.seed, o.count) : SceneBatch{};
+  const SceneBatch batch = thesis_case(cat, 1, base.seed, o.count);
   StagedFolder folder(o.out);
-
-  // The scenario set: thesis case 1 (a gun is a threat), balanced, 0 to 4 objects.
-  GeneratorSpec gs;
-  gs.rule = "gun";
-  gs.balance = true;
-  Generator gen(cat, gs, model.seed);
-  SceneBatch batch;
-  for (uint64_t i = 0; i < o.count; ++i) batch.push(gen(i));
 
   auto rt = std::make_shared<OpenCLRuntime>(OpenCLOptions{o.common.device, ""});
   const std::string staging = folder.dir();
-
-  std::printf("tradeoff: %llu scenarios (case 1, balanced), pixel noise %.3g, block %d\n",
-              static_cast<unsigned long long>(o.count), model.pixel_sigma, model.block);
-  std::fflush(stdout);
-  auto reference = make_reference_backend(cat, s.assets);
-  const Timed ref = run_timed(*reference, batch, images_plan(model), 256, 0.0);
-  // The reference renders every image for features too: one rate serves both.
-  json rows = json::array();
-  auto add_row = [&](const std::string& name, const Fidelity* f, double feat_rate, double img_rate,
-                     const OutputDiff& img_err, const OutputDiff& feat_err, const BatchOutput& feats) {
-    json r;
-    r["name"] = name;
-    if (f) {
-      r["precision"] = precision_name(f->precision);
-      r["pooling"] = f->pooling == Pooling::sparse ? "sparse" : "dense";
-      r["fast_math"] = f->fast_math;
-      r["noise_model"] = f->noise == NoiseModel::block_mean ? "block-mean" : "per-pixel";
-    } else {
-      r["precision"] = "fp64 (CPU reference)";
-    }
-    r["features_per_s"] = feat_rate;
-    r["images_per_s"] = img_rate;
-    r["mmw_max_abs"] = img_err.mmw.max_abs;
-    r["mmw_rmse_mean"] = img_err.mmw.rmse_mean;
-    r["mmw_rmse_max"] = img_err.mmw.rmse_max;
-    r["mmw_psnr_db"] = img_err.mmw.psnr;
-    r["mmw_share_off_by_more_than_1"] = img_err.mmw.share_off_by_more_than_1;
-    r["ir_max_abs"] = img_err.ir.max_abs;
-    r["ir_rmse_mean"] = img_err.ir.rmse_mean;
-    r["ir_psnr_db"] = img_err.ir.psnr;
-    r["ir_share_off_by_more_than_1"] = img_err.ir.share_off_by_more_than_1;
-    r["feature_max_abs"] = feat_err.feature_max_abs;
-    r["feature_mean_abs"] = feat_err.feature_mean_abs;
-    r["metal_exact_rate"] = feat_err.metal_exact;
-    r["label_exact_rate"] = 1.0;  // labels come from the scenes, which every tier shares
-    r["j48_accuracy"] = nullptr;
-    if (o.classifier) {
-      const std::string arff = name + ".arff";
-      write_arff(staging, arff, batch, feats, cat);
-      std::string why;
-      if (auto acc = j48_cv_accuracy((std::filesystem::path(staging) / arff).string(), why))
-        r["j48_accuracy"] = *acc;
-      else
-        r["j48_note"] = why;
-      folder.path(arff);  // keep it
-    }
-    rows.push_back(r);
-    std::printf(
-        "  %-9s features %10.0f/s  images %8.0f/s  MMW max %d rmse %.4f  feature max %.4g  metal %.4f%s\n",
-        name.c_str(), feat_rate, img_rate, img_err.mmw.max_abs, img_err.mmw.rmse_mean, feat_err.feature_max_abs,
-        feat_err.metal_exact,
-        r["j48_accuracy"].is_null() ? "" : ("  J48 " + std::to_string(r["j48_accuracy"].get<double>())).c_str());
-    std::fflush(stdout);
+  // J48's 10-fold accuracy on one tier's features of one case, or null (with a note).
+  auto j48 = [&](json& r, const std::string& key, const std::string& arff, const SceneBatch& scenes,
+                 const BatchOutput& feats) {
+    r[key] = nullptr;
+    write_arff(staging, arff, scenes, feats, cat);
+    std::string why;
+    if (auto acc = j48_cv_accuracy((std::filesystem::path(staging) / arff).string(), why))
+      r[key] = *acc;
+    else
+      r["j48_note"] = why;
+    folder.path(arff);  // keep it
   };
-  const OutputDiff self = compare_outputs(ref.out, ref.out);
-  add_row("reference", nullptr, ref.rate, ref.rate, self, self, ref.out);
-  for (Tier t : {Tier::exact, Tier::standard, Tier::fast}) {
-    const Fidelity f = tier_fidelity(t);
-    auto cl = make_opencl_backend(cat, s.assets, rt);
-    Plan ip = images_plan(model), fp = features_plan(model);
-    ip.fidelity = fp.fidelity = f;
-    const Timed img = run_timed(*cl, batch, ip, 1024, 0.3);
-    const Timed feat = run_timed(*cl, batch, fp, 16384, 0.3);
-    add_row(tier_name(t), &f, feat.rate, img.rate, compare_outputs(img.out, ref.out),
-            compare_outputs(feat.out, ref.out), feat.out);
+
+  json rows = json::array();
+  for (Model m : models) {
+    ModelSettings model = base;
+    model.model = m;
+    const std::string mname = model_name(m);
+    std::printf("tradeoff, %s model: %llu scenarios (case 1, balanced), pixel noise %.3g, block %d", mname.c_str(),
+                static_cast<unsigned long long>(o.count), model.pixel_sigma, model.block);
+    if (m == Model::physics)
+      std::printf(", NETD %.3g K, raw grid %dx%d, illumination %.4g K", model.netd, model.raw_width, model.raw_height,
+                  model.illumination);
+    std::printf("\n");
+    std::fflush(stdout);
+    auto reference = make_reference_backend(cat, s.assets);
+    const Timed ref = run_timed(*reference, batch, images_plan(model), 256, 0.0);
+    // The reference renders every image for features too: one rate serves both.
+    auto add_row = [&](const std::string& name, std::optional<Tier> tier, double feat_rate, double img_rate,
+                       const OutputDiff& img_err, const OutputDiff& feat_err, const BatchOutput& feats,
+                       const BatchOutput& feats2) {
+      json r;
+      r["model"] = mname;
+      r["name"] = name;
+      r["features_per_s"] = feat_rate;
+      r["images_per_s"] = img_rate;
+      r["mmw_max_abs"] = img_err.mmw.max_abs;
+      r["mmw_rmse_mean"] = img_err.mmw.rmse_mean;
+      r["mmw_rmse_max"] = img_err.mmw.rmse_max;
+      r["mmw_psnr_db"] = img_err.mmw.psnr;
+      r["mmw_share_off_by_more_than_1"] = img_err.mmw.share_off_by_more_than_1;
+      r["mmw_share_differing"] = img_err.mmw.share_differing;
+      r["ir_max_abs"] = img_err.ir.max_abs;
+      r["ir_rmse_mean"] = img_err.ir.rmse_mean;
+      r["ir_psnr_db"] = img_err.ir.psnr;
+      r["ir_share_off_by_more_than_1"] = img_err.ir.share_off_by_more_than_1;
+      r["feature_max_abs"] = feat_err.feature_max_abs;
+      r["feature_mean_abs"] = feat_err.feature_mean_abs;
+      r["metal_exact_rate"] = feat_err.metal_exact;
+      r["label_exact_rate"] = 1.0;  // labels come from the scenes, which every tier shares
+      std::string why;
+      if (tier) {
+        const Fidelity f = tier_fidelity(*tier);
+        r["precision"] = precision_name(f.precision);
+        r["pooling"] = f.pooling == Pooling::sparse ? "sparse" : "dense";
+        r["fast_math"] = f.fast_math;
+        r["noise_model"] = f.noise == NoiseModel::block_mean ? "block-mean" : "per-pixel";
+        // The tier's stated tolerance for this model (plan/tolerance.h), on images and features.
+        const Tolerance tol = model_tolerance(m, *tier);
+        // The features-only run holds no images. Its feature bounds hold without the
+        // block-mean noise model, which draws each mean's noise directly.
+        OutputDiff feat_checked;
+        feat_checked.metal_exact = feat_err.metal_exact;
+        if (f.noise != NoiseModel::block_mean || model.pixel_sigma == 0) {
+          feat_checked.feature_max_abs = feat_err.feature_max_abs;
+          feat_checked.feature_mean_abs = feat_err.feature_mean_abs;
+        }
+        for (auto [run, d] :
+             {std::pair{"images run: ", &img_err}, std::pair{"features run: ", &std::as_const(feat_checked)}})
+          if (const std::string broke = check_tolerance(*d, tol); !broke.empty()) why += run + broke;
+      } else {
+        r["precision"] = "fp64 (CPU reference)";
+      }
+      r["within_tolerance"] = why.empty();
+      if (!why.empty()) r["tolerance_note"] = why;
+      r["j48_accuracy"] = nullptr;
+      r["j48_case2_accuracy"] = nullptr;
+      if (o.classifier) {
+        j48(r, "j48_accuracy", mname + "-" + name + "-case1.arff", batch, feats);
+        j48(r, "j48_case2_accuracy", mname + "-" + name + "-case2.arff", case2, feats2);
+      }
+      rows.push_back(r);
+      auto pct = [&](const char* key) {
+        char text[32] = "-";
+        if (!r[key].is_null()) std::snprintf(text, sizeof text, "%.1f%%", r[key].get<double>());
+        return std::string(text);
+      };
+      std::printf(
+          "  %-9s features %10.0f/s  images %8.0f/s  MMW max %d rmse %.4f  feature max %.4g  metal %.4f  J48 case 1 %s "
+          "case 2 %s%s\n",
+          name.c_str(), feat_rate, img_rate, img_err.mmw.max_abs, img_err.mmw.rmse_mean, feat_err.feature_max_abs,
+          feat_err.metal_exact, pct("j48_accuracy").c_str(), pct("j48_case2_accuracy").c_str(),
+          why.empty() ? "" : ("  OUT OF TOLERANCE: " + why).c_str());
+      std::fflush(stdout);
+    };
+    // Case 2's features, one untimed pass (only the classifier reads them).
+    auto case2_features = [&](Backend& b, const Plan& plan) {
+      BatchOutput out;
+      if (o.classifier) b.run(case2, plan, out);
+      return out;
+    };
+    const OutputDiff self = compare_outputs(ref.out, ref.out);
+    add_row("reference", std::nullopt, ref.rate, ref.rate, self, self, ref.out,
+            case2_features(*reference, features_plan(model)));
+    for (Tier t : {Tier::exact, Tier::standard, Tier::fast}) {
+      const Fidelity f = tier_fidelity(t);
+      auto cl = make_opencl_backend(cat, s.assets, rt);
+      Plan ip = images_plan(model), fp = features_plan(model);
+      ip.fidelity = fp.fidelity = f;
+      const Timed img = run_timed(*cl, batch, ip, 1024, 0.3);
+      const Timed feat = run_timed(*cl, batch, fp, 16384, 0.3);
+      add_row(tier_name(t), t, feat.rate, img.rate, compare_outputs(img.out, ref.out),
+              compare_outputs(feat.out, ref.out), feat.out, case2_features(*cl, fp));
+    }
   }
 
   json report;
   report["count"] = o.count;
-  report["seed"] = std::to_string(model.seed);
-  report["pixel_noise"] = model.pixel_sigma;
-  report["pattern_noise"] = model.pattern_noise;
-  report["block"] = model.block;
+  report["seed"] = std::to_string(base.seed);
+  report["pixel_noise"] = base.pixel_sigma;
+  report["pattern_noise"] = base.pattern_noise;
+  report["block"] = base.block;
+  report["models"] = json::array();
+  for (Model m : models) report["models"].push_back(model_name(m));
+  report["physics"] = {{"netd_k", base.netd},
+                       {"mmw_raw", std::to_string(base.raw_width) + "x" + std::to_string(base.raw_height)},
+                       {"illumination_k", base.illumination},
+                       {"worn_minutes", base.worn_minutes}};
   report["scenario_set"] = "thesis case 1: rule gun, balanced, 0..4 objects from every object";
+  report["case2_scenario_set"] =
+      "thesis case 2: rule iron-rod & metal-plate, balanced, 0..4 objects from metal-plate, iron-rod, compact-disk, "
+      "cement-tile, ceramic-plate, mobile-phone (classifier only)";
+  report["errors_against"] = "the fp64 CPU reference of the row's own model";
   report["machine"] = std::to_string(::sysconf(_SC_NPROCESSORS_ONLN)) + " cores, " + rt->device_name();
   report["rows"] = rows;
   write_text_atomic(folder.path("tradeoff.json"), report.dump(2) + "\n");
   std::string csv =
-      "tier,precision,features_per_s,images_per_s,mmw_max_abs,mmw_rmse_mean,mmw_psnr_db,mmw_share_off_by_more_than_1,"
-      "ir_max_abs,feature_max_abs,feature_mean_abs,metal_exact_rate,label_exact_rate,j48_accuracy\n";
+      "model,tier,precision,features_per_s,images_per_s,mmw_max_abs,mmw_rmse_mean,mmw_psnr_db,"
+      "mmw_share_off_by_more_than_1,ir_max_abs,feature_max_abs,feature_mean_abs,metal_exact_rate,label_exact_rate,"
+      "j48_accuracy,j48_case2_accuracy,within_tolerance\n";
+  auto opt = [](const json& v) { return v.is_null() ? std::string() : std::to_string(v.get<double>()); };
   for (const json& r : rows) {
     char line[512];
-    std::snprintf(line, sizeof line, "%s,%s,%.0f,%.0f,%d,%.6f,%.3f,%.8f,%d,%.6g,%.6g,%.6f,%.6f,%s\n",
-                  r["name"].get<std::string>().c_str(), r["precision"].get<std::string>().c_str(),
-                  r["features_per_s"].get<double>(), r["images_per_s"].get<double>(), r["mmw_max_abs"].get<int>(),
-                  r["mmw_rmse_mean"].get<double>(), r["mmw_psnr_db"].get<double>(),
-                  r["mmw_share_off_by_more_than_1"].get<double>(), r["ir_max_abs"].get<int>(),
-                  r["feature_max_abs"].get<double>(), r["feature_mean_abs"].get<double>(),
+    std::snprintf(line, sizeof line, "%s,%s,%s,%.0f,%.0f,%d,%.6f,%.3f,%.8f,%d,%.6g,%.6g,%.6f,%.6f,%s,%s,%s\n",
+                  r["model"].get<std::string>().c_str(), r["name"].get<std::string>().c_str(),
+                  r["precision"].get<std::string>().c_str(), r["features_per_s"].get<double>(),
+                  r["images_per_s"].get<double>(), r["mmw_max_abs"].get<int>(), r["mmw_rmse_mean"].get<double>(),
+                  r["mmw_psnr_db"].get<double>(), r["mmw_share_off_by_more_than_1"].get<double>(),
+                  r["ir_max_abs"].get<int>(), r["feature_max_abs"].get<double>(), r["feature_mean_abs"].get<double>(),
                   r["metal_exact_rate"].get<double>(), r["label_exact_rate"].get<double>(),
-                  r["j48_accuracy"].is_null() ? "" : std::to_string(r["j48_accuracy"].get<double>()).c_str());
+                  opt(r["j48_accuracy"]).c_str(), opt(r["j48_case2_accuracy"]).c_str(),
+                  r["within_tolerance"].get<bool>() ? "yes" : "no");
     csv += line;
   }
   write_text_atomic(folder.path("tradeoff.csv"), csv);
@@ -237,7 +343,7 @@ int tradeoff(TradeoffOptions& o) {
   folder.path("tradeoff.png");
   folder.commit();
   std::printf("%s: tradeoff.json, tradeoff.csv, tradeoff.png%s\n", o.out.c_str(),
-              o.classifier ? ", one ARFF per tier" : "");
+              o.classifier ? ", two ARFFs (cases 1 and 2) per model and tier" : "");
   return 0;
 }
 }  // namespace
@@ -245,7 +351,8 @@ int tradeoff(TradeoffOptions& o) {
 std::function<int()> add_tradeoff(CLI::App& app) {
   auto o = std::make_shared<TradeoffOptions>();
   o->model.pixel_sigma = 2.0;
-  CLI::App* sub = app.add_subcommand("tradeoff", "measure every fidelity tier against the fp64 reference");
+  CLI::App* sub =
+      app.add_subcommand("tradeoff", "measure every fidelity tier against the fp64 reference, per sensor model");
   sub->add_option("--count", o->count, "scenarios in the set (default 2000)");
   sub->add_option("--out", o->out, "output folder (default tradeoff)");
   sub->add_option("--seed", o->common.seed, "run seed (default 0)");
@@ -253,6 +360,7 @@ std::function<int()> add_tradeoff(CLI::App& app) {
   sub->add_option("--device", o->common.device, "OpenCL device: a substring of its platform or device name");
   sub->add_option("--pixel-noise", o->model.pixel_sigma, "per-pixel sensor noise sigma (default 2)");
   sub->add_option("--block", o->model.block, "feature block side (default 10)");
+  sub->add_option("--models", o->models, "sensor models to measure, comma-separated (default thesis,physics)");
   sub->add_flag("!--no-classifier", o->classifier, "skip WEKA J48 (faster)");
   return [o] { return tradeoff(*o); };
 }

@@ -3,6 +3,8 @@
 // where each tier actually lands.
 #pragma once
 
+#include <algorithm>
+
 #include "plan/plan.h"
 
 namespace portalsim {
@@ -30,6 +32,16 @@ inline Tolerance tier_tolerance(Tier t) {
       return {2, 0.5, 2.0, 0.5};
   }
   return {0, 0, 0, 0};
+}
+
+// The physics model's MMW camera in every tier (tests/physics_test.cpp): pixels within 1
+// gray level, at most 0.5% of them off by one, features within 1 and, being means of
+// those pixels, on average within 0.005 (plus float rounding). Its other sensors still run
+// the thesis's chains, so pixels keep the tier's bounds where those are wider.
+inline Tolerance model_tolerance(Model m, Tier t) {
+  const Tolerance thesis = tier_tolerance(t);
+  if (m == Model::thesis) return thesis;
+  return {std::max(1, thesis.pixel_max_abs), std::max(0.005, thesis.pixel_share_differing), 1.0 + 1e-4, 0.005 + 1e-4};
 }
 
 }  // namespace portalsim

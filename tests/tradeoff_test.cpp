@@ -1,0 +1,182 @@
+// portalsim tradeoff's model axis, run as a user runs it: every sensor model gets its own
+// reference and tier rows, each tier's error is measured against the fp64 reference of the
+// same model (checked here by recomputing it), and J48 scores thesis cases 1 and 2 per model.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "backend/compare.h"
+#include "plan/tolerance.h"
+#include "run_binary.h"
+#include "scene/generator.h"
+#include "support.h"
+
+namespace portalsim {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+constexpr int kCount = 40;
+const std::vector<std::string> kRowNames = {"reference", "exact", "standard", "fast"};
+
+const json& row(const json& report, const std::string& model, const std::string& name) {
+  for (const json& r : report["rows"])
+    if (r["model"] == model && r["name"] == name) return r;
+  static const json none;
+  ADD_FAILURE() << "no row for model " << model << ", " << name;
+  return none;
+}
+
+void every_model_has_its_reference_and_every_tier(const json& report, const fs::path& out) {
+  EXPECT_EQ(report["models"], json({"thesis", "physics"}));
+  ASSERT_EQ(report["rows"].size(), 8u);
+  for (size_t i = 0; i < 8; ++i) {
+    const json& r = report["rows"][i];
+    SCOPED_TRACE(r.dump());
+    EXPECT_EQ(r["model"], i < 4 ? "thesis" : "physics");
+    EXPECT_EQ(r["name"], kRowNames[i % 4]);
+    EXPECT_GT(r["features_per_s"].get<double>(), 0);
+    EXPECT_GT(r["images_per_s"].get<double>(), 0);
+    EXPECT_EQ(r["metal_exact_rate"], 1.0);
+    EXPECT_EQ(r["within_tolerance"], true);
+    for (const char* key : {"j48_accuracy", "j48_case2_accuracy"}) {
+      ASSERT_TRUE(r[key].is_number()) << key;
+      EXPECT_GE(r[key].get<double>(), 0);
+      EXPECT_LE(r[key].get<double>(), 100);
+    }
+    for (const char* c : {"case1", "case2"})
+      EXPECT_TRUE(fs::is_regular_file(
+          out / (r["model"].get<std::string>() + "-" + r["name"].get<std::string>() + "-" + c + ".arff")));
+  }
+  EXPECT_TRUE(fs::is_regular_file(out / "tradeoff.png"));
+}
+
+// The thesis rows keep every field they had before the model axis, and the CSV keeps its
+// columns behind a leading model column.
+void thesis_rows_keep_their_layout(const json& report, const fs::path& out) {
+  for (const std::string& name : kRowNames)
+    for (const char* key : {"name", "precision", "features_per_s", "images_per_s", "mmw_max_abs", "mmw_rmse_mean",
+                            "mmw_rmse_max", "mmw_psnr_db", "mmw_share_off_by_more_than_1", "ir_max_abs", "ir_rmse_mean",
+                            "ir_psnr_db", "ir_share_off_by_more_than_1", "feature_max_abs", "feature_mean_abs",
+                            "metal_exact_rate", "label_exact_rate", "j48_accuracy"})
+      EXPECT_TRUE(row(report, "thesis", name).contains(key)) << name << " " << key;
+  const std::string csv = test::slurp(out / "tradeoff.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "model,tier,precision,features_per_s,images_per_s,mmw_max_abs,mmw_rmse_mean,mmw_psnr_db,"
+            "mmw_share_off_by_more_than_1,ir_max_abs,feature_max_abs,feature_mean_abs,metal_exact_rate,"
+            "label_exact_rate,j48_accuracy,j48_case2_accuracy,within_tolerance");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 9);
+  EXPECT_NE(csv.find("\nthesis,reference,fp64 (CPU reference),"), std::string::npos);
+  EXPECT_NE(csv.find("\nphysics,fast,fixed16,"), std::string::npos);
+}
+
+// Each model's exact tier against its own reference, recomputed here on the same scenes
+// (thesis case 1, seed 0, pixel noise 2): the report must give the same numbers, and the
+// physics row must not be the distance to the thesis reference.
+void errors_are_against_the_same_models_reference(const json& report, const fs::path& out) {
+  GeneratorSpec gs;
+  gs.rule = "gun";
+  gs.balance = true;
+  Generator gen(test::catalogue(), gs, 0);
+  SceneBatch batch;
+  for (int i = 0; i < kCount; ++i) batch.push(gen(i));
+  auto ref = make_reference_backend(test::catalogue(), test::assets());
+  auto cl = make_opencl_backend(test::catalogue(), test::assets(), test::runtime());
+  std::map<Model, BatchOutput> refs;
+  for (Model m : {Model::thesis, Model::physics}) {
+    Plan plan;
+    plan.model.model = m;
+    plan.model.pixel_sigma = 2;
+    ref->run(batch, plan, refs[m]);
+  }
+  for (Model m : {Model::thesis, Model::physics}) {
+    SCOPED_TRACE(model_name(m));
+    Plan plan;
+    plan.model.model = m;
+    plan.model.pixel_sigma = 2;
+    plan.fidelity = tier_fidelity(Tier::exact);
+    BatchOutput exact;
+    cl->run(batch, plan, exact);
+    const OutputDiff d = compare_outputs(exact, refs[m]);
+    const json& r = row(report, model_name(m), "exact");
+    EXPECT_EQ(r["mmw_max_abs"].get<int>(), d.mmw.max_abs);
+    EXPECT_DOUBLE_EQ(r["mmw_rmse_mean"].get<double>(), d.mmw.rmse_mean);
+    EXPECT_DOUBLE_EQ(r["mmw_share_differing"].get<double>(), d.mmw.share_differing);
+    EXPECT_EQ(r["ir_max_abs"].get<int>(), d.ir.max_abs);
+    // Within the model's stated tolerance (plan/tolerance.h).
+    EXPECT_EQ(check_tolerance(d, model_tolerance(m, Tier::exact)), "");
+    // Against the other model's reference the same images are far off.
+    const OutputDiff other = compare_outputs(exact, refs[m == Model::thesis ? Model::physics : Model::thesis]);
+    EXPECT_GT(other.mmw.max_abs, 1);
+    EXPECT_GT(other.mmw.rmse_mean, 10 * std::max(d.mmw.rmse_mean, 0.01));
+  }
+  // The physics exact tier within the physics camera's bounds: 1 gray level, 0.5% of pixels.
+  const json& p = row(report, "physics", "exact");
+  EXPECT_LE(p["mmw_max_abs"].get<int>(), 1);
+  EXPECT_LE(p["mmw_share_differing"].get<double>(), 0.005);
+  EXPECT_LE(p["feature_max_abs"].get<double>(), 1.0);
+  // The models' data sets differ (the physics MMW features are not the thesis's).
+  EXPECT_NE(test::slurp(out / "thesis-reference-case1.arff"), test::slurp(out / "physics-reference-case1.arff"));
+  EXPECT_NE(test::slurp(out / "thesis-reference-case2.arff"), test::slurp(out / "physics-reference-case2.arff"));
+}
+
+// One default run (both models, classifier on) of kCount scenarios; ctest runs each test
+// in its own process, so the checks share one test.
+TEST(TradeoffModels, BothModelsByDefault) {
+  test::TempDir t;
+  const fs::path out = t.w() / "trade";
+  const test::Result r =
+      test::finish(test::start(t.cap(), {"tradeoff", "--count", std::to_string(kCount), "--out", out.string()}), 600);
+  ASSERT_TRUE(r.exited && r.status == 0) << test::describe(r);
+  const json report = json::parse(test::slurp(out / "tradeoff.json"));
+  {
+    SCOPED_TRACE("every model has its reference and every tier");
+    every_model_has_its_reference_and_every_tier(report, out);
+  }
+  {
+    SCOPED_TRACE("thesis rows keep their layout");
+    thesis_rows_keep_their_layout(report, out);
+  }
+  {
+    SCOPED_TRACE("errors are against the same model's reference");
+    errors_are_against_the_same_models_reference(report, out);
+  }
+}
+
+TEST(TradeoffModelsOption, SelectsOneModel) {
+  test::TempDir t;
+  const fs::path out = t.w() / "trade";
+  const test::Result r = test::finish(test::start(t.cap(), {"tradeoff", "--count", "10", "--models", "physics",
+                                                            "--no-classifier", "--out", out.string()}),
+                                      600);
+  ASSERT_TRUE(r.exited && r.status == 0) << test::describe(r);
+  const json report = json::parse(test::slurp(out / "tradeoff.json"));
+  EXPECT_EQ(report["models"], json({"physics"}));
+  ASSERT_EQ(report["rows"].size(), 4u);
+  for (const json& row : report["rows"]) {
+    EXPECT_EQ(row["model"], "physics");
+    EXPECT_TRUE(row["j48_accuracy"].is_null());
+    EXPECT_TRUE(row["j48_case2_accuracy"].is_null());
+  }
+}
+
+TEST(TradeoffModelsOption, BadListsAreRejectedBeforeAnythingIsWritten) {
+  test::TempDir t;
+  for (const std::string models : {"thesis,bogus", "thesis,thesis", "", "physics,"}) {
+    SCOPED_TRACE(models);
+    const fs::path out = t.w() / "trade";
+    const test::Result r = test::finish(test::start(t.cap(), {"tradeoff", "--models", models, "--out", out.string()}));
+    EXPECT_TRUE(r.exited && r.status != 0) << test::describe(r);
+    EXPECT_NE(r.err.find("--models"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+}  // namespace
+}  // namespace portalsim
