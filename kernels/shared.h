@@ -12,8 +12,8 @@
 #define PS_MAX_LAYERS PS_REGIONS
 
 /* The metal detector under --model physics (README, "Metal detector physics"). */
-#define PS_METAL_PANEL_A_ZONES 9     /* zones 1..9 transmit from panel A (x < 0), the rest from B */
-#define PS_METAL_MAX_DEDUCTION 199   /* most one zone's response takes off its base value */
+#define PS_METAL_PANEL_A_ZONES 9            /* zones 1..9 transmit from panel A (x < 0), the rest from B */
+#define PS_METAL_MAX_DEDUCTION 199          /* most one zone's response takes off its base value */
 #define PS_METAL_FOUR_PI 12.566370614359172 /* 4 pi, the dipole field's denominator */
 /* Record of one zone's coils, doubles: transmit and receive coil position (x, z, metres;
  * y = 0) and moment (along x, A m^2), then the zone's gain. */
