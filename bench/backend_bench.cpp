@@ -8,7 +8,6 @@
 namespace portalsim {
 namespace {
 using bench::fx;
-using bench::make_batch;
 
 enum Path { kFeaturesSparse, kFeaturesDense, kImages, kMetal, kMetalPhysics };
 
@@ -45,14 +44,7 @@ void run(benchmark::State& state, Backend& backend, Path path, Tier tier = Tier:
   const Pooling pooling = plan.fidelity.pooling;
   plan.fidelity = tier_fidelity(tier);
   if (path == kFeaturesDense) plan.fidelity.pooling = pooling;
-  const SceneBatch batch = make_batch(n);
-  BatchOutput out;
-  backend.run(batch, plan, out);  // warm: tables, work-group compilation
-  for (auto _ : state) {
-    backend.run(batch, plan, out);
-    benchmark::DoNotOptimize(out.metal.data());
-  }
-  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+  bench::time_runs(state, backend, plan, n);
 }
 
 // Args: batch size, block size, threads (PoCL compute units: 1 or all).

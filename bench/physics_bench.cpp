@@ -11,7 +11,6 @@
 namespace portalsim {
 namespace {
 using bench::fx;
-using bench::make_batch;
 
 Plan model_plan(const benchmark::State& state, bool images) {
   Plan p;
@@ -28,14 +27,7 @@ void run_model(benchmark::State& state, Backend& backend, bool images) {
   const size_t n = static_cast<size_t>(state.range(0));
   const Plan plan = model_plan(state, images);
   state.SetLabel(std::string(model_name(plan.model.model)) + (images ? " images" : " features"));
-  const SceneBatch batch = make_batch(n);
-  BatchOutput out;
-  backend.run(batch, plan, out);  // warm: work-group compilation
-  for (auto _ : state) {
-    backend.run(batch, plan, out);
-    benchmark::DoNotOptimize(out.metal.data());
-  }
-  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+  bench::time_runs(state, backend, plan, n);
 }
 
 void BM_ModelOpenCL(benchmark::State& state, bool images) {
@@ -74,15 +66,7 @@ void BM_IrImages(benchmark::State& state) {
   p.features = false;
   p.metal = false;
   state.SetLabel(std::string(model_name(p.model.model)) + " IR images");
-  const size_t n = 1024;
-  const SceneBatch batch = make_batch(n);
-  BatchOutput out;
-  b->run(batch, p, out);
-  for (auto _ : state) {
-    b->run(batch, p, out);
-    benchmark::DoNotOptimize(out.views.data());
-  }
-  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+  bench::time_runs(state, *b, p, 1024);
 }
 
 // The IR physics chain's first `range(0)` stages, then ir_display: a stage's cost is the
@@ -99,15 +83,7 @@ void BM_IrPhysicsStages(benchmark::State& state) {
   p.features = false;
   p.metal = false;
   state.SetLabel(chain[chain.size() - 2]);
-  const size_t n = 1024;
-  const SceneBatch batch = make_batch(n);
-  BatchOutput out;
-  b->run(batch, p, out);
-  for (auto _ : state) {
-    b->run(batch, p, out);
-    benchmark::DoNotOptimize(out.views.data());
-  }
-  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+  bench::time_runs(state, *b, p, 1024);
 }
 
 BENCHMARK(BM_IrImages)->Args({0, 0})->Args({1, 0})->Args({1, 50})->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -37,14 +37,7 @@ Plan images_plan() {
 }
 
 void time_backend(benchmark::State& state, Backend& backend, const Plan& plan, size_t n) {
-  const SceneBatch batch = make_batch(n);
-  BatchOutput out;
-  backend.run(batch, plan, out);  // warm: work-group compilation
-  for (auto _ : state) {
-    backend.run(batch, plan, out);
-    benchmark::DoNotOptimize(out.views.data());
-  }
-  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+  bench::time_runs(state, backend, plan, n);
   state.SetLabel(fused_chain()[state.range(0) - 1]);
 }
 
@@ -64,15 +57,7 @@ void BM_ChainFusedOrStaged(benchmark::State& state) {
   auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
   Plan plan = images_plan();
   plan.fidelity.fused = state.range(0) == 1;
-  const size_t n = 1024;
-  const SceneBatch batch = make_batch(n);
-  BatchOutput out;
-  b->run(batch, plan, out);
-  for (auto _ : state) {
-    b->run(batch, plan, out);
-    benchmark::DoNotOptimize(out.views.data());
-  }
-  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+  bench::time_runs(state, *b, plan, 1024);
   state.SetLabel(plan.fidelity.fused ? "fused render_view" : "stage kernels");
 }
 

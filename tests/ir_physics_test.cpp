@@ -24,21 +24,10 @@ namespace {
 
 using test::assets;
 using test::catalogue;
-
-Plan physics_plan(uint64_t seed = 7) {
-  Plan p;
-  p.model.model = Model::physics;
-  p.model.seed = seed;
-  return p;
-}
+using test::physics_plan;
+using test::variant_of;
 
 int ir_view(const Catalogue& cat) { return cat.sensor_index("ir"); }
-
-int variant_of(const Catalogue& cat, const std::string& object) {
-  const int o = cat.find_object(object);
-  EXPECT_GE(o, 0) << object;
-  return cat.objects[o].first_variant;
-}
 
 using Edits = std::vector<std::pair<std::string, std::string>>;
 

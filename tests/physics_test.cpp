@@ -29,24 +29,13 @@ namespace fs = std::filesystem;
 
 using test::assets;
 using test::catalogue;
-
-Plan physics_plan(uint64_t seed = 7) {
-  Plan p;
-  p.model.model = Model::physics;
-  p.model.seed = seed;
-  return p;
-}
+using test::physics_plan;
+using test::variant_of;
 
 std::vector<Scenario> scenes(size_t n) {
   std::vector<Scenario> v;
   for (size_t k = 0; k < n; ++k) v.push_back(test::random_scenario(catalogue(), k, 6));
   return v;
-}
-
-int variant_of(const Catalogue& cat, const std::string& object) {
-  const int o = cat.find_object(object);
-  EXPECT_GE(o, 0) << object;
-  return cat.objects[o].first_variant;
 }
 
 // The Airy core's FWHM in view pixels, from the catalogue's camera, written out here.

@@ -1,11 +1,15 @@
 // Shared test fixtures: the default catalogue and its assets built once, one OpenCL
 // runtime for the whole run, and random scenarios covering the catalogue.
 #pragma once
+#include <gtest/gtest.h>
+
 #include <memory>
+#include <string>
 
 #include "assets/assets.h"
 #include "backend/backend.h"
 #include "backend/opencl/opencl_backend.h"
+#include "plan/plan.h"
 #include "scene/catalogue.h"
 #include "scene/philox.h"
 
@@ -38,6 +42,21 @@ inline Scenario random_scenario(const Catalogue& cat, uint64_t k, int max_object
   }
   s.label = static_cast<int>(r[2] & 1);
   return s;
+}
+
+// The physics model's plan at its defaults, with a run seed.
+inline Plan physics_plan(uint64_t seed = 7) {
+  Plan p;
+  p.model.model = Model::physics;
+  p.model.seed = seed;
+  return p;
+}
+
+// The first drawing of the object called `name`; -1 (and a test failure) when none is.
+inline int variant_of(const Catalogue& cat, const std::string& name) {
+  const int o = cat.find_object(name);
+  if (o < 0) ADD_FAILURE() << "no object called " << name;
+  return o < 0 ? -1 : cat.objects[o].first_variant;
 }
 
 inline SceneBatch batch_of(const std::vector<Scenario>& scenes, uint64_t first_index = 0) {
