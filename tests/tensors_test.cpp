@@ -7,8 +7,10 @@
 
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
@@ -228,29 +230,100 @@ long long checkpoint_next(const fs::path& dir) {
   return static_cast<long long>(j["next"].get<uint64_t>());
 }
 
-TEST(TensorsH5, ResumeAfterKill9IsExact) {
-  portalsim::test::TempDir t;
-  const Args spec{"--count", "4000", "--seed", "10", "--rule", "gun", "--what", "both", "--format", "h5,csv"};
+// Runs `spec` to completion in ref/, and again in killed/ with kill -9 after its checkpoint
+// passes 300 scenarios; `after_kill` looks at (and may change) what the kill left; then
+// resumes with another batch size. Returns the resumed run's result.
+portalsim::test::Result kill_then_resume(portalsim::test::TempDir& t, const Args& spec,
+                                         const std::function<void(const fs::path&)>& after_kill) {
   const fs::path ref = t.w() / "ref", dir = t.w() / "killed";
   ExpectOk(run(t, plus(spec, {"--batch", "500"}), ref));
   Args victim_args{"generate"};
   victim_args.insert(victim_args.end(), spec.begin(), spec.end());
   victim_args.insert(victim_args.end(), {"--batch", "100", "--out", dir.string(), "--quiet"});
   const portalsim::test::Running victim = portalsim::test::start_program(t.cap(), PORTALSIM_BINARY, victim_args);
-  ASSERT_GT(victim.pid, 0);
+  EXPECT_GT(victim.pid, 0);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   while (checkpoint_next(dir) < 300 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   ::kill(victim.pid, SIGKILL);
   const portalsim::test::Result k = portalsim::test::finish(victim, 120);
-  ASSERT_TRUE(k.signaled) << "the run ended before it could be killed: " << portalsim::test::describe(k);
-  ASSERT_FALSE(fs::exists(dir / "data.h5")) << "killed mid-run, there is no data.h5 yet";
-  ASSERT_TRUE(fs::exists(dir / ".portalsim" / "tensors")) << "the batches are checkpointed as .npy files";
-  ExpectOk(run(t, plus(spec, {"--batch", "333", "--resume"}), dir));
+  EXPECT_TRUE(k.signaled) << "the run ended before it could be killed: " << portalsim::test::describe(k);
+  EXPECT_FALSE(fs::exists(dir / "data.h5")) << "killed mid-run, there is no data.h5 yet";
+  after_kill(dir);
+  return run(t, plus(spec, {"--batch", "333", "--resume"}), dir);
+}
+
+void expect_same_run(const fs::path& ref, const fs::path& dir) {
   EXPECT_TRUE(slurp(dir / "data.h5") == slurp(ref / "data.h5")) << "the resumed data.h5 differs";
   EXPECT_EQ(slurp(dir / "features.csv"), slurp(ref / "features.csv"));
   EXPECT_EQ(slurp(dir / "manifest.json"), slurp(ref / "manifest.json"));
   EXPECT_FALSE(fs::exists(dir / ".portalsim"));
+  EXPECT_FALSE(fs::exists(dir / "data.h5.partial"));
+}
+
+TEST(TensorsH5, ResumeAfterKill9IsExact) {
+  portalsim::test::TempDir t;
+  const Args spec{"--count", "4000", "--seed", "10", "--rule", "gun", "--what", "both", "--format", "h5,csv"};
+  const portalsim::test::Result r = kill_then_resume(t, spec, [](const fs::path& dir) {
+    // Laid out before the first row was written: what the kill left is an HDF5 file
+    // that HDF5 opens, with every dataset at its full length.
+    const fs::path partial = dir / "data.h5.partial";
+    ASSERT_TRUE(fs::exists(partial)) << "data.h5 is written in place as data.h5.partial";
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    const hid_t f = H5Fopen(partial.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    ASSERT_GE(f, 0) << "the killed run's data.h5.partial must be a valid HDF5 file";
+    const hid_t ds = H5Dopen2(f, "upper", H5P_DEFAULT);
+    ASSERT_GE(ds, 0);
+    const hid_t space = H5Dget_space(ds);
+    hsize_t dims[3] = {0, 0, 0};
+    H5Sget_simple_extent_dims(space, dims, nullptr);
+    EXPECT_EQ(dims[0], 4000u);
+    H5Sclose(space);
+    H5Dclose(ds);
+    H5Fclose(f);
+    EXPECT_FALSE(fs::exists(dir / ".portalsim" / "tensors")) << "uncompressed, no .npy copy is kept";
+  });
+  ExpectOk(r);
+  expect_same_run(t.w() / "ref", t.w() / "killed");
+}
+
+TEST(TensorsH5, CompressedResumeAfterKill9IsExact) {
+  portalsim::test::TempDir t;
+  const Args spec{"--count", "1500", "--seed",   "10",     "--rule",    "gun",
+                  "--what",  "both", "--format", "h5,csv", "--compress"};
+  const portalsim::test::Result r = kill_then_resume(t, spec, [](const fs::path& dir) {
+    EXPECT_TRUE(fs::exists(dir / ".portalsim" / "tensors")) << "compressed, the batches are .npy files until the end";
+    EXPECT_FALSE(fs::exists(dir / "data.h5.partial"));
+  });
+  ExpectOk(r);
+  expect_same_run(t.w() / "ref", t.w() / "killed");
+}
+
+TEST(TensorsH5, ResumeRefusesRowsChangedSinceTheCheckpoint) {
+  portalsim::test::TempDir t;
+  const Args spec{"--count", "4000", "--seed", "10", "--rule", "gun", "--what", "images", "--format", "h5"};
+  const portalsim::test::Result r = kill_then_resume(t, spec, [](const fs::path& dir) {
+    // Flip the first written pixel of `upper` (its rows start where HDF5 says).
+    const fs::path partial = dir / "data.h5.partial";
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    const hid_t f = H5Fopen(partial.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    const hid_t ds = H5Dopen2(f, "upper", H5P_DEFAULT);
+    const haddr_t at = H5Dget_offset(ds);
+    H5Dclose(ds);
+    H5Fclose(f);
+    ASSERT_NE(at, HADDR_UNDEF);
+    std::FILE* fp = std::fopen(partial.c_str(), "rb+");
+    ASSERT_NE(fp, nullptr);
+    std::fseek(fp, static_cast<long>(at), SEEK_SET);
+    const int c = std::fgetc(fp);
+    std::fseek(fp, static_cast<long>(at), SEEK_SET);
+    std::fputc(c ^ 0xff, fp);
+    std::fclose(fp);
+  });
+  EXPECT_TRUE(r.exited && r.status != 0) << portalsim::test::describe(r);
+  EXPECT_NE(r.err.find("data.h5.partial"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("upper"), std::string::npos) << r.err;
 }
 
 TEST(TensorsH5, CompressWithoutH5IsRefusedNamingTheFlag) {

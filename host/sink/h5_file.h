@@ -1,6 +1,9 @@
-// data.h5 through libhdf5: built from per-tensor .npy files (by a run, or by a merge of
-// parts), and read back (a merge reads its parts' datasets and attributes). One writer,
-// so the bytes of data.h5 depend only on its contents and their order.
+// data.h5 through libhdf5, and read back (a merge reads its parts' datasets and
+// attributes). Uncompressed, the file is laid out first (attributes, contiguous datasets
+// allocated in full) and closed, then rows are written in place at their offsets: HDF5's
+// metadata is final before any row is, so a kill -9 mid-run leaves a valid file to resume
+// into. Compressed, it is built through HDF5 from per-tensor .npy files at the end. One
+// layout, so the bytes of data.h5 depend only on its contents and their order.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -37,7 +40,17 @@ struct H5Layout {
 
 // Writes dir/data.h5 (to data.h5.tmp, synced, then renamed). `npy_path(i)` is the .npy
 // file holding dataset i's rows; its header is skipped. Throws OutputError.
+// (Uncompressed: create_h5_in_place, then the rows written at their offsets.)
 void write_h5(const std::string& dir, const H5Layout& layout, const std::vector<std::string>& npy_paths);
+
+// Creates `path` laid out for `layout` (not compressed) and returns the file offset where
+// each dataset's rows start; rows are then written there with write_at. Throws OutputError.
+std::vector<uint64_t> create_h5_in_place(const std::string& path, const H5Layout& layout);
+// The same offsets of a file create_h5_in_place made, after checking its datasets are
+// `layout`'s (resuming a run). Throws OutputError naming the file.
+std::vector<uint64_t> h5_data_offsets(const std::string& path, const H5Layout& layout);
+// pwrite all of [data, data + n) at `offset`. Throws OutputError naming `path`.
+void write_at(int fd, const char* data, size_t n, uint64_t offset, const std::string& path);
 
 // The layout of a data.h5 this program wrote. Throws InputError naming the file.
 H5Layout read_h5_layout(const std::string& path);

@@ -1,12 +1,17 @@
 #include "sink/tensors.h"
 
+#include <fcntl.h>
 #include <unistd.h>
+#include <xxhash.h>
 
+#include <array>
+#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <optional>
+#include <string_view>
 
 #include "base/error.h"
 #include "base/parallel.h"
@@ -34,11 +39,21 @@ std::string npy_array_header(const std::string& descr, const std::vector<uint64_
 
 namespace {
 
-// One tensor: its dataset description and how a batch fills it.
+template <class T>
+std::string_view bytes_of(const std::vector<T>& v) {
+  return {reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T)};
+}
+
+// One tensor: its dataset description and how a batch fills it; then either its .npy file
+// or, for data.h5 written in place, where its rows start and the hash of those written.
 struct Tensor {
   H5Dataset ds;
-  std::function<void(const SceneBatch&, const BatchOutput&, std::string&)> fill;
+  // The batch's rows: a view of the batch's own memory, or of `scratch` filled here.
+  std::function<std::string_view(const SceneBatch&, const BatchOutput&, std::string& scratch)> fill;
+  std::string scratch;  // kept from batch to batch, so its pages are touched once
   std::unique_ptr<AppendFile> file;
+  uint64_t offset = 0, bytes = 0;
+  std::unique_ptr<XXH3_state_t, XXH_errorcode (*)(XXH3_state_t*)> hash{nullptr, XXH3_freeState};
 };
 
 class TensorSink final : public Sink {
@@ -46,7 +61,7 @@ class TensorSink final : public Sink {
   TensorSink(const SinkContext& ctx, const TensorOptions& opt, const std::map<std::string, FileState>* resume)
       : ctx_(ctx), opt_(opt) {
     const Catalogue& cat = *ctx.cat;
-    if (opt.h5) {
+    if (opt.h5 && opt.compress) {
       std::error_code ec;
       fs::create_directories(fs::path(ctx.dir) / kStateDir / "tensors", ec);
       if (ec) throw OutputError(ctx.dir + "/" + kStateDir + "/tensors: cannot create: " + ec.message());
@@ -56,64 +71,59 @@ class TensorSink final : public Sink {
         const Sensor& s = cat.sensors[k];
         const uint64_t h = static_cast<uint64_t>(s.height), w = static_cast<uint64_t>(s.width);
         if (s.palette) {
-          add(s.name, TensorType::u8, {h, w, 3},
-              [this, k](const SceneBatch& b, const BatchOutput& o, std::string& buf) {
-                const ViewImages& v = o.views[k];
-                const size_t px = v.pixels_per_image();
-                buf.resize(b.size() * px * 3);
-                for (size_t i = 0; i < b.size() * px; ++i)
-                  std::memcpy(&buf[i * 3], ctx_.palette[v.pixels[i]].data(), 3);
-              });
-          add(s.name + "_index", TensorType::u8, {h, w},
-              [k](const SceneBatch&, const BatchOutput& o, std::string& buf) {
-                buf.assign(reinterpret_cast<const char*>(o.views[k].pixels.data()), o.views[k].pixels.size());
-              });
-        } else {
-          add(s.name, TensorType::u8, {h, w}, [k](const SceneBatch&, const BatchOutput& o, std::string& buf) {
-            buf.assign(reinterpret_cast<const char*>(o.views[k].pixels.data()), o.views[k].pixels.size());
+          // Through the palette as 4-byte words, each store overlapping the next pixel's.
+          std::array<uint32_t, 256> rgb{};
+          for (size_t i = 0; i < rgb.size(); ++i) std::memcpy(&rgb[i], ctx_.palette[i].data(), 3);
+          add(s.name, TensorType::u8, {h, w, 3}, [k, rgb](const SceneBatch& b, const BatchOutput& o, std::string& buf) {
+            const ViewImages& v = o.views[k];
+            const size_t n = b.size() * v.pixels_per_image();
+            buf.resize(n * 3 + 1);
+            char* d = buf.data();
+            for (size_t i = 0; i < n; ++i) std::memcpy(d + i * 3, &rgb[v.pixels[i]], 4);
+            return std::string_view(buf.data(), n * 3);
           });
+          add(s.name + "_index", TensorType::u8, {h, w},
+              [k](const SceneBatch&, const BatchOutput& o, std::string&) { return bytes_of(o.views[k].pixels); });
+        } else {
+          add(s.name, TensorType::u8, {h, w},
+              [k](const SceneBatch&, const BatchOutput& o, std::string&) { return bytes_of(o.views[k].pixels); });
         }
       }
     if (opt.annotations)
       for (size_t k = 0; k < cat.sensors.size(); ++k) {
         const Sensor& s = cat.sensors[k];
         add("mask_" + s.name, TensorType::u8, {static_cast<uint64_t>(s.height), static_cast<uint64_t>(s.width)},
-            [k](const SceneBatch&, const BatchOutput& o, std::string& buf) {
-              buf.assign(reinterpret_cast<const char*>(o.annotations[k].masks.data()), o.annotations[k].masks.size());
-            });
+            [k](const SceneBatch&, const BatchOutput& o, std::string&) { return bytes_of(o.annotations[k].masks); });
       }
     if (opt.features)
       add("features", TensorType::f32, {static_cast<uint64_t>(ctx.layout.image_features())},
-          [](const SceneBatch&, const BatchOutput& o, std::string& buf) {
-            buf.assign(reinterpret_cast<const char*>(o.features.data()), o.features.size() * sizeof(float));
-          });
+          [](const SceneBatch&, const BatchOutput& o, std::string&) { return bytes_of(o.features); });
     if (opt.scenario) {
-      add("metal", TensorType::u8, {kZones}, [](const SceneBatch&, const BatchOutput& o, std::string& buf) {
-        buf.assign(reinterpret_cast<const char*>(o.metal.data()), o.metal.size());
-      });
-      add("label", TensorType::u8, {}, [](const SceneBatch& b, const BatchOutput&, std::string& buf) {
-        buf.assign(reinterpret_cast<const char*>(b.label.data()), b.label.size());
-      });
+      add("metal", TensorType::u8, {kZones},
+          [](const SceneBatch&, const BatchOutput& o, std::string&) { return bytes_of(o.metal); });
+      add("label", TensorType::u8, {},
+          [](const SceneBatch& b, const BatchOutput&, std::string&) { return bytes_of(b.label); });
       add("subject", TensorType::u8, {}, [](const SceneBatch& b, const BatchOutput&, std::string& buf) {
         buf.resize(b.size());
         for (size_t i = 0; i < b.size(); ++i) buf[i] = static_cast<char>(b.subject[i] + 1);
+        return std::string_view(buf);
       });
       add("region_object", TensorType::i16, {kRegions},
           [this](const SceneBatch& b, const BatchOutput&, std::string& buf) {
-            per_region(b, buf, [&](int16_t v) {
+            return per_region(b, buf, [&](int16_t v) {
               return v == kNoObject ? int16_t(-1) : int16_t(ctx_.cat->variant_list[v].object);
             });
           });
       add("region_orientation", TensorType::i16, {kRegions},
           [this](const SceneBatch& b, const BatchOutput&, std::string& buf) {
-            per_region(b, buf, [&](int16_t v) {
+            return per_region(b, buf, [&](int16_t v) {
               return v == kNoObject ? int16_t(-1) : int16_t(ctx_.cat->variant_list[v].variant);
             });
           });
       add("region_label", TensorType::u8, {kRegions},
           [this](const SceneBatch& b, const BatchOutput&, std::string& buf) {
             buf.assign(b.size() * kRegions, '\0');
-            if (!opt_.rule) return;
+            if (!opt_.rule) return std::string_view(buf);
             for (size_t i = 0; i < b.size(); ++i)
               for (int r = 0; r < kRegions; ++r) {
                 const int16_t v = b.objects[i * kRegions + r];
@@ -123,41 +133,79 @@ class TensorSink final : public Sink {
                 alone.objects[r] = v;
                 buf[i * kRegions + r] = (*opt_.rule)(alone) ? 1 : 0;
               }
+            return std::string_view(buf);
           });
     }
-    for (Tensor& t : tensors_) {
-      const std::string file = file_name(t.ds.name);
-      const FileState* state = nullptr;
-      if (resume) {
-        auto it = resume->find(file);
-        if (it == resume->end()) throw OutputError(ctx.dir + "/.portalsim/checkpoint.json: no state for " + file);
-        state = &it->second;
+    if (in_place())
+      open_in_place(resume);
+    else
+      for (Tensor& t : tensors_) {
+        const std::string file = file_name(t.ds.name);
+        const FileState* state = nullptr;
+        if (resume) {
+          auto it = resume->find(file);
+          if (it == resume->end()) throw OutputError(ctx.dir + "/.portalsim/checkpoint.json: no state for " + file);
+          state = &it->second;
+        }
+        std::vector<uint64_t> shape{ctx.rows};
+        shape.insert(shape.end(), t.ds.dims.begin(), t.ds.dims.end());
+        const std::string header = npy_array_header(npy_descr(t.ds.type), shape);
+        t.file = std::make_unique<AppendFile>(ctx.dir, file, state);
+        if (!state) t.file->append(header);
       }
-      std::vector<uint64_t> shape{ctx.rows};
-      shape.insert(shape.end(), t.ds.dims.begin(), t.ds.dims.end());
-      const std::string header = npy_array_header(npy_descr(t.ds.type), shape);
-      t.file = std::make_unique<AppendFile>(ctx.dir, file, state);
-      if (!state) t.file->append(header);
-    }
+  }
+
+  ~TensorSink() override {
+    if (fd_ >= 0) ::close(fd_);
   }
 
   void write(const SceneBatch& scenes, const BatchOutput& out) override {
-    std::vector<std::string> bufs(tensors_.size());
-    parallel_for(tensors_.size(), std::min<unsigned>(ctx_.threads, static_cast<unsigned>(tensors_.size())),
-                 [&](size_t b, size_t e) {
-                   for (size_t k = b; k < e; ++k) tensors_[k].fill(scenes, out, bufs[k]);
-                 });
-    for (size_t k = 0; k < tensors_.size(); ++k) tensors_[k].file->append(bufs[k]);
+    std::vector<std::string_view> rows(tensors_.size());
+    const unsigned threads = std::min<unsigned>(ctx_.threads, static_cast<unsigned>(tensors_.size()));
+    parallel_for(tensors_.size(), threads, [&](size_t b, size_t e) {
+      for (size_t k = b; k < e; ++k) rows[k] = tensors_[k].fill(scenes, out, tensors_[k].scratch);
+    });
+    if (!in_place()) {
+      for (size_t k = 0; k < tensors_.size(); ++k) tensors_[k].file->append(rows[k]);
+      return;
+    }
+    // Each thread writes its share of every tensor's rows: the bytes, not the tensors, are
+    // split evenly (the camera views are most of them).
+    const size_t n = scenes.size();
+    parallel_for(n, ctx_.threads, [&](size_t b, size_t e) {
+      for (size_t k = 0; k < tensors_.size(); ++k) {
+        const Tensor& t = tensors_[k];
+        const size_t row = t.ds.row_bytes();
+        write_at(fd_, rows[k].data() + b * row, (e - b) * row, t.offset + (rows_ + b) * row, partial_);
+      }
+    });
+    for (size_t k = 0; k < tensors_.size(); ++k) {
+      XXH3_64bits_update(tensors_[k].hash.get(), rows[k].data(), rows[k].size());
+      tensors_[k].bytes += rows[k].size();
+    }
+    rows_ += n;
   }
 
   std::vector<FileState> files() const override {
     if (h5_state_) return {*h5_state_};
     std::vector<FileState> f;
-    for (const Tensor& t : tensors_) f.push_back(t.file->state());
+    for (const Tensor& t : tensors_)
+      f.push_back(in_place() ? FileState{in_place_name(t), t.bytes, XXH3_64bits_digest(t.hash.get())}
+                             : t.file->state());
     return f;
   }
 
   void finish() override {
+    if (in_place()) {
+      if (::fsync(fd_) != 0) throw OutputError(partial_ + ": fsync failed: " + std::strerror(errno));
+      ::close(fd_);
+      fd_ = -1;
+      std::error_code ec;
+      fs::rename(partial_, fs::path(ctx_.dir) / "data.h5", ec);
+      if (ec) throw OutputError(ctx_.dir + "/data.h5: cannot move into place: " + ec.message());
+      h5_state_ = hash_file(ctx_.dir, "data.h5");
+      return;
+    }
     for (Tensor& t : tensors_) t.file->finish();
     if (opt_.h5) build_h5();
   }
@@ -167,12 +215,76 @@ class TensorSink final : public Sink {
   TensorOptions opt_;
   std::vector<Tensor> tensors_;
   std::optional<FileState> h5_state_;
+  std::string partial_;  // data.h5 in place: its name while the run goes
+  int fd_ = -1;
+  uint64_t rows_ = 0;  // rows written so far
+
+  // Uncompressed data.h5 is laid out at the start and its rows written in place; compressed,
+  // it is built at the end from .npy files (HDF5 writes the chunks).
+  bool in_place() const { return opt_.h5 && !opt_.compress; }
+  static std::string in_place_name(const Tensor& t) { return "data.h5#" + t.ds.name; }
+
+  H5Layout h5_layout() const {
+    H5Layout layout;
+    layout.rows = ctx_.rows;
+    layout.compress = opt_.compress;
+    layout.attributes = attributes();
+    for (const Tensor& t : tensors_) layout.datasets.push_back(t.ds);
+    return layout;
+  }
+
+  // Lays data.h5.partial out (a new run), or takes it back and checks that every dataset's
+  // rows so far are what the checkpoint recorded (a resumed run).
+  void open_in_place(const std::map<std::string, FileState>* resume) {
+    partial_ = (fs::path(ctx_.dir) / "data.h5.partial").string();
+    const H5Layout layout = h5_layout();
+    std::vector<uint64_t> offsets;
+    if (!resume) {
+      offsets = create_h5_in_place(partial_, layout);
+    } else {
+      std::error_code ec;  // a run that died while renaming its finished file
+      const fs::path final_path = fs::path(ctx_.dir) / "data.h5";
+      if (!fs::exists(partial_, ec) && fs::exists(final_path, ec)) fs::rename(final_path, partial_, ec);
+      offsets = h5_data_offsets(partial_, layout);
+    }
+    fd_ = ::open(partial_.c_str(), O_RDWR | O_CLOEXEC);
+    if (fd_ < 0) throw OutputError(partial_ + ": cannot open: " + std::strerror(errno));
+    std::vector<char> buf;
+    for (size_t k = 0; k < tensors_.size(); ++k) {
+      Tensor& t = tensors_[k];
+      t.offset = offsets[k];
+      t.hash.reset(XXH3_createState());
+      if (!t.hash) throw std::bad_alloc();
+      XXH3_64bits_reset(t.hash.get());
+      if (!resume) continue;
+      auto it = resume->find(in_place_name(t));
+      if (it == resume->end())
+        throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: no state for " + in_place_name(t));
+      const uint64_t row = t.ds.row_bytes(), rows = row ? it->second.bytes / row : 0;
+      if (k == 0) rows_ = rows;
+      if ((row && it->second.bytes % row) || rows != rows_ || rows > ctx_.rows)
+        throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: " + in_place_name(t) + " records " +
+                          std::to_string(it->second.bytes) + " bytes, not whole rows of every dataset");
+      // The rows so far, hashed again: they must be what the checkpoint recorded.
+      for (uint64_t at = 0; at < it->second.bytes;) {
+        buf.resize(static_cast<size_t>(std::min<uint64_t>(it->second.bytes - at, 1u << 20)));
+        const ssize_t r = ::pread(fd_, buf.data(), buf.size(), static_cast<off_t>(t.offset + at));
+        if (r <= 0) throw OutputError(partial_ + ": cannot read back for resume: " + std::strerror(errno));
+        XXH3_64bits_update(t.hash.get(), buf.data(), static_cast<size_t>(r));
+        at += static_cast<uint64_t>(r);
+      }
+      t.bytes = it->second.bytes;
+      if (XXH3_64bits_digest(t.hash.get()) != it->second.xxh3)
+        throw OutputError(partial_ + ": dataset " + t.ds.name +
+                          " differs from the checkpoint; the run cannot be resumed");
+    }
+  }
 
   std::string file_name(const std::string& tensor) const {
     return opt_.h5 ? std::string(kStateDir) + "/tensors/" + tensor + ".npy" : tensor + ".npy";
   }
   void add(const std::string& name, TensorType type, std::vector<uint64_t> dims,
-           std::function<void(const SceneBatch&, const BatchOutput&, std::string&)> fill) {
+           std::function<std::string_view(const SceneBatch&, const BatchOutput&, std::string&)> fill) {
     Tensor t;
     t.ds.name = name;
     t.ds.type = type;
@@ -182,26 +294,20 @@ class TensorSink final : public Sink {
     tensors_.push_back(std::move(t));
   }
   template <class F>
-  static void per_region(const SceneBatch& b, std::string& buf, F f) {
+  static std::string_view per_region(const SceneBatch& b, std::string& buf, F f) {
     buf.resize(b.size() * kRegions * sizeof(int16_t));
     for (size_t i = 0; i < b.size() * kRegions; ++i) {
       const int16_t v = f(b.objects[i]);
       std::memcpy(&buf[i * sizeof(int16_t)], &v, sizeof v);
     }
+    return buf;
   }
 
-  // data.h5 from the finished tensor files.
+  // data.h5 from the finished tensor files (compressed).
   void build_h5() {
-    H5Layout layout;
-    layout.rows = ctx_.rows;
-    layout.compress = opt_.compress;
-    layout.attributes = attributes();
     std::vector<std::string> paths;
-    for (const Tensor& t : tensors_) {
-      layout.datasets.push_back(t.ds);
-      paths.push_back((fs::path(ctx_.dir) / file_name(t.ds.name)).string());
-    }
-    write_h5(ctx_.dir, layout, paths);
+    for (const Tensor& t : tensors_) paths.push_back((fs::path(ctx_.dir) / file_name(t.ds.name)).string());
+    write_h5(ctx_.dir, h5_layout(), paths);
     h5_state_ = hash_file(ctx_.dir, "data.h5");
   }
 

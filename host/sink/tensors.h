@@ -1,9 +1,11 @@
-// Tensor outputs for deep learning: per-scenario arrays, each appended batch by batch to
-// one .npy file (an AppendFile, so it is checkpointed and resumed like every table).
-//   --format npy: the files are the output, <name>.npy in the folder.
-//   --format h5:  the files live under .portalsim/tensors/ while the run goes; at the end
-//                 data.h5 is built from them (written to a temporary name, then renamed),
-//                 so a kill -9 never leaves a half-written HDF5 file to resume from.
+// Tensor outputs for deep learning: per-scenario arrays, checkpointed and resumed like
+// every table.
+//   --format npy: each appended batch by batch to <name>.npy (an AppendFile).
+//   --format h5:  data.h5.partial is laid out at the start (HDF5 metadata final, closed)
+//                 and each batch's rows are written in place at their datasets' offsets,
+//                 each dataset's rows hashed for the checkpoint; renamed data.h5 at the end.
+//   --format h5 --compress: the tensors are .npy files under .portalsim/tensors/ while the
+//                 run goes, and data.h5 is built from them through HDF5 at the end.
 // Tensors (N scenarios): upper, lower uint8 NxHxW; ir uint8 NxHxWx3 (RGB through the
 // palette) and ir_index uint8 NxHxW (temperature index); metal uint8 Nx19; features
 // float32 NxF (image features, when computed); label, subject uint8 N; region_object,

@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""End-to-end rate of `portalsim generate` against the destination's own write speed.
+
+Each round runs, interleaved: `dd` writing fresh bytes to the destination (oflag=direct
+unless it is a tmpfs, which has no direct I/O), then every given build's `generate` into a
+new folder there. Prints a markdown table of medians: the run's scenarios/s from its
+summary line, its bytes/s, the whole command's wall time, and its share of dd's rate.
+
+  python3 bench/end_to_end.py --dest /dev/shm --count 5000 --rounds 3 \\
+      --build new=build/portalsim --build old=OLD/portalsim \\
+      -- --seed 1 --rule gun --what images --format h5
+"""
+import argparse
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import tempfile
+import time
+
+
+def folder_bytes(path):
+    total = 0
+    for root, _, files in os.walk(path):
+        for f in files:
+            total += os.path.getsize(os.path.join(root, f))
+    return total
+
+
+def is_tmpfs(path):
+    out = subprocess.run(["stat", "-f", "-c", "%T", path], capture_output=True, text=True).stdout.strip()
+    return out == "tmpfs"
+
+
+def dd_rate(dest, mb):
+    """Bytes/s of dd writing `mb` MiB of fresh bytes to a new file in dest."""
+    target = os.path.join(dest, "portalsim-dd-%d" % os.getpid())
+    args = ["dd", "if=/dev/zero", "of=" + target, "bs=1M", "count=%d" % mb]
+    if not is_tmpfs(dest):
+        args.append("oflag=direct")
+    t0 = time.monotonic()
+    subprocess.run(args, check=True, capture_output=True)
+    seconds = time.monotonic() - t0
+    os.remove(target)
+    return mb * 1048576 / seconds
+
+
+def run_generate(binary, dest, count, extra):
+    out = tempfile.mkdtemp(prefix="portalsim-e2e-", dir=dest)
+    shutil.rmtree(out)
+    t0 = time.monotonic()
+    p = subprocess.run([binary, "generate", "--count", str(count), "--out", out] + extra,
+                       capture_output=True, text=True)
+    wall = time.monotonic() - t0
+    if p.returncode != 0:
+        raise SystemExit("%s failed (%d): %s" % (binary, p.returncode, p.stderr[-2000:]))
+    m = re.search(r"([0-9.]+) scenarios/s", p.stdout + p.stderr)
+    if not m:
+        raise SystemExit("%s: no scenarios/s in its summary line" % binary)
+    size = folder_bytes(out)
+    shutil.rmtree(out)
+    return float(m.group(1)), wall, size
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--dest", required=True, help="folder on the filesystem to measure")
+    ap.add_argument("--count", type=int, default=5000)
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--dd-mb", type=int, default=1000, help="MiB that dd writes per round")
+    ap.add_argument("--build", action="append", required=True, help="LABEL=PATH of a portalsim binary")
+    ap.add_argument("generate_args", nargs=argparse.REMAINDER, help="-- then generate's arguments")
+    a = ap.parse_args()
+    extra = [x for x in a.generate_args if x != "--"] + ["--quiet"]
+    builds = [b.split("=", 1) for b in a.build]
+    dd, rates, walls, sizes = [], {l: [] for l, _ in builds}, {l: [] for l, _ in builds}, {}
+    for _ in range(a.rounds):
+        dd.append(dd_rate(a.dest, a.dd_mb))
+        for label, path in builds:
+            r, w, s = run_generate(path, a.dest, a.count, extra)
+            rates[label].append(r)
+            walls[label].append(w)
+            sizes[label] = s
+    load = os.getloadavg()[0]
+    dd_med = statistics.median(dd)
+    kind = "tmpfs" if is_tmpfs(a.dest) else "direct I/O"
+    print("%s (%s), %d scenarios, medians of %d rounds, load average %.1f at the end; "
+          "dd writes fresh bytes at %.2f GB/s" % (a.dest, kind, a.count, a.rounds, load, dd_med / 1e9))
+    print()
+    print("| build | scenarios/s | bytes per scenario | GB/s written | share of dd | wall, whole command |")
+    print("|---|---|---|---|---|---|")
+    for label, _ in builds:
+        r = statistics.median(rates[label])
+        per = sizes[label] / a.count
+        print("| %s | %s | %s | %.2f | %.0f%% | %.2f s |" % (label, f"{r:,.0f}", f"{per:,.0f}", r * per / 1e9,
+                                                            100 * r * per / dd_med, statistics.median(walls[label])))
+
+
+if __name__ == "__main__":
+    main()
