@@ -184,7 +184,7 @@ long long part_next(const fs::path& part) {
 
 TEST(Mpi, KilledRankEndsTheJobAndResumeFinishesItOnAnyNumberOfRanks) {
   TempDir t;
-  const Args spec{"--count", "3000", "--seed", "5", "--what", "both", "--format", "csv", "--batch", "16", "--quiet"};
+  const Args spec{"--count", "1200", "--seed", "5", "--what", "both", "--format", "csv", "--batch", "16", "--quiet"};
   const fs::path whole = t.w() / "whole";
   ExpectOk(ps(t, gen(spec, whole)));
   for (int resume_ranks : {1, 2}) {
