@@ -16,6 +16,7 @@ import sys
 
 import h5py
 import numpy as np
+import torch
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
@@ -77,6 +78,27 @@ def main():
     ir = PortalsimDataset(out / "data.h5", views=("ir",), target="region_label")
     x, y = ir[0]
     expect(tuple(x.shape) == (3, 200, 100) and tuple(y.shape) == (13,), f"ir item {tuple(x.shape)}, {tuple(y.shape)}")
+
+    # Mask targets: a small annotated set; the loader's masks and boxes are annotations.json's.
+    ann = work / "annotated"
+    subprocess.run([portalsim, "generate", "--count", "40", "--seed", "3", "--objects", "2..5", "--what", "images",
+                    "--format", "h5", "--annotations", "--out", str(ann), "--quiet"], check=True)
+    seg = PortalsimDataset(ann / "data.h5", views=("upper", "lower"), target="mask")
+    coco = json.loads((ann / "annotations.json").read_text())
+    by_image = {}
+    for a in coco["annotations"]:
+        by_image.setdefault(a["image_id"], {})[a["region"]] = tuple(a["bbox"])
+    views = [im for im in coco["images"] if im["view"] in ("upper", "lower")]
+    expect(len(views) == 2 * 40, f"annotations.json has {len(views)} upper/lower images, expected 80")
+    seen = 0
+    for im in views:
+        x, m = seg[im["scenario"]]
+        expect(tuple(m.shape) == (2, 200, 200) and m.dtype == torch.int64, f"mask target {tuple(m.shape)} {m.dtype}")
+        got = PortalsimDataset.boxes(m[("upper", "lower").index(im["view"])].numpy())
+        expect(got == by_image.get(im["id"], {}),
+               f"scenario {im['scenario']} view {im['view']}: loader boxes {got}, COCO {by_image.get(im['id'], {})}")
+        seen += len(got)
+    expect(seen > 40, f"only {seen} boxes in 40 scenarios of 2..5 objects")
 
     r = subprocess.run([sys.executable, str(ROOT / "tools" / "train_example.py"), str(out / "data.h5"),
                         "--steps", "250"], capture_output=True, text=True)

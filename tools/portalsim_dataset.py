@@ -6,7 +6,10 @@
 
 `views` picks the image datasets stacked as channels (views of one size: upper and lower
 are 200x200; ir is 200x100x3 and comes alone, channels first). `target` is "label" (one
-class per scenario) or "region_label" (13 per-region threat labels, float32). The file is
+class per scenario), "region_label" (13 per-region threat labels, float32) or "mask" (the
+instance masks of the chosen views, int64 (V, H, W): each pixel the region 1-13 whose
+object covers it, 0 none; needs a set made with --annotations). For detection, `boxes()`
+gives an item's boxes from its masks. The file is
 opened lazily in each worker process, so the dataset works with DataLoader(num_workers>0).
 Needs Debian python3-torch, python3-h5py, python3-numpy.
 """
@@ -21,12 +24,14 @@ class PortalsimDataset(Dataset):
         self.path = str(path)
         self.views = tuple(views)
         self.target = target
+        # The datasets a target reads.
+        self._targets = tuple(f"mask_{v}" for v in self.views) if target == "mask" else (target,)
         with h5py.File(self.path, "r") as f:
-            missing = [v for v in (*self.views, target) if v not in f]
+            missing = [v for v in (*self.views, *self._targets) if v not in f]
             if missing:
                 raise KeyError(f"{self.path}: no dataset {', '.join(missing)} "
                                f"(it has {', '.join(sorted(f.keys()))}; images need --what images|both)")
-            self.length = f[target].shape[0]
+            self.length = f[self._targets[0]].shape[0]
             self.class_names = [str(c) for c in f.attrs["class_names"]]
             self.spec = f.attrs["spec"]
             shapes = {f[v].shape[1:3] for v in self.views}
@@ -38,7 +43,7 @@ class PortalsimDataset(Dataset):
         self._cache = None
         if in_memory:
             with h5py.File(self.path, "r") as f:
-                self._cache = {k: f[k][:][self.indices] for k in (*self.views, target)}
+                self._cache = {k: f[k][:][self.indices] for k in (*self.views, *self._targets)}
 
     def __len__(self):
         return len(self.indices)
@@ -58,9 +63,24 @@ class PortalsimDataset(Dataset):
             a = f[v][j]
             planes.extend(np.moveaxis(a, -1, 0) if a.ndim == 3 else a[None])
         x = torch.from_numpy(np.stack(planes).astype(np.float32) / 255.0)
+        if self.target == "mask":
+            return x, torch.from_numpy(np.stack([f[m][j] for m in self._targets]).astype(np.int64))
         y = f[self.target][j]
         y = torch.tensor(y, dtype=torch.float32) if self.target == "region_label" else torch.tensor(int(y))
         return x, y
+
+    @staticmethod
+    def boxes(mask):
+        """The boxes of one view's mask (H, W): {region: (x, y, w, h)} over the pixels each
+        region's object owns, as annotations.json's bbox."""
+        m = np.asarray(mask)
+        out = {}
+        for r in np.unique(m):
+            if r == 0:
+                continue
+            ys, xs = np.nonzero(m == r)
+            out[int(r)] = (int(xs.min()), int(ys.min()), int(xs.max() - xs.min() + 1), int(ys.max() - ys.min() + 1))
+        return out
 
     def __getstate__(self):  # DataLoader workers open their own handle
         s = dict(self.__dict__)
