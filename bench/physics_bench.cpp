@@ -1,6 +1,7 @@
 // The physics model against the thesis model, per scenario, in the same run:
 //   ./build/portalsim_bench --benchmark_filter=Model --benchmark_repetitions=3
-// Args: batch size, model (0 thesis, 1 physics), NETD in kelvin (physics only).
+// Args: batch size, model (0 thesis, 1 physics), NETD in kelvin (physics only), tier (0
+// standard, 1 fast: physics features-only from the raw grid).
 // The IR camera alone, and its physics chain cut after each stage:
 //   ./build/portalsim_bench --benchmark_filter='Ir' --benchmark_repetitions=3
 #include <benchmark/benchmark.h>
@@ -16,6 +17,7 @@ Plan model_plan(const benchmark::State& state, bool images) {
   Plan p;
   p.model.model = state.range(1) == 1 ? Model::physics : Model::thesis;
   p.model.netd = static_cast<double>(state.range(2));
+  if (state.range(3) == 1) p.fidelity = tier_fidelity(Tier::fast);
   if (images)
     p.features = false;
   else
@@ -26,7 +28,8 @@ Plan model_plan(const benchmark::State& state, bool images) {
 void run_model(benchmark::State& state, Backend& backend, bool images) {
   const size_t n = static_cast<size_t>(state.range(0));
   const Plan plan = model_plan(state, images);
-  state.SetLabel(std::string(model_name(plan.model.model)) + (images ? " images" : " features"));
+  state.SetLabel(std::string(model_name(plan.model.model)) + (images ? " images" : " features") +
+                 (plan.physics_sparse_features() ? " (raw grid)" : ""));
   bench::time_runs(state, backend, plan, n);
 }
 
@@ -40,19 +43,21 @@ void BM_ModelReference(benchmark::State& state, bool images) {
 }
 
 BENCHMARK_CAPTURE(BM_ModelOpenCL, images, true)
-    ->Args({1024, 0, 0})
-    ->Args({1024, 1, 0})
-    ->Args({1024, 1, 3})
+    ->Args({1024, 0, 0, 0})
+    ->Args({1024, 1, 0, 0})
+    ->Args({1024, 1, 3, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_ModelOpenCL, features, false)
-    ->Args({4096, 0, 0})
-    ->Args({4096, 1, 3})
+    ->Args({4096, 0, 0, 0})
+    ->Args({4096, 1, 3, 0})
+    ->Args({4096, 1, 0, 1})
+    ->Args({4096, 1, 3, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_ModelReference, images, true)
-    ->Args({16, 0, 0})
-    ->Args({16, 1, 3})
+    ->Args({16, 0, 0, 0})
+    ->Args({16, 1, 3, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

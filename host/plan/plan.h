@@ -89,6 +89,13 @@ struct Plan {
     return features && images == 0 && model.model == Model::thesis && fidelity.pooling == Pooling::sparse &&
            !pixel_noise_per_pixel() && model.block <= 256 && !model.moves_sprites();
   }
+  // Physics features-only runs from the MMW raw grid (backend/opencl/raw_grid_pooling.h),
+  // when the block-mean noise model is chosen: like it, this leaves single pixels' rounding
+  // and clipping out. It needs the raw-grid fast path (fused).
+  bool physics_sparse_features() const {
+    return features && images == 0 && model.model == Model::physics && fidelity.pooling == Pooling::sparse &&
+           fidelity.noise == NoiseModel::block_mean && fidelity.fused;
+  }
 };
 
 // The layout of a feature row: the blocks of each pooled view in turn (row-major,

@@ -37,11 +37,17 @@ inline Tolerance tier_tolerance(Tier t) {
 // The physics model's MMW camera in every tier (tests/physics_test.cpp): pixels within 1
 // gray level, at most 0.5% of them off by one, features within 1 and, being means of
 // those pixels, on average within 0.005 (plus float rounding). Its other sensors still run
-// the thesis's chains, so pixels keep the tier's bounds where those are wider.
+// the thesis's chains, so pixels keep the tier's bounds where those are wider. The fast
+// tier's features-only runs take the raw-grid path, which leaves each pixel's rounding
+// and clamping out (backend/opencl/raw_grid_pooling.h): where the display window clamps
+// noisy pixels a mean may be off by many levels, so only the mean error is bounded
+// (0.031 measured on 2,000 scenarios at NETD 3 K).
 inline Tolerance model_tolerance(Model m, Tier t) {
   const Tolerance thesis = tier_tolerance(t);
   if (m == Model::thesis) return thesis;
-  return {std::max(1, thesis.pixel_max_abs), std::max(0.005, thesis.pixel_share_differing), 1.0 + 1e-4, 0.005 + 1e-4};
+  const bool raw_grid = t == Tier::fast;
+  return {std::max(1, thesis.pixel_max_abs), std::max(0.005, thesis.pixel_share_differing),
+          raw_grid ? 255.0 : 1.0 + 1e-4, raw_grid ? 0.1 : 0.005 + 1e-4};
 }
 
 }  // namespace portalsim

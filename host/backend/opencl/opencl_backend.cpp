@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "backend/opencl/raw_grid_pooling.h"
 #include "backend/stages.h"
 #include "base/error.h"
 
@@ -170,9 +171,10 @@ class OpenCLBackend final : public Backend {
     q.enqueueWriteBuffer(objects, CL_FALSE, 0, n * kRegions * sizeof(int16_t), batch.objects.data());
     const cl_uint2 seed = split(plan.model.seed), first = split(batch.first_index);
 
-    const bool sparse = plan.sparse_features();
+    const bool sparse = plan.sparse_features(), raw_grid = plan.physics_sparse_features();
     cl::Buffer& feats = features_.at_least(ctx, std::max<size_t>(1, n * row_len * sizeof(float)));
     if (plan.features && sparse) sparse_features(K, plan, n, subject, objects, seed, first, feats);
+    if (plan.features && raw_grid) raw_grid_features(K, plan, n, subject, objects, seed, first, feats);
 
     // Each camera view the plan needs: rendered into the caller's buffer when its images
     // are kept (PoCL on the CPU writes there directly), else into a device buffer that
@@ -182,11 +184,11 @@ class OpenCLBackend final : public Backend {
       const Sensor& s = cat_.sensors[k];
       const int view = static_cast<int>(k);
       const bool keep = plan.image(view);
-      if (!keep && !(plan.features && s.pooled && !sparse)) continue;
+      if (!keep && !(plan.features && s.pooled && !sparse && !raw_grid)) continue;
       rendered[k] = keep ? wrap(out.views[k].pixels) : scratch_[k].at_least(ctx, n * s.pixels());
       render(K, plan, view, n, subject, objects, seed, first, rendered[k]);
     }
-    if (plan.features && !sparse) {
+    if (plan.features && !sparse && !raw_grid) {
       for (size_t slot = 0; slot < lay.pooled.size(); ++slot)
         pool(K, lay, n, static_cast<int>(slot), rendered[lay.pooled[slot]], feats);
     }
@@ -314,8 +316,9 @@ class OpenCLBackend final : public Backend {
 
   // One camera view for the batch: the fused kernel, or the chain of stage kernels over a
   // field buffer. Both take VIEW_STAGE_ARGS (kernels/composite.cl).
+  // raw_only: the physics MMW fast path's raw grid alone (into raw_), for raw_grid_features.
   void render(Kernels& K, const Plan& plan, int view, size_t n, cl::Buffer& subject, cl::Buffer& objects, cl_uint2 seed,
-              cl_uint2 first, cl::Buffer& dst) {
+              cl_uint2 first, cl::Buffer& dst, bool raw_only = false) {
     const Sensor& s = cat_.sensors[view];
     PsViewLaunch L{};
     L.n = static_cast<uint32_t>(n);
@@ -375,9 +378,10 @@ class OpenCLBackend final : public Backend {
       launch(K.render, n * s.height);
       return;
     }
+    if (raw_only && !physics_fast) throw std::logic_error("the raw grid alone needs the physics fast path");
     if (physics_fast) {
       launch(stage_kernel(K, "physics_raw"), n);
-      launch(stage_kernel(K, "stage_mmw_display"), n * s.height);
+      if (!raw_only) launch(stage_kernel(K, "stage_mmw_display"), n * s.height);
       return;
     }
     for (const std::string& name : chain)
@@ -619,6 +623,47 @@ class OpenCLBackend final : public Backend {
     return 0;
   }
 
+  // Physics features-only: each pooled view's raw grid (physics_raw, as the dense path
+  // makes it), then its features as tabulated sums of raw cells (raw_grid_pooling.h).
+  void raw_grid_features(Kernels& K, const Plan& plan, size_t n, cl::Buffer& subject, cl::Buffer& objects,
+                         cl_uint2 seed, cl_uint2 first, cl::Buffer& feats) {
+    const FeatureLayout lay = FeatureLayout::of(cat_, plan.model.block);
+    const int RW = plan.model.raw_width, RH = plan.model.raw_height;
+    cl::Context& ctx = rt_->context();
+    for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
+      const int view = lay.pooled[slot];
+      render(K, plan, view, n, subject, objects, seed, first, scratch_[view].at_least(ctx, 1), true);
+      PsViewLaunch L{};
+      const cl::Buffer phys = physics_params(K, plan, view, L);
+      char key[96];
+      std::snprintf(key, sizeof key, "%d %d %d %d %d", view, lay.block, RW, RH, int(K.fp64));
+      RawGridTables& t = raw_grid_tables_[key];
+      if (!t.first()) {
+        const RawGridPooling p = raw_grid_pooling(cat_.sensors[view], lay, static_cast<int>(slot), RW, RH);
+        t.count = static_cast<int>(p.columns.size());
+        t.first = constant(ctx, p.first);
+        t.cells = constant(ctx, p.cells);
+        t.columns = constant(ctx, p.columns);
+        t.weights = K.fp64 ? constant(ctx, p.weights)
+                           : constant(ctx, std::vector<cl_float>(p.weights.begin(), p.weights.end()));
+      }
+      cl::Kernel& k = stage_kernel(K, "physics_features");
+      int a = 0;
+      k.setArg(a++, raw_.buf);
+      k.setArg(a++, t.first);
+      k.setArg(a++, t.cells);
+      k.setArg(a++, t.weights);
+      k.setArg(a++, t.columns);
+      k.setArg(a++, static_cast<cl_int>(t.count));
+      k.setArg(a++, static_cast<cl_int>(RW * RH));
+      k.setArg(a++, phys);
+      k.setArg(a++, static_cast<cl_uint>(n));
+      k.setArg(a++, static_cast<cl_int>(lay.image_features()));
+      k.setArg(a++, feats);
+      rt_->queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
+    }
+  }
+
   // Block-mean noise model: each mean gets N(0, sigma^2 / pixels) from the generator.
   void analytic_noise(Kernels& K, const Plan& plan, size_t n, cl_uint2 seed, cl_uint2 first, cl::Buffer& feats) {
     const FeatureLayout lay = FeatureLayout::of(cat_, plan.model.block);
@@ -802,7 +847,12 @@ class OpenCLBackend final : public Backend {
   std::vector<cl::Buffer> view_rects_;  // per view: int4 per region
   Grown subject_, objects_, metal_out_, features_, field_, records_, raw_, view_scratch_, physics_none_;
   std::map<std::string, PhysicsTables> physics_tables_;
-  std::vector<Grown> scratch_;  // per view: images only pooled
+  struct RawGridTables {
+    int count = 0;
+    cl::Buffer first, cells, weights, columns;
+  };
+  std::map<std::string, RawGridTables> raw_grid_tables_;  // per (view, block, raw grid, precision)
+  std::vector<Grown> scratch_;                            // per view: images only pooled
 };
 
 }  // namespace
