@@ -14,7 +14,9 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   global const int* rec = records + (size_t)i * PS_REC_LEN;
   const int W = L.width, H = L.height, RW = L.raw_width, RH = L.raw_height, cells = RW * RH;
   global preal* r = (global preal*)raw + (size_t)i * cells;
-  global preal* acc = (global preal*)scratch + (size_t)i * RW;  // one view row's change per raw column
+  // Scratch: one view row's change per raw column, then its change per view pixel.
+  global preal* restrict acc = (global preal*)scratch + (size_t)i * (RW + W);
+  global preal* restrict d = acc + RW;
   const int s = subject[i];
   global const param* bare = phys + L.phys_base + (size_t)s * cells;
   for (int k = 0; k < cells; ++k) r[k] = (preal)bare[k];
@@ -43,18 +45,29 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
       x_lo = min(x_lo, max(Ly.x0[k], 0));
       x_hi = max(x_hi, min(Ly.x0[k] + Ly.width[k], W));
     }
+    if (x_lo >= x_hi) continue;
     global const uchar* base = base_row(atlas, bases, subject, &L, i, y);
-    int c_lo = RW, c_hi = -1;
-    for (int c = 0; c < RW; ++c) acc[c] = 0;
     for (int x = x_lo; x < x_hi; ++x) {
       const preal t0 = gain * (preal)base[x] + offset;
-      const preal v = lay_values(&Ly, atlas, x, object_t, t0);
-      const preal d = v - t0;
-      if (d == 0) continue;
-      const int c0 = (int)cband[2 * x], c1 = (int)cband[2 * x + 1];
-      for (int c = c0; c <= c1; ++c) acc[c] += (preal)wx[(size_t)c * W + x] * d;
-      c_lo = min(c_lo, c0);
-      c_hi = max(c_hi, c1);
+      d[x] = lay_values(&Ly, atlas, x, object_t, t0) - t0;
+    }
+    // Each raw column's share of the row: its weights (zero outside its band) against
+    // the change, as dot products over the span; fp32 builds in 16-lane partial sums.
+    const int c_lo = (int)cband[2 * x_lo], c_hi = (int)cband[2 * (x_hi - 1) + 1];
+    for (int c = c_lo; c <= c_hi; ++c) {
+      global const param* restrict w = wx + (size_t)c * W;
+      int x = x_lo;
+      preal sum = 0;
+#if !defined(PRECISION_FP64)
+      float16 part = 0.0f;
+      for (; x + 16 <= x_hi; x += 16) part += vload16(0, w + x) * vload16(0, d + x);
+      const float8 p8 = part.lo + part.hi;
+      const float4 p4 = p8.lo + p8.hi;
+      const float2 p2 = p4.lo + p4.hi;
+      sum = p2.x + p2.y;
+#endif
+      for (; x < x_hi; ++x) sum += (preal)w[x] * d[x];
+      acc[c] = sum;
     }
     for (int rr = (int)rband[2 * y]; rr <= (int)rband[2 * y + 1]; ++rr) {
       const preal w = (preal)wy[(size_t)rr * H + y];

@@ -351,7 +351,9 @@ class OpenCLBackend final : public Backend {
     cl::Buffer phys = physics_params(K, plan, view, L);
     const bool physics = plan.model.model == Model::physics;
     cl::Buffer& raw = raw_.at_least(ctx, physics ? n * plan.model.raw_width * plan.model.raw_height * K.real_bytes : 1);
-    cl::Buffer& scratch = view_scratch_.at_least(ctx, physics ? n * s.pixels() * K.real_bytes : 1);
+    // Physics: a second field for the stage chain; physics_raw's per-scenario row sums.
+    const size_t scratch_values = std::max<size_t>(s.pixels(), size_t(s.width) + plan.model.raw_width);
+    cl::Buffer& scratch = view_scratch_.at_least(ctx, physics ? n * scratch_values * K.real_bytes : 1);
     const auto launch = [&](cl::Kernel& k, size_t items) {
       int a = 0;
       k.setArg(a++, atlas_);
