@@ -372,7 +372,7 @@ class OpenCLBackend final : public Backend {
     };
     launch(K.place, n);  // one placement record per scenario, read by every row below
     if (fused) {
-      launch(K.render, n * s.height);
+      launch(K.render, n);  // one work-item per scenario, the whole view
       return;
     }
     if (physics_fast) {
