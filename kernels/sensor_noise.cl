@@ -25,8 +25,8 @@
     return convert_##F(e) * 0.69314718f + p;                                                                \
   }                                                                                                         \
   inline void __attribute__((overloadable)) sincos_turns(F u, F* sn, F* cs) {                               \
-    const F t = u - rint(u);                                                                                \
-    const F kf = rint(t * 4.0f);                                                                            \
+    const F t = u - RINT(u);                                                                                \
+    const F kf = RINT(t * 4.0f);                                                                            \
     const F a = (t - kf * 0.25f) * 6.2831853f, a2 = a * a;                                                  \
     const F s = a * (1.0f + a2 * (-0.16666667f + a2 * (8.3333333e-3f + a2 * (-1.9841270e-4f +               \
                                                                                  a2 * 2.7557319e-6f))));    \
@@ -41,7 +41,11 @@ GAUSS_POLY(float16, int16)
 
 // Philox4x32-10 of 16 counters at once (kernels/philox.cl, lane by lane). The 32x32-bit
 // products are written as 64-bit ones: PoCL's mul_hi on vectors splits into 16-bit parts.
-inline void philox16(uint16* c0, uint16* c1, uint16* c2, uint16* c3, uint2 k) {
+// Unrolled, the compiler keeps the round keys scalar, multiplies the words that are the
+// same in every lane (stream, scenario) once in the first two rounds, and drops the last
+// round's products that no caller reads.
+__attribute__((always_inline)) inline void philox16(uint16* c0, uint16* c1, uint16* c2, uint16* c3, uint2 k) {
+#pragma unroll
   for (int r = 0; r < 10; ++r) {
     const ulong16 p0 = convert_ulong16(*c0) * 0xD2511F53ul, p1 = convert_ulong16(*c2) * 0xCD9E8D57ul;
     const uint16 lo0 = convert_uint16(p0), hi0 = convert_uint16(p0 >> 32);
