@@ -144,11 +144,25 @@ __attribute__((always_inline)) inline real16 composite16(global const uchar* atl
 // 64 bytes at any address.
 typedef uint16 __attribute__((aligned(1))) uint16_any;
 
+// Copies base[p, q) to img[p, q) in 64-byte steps while a whole step fits and returns
+// where it stopped. The output (100 KB a scenario) does not fit in cache, so the steps go
+// to aligned addresses with non-temporal stores, which skip reading the lines first; one
+// plain unaligned step reaches the alignment.
+inline int copy_run(global const uchar* base, global uchar* img, int p, int q) {
+  if (q - p < 128) return p;
+  *(global uint16_any*)(img + p) = *(global const uint16_any*)(base + p);
+  p += 64 - (int)((size_t)(img + p) & 63);
+  for (; p + 64 <= q; p += 64) {
+    const uint16 v = *(global const uint16_any*)(base + p);
+    __builtin_nontemporal_store(v, (global uint16*)(img + p));
+  }
+  return p;
+}
+
 // Bytes [p, q) of the base image into the view's image. Writes up to 15 bytes past q: the
 // caller draws a span of at least 16 pixels there next.
 inline void copy_gap(global const uchar* base, global uchar* img, int p, int q) {
-  for (; p + 64 <= q; p += 64) *(global uint16_any*)(img + p) = *(global const uint16_any*)(base + p);
-  for (; p < q; p += 16) store16(load16(base + p), img + p);
+  for (p = copy_run(base, img, p, q); p < q; p += 16) store16(load16(base + p), img + p);
 }
 
 // Without pixel noise: the rows no layer or tile crosses are one flat copy of the base
@@ -200,9 +214,14 @@ inline void render_plain(global const uchar* atlas, global const uchar* base, gl
     }
   }
   const int HW = W * H;
-  for (; p + 64 <= HW; p += 64) *(global uint16_any*)(img + p) = *(global const uint16_any*)(base + p);
-  for (; p + 16 <= HW; p += 16) store16(load16(base + p), img + p);
+  for (p = copy_run(base, img, p, HW); p + 16 <= HW; p += 16) store16(load16(base + p), img + p);
   for (; p < HW; ++p) img[p] = base[p];
+  // Non-temporal stores are weakly ordered: make them visible before the kernel ends.
+#if defined(__SSE__)
+  __builtin_ia32_sfence();
+#else
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
+#endif
 }
 
 // With pixel noise every pixel is drawn, in flat runs of 32 (16 Box-Muller pairs of the
