@@ -224,17 +224,46 @@ inline void render_plain(global const uchar* atlas, global const uchar* base, gl
 #endif
 }
 
-// With pixel noise every pixel is drawn, in flat runs of 32 (16 Box-Muller pairs of the
-// pixel index, so HW must be even); a run of 16 that crosses a row end takes each pixel
-// from its own row's layers. The last run overlaps the one before it.
+// 16 pixels from flat position p (row *y, column *x) with their draws g, then on to the
+// next 16. A run that crosses the row end takes each pixel from its own row's layers.
+__attribute__((always_inline)) inline void noisy16(global const uchar* atlas, global const uchar* base,
+                                                   global uchar* img, const ViewLayers* V, RowLayers* R, int* cur,
+                                                   int* y, int* x, int p, int W, int tile, float gain, param alpha,
+                                                   param sigma, float16 g) {
+  const uchar16 b = load16(base + p);
+  real16 v = composite16(atlas, &R[*cur], b, *x, tile, gain, alpha);
+  if (*x + 16 > W) {
+    const real16 v1 = composite16(atlas, &R[*cur ^ 1], b, *x - W, tile, gain, alpha);
+    v = select(v, v1, (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15) >= W - *x);
+  }
+  store16(to_pixel16(add_gauss16(v, sigma, g)), img + p);
+  *x += 16;
+  if (*x >= W) {
+    *x -= W;
+    ++*y;
+    *cur ^= 1;
+    row_layers(&R[*cur ^ 1], V, tile, *y + 1);
+  }
+}
+
+// With pixel noise every pixel is drawn, in flat runs of 64 pixels (32 Box-Muller pairs
+// of the pixel index, so HW must be even; two Philox chains that overlap), then of 32; the
+// last run overlaps the one before it.
 inline void render_noisy(global const uchar* atlas, global const uchar* base, global uchar* img, const ViewLayers* V,
                          const PsViewLaunch* L, float gain, param alpha, param sigma, uint2 seed, ulong index) {
   const int W = L->width, H = L->height, tile = L->tile_size, HW = W * H;
-  RowLayers R[2];  // rows y and y + 1
+  RowLayers R[2];  // rows y and y + 1, R[cur] is row y
   int y = 0, x = 0, cur = 0;
   row_layers(&R[0], V, tile, 0);
   row_layers(&R[1], V, tile, 1);
-  for (int c = 0; c < HW; c += 32) {
+  int c = 0;
+  for (; c + 64 <= HW; c += 64) {
+    float16 g[4];
+    gauss64(seed, index, PS_STREAM_PIXEL_NOISE, L->view, c >> 1, g);
+    for (int h = 0; h < 4; ++h)
+      noisy16(atlas, base, img, V, R, &cur, &y, &x, c + 16 * h, W, tile, gain, alpha, sigma, g[h]);
+  }
+  for (; c < HW; c += 32) {
     const int p = min(c, HW - 32);
     if (p != c) {
       y = p / W;
@@ -245,22 +274,8 @@ inline void render_noisy(global const uchar* atlas, global const uchar* base, gl
     }
     float16 g[2];
     gauss32(seed, index, PS_STREAM_PIXEL_NOISE, L->view, p >> 1, &g[0], &g[1]);
-    for (int h = 0; h < 2; ++h) {
-      const uchar16 b = load16(base + p + 16 * h);
-      real16 v = composite16(atlas, &R[cur], b, x, tile, gain, alpha);
-      if (x + 16 > W) {
-        const real16 v1 = composite16(atlas, &R[cur ^ 1], b, x - W, tile, gain, alpha);
-        v = select(v, v1, (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15) >= W - x);
-      }
-      store16(to_pixel16(add_gauss16(v, sigma, g[h])), img + p + 16 * h);
-      x += 16;
-      if (x >= W) {
-        x -= W;
-        ++y;
-        cur ^= 1;
-        row_layers(&R[cur ^ 1], V, tile, y + 1);
-      }
-    }
+    for (int h = 0; h < 2; ++h)
+      noisy16(atlas, base, img, V, R, &cur, &y, &x, p + 16 * h, W, tile, gain, alpha, sigma, g[h]);
   }
 }
 #endif
