@@ -9,7 +9,7 @@ namespace portalsim {
 namespace {
 using bench::fx;
 
-enum Path { kFeaturesSparse, kFeaturesDense, kImages, kMetal, kMetalPhysics };
+enum Path { kFeaturesSparse, kFeaturesDense, kImages, kNoisyImages, kMetal, kMetalPhysics };
 
 Plan plan_for(Path path, int block) {
   Plan p;
@@ -24,6 +24,10 @@ Plan plan_for(Path path, int block) {
       break;
     case kImages:
       p.features = false;
+      break;
+    case kNoisyImages:  // per-pixel sensor noise, sigma 2 (issue 14's table)
+      p.features = false;
+      p.model.pixel_sigma = 2;
       break;
     case kMetal:
       p.images = 0;
@@ -93,6 +97,10 @@ BENCHMARK_CAPTURE(BM_Tier, features, kFeaturesSparse)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Tier, images, kImages)
+    ->ArgsProduct({{1024}, {10}, {0, 1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Tier, noisy_images, kNoisyImages)
     ->ArgsProduct({{1024}, {10}, {0, 1, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

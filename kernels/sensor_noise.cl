@@ -25,8 +25,8 @@
     return convert_##F(e) * 0.69314718f + p;                                                                \
   }                                                                                                         \
   inline void __attribute__((overloadable)) sincos_turns(F u, F* sn, F* cs) {                               \
-    const F t = u - rint(u);                                                                                \
-    const F kf = rint(t * 4.0f);                                                                            \
+    const F t = u - RINT(u);                                                                                \
+    const F kf = RINT(t * 4.0f);                                                                            \
     const F a = (t - kf * 0.25f) * 6.2831853f, a2 = a * a;                                                  \
     const F s = a * (1.0f + a2 * (-0.16666667f + a2 * (8.3333333e-3f + a2 * (-1.9841270e-4f +               \
                                                                                  a2 * 2.7557319e-6f))));    \
@@ -39,19 +39,49 @@
 GAUSS_POLY(float, int)
 GAUSS_POLY(float16, int16)
 
-// Philox4x32-10 of 16 counters at once (kernels/philox.cl, lane by lane). The 32x32-bit
-// products are written as 64-bit ones: PoCL's mul_hi on vectors splits into 16-bit parts.
-inline void philox16(uint16* c0, uint16* c1, uint16* c2, uint16* c3, uint2 k) {
+// Philox4x32-10 of 16 counters at once (kernels/philox.cl, lane by lane). Each 32-bit word
+// lives in a 64-bit lane, so one vpmuludq gives 8 whole products: hi = p >> 32, and lo is p
+// itself, whose high half only ever reaches a multiply (which masks it off) or an xor into
+// a word whose high half is masked or dropped in turn. Per round of 16 lanes that is 4
+// multiplies, 4 shifts and 4 xors, where 32-bit lanes took 6 multiplies and 2 two-source
+// permutes. Unrolled, the compiler keeps the round keys scalar, multiplies the words that
+// are the same in every lane (stream, scenario) once in the first two rounds, and drops
+// the last round's products that no caller reads.
+#define PHILOX16_ROUND(c0, c1, c2, c3, k)                                                              \
+  {                                                                                                   \
+    const ulong16 p0 = (c0 & 0xFFFFFFFFul) * 0xD2511F53ul, p1 = (c2 & 0xFFFFFFFFul) * 0xCD9E8D57ul; \
+    c0 = (p1 >> 32) ^ c1 ^ (ulong)k.x;                                                                \
+    c1 = p1;                                                                                          \
+    c2 = (p0 >> 32) ^ c3 ^ (ulong)k.y;                                                                \
+    c3 = p0;                                                                                          \
+  }
+__attribute__((always_inline)) inline void philox16(uint16* c0, uint16* c1, uint16* c2, uint16* c3, uint2 k) {
+  ulong16 d0 = convert_ulong16(*c0), d1 = convert_ulong16(*c1), d2 = convert_ulong16(*c2), d3 = convert_ulong16(*c3);
+#pragma unroll
   for (int r = 0; r < 10; ++r) {
-    const ulong16 p0 = convert_ulong16(*c0) * 0xD2511F53ul, p1 = convert_ulong16(*c2) * 0xCD9E8D57ul;
-    const uint16 lo0 = convert_uint16(p0), hi0 = convert_uint16(p0 >> 32);
-    const uint16 lo1 = convert_uint16(p1), hi1 = convert_uint16(p1 >> 32);
-    *c0 = hi1 ^ *c1 ^ k.x;
-    *c1 = lo1;
-    *c2 = hi0 ^ *c3 ^ k.y;
-    *c3 = lo0;
+    PHILOX16_ROUND(d0, d1, d2, d3, k);
     k += (uint2)(0x9E3779B9u, 0xBB67AE85u);
   }
+  *c0 = convert_uint16(d0);
+  *c1 = convert_uint16(d1);
+  *c2 = convert_uint16(d2);
+  *c3 = convert_uint16(d3);
+}
+// Two sets of 16 counters, their rounds interleaved so that one set's multiplies fill the
+// other's wait; only words 0 and 1 (what Box-Muller reads) are written back.
+__attribute__((always_inline)) inline void philox16x2(uint16* a, uint16* b, uint2 k) {
+  ulong16 a0 = convert_ulong16(a[0]), a1 = convert_ulong16(a[1]), a2 = convert_ulong16(a[2]), a3 = convert_ulong16(a[3]);
+  ulong16 b0 = convert_ulong16(b[0]), b1 = convert_ulong16(b[1]), b2 = convert_ulong16(b[2]), b3 = convert_ulong16(b[3]);
+#pragma unroll
+  for (int r = 0; r < 10; ++r) {
+    PHILOX16_ROUND(a0, a1, a2, a3, k);
+    PHILOX16_ROUND(b0, b1, b2, b3, k);
+    k += (uint2)(0x9E3779B9u, 0xBB67AE85u);
+  }
+  a[0] = convert_uint16(a0);
+  a[1] = convert_uint16(a1);
+  b[0] = convert_uint16(b0);
+  b[1] = convert_uint16(b1);
 }
 
 #if defined(PRECISION_FP64)
@@ -74,16 +104,11 @@ inline greal2 gauss_pair_of(uint2 seed, ulong index, uint stream, int view, int 
   return (float2)(rad * c, rad * s);
 }
 
-// The draws of pixels 2 pair .. 2 pair + 31 of a stream: 16 Box-Muller pairs, interleaved,
+// Box-Muller of 16 Philox outputs (words r0, r1): the draws of 32 pixels, interleaved,
 // the first 16 pixels in *g0 and the next 16 in *g1.
-__attribute__((always_inline)) inline void gauss32(uint2 seed, ulong index, uint stream, int view, int pair,
-                                                   float16* g0, float16* g1) {
-  uint16 c0 = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
-              ((uint)pair + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
-  uint16 c1 = (uint16)(stream), c2 = (uint16)((uint)index), c3 = (uint16)((uint)(index >> 32));
-  philox16(&c0, &c1, &c2, &c3, seed);
-  const float16 u1 = 1.0f - convert_float16(c0 >> 8) * (1.0f / 16777216.0f);
-  const float16 u2 = convert_float16(c1 >> 8) * (1.0f / 16777216.0f);
+__attribute__((always_inline)) inline void box_muller16(uint16 r0, uint16 r1, float16* g0, float16* g1) {
+  const float16 u1 = 1.0f - convert_float16(r0 >> 8) * (1.0f / 16777216.0f);
+  const float16 u2 = convert_float16(r1 >> 8) * (1.0f / 16777216.0f);
   const float16 rad = sqrt(-2.0f * ln_poly(u1));
   float16 s, c;
   sincos_turns(u2, &s, &c);
@@ -91,6 +116,36 @@ __attribute__((always_inline)) inline void gauss32(uint2 seed, ulong index, uint
   s *= rad;
   *g0 = shuffle2(c, s, (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23));
   *g1 = shuffle2(c, s, (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
+}
+
+// The counters of pairs pair .. pair + 15 of a stream.
+inline void pair_counters16(uint16* c, ulong index, uint stream, int view, int pair) {
+  c[0] = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
+         ((uint)pair + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+  c[1] = (uint16)(stream);
+  c[2] = (uint16)((uint)index);
+  c[3] = (uint16)((uint)(index >> 32));
+}
+
+// The draws of pixels 2 pair .. 2 pair + 31 of a stream: 16 Box-Muller pairs, interleaved,
+// the first 16 pixels in *g0 and the next 16 in *g1.
+__attribute__((always_inline)) inline void gauss32(uint2 seed, ulong index, uint stream, int view, int pair,
+                                                   float16* g0, float16* g1) {
+  uint16 c[4];
+  pair_counters16(c, index, stream, view, pair);
+  philox16(&c[0], &c[1], &c[2], &c[3], seed);
+  box_muller16(c[0], c[1], g0, g1);
+}
+
+// The draws of pixels 2 pair .. 2 pair + 63, 16 at a time in g[0..3].
+__attribute__((always_inline)) inline void gauss64(uint2 seed, ulong index, uint stream, int view, int pair,
+                                                   float16* g) {
+  uint16 a[4], b[4];
+  pair_counters16(a, index, stream, view, pair);
+  pair_counters16(b, index, stream, view, pair + 16);
+  philox16x2(a, b, seed);
+  box_muller16(a[0], a[1], &g[0], &g[1]);
+  box_muller16(b[0], b[1], &g[2], &g[3]);
 }
 #endif
 

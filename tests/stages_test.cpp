@@ -64,7 +64,13 @@ TEST(Stages, FusedRenderEqualsTheChainOfStageKernels) {
   for (const Case& c :
        {Case{"standard", Tier::standard, 0, 0, false}, Case{"standard noisy", Tier::standard, 2.5, 0, false},
         Case{"exact jitter", Tier::exact, 1.5, 3, false}, Case{"fast bilinear", Tier::fast, 2, 2.5, true},
-        Case{"standard bilinear", Tier::standard, 0, 4, true}}) {
+        Case{"standard bilinear", Tier::standard, 0, 4, true}, Case{"fast", Tier::fast, 0, 0, false},
+        Case{"fast noisy", Tier::fast, 2, 0, false},
+        // Sprites and tiles moved across the image edges: spans clipped at both ends of
+        // rows, and runs of noisy pixels that cross a row end with layers on both rows.
+        Case{"standard over the edges", Tier::standard, 0, 60, false},
+        Case{"standard noisy over the edges", Tier::standard, 2, 60, false},
+        Case{"fast noisy over the edges", Tier::fast, 3, 60, false}}) {
     SCOPED_TRACE(c.name);
     Plan plan;
     plan.model.seed = 11;

@@ -377,7 +377,7 @@ class OpenCLBackend final : public Backend {
     };
     launch(K.place, n);  // one placement record per scenario, read by every row below
     if (fused) {
-      launch(K.render, n * s.height);
+      launch(K.render, n);  // one work-item per scenario, the whole view
       return;
     }
     if (raw_only && !physics_fast) throw std::logic_error("the raw grid alone needs the physics fast path");
