@@ -107,6 +107,14 @@ inline int in_blocks(int bx, int by, const int* fp) {
   return bx >= fp[PS_FP_BLOCK_X0] && by >= fp[PS_FP_BLOCK_Y0] && bx < fp[PS_FP_BLOCK_X0] + fp[PS_FP_BLOCKS_W] && by < fp[PS_FP_BLOCK_Y0] + fp[PS_FP_BLOCKS_H];
 }
 
+// Each scenario's noise pattern (under pattern noise), apart from features_sparse so that
+// PoCL runs the generator across the work-items of a group, in vector registers.
+kernel void sparse_patterns(uint n, int P, uint2 seed, uint2 first, global int* patterns) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= n) return;
+  patterns[i] = (int)below(draw(seed, upsample(first.y, first.x) + i, PS_STREAM_NOISE_PATTERN, 0u).x, (uint)P);
+}
+
 #if defined(VECTOR_RENDER)
 inline int sum16(int16 v) {
   const int8 a = v.lo + v.hi;
@@ -127,9 +135,9 @@ kernel void features_sparse(global const uchar* restrict atlas, global const int
                             global const float* restrict noise_gains, global const int4* restrict rects,
                             global const int* restrict pooled, int npooled, int views,
                             global const int* restrict region_slot, global const uchar* restrict subject,
-                            global const short* restrict objects, uint n, int S, int P, int W, int H, int block,
-                            int bx_count, int by_count, param alpha, int tile, int use_noise, uint2 seed,
-                            uint2 first, int row_len, global float* restrict features) {
+                            global const short* restrict objects, global const int* restrict patterns, uint n,
+                            int S, int P, int W, int H, int block, int bx_count, int by_count, param alpha, int tile,
+                            int use_noise, int row_len, global float* restrict features) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const int s = subject[i], per_view = bx_count * by_count;
@@ -138,8 +146,7 @@ kernel void features_sparse(global const uchar* restrict atlas, global const int
   global const float* bm = base_means + s * row_len;
   global const int* bs = base_sums + s * row_len;
   for (int f = 0; f < row_len; ++f) row[f] = bm[f];
-  int p = 0;
-  if (use_noise) p = (int)below(draw(seed, upsample(first.y, first.x) + i, PS_STREAM_NOISE_PATTERN, 0u).x, (uint)P);
+  const int p = use_noise ? patterns[i] : 0;
   const int toff = noise_offsets[p];
   const float gain = noise_gains[p];
 
@@ -162,14 +169,12 @@ kernel void features_sparse(global const uchar* restrict atlas, global const int
     touched_regions = 1;
     global float* vrow = row + slot * per_view;
     global const int* vbs = bs + slot * per_view;
-    // Touched blocks hold integer sums (exact in float below 2^24) until the division.
+    // Touched blocks hold integer sums (exact in float below 2^24) until the division;
+    // a block in several footprints is set to its base sum more than once, alike.
     for (int k = 0; k < cnt; ++k)
       for (int by = fp[k][PS_FP_BLOCK_Y0]; by < fp[k][PS_FP_BLOCK_Y0] + fp[k][PS_FP_BLOCKS_H]; ++by)
-        for (int bx = fp[k][PS_FP_BLOCK_X0]; bx < fp[k][PS_FP_BLOCK_X0] + fp[k][PS_FP_BLOCKS_W]; ++bx) {
-          int seen = 0;
-          for (int j = 0; j < k; ++j) seen |= in_blocks(bx, by, fp[j]);
-          if (!seen) vrow[by * bx_count + bx] = (float)vbs[by * bx_count + bx];
-        }
+        for (int bx = fp[k][PS_FP_BLOCK_X0]; bx < fp[k][PS_FP_BLOCK_X0] + fp[k][PS_FP_BLOCKS_W]; ++bx)
+          vrow[by * bx_count + bx] = (float)vbs[by * bx_count + bx];
     for (int k = 0; k < cnt; ++k) {
       global const int* d = deltas + fp[k][PS_FP_DELTAS] + (s * P + p) * fp[k][PS_FP_BLOCKS_W] * fp[k][PS_FP_BLOCKS_H];
       for (int by = 0; by < fp[k][PS_FP_BLOCKS_H]; ++by)

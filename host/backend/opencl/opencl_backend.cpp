@@ -228,8 +228,8 @@ class OpenCLBackend final : public Backend {
   };
   struct Kernels {
     cl::Program program;
-    cl::Kernel place, render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, features_sparse,
-        analytic_noise;
+    cl::Kernel place, render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, sparse_patterns,
+        features_sparse, analytic_noise;
     cl::Kernel metal_physics;                  // made on first use: needs cl_khr_fp64
     std::map<std::string, cl::Kernel> stages;  // stage kernels and fast paths, made on first use
     SparseTables tables;
@@ -609,6 +609,7 @@ class OpenCLBackend final : public Backend {
     k.metal = cl::Kernel(k.program, "metal_zones");
     k.base_features = cl::Kernel(k.program, "base_features");
     k.footprint_deltas = cl::Kernel(k.program, "footprint_deltas");
+    k.sparse_patterns = cl::Kernel(k.program, "sparse_patterns");
     k.features_sparse = cl::Kernel(k.program, "features_sparse");
     k.analytic_noise = cl::Kernel(k.program, "analytic_noise");
     k.fp64 = f.precision == Precision::fp64;
@@ -760,6 +761,16 @@ class OpenCLBackend final : public Backend {
     const FeatureLayout lay = FeatureLayout::of(cat_, plan.model.block);
     const Sensor& view = pooled_view(lay);
     const int row_len = lay.image_features();
+    cl::Buffer& patterns = patterns_.at_least(rt_->context(), n * sizeof(cl_int));
+    if (tables_.noise) {
+      cl::Kernel& kp = K.sparse_patterns;
+      kp.setArg(0, static_cast<cl_uint>(n));
+      kp.setArg(1, static_cast<cl_int>(tables_.patterns));
+      kp.setArg(2, seed);
+      kp.setArg(3, first);
+      kp.setArg(4, patterns);
+      rt_->queue().enqueueNDRangeKernel(kp, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
+    }
     cl::Kernel& k = K.features_sparse;
     int a = 0;
     k.setArg(a++, atlas_);
@@ -778,6 +789,7 @@ class OpenCLBackend final : public Backend {
     k.setArg(a++, region_slot_);
     k.setArg(a++, subject);
     k.setArg(a++, objects);
+    k.setArg(a++, patterns);
     k.setArg(a++, static_cast<cl_uint>(n));
     k.setArg(a++, static_cast<cl_int>(cat_.subjects.size()));
     k.setArg(a++, static_cast<cl_int>(tables_.patterns));
@@ -789,8 +801,6 @@ class OpenCLBackend final : public Backend {
     set_param(K, k, a++, ic.alpha);
     k.setArg(a++, static_cast<cl_int>(ic.noise_size));
     k.setArg(a++, static_cast<cl_int>(tables_.noise ? 1 : 0));
-    k.setArg(a++, seed);
-    k.setArg(a++, first);
     k.setArg(a++, static_cast<cl_int>(row_len));
     k.setArg(a++, feats);
     rt_->queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
@@ -805,7 +815,7 @@ class OpenCLBackend final : public Backend {
       influence_, categories_, base_zones_, metal_zone_rec_, metal_region_rec_, metal_tensors_;
   const Sensor* metal_view_ = nullptr;  // the first MMW view: the metal model's pixel scale
   std::vector<cl::Buffer> view_rects_;  // per view: int4 per region
-  Grown subject_, objects_, metal_out_, field_, records_, raw_, view_scratch_, physics_none_;
+  Grown subject_, objects_, patterns_, metal_out_, field_, records_, raw_, view_scratch_, physics_none_;
   std::map<std::string, PhysicsTables> physics_tables_;
   std::vector<Grown> scratch_;  // per view: images only pooled
 };
