@@ -106,6 +106,10 @@ inline int in_rect(int x, int y, const int* fp) {
 inline int in_blocks(int bx, int by, const int* fp) {
   return bx >= fp[PS_FP_BLOCK_X0] && by >= fp[PS_FP_BLOCK_Y0] && bx < fp[PS_FP_BLOCK_X0] + fp[PS_FP_BLOCKS_W] && by < fp[PS_FP_BLOCK_Y0] + fp[PS_FP_BLOCKS_H];
 }
+inline int blocks_meet(const int* a, const int* b) {
+  return max(a[PS_FP_BLOCK_X0], b[PS_FP_BLOCK_X0]) < min(a[PS_FP_BLOCK_X0] + a[PS_FP_BLOCKS_W], b[PS_FP_BLOCK_X0] + b[PS_FP_BLOCKS_W]) &&
+         max(a[PS_FP_BLOCK_Y0], b[PS_FP_BLOCK_Y0]) < min(a[PS_FP_BLOCK_Y0] + a[PS_FP_BLOCKS_H], b[PS_FP_BLOCK_Y0] + b[PS_FP_BLOCKS_H]);
+}
 
 // Each scenario's noise pattern (under pattern noise), apart from features_sparse so that
 // PoCL runs the generator across the work-items of a group, in vector registers.
@@ -299,13 +303,18 @@ kernel void features_sparse(global const uchar* restrict atlas, global const int
             }
         }
     }
-    for (int k = 0; k < cnt; ++k)
+    // Sums to means, each block once: a block of an earlier footprint is done (`near`:
+    // the earlier footprints whose blocks meet this one's, mostly none).
+    for (int k = 0; k < cnt; ++k) {
+      uint near = 0;
+      for (int j = 0; j < k; ++j) near |= (uint)blocks_meet(fp[j], fp[k]) << j;
       for (int by = fp[k][PS_FP_BLOCK_Y0]; by < fp[k][PS_FP_BLOCK_Y0] + fp[k][PS_FP_BLOCKS_H]; ++by)
         for (int bx = fp[k][PS_FP_BLOCK_X0]; bx < fp[k][PS_FP_BLOCK_X0] + fp[k][PS_FP_BLOCKS_W]; ++bx) {
           int seen = 0;
-          for (int j = 0; j < k; ++j) seen |= in_blocks(bx, by, fp[j]);
+          for (uint m = near; m != 0; m &= m - 1) seen |= in_blocks(bx, by, fp[31 - clz(m & -m)]);
           if (!seen) vrow[by * bx_count + bx] = mean_of((uint)vrow[by * bx_count + bx], block_count(bx, by, block, W, H));
         }
+    }
   }
   if (touched_regions)
     for (int r = 0; r < PS_REGIONS; ++r) {
