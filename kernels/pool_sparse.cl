@@ -107,8 +107,9 @@ inline int in_blocks(int bx, int by, const int* fp) {
   return bx >= fp[PS_FP_BLOCK_X0] && by >= fp[PS_FP_BLOCK_Y0] && bx < fp[PS_FP_BLOCK_X0] + fp[PS_FP_BLOCKS_W] && by < fp[PS_FP_BLOCK_Y0] + fp[PS_FP_BLOCKS_H];
 }
 inline int blocks_meet(const int* a, const int* b) {
-  return max(a[PS_FP_BLOCK_X0], b[PS_FP_BLOCK_X0]) < min(a[PS_FP_BLOCK_X0] + a[PS_FP_BLOCKS_W], b[PS_FP_BLOCK_X0] + b[PS_FP_BLOCKS_W]) &&
-         max(a[PS_FP_BLOCK_Y0], b[PS_FP_BLOCK_Y0]) < min(a[PS_FP_BLOCK_Y0] + a[PS_FP_BLOCKS_H], b[PS_FP_BLOCK_Y0] + b[PS_FP_BLOCKS_H]);
+  const int ax = a[PS_FP_BLOCK_X0], ay = a[PS_FP_BLOCK_Y0], bx = b[PS_FP_BLOCK_X0], by = b[PS_FP_BLOCK_Y0];
+  return max(ax, bx) < min(ax + a[PS_FP_BLOCKS_W], bx + b[PS_FP_BLOCKS_W]) &&
+         max(ay, by) < min(ay + a[PS_FP_BLOCKS_H], by + b[PS_FP_BLOCKS_H]);
 }
 
 // Each scenario's noise pattern (under pattern noise), apart from features_sparse so that
@@ -220,7 +221,8 @@ kernel void features_sparse(global const uchar* restrict atlas, global const int
                 real16 one = b0;
                 const int sx = xs - fp[k][PS_FP_SPRITE_X0], sy = y - fp[k][PS_FP_SPRITE_Y0], sw = fp[k][PS_FP_SPRITE_W];
                 if (sy >= 0 && sy < fp[k][PS_FP_SPRITE_H] && sx > -16 && sx < sw) {
-                  global const uchar* vr = atlas + fp[k][PS_FP_SPRITE_PADDED] + sy * 2 * (sw + 2 * PS_PAD) + PS_PAD + sx;
+                  global const uchar* vr =
+                      atlas + fp[k][PS_FP_SPRITE_PADDED] + sy * 2 * (sw + 2 * PS_PAD) + PS_PAD + sx;
                   const uchar16 value = load16(vr), coverage = load16(vr + sw + 2 * PS_PAD);
                   one = blend16(one, value, coverage, alpha);
                   v = blend16(v, value, coverage, alpha);
