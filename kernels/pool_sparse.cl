@@ -100,23 +100,49 @@ kernel void footprint_deltas(global const uchar* atlas, global const int* bases,
   for (int k = 0; k < PS_REGIONS; ++k) region_deltas[g * PS_REGIONS + k] = reg[k];
 }
 
-inline int in_rect(int x, int y, global const int* fp) {
+inline int in_rect(int x, int y, const int* fp) {
   return x >= fp[PS_FP_X0] && y >= fp[PS_FP_Y0] && x < fp[PS_FP_X1] && y < fp[PS_FP_Y1];
 }
-inline int in_blocks(int bx, int by, global const int* fp) {
+inline int in_blocks(int bx, int by, const int* fp) {
   return bx >= fp[PS_FP_BLOCK_X0] && by >= fp[PS_FP_BLOCK_Y0] && bx < fp[PS_FP_BLOCK_X0] + fp[PS_FP_BLOCKS_W] && by < fp[PS_FP_BLOCK_Y0] + fp[PS_FP_BLOCKS_H];
 }
+inline int blocks_meet(const int* a, const int* b) {
+  const int ax = a[PS_FP_BLOCK_X0], ay = a[PS_FP_BLOCK_Y0], bx = b[PS_FP_BLOCK_X0], by = b[PS_FP_BLOCK_Y0];
+  return max(ax, bx) < min(ax + a[PS_FP_BLOCKS_W], bx + b[PS_FP_BLOCKS_W]) &&
+         max(ay, by) < min(ay + a[PS_FP_BLOCKS_H], by + b[PS_FP_BLOCKS_H]);
+}
+
+// Each scenario's noise pattern (under pattern noise), apart from features_sparse so that
+// PoCL runs the generator across the work-items of a group, in vector registers.
+kernel void sparse_patterns(uint n, int P, uint2 seed, uint2 first, global int* patterns) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= n) return;
+  patterns[i] = (int)below(draw(seed, upsample(first.y, first.x) + i, PS_STREAM_NOISE_PATTERN, 0u).x, (uint)P);
+}
+
+#if defined(VECTOR_RENDER)
+inline int sum16(int16 v) {
+  const int8 a = v.lo + v.hi;
+  const int4 b = a.lo + a.hi;
+  const int2 c = b.lo + b.hi;
+  return c.x + c.y;
+}
+#endif
 
 // One work-item per scenario: a features row from base means, table deltas and the
-// overlap pixels rendered here.
-kernel void features_sparse(global const uchar* atlas, global const int* bases, global const int* fps,
-                            global const int* deltas, global const int* region_deltas, global const int* base_sums,
-                            global const float* base_means, global const int* noise_offsets,
-                            global const float* noise_gains, global const int4* rects, global const int* pooled,
-                            int npooled, int views, global const int* region_slot, global const uchar* subject,
-                            global const short* objects, uint n, int S, int P, int W, int H, int block,
-                            int bx_count, int by_count, param alpha, int tile, int use_noise, uint2 seed,
-                            uint2 first, int row_len, global float* features) {
+// overlap pixels rendered here. The scenario's footprint records are copied to private
+// memory first, and the pointers are restrict: otherwise every store to the row would
+// make the compiler reload them.
+kernel void features_sparse(global const uchar* restrict atlas, global const int* restrict bases,
+                            global const int* restrict fps, global const int* restrict deltas,
+                            global const int* restrict region_deltas, global const int* restrict base_sums,
+                            global const float* restrict base_means, global const int* restrict noise_offsets,
+                            global const float* restrict noise_gains, global const int4* restrict rects,
+                            global const int* restrict pooled, int npooled, int views,
+                            global const int* restrict region_slot, global const uchar* restrict subject,
+                            global const short* restrict objects, global const int* restrict patterns, uint n,
+                            int S, int P, int W, int H, int block, int bx_count, int by_count, param alpha, int tile,
+                            int use_noise, int row_len, global float* restrict features) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const int s = subject[i], per_view = bx_count * by_count;
@@ -125,8 +151,7 @@ kernel void features_sparse(global const uchar* atlas, global const int* bases, 
   global const float* bm = base_means + s * row_len;
   global const int* bs = base_sums + s * row_len;
   for (int f = 0; f < row_len; ++f) row[f] = bm[f];
-  int p = 0;
-  if (use_noise) p = (int)below(draw(seed, upsample(first.y, first.x) + i, PS_STREAM_NOISE_PATTERN, 0u).x, (uint)P);
+  const int p = use_noise ? patterns[i] : 0;
   const int toff = noise_offsets[p];
   const float gain = noise_gains[p];
 
@@ -135,13 +160,13 @@ kernel void features_sparse(global const uchar* atlas, global const int* bases, 
   int touched_regions = 0;
 
   for (int slot = 0; slot < npooled; ++slot) {
-    global const int* fp[PS_REGIONS];
+    int fp[PS_REGIONS][FP_LEN];  // the footprints of this view's objects, in region order
     int comb[PS_REGIONS];
     int cnt = 0;
     for (int r = 0; r < PS_REGIONS; ++r) {
       const int v = objs[r];
       if (v < 0 || region_slot[r] != slot) continue;
-      fp[cnt] = fps + (v * PS_REGIONS + r) * FP_LEN;
+      for (int q = 0; q < FP_LEN; ++q) fp[cnt][q] = fps[(v * PS_REGIONS + r) * FP_LEN + q];
       comb[cnt] = (v * PS_REGIONS + r) * S * P + s * P + p;
       ++cnt;
     }
@@ -149,14 +174,12 @@ kernel void features_sparse(global const uchar* atlas, global const int* bases, 
     touched_regions = 1;
     global float* vrow = row + slot * per_view;
     global const int* vbs = bs + slot * per_view;
-    // Touched blocks hold integer sums (exact in float below 2^24) until the division.
+    // Touched blocks hold integer sums (exact in float below 2^24) until the division;
+    // a block in several footprints is set to its base sum more than once, alike.
     for (int k = 0; k < cnt; ++k)
       for (int by = fp[k][PS_FP_BLOCK_Y0]; by < fp[k][PS_FP_BLOCK_Y0] + fp[k][PS_FP_BLOCKS_H]; ++by)
-        for (int bx = fp[k][PS_FP_BLOCK_X0]; bx < fp[k][PS_FP_BLOCK_X0] + fp[k][PS_FP_BLOCKS_W]; ++bx) {
-          int seen = 0;
-          for (int j = 0; j < k; ++j) seen |= in_blocks(bx, by, fp[j]);
-          if (!seen) vrow[by * bx_count + bx] = (float)vbs[by * bx_count + bx];
-        }
+        for (int bx = fp[k][PS_FP_BLOCK_X0]; bx < fp[k][PS_FP_BLOCK_X0] + fp[k][PS_FP_BLOCKS_W]; ++bx)
+          vrow[by * bx_count + bx] = (float)vbs[by * bx_count + bx];
     for (int k = 0; k < cnt; ++k) {
       global const int* d = deltas + fp[k][PS_FP_DELTAS] + (s * P + p) * fp[k][PS_FP_BLOCKS_W] * fp[k][PS_FP_BLOCKS_H];
       for (int by = 0; by < fp[k][PS_FP_BLOCKS_H]; ++by)
@@ -167,53 +190,133 @@ kernel void features_sparse(global const uchar* atlas, global const int* bases, 
     // Where footprints overlap, the table's single-object values are wrong: replace
     // their sum by the pixel rendered with every object, as the dense kernel does.
     global const uchar* base = atlas + bases[s * views + pooled[slot]];
-    for (int a = 0; a < cnt; ++a)
-      for (int b = a + 1; b < cnt; ++b) {
-        const int x0 = max(fp[a][PS_FP_X0], fp[b][PS_FP_X0]), y0 = max(fp[a][PS_FP_Y0], fp[b][PS_FP_Y0]);
-        const int x1 = min(fp[a][PS_FP_X1], fp[b][PS_FP_X1]), y1 = min(fp[a][PS_FP_Y1], fp[b][PS_FP_Y1]);
-        for (int y = y0; y < y1; ++y)
-          for (int x = x0; x < x1; ++x) {
-            int earlier = 0;  // a pixel in several overlaps is corrected once
-            for (int a2 = 0; a2 <= a && !earlier; ++a2)
-              for (int b2 = a2 + 1; b2 < (a2 == a ? b : cnt) && !earlier; ++b2)
-                earlier = in_rect(x, y, fp[a2]) && in_rect(x, y, fp[b2]);
-            if (earlier) continue;
-            const uchar bp = base[y * W + x];
-            real v = from_pixel(bp), nsum = real_zero();
-            int singles = 0;
-            for (int k = 0; k < cnt; ++k) {
-              if (!in_rect(x, y, fp[k])) continue;
-              singles += (int)single_pixel(atlas, fp[k], bp, x, y, W, alpha, tile, toff, gain, use_noise) - (int)bp;
-              const int sx = x - fp[k][PS_FP_SPRITE_X0], sy = y - fp[k][PS_FP_SPRITE_Y0];
-              if (sx >= 0 && sy >= 0 && sx < fp[k][PS_FP_SPRITE_W] && sy < fp[k][PS_FP_SPRITE_H]) {
-                const int o = fp[k][PS_FP_SPRITE_OFFSET] + (sy * fp[k][PS_FP_SPRITE_W] + sx) * 2;
-                v = blend(v, atlas[o], atlas[o + 1], alpha);
-              }
-            }
-            if (use_noise) {
+#if defined(VECTOR_RENDER)
+    // 16 pixels of an overlap row at a time, every step element for element as the pixel
+    // loop below (so bit for bit): sprites and tiles read from their padded copies, where
+    // pixels outside a sprite have coverage 0 (blending to the same value) and outside a
+    // tile 128 (adding 0). The last chunk of a row may start left of the rectangle (and
+    // overlap the one before it) so as to stay in the view: `mine` masks the lanes this
+    // pair corrects.
+    if (W >= 16) {
+      const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+      const int tpoff = use_noise ? noise_offsets[P + p] : 0;
+      for (int a = 0; a < cnt; ++a)
+        for (int b = a + 1; b < cnt; ++b) {
+          const int x0 = max(fp[a][PS_FP_X0], fp[b][PS_FP_X0]), y0 = max(fp[a][PS_FP_Y0], fp[b][PS_FP_Y0]);
+          const int x1 = min(fp[a][PS_FP_X1], fp[b][PS_FP_X1]), y1 = min(fp[a][PS_FP_Y1], fp[b][PS_FP_Y1]);
+          for (int y = y0; y < y1; ++y)
+            for (int xc = x0; xc < x1; xc += 16) {
+              const int xs = min(xc, W - 16);
+              const int16 xv = xs + lane;
+              const uchar16 bp = load16(base + y * W + xs);
+              const int16 bi = convert_int16(bp);
+              const real16 b0 = from_pixel16(bp);
+              real16 v = b0, nsum = real16_zero();
+              int16 singles = (int16)(0), cover = (int16)(0);
               for (int k = 0; k < cnt; ++k) {
-                const int tx = x - fp[k][PS_FP_TILE_X0], ty = y - fp[k][PS_FP_TILE_Y0];
-                if (tx >= 0 && ty >= 0 && tx < tile && ty < tile) nsum = noise_acc(nsum, atlas[toff + ty * tile + tx]);
+                if (y < fp[k][PS_FP_Y0] || y >= fp[k][PS_FP_Y1] || xs + 16 <= fp[k][PS_FP_X0] || xs >= fp[k][PS_FP_X1])
+                  continue;
+                const int16 in = (xv >= fp[k][PS_FP_X0]) & (xv < fp[k][PS_FP_X1]);
+                cover |= in & (int16)(1 << k);
+                real16 one = b0;
+                const int sx = xs - fp[k][PS_FP_SPRITE_X0], sy = y - fp[k][PS_FP_SPRITE_Y0], sw = fp[k][PS_FP_SPRITE_W];
+                if (sy >= 0 && sy < fp[k][PS_FP_SPRITE_H] && sx > -16 && sx < sw) {
+                  global const uchar* vr =
+                      atlas + fp[k][PS_FP_SPRITE_PADDED] + sy * 2 * (sw + 2 * PS_PAD) + PS_PAD + sx;
+                  const uchar16 value = load16(vr), coverage = load16(vr + sw + 2 * PS_PAD);
+                  one = blend16(one, value, coverage, alpha);
+                  v = blend16(v, value, coverage, alpha);
+                }
+                if (use_noise) {
+                  real16 n1 = real16_zero();
+                  const int tx = xs - fp[k][PS_FP_TILE_X0], ty = y - fp[k][PS_FP_TILE_Y0];
+                  if (ty >= 0 && ty < tile && tx > -16 && tx < tile) {
+                    const uchar16 t = load16(atlas + tpoff + ty * (tile + 2 * PS_PAD) + PS_PAD + tx);
+                    n1 = noise_acc16(n1, t);
+                    nsum = noise_acc16(nsum, t);
+                  }
+                  one = add_noise16(one, gain, n1);
+                }
+                singles += in & (convert_int16(to_pixel16(one)) - bi);
               }
-              v = add_noise(v, gain, nsum);
+              if (use_noise) v = add_noise16(v, gain, nsum);
+              // A pixel in several overlaps is corrected once, with its first two footprints.
+              const int16 mine = (xv >= xc) & (xv < x1) & ((cover & (int16)((1 << b) - 1)) == (int16)(1 << a));
+              const int16 corr = mine & (convert_int16(to_pixel16(v)) - bi - singles);
+              if (!any(corr != 0)) continue;
+              int c[16];
+              vstore16(corr, 0, c);
+              global float* brow = vrow + (y / block) * bx_count;
+              for (int j = 0; j < 16; ++j)
+                if (c[j] != 0) brow[(xs + j) / block] += (float)c[j];
+              for (int r = 0; r < PS_REGIONS; ++r) {
+                if (region_slot[r] != slot) continue;
+                const int4 rc = rects[r];
+                if (y >= rc.y && y < rc.y + rc.w) reg[r] += sum16(corr & (xv >= rc.x) & (xv < rc.x + rc.z));
+              }
             }
-            const int corr = (int)to_pixel(v) - (int)bp - singles;
-            if (corr == 0) continue;
-            vrow[(y / block) * bx_count + x / block] += (float)corr;
-            for (int r = 0; r < PS_REGIONS; ++r) {
-              if (region_slot[r] != slot) continue;
-              const int4 rc = rects[r];
-              if (x >= rc.x && y >= rc.y && x < rc.x + rc.z && y < rc.y + rc.w) reg[r] += corr;
+        }
+    } else
+#endif
+    {
+      for (int a = 0; a < cnt; ++a)
+        for (int b = a + 1; b < cnt; ++b) {
+          const int x0 = max(fp[a][PS_FP_X0], fp[b][PS_FP_X0]), y0 = max(fp[a][PS_FP_Y0], fp[b][PS_FP_Y0]);
+          const int x1 = min(fp[a][PS_FP_X1], fp[b][PS_FP_X1]), y1 = min(fp[a][PS_FP_Y1], fp[b][PS_FP_Y1]);
+          for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) {
+              uint cover = 0;  // bit k: footprint k holds the pixel
+              for (int k = 0; k < cnt; ++k) cover |= (uint)in_rect(x, y, fp[k]) << k;
+              // A pixel in several overlaps is corrected once, with its first two footprints.
+              if ((cover & ((1u << b) - 1u)) != (1u << a)) continue;
+              const uchar bp = base[y * W + x];
+              const real b0 = from_pixel(bp);
+              real v = b0, nsum = real_zero();
+              int singles = 0;
+              for (int k = 0; k < cnt; ++k) {
+                if (!(cover & (1u << k))) continue;
+                real one = b0, n1 = real_zero();
+                const int sx = x - fp[k][PS_FP_SPRITE_X0], sy = y - fp[k][PS_FP_SPRITE_Y0];
+                if (sx >= 0 && sy >= 0 && sx < fp[k][PS_FP_SPRITE_W] && sy < fp[k][PS_FP_SPRITE_H]) {
+                  const int o = fp[k][PS_FP_SPRITE_OFFSET] + (sy * fp[k][PS_FP_SPRITE_W] + sx) * 2;
+                  one = blend(one, atlas[o], atlas[o + 1], alpha);
+                  v = blend(v, atlas[o], atlas[o + 1], alpha);
+                }
+                if (use_noise) {
+                  const int tx = x - fp[k][PS_FP_TILE_X0], ty = y - fp[k][PS_FP_TILE_Y0];
+                  if (tx >= 0 && ty >= 0 && tx < tile && ty < tile) {
+                    const uchar t = atlas[toff + ty * tile + tx];
+                    n1 = noise_acc(n1, t);
+                    nsum = noise_acc(nsum, t);
+                  }
+                  one = add_noise(one, gain, n1);
+                }
+                singles += (int)to_pixel(one) - (int)bp;
+              }
+              if (use_noise) v = add_noise(v, gain, nsum);
+              const int corr = (int)to_pixel(v) - (int)bp - singles;
+              if (corr == 0) continue;
+              vrow[(y / block) * bx_count + x / block] += (float)corr;
+              for (int r = 0; r < PS_REGIONS; ++r) {
+                if (region_slot[r] != slot) continue;
+                const int4 rc = rects[r];
+                if (x >= rc.x && y >= rc.y && x < rc.x + rc.z && y < rc.y + rc.w) reg[r] += corr;
+              }
             }
-          }
-      }
-    for (int k = 0; k < cnt; ++k)
+        }
+    }
+    // Sums to means, each block once: a block of an earlier footprint is done (`near`:
+    // the earlier footprints whose blocks meet this one's, mostly none).
+    for (int k = 0; k < cnt; ++k) {
+      uint near = 0;
+      for (int j = 0; j < k; ++j) near |= (uint)blocks_meet(fp[j], fp[k]) << j;
       for (int by = fp[k][PS_FP_BLOCK_Y0]; by < fp[k][PS_FP_BLOCK_Y0] + fp[k][PS_FP_BLOCKS_H]; ++by)
         for (int bx = fp[k][PS_FP_BLOCK_X0]; bx < fp[k][PS_FP_BLOCK_X0] + fp[k][PS_FP_BLOCKS_W]; ++bx) {
           int seen = 0;
-          for (int j = 0; j < k; ++j) seen |= in_blocks(bx, by, fp[j]);
+          for (uint m = near; m != 0; m &= m - 1) seen |= in_blocks(bx, by, fp[31 - clz(m & -m)]);
           if (!seen) vrow[by * bx_count + bx] = mean_of((uint)vrow[by * bx_count + bx], block_count(bx, by, block, W, H));
         }
+    }
   }
   if (touched_regions)
     for (int r = 0; r < PS_REGIONS; ++r) {

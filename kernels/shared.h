@@ -64,8 +64,9 @@
 #define PS_FP_BLOCK_Y0 12
 #define PS_FP_BLOCKS_W 13
 #define PS_FP_BLOCKS_H 14
-#define PS_FP_DELTAS 15 /* offset of its block delta table */
-#define PS_FP_LEN 16
+#define PS_FP_DELTAS 15        /* offset of its block delta table */
+#define PS_FP_SPRITE_PADDED 16 /* atlas offset of the sprite's padded copy (PS_PAD) */
+#define PS_FP_LEN 17
 
 /* One camera view's launch of a render stage, passed by value to every stage kernel.
  * 4-byte fields only, so host and device lay it out alike. */

@@ -75,7 +75,7 @@ AppendFile::AppendFile(const std::string& dir, const std::string& name, const Fi
       XXH3_64bits_update(state_of(hash_), buf.data(), static_cast<size_t>(r));
       left -= static_cast<uint64_t>(r);
     }
-    bytes_ = resume->bytes;
+    bytes_ = flushing_ = flushed_ = resume->bytes;
     if (XXH3_64bits_digest(state_of(hash_)) != resume->xxh3)
       throw OutputError(partial_ + ": its contents differ from the checkpoint; the run cannot be resumed");
   } else {
@@ -103,6 +103,22 @@ void AppendFile::append(std::string_view data) {
   }
   XXH3_64bits_update(state_of(hash_), data.data(), data.size());
   bytes_ += data.size();
+  // Large outputs stream to the disk as they are written, rather than piling up in the
+  // page cache until the kernel throttles the writer: every kWindow bytes, start the
+  // writeback of the window just written, wait for the one before it and drop it from
+  // the cache. Hints only; finish() fsyncs, and a resumed run reads back what is there.
+  constexpr uint64_t kWindow = 32ull << 20;
+  if (bytes_ - flushing_ >= kWindow) {
+    ::sync_file_range(fd_, static_cast<off_t>(flushing_), static_cast<off_t>(bytes_ - flushing_),
+                      SYNC_FILE_RANGE_WRITE);
+    if (flushing_ > flushed_) {
+      ::sync_file_range(fd_, static_cast<off_t>(flushed_), static_cast<off_t>(flushing_ - flushed_),
+                        SYNC_FILE_RANGE_WAIT_BEFORE | SYNC_FILE_RANGE_WRITE | SYNC_FILE_RANGE_WAIT_AFTER);
+      ::posix_fadvise(fd_, static_cast<off_t>(flushed_), static_cast<off_t>(flushing_ - flushed_), POSIX_FADV_DONTNEED);
+      flushed_ = flushing_;
+    }
+    flushing_ = bytes_;
+  }
 }
 
 FileState AppendFile::state() const { return FileState{name_, bytes_, XXH3_64bits_digest(state_of(hash_))}; }

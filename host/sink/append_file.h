@@ -38,7 +38,8 @@ class AppendFile {
   std::string partial_, final_;
   std::string name_;
   uint64_t bytes_ = 0;
-  void* hash_ = nullptr;  // XXH3_state_t
+  uint64_t flushing_ = 0, flushed_ = 0;  // writeback started from / done up to (see append)
+  void* hash_ = nullptr;                 // XXH3_state_t
   int fd_ = -1;
 };
 

@@ -105,8 +105,8 @@ class OpenCLBackend final : public Backend {
     }
     for (const Image& tile : assets.noise) noise_offsets.push_back(add_padded_tile(tile));
     if (atlas.size() > 0x7fffffffu) throw std::runtime_error("catalogue images exceed 2 GiB");
-    sprite_offsets_.resize(V);
-    for (size_t v = 0; v < V; ++v) sprite_offsets_[v] = sprites[static_cast<int>(Camera::mmw) * V + v].s[0];
+    mmw_sprites_.assign(sprites.begin() + static_cast<int>(Camera::mmw) * V,
+                        sprites.begin() + (static_cast<int>(Camera::mmw) + 1) * V);
 
     // Pooled views: each region's rectangle in the pooled view that sees it.
     const FeatureLayout lay = FeatureLayout::of(cat, 1);
@@ -160,7 +160,6 @@ class OpenCLBackend final : public Backend {
     annotations(cat_, assets_, batch, plan, out);
     if (n == 0) return;
     const FeatureLayout& lay = out.layout;
-    const int row_len = lay.image_features();
 
     cl::Context& ctx = rt_->context();
     cl::CommandQueue& q = rt_->queue();
@@ -172,7 +171,9 @@ class OpenCLBackend final : public Backend {
     const cl_uint2 seed = split(plan.model.seed), first = split(batch.first_index);
 
     const bool sparse = plan.sparse_features(), raw_grid = plan.physics_sparse_features();
-    cl::Buffer& feats = features_.at_least(ctx, std::max<size_t>(1, n * row_len * sizeof(float)));
+    // Features are written straight into the caller's rows, as kept images are.
+    cl::Buffer feats;
+    if (plan.features) feats = wrap(out.features);
     if (plan.features && sparse) sparse_features(K, plan, n, subject, objects, seed, first, feats);
     if (plan.features && raw_grid) raw_grid_features(K, plan, n, subject, objects, seed, first, feats);
 
@@ -194,7 +195,7 @@ class OpenCLBackend final : public Backend {
     }
     if (plan.features) {
       if (plan.model.pixel_sigma > 0 && !plan.pixel_noise_per_pixel()) analytic_noise(K, plan, n, seed, first, feats);
-      q.enqueueReadBuffer(feats, CL_FALSE, 0, n * row_len * sizeof(float), out.features.data());
+      sync(feats, out.features);
     }
     for (size_t k = 0; k < cat_.sensors.size(); ++k)
       if (plan.image(static_cast<int>(k))) sync(rendered[k], out.views[k].pixels);
@@ -229,8 +230,8 @@ class OpenCLBackend final : public Backend {
   };
   struct Kernels {
     cl::Program program;
-    cl::Kernel place, render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, features_sparse,
-        analytic_noise;
+    cl::Kernel place, render, pool_blocks, pool_regions, metal, base_features, footprint_deltas, sparse_patterns,
+        features_sparse, analytic_noise;
     cl::Kernel metal_physics;                  // made on first use: needs cl_khr_fp64
     std::map<std::string, cl::Kernel> stages;  // stage kernels and fast paths, made on first use
     SparseTables tables;
@@ -580,13 +581,16 @@ class OpenCLBackend final : public Backend {
   }
 
   // A device view of host memory: PoCL on the CPU writes there directly.
-  cl::Buffer wrap(std::vector<uint8_t>& v) {
-    return cl::Buffer(rt_->context(), CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, v.size(), v.data());
+  template <class T>
+  cl::Buffer wrap(std::vector<T>& v) {
+    return cl::Buffer(rt_->context(), CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, v.size() * sizeof(T), v.data());
   }
   // Makes the kernel's writes visible in host memory (a no-op copy where shared).
-  void sync(cl::Buffer& b, std::vector<uint8_t>& v) {
-    void* p = rt_->queue().enqueueMapBuffer(b, CL_TRUE, CL_MAP_READ, 0, v.size());
-    if (p != v.data()) std::memcpy(v.data(), p, v.size());
+  template <class T>
+  void sync(cl::Buffer& b, std::vector<T>& v) {
+    const size_t bytes = v.size() * sizeof(T);
+    void* p = rt_->queue().enqueueMapBuffer(b, CL_TRUE, CL_MAP_READ, 0, bytes);
+    if (p != v.data()) std::memcpy(v.data(), p, bytes);
     rt_->queue().enqueueUnmapMemObject(b, p);
   }
 
@@ -611,6 +615,7 @@ class OpenCLBackend final : public Backend {
     k.metal = cl::Kernel(k.program, "metal_zones");
     k.base_features = cl::Kernel(k.program, "base_features");
     k.footprint_deltas = cl::Kernel(k.program, "footprint_deltas");
+    k.sparse_patterns = cl::Kernel(k.program, "sparse_patterns");
     k.features_sparse = cl::Kernel(k.program, "features_sparse");
     k.analytic_noise = cl::Kernel(k.program, "analytic_noise");
     k.fp64 = f.precision == Precision::fp64;
@@ -711,7 +716,8 @@ class OpenCLBackend final : public Backend {
         f[PS_FP_SPRITE_Y0] = rc.y + ((rc.h - sp.height) >> 1);
         f[PS_FP_SPRITE_W] = sp.width;
         f[PS_FP_SPRITE_H] = sp.height;
-        f[PS_FP_SPRITE_OFFSET] = sprite_offsets_[v];
+        f[PS_FP_SPRITE_OFFSET] = mmw_sprites_[v].s[0];
+        f[PS_FP_SPRITE_PADDED] = mmw_sprites_[v].s[3];
         f[PS_FP_TILE_X0] = f[PS_FP_SPRITE_X0] + (sp.width >> 1) - (N >> 1);
         f[PS_FP_TILE_Y0] = f[PS_FP_SPRITE_Y0] + (sp.height >> 1) - (N >> 1);
         int x0 = f[PS_FP_SPRITE_X0], y0 = f[PS_FP_SPRITE_Y0], x1 = f[PS_FP_SPRITE_X0] + f[PS_FP_SPRITE_W],
@@ -802,6 +808,16 @@ class OpenCLBackend final : public Backend {
     const FeatureLayout lay = FeatureLayout::of(cat_, plan.model.block);
     const Sensor& view = pooled_view(lay);
     const int row_len = lay.image_features();
+    cl::Buffer& patterns = patterns_.at_least(rt_->context(), n * sizeof(cl_int));
+    if (tables_.noise) {
+      cl::Kernel& kp = K.sparse_patterns;
+      kp.setArg(0, static_cast<cl_uint>(n));
+      kp.setArg(1, static_cast<cl_int>(tables_.patterns));
+      kp.setArg(2, seed);
+      kp.setArg(3, first);
+      kp.setArg(4, patterns);
+      rt_->queue().enqueueNDRangeKernel(kp, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
+    }
     cl::Kernel& k = K.features_sparse;
     int a = 0;
     k.setArg(a++, atlas_);
@@ -820,6 +836,7 @@ class OpenCLBackend final : public Backend {
     k.setArg(a++, region_slot_);
     k.setArg(a++, subject);
     k.setArg(a++, objects);
+    k.setArg(a++, patterns);
     k.setArg(a++, static_cast<cl_uint>(n));
     k.setArg(a++, static_cast<cl_int>(cat_.subjects.size()));
     k.setArg(a++, static_cast<cl_int>(tables_.patterns));
@@ -831,8 +848,6 @@ class OpenCLBackend final : public Backend {
     set_param(K, k, a++, ic.alpha);
     k.setArg(a++, static_cast<cl_int>(ic.noise_size));
     k.setArg(a++, static_cast<cl_int>(tables_.noise ? 1 : 0));
-    k.setArg(a++, seed);
-    k.setArg(a++, first);
     k.setArg(a++, static_cast<cl_int>(row_len));
     k.setArg(a++, feats);
     rt_->queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
@@ -841,13 +856,13 @@ class OpenCLBackend final : public Backend {
   const Catalogue& cat_;
   const AssetSet& assets_;
   std::shared_ptr<OpenCLRuntime> rt_;
-  std::vector<cl_int> sprite_offsets_;  // atlas offset of each variant's MMW sprite
+  std::vector<cl_int4> mmw_sprites_;  // each variant's MMW sprite: atlas offset, width, height, padded offset
   std::map<std::string, Kernels> variants_;
   cl::Buffer atlas_, bases_, sprites_, places_, noise_offsets_, noise_gains_, pooled_, region_slot_, region_rects_,
       influence_, categories_, base_zones_, metal_zone_rec_, metal_region_rec_, metal_tensors_;
   const Sensor* metal_view_ = nullptr;  // the first MMW view: the metal model's pixel scale
   std::vector<cl::Buffer> view_rects_;  // per view: int4 per region
-  Grown subject_, objects_, metal_out_, features_, field_, records_, raw_, view_scratch_, physics_none_;
+  Grown subject_, objects_, patterns_, metal_out_, field_, records_, raw_, view_scratch_, physics_none_;
   std::map<std::string, PhysicsTables> physics_tables_;
   struct RawGridTables {
     int count = 0;
