@@ -333,9 +333,14 @@ class OpenCLBackend final : public Backend {
     L.patterns = static_cast<int32_t>(cat_.noise.size());
     L.tile_size = cat_.images.noise_size;
     L.flags = (s.pattern_noise && plan.model.pattern_noise ? PS_FLAG_PATTERN_NOISE : 0) |
-              (plan.pixel_noise_per_pixel() ? PS_FLAG_PIXEL_NOISE : 0) | (plan.model.bilinear ? PS_FLAG_BILINEAR : 0);
+              (plan.pixel_noise_per_pixel() ? PS_FLAG_PIXEL_NOISE : 0) | (plan.model.bilinear ? PS_FLAG_BILINEAR : 0) |
+              (plan.model.transforms() ? PS_FLAG_AFFINE : 0) | (plan.model.flip ? PS_FLAG_FLIP : 0);
     L.jitter_x = static_cast<float>(plan.model.jitter * s.jitter_scale_x);
     L.jitter_y = static_cast<float>(plan.model.jitter * s.jitter_scale_y);
+    L.rotate_lo = static_cast<float>(plan.model.rotate_lo);
+    L.rotate_hi = static_cast<float>(plan.model.rotate_hi);
+    L.scale_lo = static_cast<float>(plan.model.scale_lo);
+    L.scale_hi = static_cast<float>(plan.model.scale_hi);
     L.raw_width = plan.model.raw_width;
     L.raw_height = plan.model.raw_height;
     L.subjects = static_cast<int32_t>(cat_.subjects.size());
