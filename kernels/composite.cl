@@ -90,10 +90,21 @@ inline greal get_greal(global const int* p) {
 inline void place_affine(global int* ly, const PsViewLaunch* L, uint2 seed, ulong index, int r, greal cx, greal cy,
                          int w, int h) {
   const uint4 q = draw(seed, index, PS_STREAM_TRANSFORM, (uint)r);
-  const greal deg = (greal)L->rotate_lo + ((greal)L->rotate_hi - (greal)L->rotate_lo) * (greal)uniform24(q.x);
-  const greal s = (greal)L->scale_lo + ((greal)L->scale_hi - (greal)L->scale_lo) * (greal)uniform24(q.y);
+#if defined(PRECISION_FP64)
+  greal range[4];
+  for (int k = 0; k < 4; ++k) range[k] = as_double((uint2)(L->ranges_fp64[2 * k], L->ranges_fp64[2 * k + 1]));
+#else
+  const greal range[4] = {L->rotate_lo, L->rotate_hi, L->scale_lo, L->scale_hi};
+#endif
+  const greal deg = range[0] + (range[1] - range[0]) * (greal)uniform24(q.x);
+  const greal s = range[2] + (range[3] - range[2]) * (greal)uniform24(q.y);
   const greal f = (L->flags & PS_FLAG_FLIP) && (q.z >> 31) ? (greal)-1 : (greal)1;
-  const greal c = cospi(deg / (greal)180), sn = sinpi(deg / (greal)180);
+#if defined(PRECISION_FP64)
+  const greal rad = deg * (M_PI / 180.0);  // the reference's formulas, to its last bits where it can
+#else
+  const greal rad = deg * (M_PI_F / 180.0f);
+#endif
+  const greal c = cos(rad), sn = sin(rad);
   // Forward: image = centre + s R F (sprite - sprite centre), R = [c sn; -sn c] (counter-
   // clockwise with y down), F = diag(f, 1); inverse: sprite = sprite centre + F R^T (image - centre) / s.
   put_greal(ly + PS_LAYER_CX, cx);
@@ -239,7 +250,11 @@ inline void affine_sample(const Layers* Ly, int k, global const uchar* atlas, in
       const int ix = i0 + i;
       if (ix < 0 || ix >= w) continue;
       const greal wgt = wj * (i ? tx : (greal)1 - tx);
+#if defined(PRECISION_FP64)
+      const greal c = (greal)atlas[off + 2 * ix + 1] / (greal)255;
+#else
       const greal c = (greal)atlas[off + 2 * ix + 1] * ((greal)1 / (greal)255);
+#endif
       *pv += wgt * c * (greal)atlas[off + 2 * ix];
       *cov += wgt * c;
     }

@@ -104,8 +104,10 @@ typedef struct {
    * first and last raw column of each view column and raw row of each view row (2 per);
    * and each subject's bare raw grid (subjects x raw_height x raw_width). */
   PS_I32 phys_wx, phys_wy, phys_cband, phys_rband, phys_base;
-  /* Randomised objects (PS_FLAG_AFFINE): the ranges of the angle (degrees) and the scale. */
+  /* Randomised objects (PS_FLAG_AFFINE): the ranges of the angle (degrees) and the scale,
+   * as floats, and the same four as doubles (low word, high word) for fp64 builds. */
   PS_F32 rotate_lo, rotate_hi, scale_lo, scale_hi;
+  PS_U32 ranges_fp64[8];
 } PsViewLaunch;
 
 /* The physics model's parameters for one launch (kernels' `phys`, at the build's parameter

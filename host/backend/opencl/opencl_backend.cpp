@@ -341,6 +341,8 @@ class OpenCLBackend final : public Backend {
     L.rotate_hi = static_cast<float>(plan.model.rotate_hi);
     L.scale_lo = static_cast<float>(plan.model.scale_lo);
     L.scale_hi = static_cast<float>(plan.model.scale_hi);
+    const double ranges[4] = {plan.model.rotate_lo, plan.model.rotate_hi, plan.model.scale_lo, plan.model.scale_hi};
+    std::memcpy(L.ranges_fp64, ranges, sizeof ranges);  // little-endian host and device: low word first
     L.raw_width = plan.model.raw_width;
     L.raw_height = plan.model.raw_height;
     L.subjects = static_cast<int32_t>(cat_.subjects.size());

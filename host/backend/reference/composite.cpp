@@ -39,17 +39,18 @@ SpriteMap sprite_map(const Placed& p, bool bilinear) {
   m.cx = p.x0 + (bilinear ? p.dx : std::floor(p.dx + 0.5)) + m.csx;
   m.cy = p.y0 + (bilinear ? p.dy : std::floor(p.dy + 0.5)) + m.csy;
   const double t = p.transform.rotation * (M_PI / 180.0);
-  m.cos_t = std::cos(t);
-  m.sin_t = std::sin(t);
-  m.flip = p.transform.flip ? -1.0 : 1.0;
-  m.scale = p.transform.scale;
+  const double c = std::cos(t), s = std::sin(t), f = p.transform.flip ? -1.0 : 1.0, scale = p.transform.scale;
+  m.a00 = f * c / scale;
+  m.a01 = -f * s / scale;
+  m.a10 = s / scale;
+  m.a11 = c / scale;
   // The corners of the sprite's bilinear support, (-1, -1) .. (w, h), turned and scaled.
   double lo_x = m.cx, hi_x = m.cx, lo_y = m.cy, hi_y = m.cy;
   for (const double px : {-1.0 - m.csx, sp.width - m.csx})
     for (const double py : {-1.0 - m.csy, sp.height - m.csy}) {
-      const double qx = m.flip * px, qy = py;
-      const double x = m.cx + m.scale * (m.cos_t * qx + m.sin_t * qy);
-      const double y = m.cy + m.scale * (-m.sin_t * qx + m.cos_t * qy);
+      const double qx = f * px, qy = py;
+      const double x = m.cx + scale * (c * qx + s * qy);
+      const double y = m.cy + scale * (-s * qx + c * qy);
       lo_x = std::min(lo_x, x), hi_x = std::max(hi_x, x), lo_y = std::min(lo_y, y), hi_y = std::max(hi_y, y);
     }
   m.x0 = static_cast<int>(std::floor(lo_x)) - 1;
@@ -61,8 +62,8 @@ SpriteMap sprite_map(const Placed& p, bool bilinear) {
 
 void SpriteMap::at(int x, int y, double& sx, double& sy) const {
   const double u = x - cx, v = y - cy;
-  sx = csx + flip * (cos_t * u - sin_t * v) / scale;
-  sy = csy + (sin_t * u + cos_t * v) / scale;
+  sx = csx + a01 * v + a00 * u;
+  sy = csy + a11 * v + a10 * u;
 }
 
 void lay_objects(const ViewScene& vs, Field& f, double alpha,

@@ -34,9 +34,9 @@ struct Placed {
 // Randomised objects: where pixel (x, y) samples a placed sprite, turned, scaled and
 // mirrored about its centre, and the box of pixels it can touch (inclusive, unclipped).
 struct SpriteMap {
-  double cx, cy;    // the sprite's centre in the image
-  double csx, csy;  // and in the sprite: ((w - 1) / 2, (h - 1) / 2)
-  double cos_t, sin_t, flip, scale;
+  double cx, cy;              // the sprite's centre in the image
+  double csx, csy;            // and in the sprite: ((w - 1) / 2, (h - 1) / 2)
+  double a00, a01, a10, a11;  // the inverse map: sprite - sprite centre = A (image - centre)
   int x0, y0, x1, y1;
   // The sprite point (sx, sy) of pixel (x, y).
   void at(int x, int y, double& sx, double& sy) const;
