@@ -232,15 +232,19 @@ inline void composite_layers(Layers* Ly, global const int* rec, const PsViewLaun
 
 // Affine sample of a sprite layer at pixel x: the sprite point the inverse map gives,
 // then bilinear on premultiplied coverage as below, over the sprite's four nearest texels.
-inline void affine_sample(const Layers* Ly, int k, global const uchar* atlas, int x, greal* pv, greal* cov) {
+__attribute__((always_inline)) inline void affine_sample(const Layers* Ly, int k, global const uchar* atlas, int x,
+                                                         greal* pv, greal* cov) {
   const greal u = (greal)x - Ly->cx[k];
   const greal sx = Ly->rx[k] + Ly->ax[k] * u, sy = Ly->ry[k] + Ly->ay[k] * u;
-  const greal i0f = floor(sx), j0f = floor(sy);
-  const int i0 = (int)i0f, j0 = (int)j0f;
-  const greal tx = sx - i0f, ty = sy - j0f;
   const int w = Ly->sw[k], h = Ly->sh[k];
   *pv = 0;
   *cov = 0;
+  // Most of a turned sprite's box maps outside it (no texel has weight): done.
+  if (!(sx > (greal)-1 && sy > (greal)-1 && sx < (greal)w && sy < (greal)h)) return;
+  const greal i0f = floor(sx), j0f = floor(sy);
+  const int i0 = (int)i0f, j0 = (int)j0f;
+  const greal tx = sx - i0f, ty = sy - j0f;
+  greal p = 0, c = 0;  // sums in registers: stores through pv and cov each texel cost most of the time
   for (int j = 0; j < 2; ++j) {
     const int jj = j0 + j;
     if (jj < 0 || jj >= h) continue;
@@ -251,14 +255,16 @@ inline void affine_sample(const Layers* Ly, int k, global const uchar* atlas, in
       if (ix < 0 || ix >= w) continue;
       const greal wgt = wj * (i ? tx : (greal)1 - tx);
 #if defined(PRECISION_FP64)
-      const greal c = (greal)atlas[off + 2 * ix + 1] / (greal)255;
+      const greal t = (greal)atlas[off + 2 * ix + 1] / (greal)255;
 #else
-      const greal c = (greal)atlas[off + 2 * ix + 1] * ((greal)1 / (greal)255);
+      const greal t = (greal)atlas[off + 2 * ix + 1] * ((greal)1 / (greal)255);
 #endif
-      *pv += wgt * c * (greal)atlas[off + 2 * ix];
-      *cov += wgt * c;
+      p += wgt * t * (greal)atlas[off + 2 * ix];
+      c += wgt * t;
     }
   }
+  *pv = p;
+  *cov = c;
 }
 
 // Bilinear sample of a sprite layer at pixel x: premultiplied value and coverage, 0..1.
