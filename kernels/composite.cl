@@ -172,11 +172,35 @@ kernel void place_view(VIEW_STAGE_ARGS) {
   rec[PS_REC_COUNT] = count;
 }
 
-// The image rows [x, y) a layer of the record can touch (with the bilinear fringe).
+// The image rows a layer of the record can touch (with the bilinear fringe): first in x,
+// one past the last in y.
 inline int2 layer_rows(global const int* ly, int flags) {
   if (flags & PS_FLAG_AFFINE) return (int2)(ly[PS_LAYER_BY0], ly[PS_LAYER_BY1] + 1);
   const int top = (flags & PS_FLAG_BILINEAR) ? (int)floor(as_float(ly[PS_LAYER_FY])) - 1 : ly[PS_LAYER_Y0];
   return (int2)(top, top + ly[PS_LAYER_H] + 2);
+}
+
+// Collects the affine layers of the scenario's record whose box crosses row y, with
+// their inverse map along the row.
+inline void affine_layers(Layers* Ly, global const int* rec, int y) {
+  for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
+    global const int* ly = rec + PS_REC_LAYERS + j * PS_LAYER_LEN;
+    if (y < ly[PS_LAYER_BY0] || y > ly[PS_LAYER_BY1]) continue;
+    const int k = Ly->count++;
+    const int w = ly[PS_LAYER_W], h = ly[PS_LAYER_H];
+    Ly->variant[k] = ly[PS_LAYER_VARIANT];
+    Ly->offset[k] = ly[PS_LAYER_OFFSET];
+    Ly->sw[k] = w;
+    Ly->sh[k] = h;
+    Ly->x0[k] = ly[PS_LAYER_BX0];
+    Ly->width[k] = ly[PS_LAYER_BX1] - ly[PS_LAYER_BX0] + 1;
+    const greal v = (greal)y - get_greal(ly + PS_LAYER_CY);
+    Ly->cx[k] = get_greal(ly + PS_LAYER_CX);
+    Ly->rx[k] = (greal)(w - 1) * (greal)0.5 + get_greal(ly + PS_LAYER_A01) * v;
+    Ly->ry[k] = (greal)(h - 1) * (greal)0.5 + get_greal(ly + PS_LAYER_A11) * v;
+    Ly->ax[k] = get_greal(ly + PS_LAYER_A00);
+    Ly->ay[k] = get_greal(ly + PS_LAYER_A10);
+  }
 }
 
 // Collects the layers of the scenario's record that cross row y.
@@ -184,26 +208,14 @@ inline void composite_layers(Layers* Ly, global const int* rec, const PsViewLaun
   Ly->count = 0;
   Ly->affine = (L->flags & PS_FLAG_AFFINE) != 0;
   Ly->bilinear = (L->flags & PS_FLAG_BILINEAR) != 0 || Ly->affine;  // both sample per pixel
+  if (Ly->affine) {
+    affine_layers(Ly, rec, y);
+    return;
+  }
   for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
     global const int* ly = rec + PS_REC_LAYERS + j * PS_LAYER_LEN;
     const int w = ly[PS_LAYER_W], h = ly[PS_LAYER_H];
     Ly->variant[Ly->count] = ly[PS_LAYER_VARIANT];
-    if (Ly->affine) {
-      if (y < ly[PS_LAYER_BY0] || y > ly[PS_LAYER_BY1]) continue;
-      const int k = Ly->count++;
-      Ly->offset[k] = ly[PS_LAYER_OFFSET];
-      Ly->sw[k] = w;
-      Ly->sh[k] = h;
-      Ly->x0[k] = ly[PS_LAYER_BX0];
-      Ly->width[k] = ly[PS_LAYER_BX1] - ly[PS_LAYER_BX0] + 1;
-      const greal v = (greal)y - get_greal(ly + PS_LAYER_CY);
-      Ly->cx[k] = get_greal(ly + PS_LAYER_CX);
-      Ly->rx[k] = (greal)(w - 1) * (greal)0.5 + get_greal(ly + PS_LAYER_A01) * v;
-      Ly->ry[k] = (greal)(h - 1) * (greal)0.5 + get_greal(ly + PS_LAYER_A11) * v;
-      Ly->ax[k] = get_greal(ly + PS_LAYER_A00);
-      Ly->ay[k] = get_greal(ly + PS_LAYER_A10);
-      continue;
-    }
     if (!Ly->bilinear) {
       const int y0 = ly[PS_LAYER_Y0];
       if (y < y0 || y >= y0 + h) continue;
