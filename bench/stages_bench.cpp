@@ -61,12 +61,6 @@ void BM_ChainFusedOrStaged(benchmark::State& state) {
   state.SetLabel(plan.fidelity.fused ? "fused render_view" : "stage kernels");
 }
 
-double process_cpu_ms() {
-  rusage u{};
-  ::getrusage(RUSAGE_SELF, &u);
-  return (u.ru_utime.tv_sec + u.ru_stime.tv_sec) * 1e3 + (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-3;
-}
-
 // An images run's batch on the kernels (default model, every view kept), with boxes and
 // instance masks (Arg 1) or without (Arg 0): the difference is what annotations cost.
 void BM_ImagesAnnotations(benchmark::State& state) {
@@ -78,7 +72,7 @@ void BM_ImagesAnnotations(benchmark::State& state) {
   const SceneBatch batch = make_batch(n);
   BatchOutput out;
   b->run(batch, plan, out);
-  const double cpu0 = process_cpu_ms();
+  const double cpu0 = bench::process_cpu_ms();
   for (auto _ : state) {
     b->run(batch, plan, out);
     benchmark::DoNotOptimize(out.views.data());
@@ -86,7 +80,8 @@ void BM_ImagesAnnotations(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
   state.SetLabel(plan.annotations ? "images + annotations" : "images");
   // Every thread's CPU time (PoCL's and the host's), steadier than wall time on a busy machine.
-  state.counters["process_cpu_ms"] = benchmark::Counter(process_cpu_ms() - cpu0, benchmark::Counter::kAvgIterations);
+  state.counters["process_cpu_ms"] =
+      benchmark::Counter(bench::process_cpu_ms() - cpu0, benchmark::Counter::kAvgIterations);
 }
 
 BENCHMARK(BM_StageOpenCL)->DenseRange(1, 3)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -58,11 +58,73 @@ typedef struct {
   int offset1[PS_MAX_LAYERS];
   float wy[PS_MAX_LAYERS];
   float fx[PS_MAX_LAYERS];
+  // Affine placement (bilinear is set too; x0 and width are the layer's box on this row,
+  // offset[k] the sprite's first row): the sprite's size, the centre's column, and the
+  // sprite point of pixel x, (rx + ax (x - cx), ry + ay (x - cx)).
+  int affine;
+  int sw[PS_MAX_LAYERS], sh[PS_MAX_LAYERS];
+  greal cx[PS_MAX_LAYERS], rx[PS_MAX_LAYERS], ry[PS_MAX_LAYERS], ax[PS_MAX_LAYERS], ay[PS_MAX_LAYERS];
 } Layers;
+
+// A value of the affine record (kernels/shared.h, PS_LAYER_CX..A11) at greal precision,
+// two ints wide.
+inline void put_greal(global int* p, greal v) {
+#if defined(PRECISION_FP64)
+  vstore2(as_int2(v), 0, p);
+#else
+  p[0] = as_int(v);
+  p[1] = 0;
+#endif
+}
+inline greal get_greal(global const int* p) {
+#if defined(PRECISION_FP64)
+  return as_double(vload2(0, p));
+#else
+  return as_float(p[0]);
+#endif
+}
+
+// Randomised objects: region r's draw (host: object_transform, the same numbers) as the
+// inverse affine map of its sprite about the sprite's centre (cx, cy), and the box of
+// pixels the turned, scaled and mirrored sprite (with its bilinear fringe) can touch.
+inline void place_affine(global int* ly, const PsViewLaunch* L, uint2 seed, ulong index, int r, greal cx, greal cy,
+                         int w, int h) {
+  const uint4 q = draw(seed, index, PS_STREAM_TRANSFORM, (uint)r);
+#if defined(PRECISION_FP64)
+  greal range[4];
+  for (int k = 0; k < 4; ++k) range[k] = as_double((uint2)(L->ranges_fp64[2 * k], L->ranges_fp64[2 * k + 1]));
+#else
+  const greal range[4] = {L->rotate_lo, L->rotate_hi, L->scale_lo, L->scale_hi};
+#endif
+  const greal deg = range[0] + (range[1] - range[0]) * (greal)uniform24(q.x);
+  const greal s = range[2] + (range[3] - range[2]) * (greal)uniform24(q.y);
+  const greal f = (L->flags & PS_FLAG_FLIP) && (q.z >> 31) ? (greal)-1 : (greal)1;
+#if defined(PRECISION_FP64)
+  const greal rad = deg * (M_PI / 180.0);  // the reference's formulas, to its last bits where it can
+#else
+  const greal rad = deg * (M_PI_F / 180.0f);
+#endif
+  const greal c = cos(rad), sn = sin(rad);
+  // Forward: image = centre + s R F (sprite - sprite centre), R = [c sn; -sn c] (counter-
+  // clockwise with y down), F = diag(f, 1); inverse: sprite = sprite centre + F R^T (image - centre) / s.
+  put_greal(ly + PS_LAYER_CX, cx);
+  put_greal(ly + PS_LAYER_CY, cy);
+  put_greal(ly + PS_LAYER_A00, f * c / s);
+  put_greal(ly + PS_LAYER_A01, -f * sn / s);
+  put_greal(ly + PS_LAYER_A10, sn / s);
+  put_greal(ly + PS_LAYER_A11, c / s);
+  const greal hw = (greal)(w + 1) * (greal)0.5, hh = (greal)(h + 1) * (greal)0.5;
+  const greal ex = s * (fabs(c) * hw + fabs(sn) * hh), ey = s * (fabs(sn) * hw + fabs(c) * hh);
+  ly[PS_LAYER_BX0] = (int)floor(cx - ex);
+  ly[PS_LAYER_BX1] = (int)ceil(cx + ex);
+  ly[PS_LAYER_BY0] = (int)floor(cy - ey);
+  ly[PS_LAYER_BY1] = (int)ceil(cy + ey);
+}
 
 // Step "place" before every chain: one work-item per scenario writes the view's record.
 // With jitter, each region's sprite moves by (jx, jy) * (2u - 1), u uniform from the
 // counter generator: rounded to whole pixels (integer placement) or kept (bilinear).
+// Randomised objects (PS_FLAG_AFFINE) add each sprite's inverse affine map and box.
 kernel void place_view(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
@@ -99,15 +161,57 @@ kernel void place_view(VIEW_STAGE_ARGS) {
     ly[PS_LAYER_TILE_X0] = pl.x + (sp.y >> 1) - (L.tile_size >> 1);
     ly[PS_LAYER_TILE_Y0] = pl.y + (sp.z >> 1) - (L.tile_size >> 1);
     ly[PS_LAYER_VARIANT] = v;
+    if (L.flags & PS_FLAG_AFFINE) {
+      const greal ox = (L.flags & PS_FLAG_BILINEAR) ? (greal)dx : (greal)floor(dx + 0.5f);
+      const greal oy = (L.flags & PS_FLAG_BILINEAR) ? (greal)dy : (greal)floor(dy + 0.5f);
+      place_affine(ly, &L, seed, index, r, (greal)pl.x + ox + (greal)(sp.y - 1) * (greal)0.5,
+                   (greal)pl.y + oy + (greal)(sp.z - 1) * (greal)0.5, sp.y, sp.z);
+    }
     ++count;
   }
   rec[PS_REC_COUNT] = count;
 }
 
+// The image rows a layer of the record can touch (with the bilinear fringe): first in x,
+// one past the last in y.
+inline int2 layer_rows(global const int* ly, int flags) {
+  if (flags & PS_FLAG_AFFINE) return (int2)(ly[PS_LAYER_BY0], ly[PS_LAYER_BY1] + 1);
+  const int top = (flags & PS_FLAG_BILINEAR) ? (int)floor(as_float(ly[PS_LAYER_FY])) - 1 : ly[PS_LAYER_Y0];
+  return (int2)(top, top + ly[PS_LAYER_H] + 2);
+}
+
+// Collects the affine layers of the scenario's record whose box crosses row y, with
+// their inverse map along the row.
+inline void affine_layers(Layers* Ly, global const int* rec, int y) {
+  for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
+    global const int* ly = rec + PS_REC_LAYERS + j * PS_LAYER_LEN;
+    if (y < ly[PS_LAYER_BY0] || y > ly[PS_LAYER_BY1]) continue;
+    const int k = Ly->count++;
+    const int w = ly[PS_LAYER_W], h = ly[PS_LAYER_H];
+    Ly->variant[k] = ly[PS_LAYER_VARIANT];
+    Ly->offset[k] = ly[PS_LAYER_OFFSET];
+    Ly->sw[k] = w;
+    Ly->sh[k] = h;
+    Ly->x0[k] = ly[PS_LAYER_BX0];
+    Ly->width[k] = ly[PS_LAYER_BX1] - ly[PS_LAYER_BX0] + 1;
+    const greal v = (greal)y - get_greal(ly + PS_LAYER_CY);
+    Ly->cx[k] = get_greal(ly + PS_LAYER_CX);
+    Ly->rx[k] = (greal)(w - 1) * (greal)0.5 + get_greal(ly + PS_LAYER_A01) * v;
+    Ly->ry[k] = (greal)(h - 1) * (greal)0.5 + get_greal(ly + PS_LAYER_A11) * v;
+    Ly->ax[k] = get_greal(ly + PS_LAYER_A00);
+    Ly->ay[k] = get_greal(ly + PS_LAYER_A10);
+  }
+}
+
 // Collects the layers of the scenario's record that cross row y.
 inline void composite_layers(Layers* Ly, global const int* rec, const PsViewLaunch* L, int y) {
   Ly->count = 0;
-  Ly->bilinear = (L->flags & PS_FLAG_BILINEAR) != 0;
+  Ly->affine = (L->flags & PS_FLAG_AFFINE) != 0;
+  Ly->bilinear = (L->flags & PS_FLAG_BILINEAR) != 0 || Ly->affine;  // both sample per pixel
+  if (Ly->affine) {
+    affine_layers(Ly, rec, y);
+    return;
+  }
   for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
     global const int* ly = rec + PS_REC_LAYERS + j * PS_LAYER_LEN;
     const int w = ly[PS_LAYER_W], h = ly[PS_LAYER_H];
@@ -138,8 +242,49 @@ inline void composite_layers(Layers* Ly, global const int* rec, const PsViewLaun
   }
 }
 
+// Affine sample of a sprite layer at pixel x: the sprite point the inverse map gives,
+// then bilinear on premultiplied coverage as below, over the sprite's four nearest texels.
+__attribute__((always_inline)) inline void affine_sample(const Layers* Ly, int k, global const uchar* atlas, int x,
+                                                         greal* pv, greal* cov) {
+  const greal u = (greal)x - Ly->cx[k];
+  const greal sx = Ly->rx[k] + Ly->ax[k] * u, sy = Ly->ry[k] + Ly->ay[k] * u;
+  const int w = Ly->sw[k], h = Ly->sh[k];
+  *pv = 0;
+  *cov = 0;
+  // Most of a turned sprite's box maps outside it (no texel has weight): done.
+  if (!(sx > (greal)-1 && sy > (greal)-1 && sx < (greal)w && sy < (greal)h)) return;
+  const greal i0f = floor(sx), j0f = floor(sy);
+  const int i0 = (int)i0f, j0 = (int)j0f;
+  const greal tx = sx - i0f, ty = sy - j0f;
+  greal p = 0, c = 0;  // sums in registers: stores through pv and cov each texel cost most of the time
+  for (int j = 0; j < 2; ++j) {
+    const int jj = j0 + j;
+    if (jj < 0 || jj >= h) continue;
+    const int off = Ly->offset[k] + jj * w * 2;
+    const greal wj = j ? ty : (greal)1 - ty;
+    for (int i = 0; i < 2; ++i) {
+      const int ix = i0 + i;
+      if (ix < 0 || ix >= w) continue;
+      const greal wgt = wj * (i ? tx : (greal)1 - tx);
+#if defined(PRECISION_FP64)
+      const greal t = (greal)atlas[off + 2 * ix + 1] / (greal)255;
+#else
+      const greal t = (greal)atlas[off + 2 * ix + 1] * ((greal)1 / (greal)255);
+#endif
+      p += wgt * t * (greal)atlas[off + 2 * ix];
+      c += wgt * t;
+    }
+  }
+  *pv = p;
+  *cov = c;
+}
+
 // Bilinear sample of a sprite layer at pixel x: premultiplied value and coverage, 0..1.
 inline void bilinear_sample(const Layers* Ly, int k, global const uchar* atlas, int x, greal* pv, greal* cov) {
+  if (Ly->affine) {
+    affine_sample(Ly, k, atlas, x, pv, cov);
+    return;
+  }
   const greal sx = (greal)x - (greal)Ly->fx[k];
   const greal i0f = floor(sx);
   const int i0 = (int)i0f;

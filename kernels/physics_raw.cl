@@ -23,12 +23,10 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
 
   // The view rows any object can touch.
   int y_lo = H, y_hi = 0;
-  const int bilinear = (L.flags & PS_FLAG_BILINEAR) != 0;
   for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
-    global const int* ly = rec + PS_REC_LAYERS + j * PS_LAYER_LEN;
-    const int top = bilinear ? (int)floor(as_float(ly[PS_LAYER_FY])) - 1 : ly[PS_LAYER_Y0];
-    y_lo = min(y_lo, max(top, 0));
-    y_hi = max(y_hi, min(top + ly[PS_LAYER_H] + 2, H));
+    const int2 rows = layer_rows(rec + PS_REC_LAYERS + j * PS_LAYER_LEN, L.flags);
+    y_lo = min(y_lo, max(rows.x, 0));
+    y_hi = max(y_hi, min(rows.y, H));
   }
   const preal gain = (preal)phys[PS_PHYS_SUBJECTS + 2 * s], offset = (preal)phys[PS_PHYS_SUBJECTS + 2 * s + 1];
   global const param* object_t = phys + PS_PHYS_VARIANTS(L.subjects);

@@ -40,6 +40,7 @@
 #define PS_STREAM_JITTER 5u        /* sprite placement jitter; element = region */
 #define PS_STREAM_RAW_NOISE 6u     /* physics: MMW noise per raw pixel; element = view << 28 | raw pixel / 2 */
 #define PS_STREAM_IR_NOISE 7u      /* physics: IR noise per pixel; element = view << 28 | pixel / 2 */
+#define PS_STREAM_TRANSFORM 8u     /* randomised objects: rotation, scale, flip; element = region */
 #define PS_STREAM_GENERATE 16u     /* scenario generators (host only) */
 #define PS_PIXEL_NOISE_VIEW_SHIFT 28
 
@@ -47,6 +48,8 @@
 #define PS_FLAG_PATTERN_NOISE 1
 #define PS_FLAG_PIXEL_NOISE 2
 #define PS_FLAG_BILINEAR 4
+#define PS_FLAG_AFFINE 8 /* randomised objects: sprites sampled through their inverse affine map */
+#define PS_FLAG_FLIP 16  /* with PS_FLAG_AFFINE: mirror each object with probability 1/2 */
 
 /* Footprint record of the sparse features path, per (variant, region), ints. */
 #define PS_FP_SPRITE_X0 0
@@ -102,6 +105,10 @@ typedef struct {
    * first and last raw column of each view column and raw row of each view row (2 per);
    * and each subject's bare raw grid (subjects x raw_height x raw_width). */
   PS_I32 phys_wx, phys_wy, phys_cband, phys_rband, phys_base;
+  /* Randomised objects (PS_FLAG_AFFINE): the ranges of the angle (degrees) and the scale,
+   * as floats, and the same four as doubles (low word, high word) for fp64 builds. */
+  PS_F32 rotate_lo, rotate_hi, scale_lo, scale_hi;
+  PS_U32 ranges_fp64[8];
 } PsViewLaunch;
 
 /* The physics model's parameters for one launch (kernels' `phys`, at the build's parameter
@@ -132,7 +139,21 @@ typedef struct {
 #define PS_LAYER_TILE_X0 8 /* the noise tile, centred on the unmoved sprite */
 #define PS_LAYER_TILE_Y0 9
 #define PS_LAYER_VARIANT 10 /* the object drawing */
-#define PS_LAYER_LEN 11
+/* Affine placement (PS_FLAG_AFFINE): the image box the transformed sprite can touch
+ * (inclusive), then the inverse map, a sprite point (sx, sy) per image pixel (x, y):
+ * sx = SCX + A00 (x - CX) + A01 (y - CY), sy = SCY + A10 (x - CX) + A11 (y - CY), each
+ * value at the kernels' sample precision (a double, or a float and a spare int). */
+#define PS_LAYER_BX0 11
+#define PS_LAYER_BY0 12
+#define PS_LAYER_BX1 13
+#define PS_LAYER_BY1 14
+#define PS_LAYER_CX 15 /* the sprite's centre in the image */
+#define PS_LAYER_CY 17
+#define PS_LAYER_A00 19
+#define PS_LAYER_A01 21
+#define PS_LAYER_A10 23
+#define PS_LAYER_A11 25
+#define PS_LAYER_LEN 27
 #define PS_REC_LEN (PS_REC_LAYERS + PS_MAX_LAYERS * PS_LAYER_LEN)
 
 /* The vector render path reads 16 pixels of a sprite or noise tile row at a time, so

@@ -323,3 +323,47 @@ TEST(Coco, SpecFileKeyTurnsThemOnAndIsCheckedThere) {
 }
 
 }  // namespace
+
+namespace {
+
+// Randomised objects: each annotation carries its object's rotation, scale and flip, the
+// values scenarios.csv records for its scenario and region; boxes still agree with masks
+// (ValidAndAgreesWithMasksAndYolo's checks run in check_coco and below).
+TEST(Coco, RandomisedObjectsCarryTheirDraws) {
+  portalsim::test::TempDir t;
+  const fs::path out = t.w() / "set";
+  ExpectOk(run(t, plus(annotated("16"), {"--rotate", "40", "--scale", "0.8..1.2", "--flip", "on"}), out));
+  const json c = check_coco(out / "annotations.json");
+  std::map<uint64_t, uint64_t> scenario_of;
+  for (const json& im : c.at("images")) scenario_of[im.at("id").get<uint64_t>()] = im.at("scenario").get<uint64_t>();
+  // scenarios.csv: index, subject, region1..13, rotation1..13, scale1..13, flip1..13, label.
+  std::map<uint64_t, std::vector<std::string>> rows;
+  std::istringstream in(slurp(out / "scenarios.csv"));
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+    rows[std::stoull(f.at(0))] = f;
+  }
+  ASSERT_EQ(rows.size(), 16u);
+  size_t checked = 0, turned = 0, mirrored = 0;
+  for (const json& a : c.at("annotations")) {
+    const std::vector<std::string>& f = rows.at(scenario_of.at(a.at("image_id").get<uint64_t>()));
+    const int r = a.at("region").get<int>();  // 1-based
+    EXPECT_EQ(a.at("rotation").get<double>(), std::stod(f.at(1 + 13 + r)));
+    EXPECT_EQ(a.at("scale").get<double>(), std::stod(f.at(1 + 26 + r)));
+    EXPECT_EQ(a.at("flip").get<bool>(), f.at(1 + 39 + r) == "1");
+    EXPECT_TRUE(a.at("rotation").get<double>() >= -40 && a.at("rotation").get<double>() <= 40);
+    turned += a.at("rotation").get<double>() != 0;
+    mirrored += a.at("flip").get<bool>();
+    ++checked;
+  }
+  EXPECT_GT(checked, 40u);
+  EXPECT_EQ(turned, checked);
+  EXPECT_GT(mirrored, 5u);
+  EXPECT_LT(mirrored, checked - 5);
+}
+
+}  // namespace

@@ -31,6 +31,10 @@ Other other_value(const Knob& k, const Plan& defaults) {
       return d.get<bool>() ? Other{"off", "false"} : Other{"on", "true"};
     case KnobKind::grid:
       return {"16x12", "\"16x12\""};
+    case KnobKind::range: {  // from the least value to the middle of the range
+      const std::string t = knob_text(k.min) + ".." + knob_text((k.min + k.max) / 2);
+      return {t, "\"" + t + "\""};
+    }
     case KnobKind::choice:
       for (const std::string& c : k.choices)
         if (c != d.get<std::string>()) return {c, "\"" + c + "\""};
@@ -70,6 +74,8 @@ TEST(Knobs, BadValuesAreRefusedNamingTheFileLineAndKey) {
     if (k.kind == KnobKind::number) bad = {"nan", "inf", "-1", "\"x\""};
     if (k.kind == KnobKind::on_off) bad = {"\"on\"", "1"};
     if (k.kind == KnobKind::choice) bad = {"\"nonsense\"", "1"};
+    if (k.kind == KnobKind::range)
+      bad = {"\"x\"", "\"2..1\"", "\"1..nan\"", "\"1..\"", "true", "\"" + knob_text(k.max + 1) + "\""};
     for (const std::string& v : bad) {
       RunSpec spec;
       try {

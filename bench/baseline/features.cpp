@@ -22,7 +22,7 @@ uint8_t to_pixel(float v) { return static_cast<uint8_t>(std::clamp(std::floor(v 
 
 SparseFeatures::SparseFeatures(const Catalogue& cat, const AssetSet& assets, const ModelSettings& model)
     : cat_(cat), assets_(assets), model_(model), layout_(FeatureLayout::of(cat, model.block)) {
-  if (model.pixel_sigma > 0 || model.jitter > 0 || model.bilinear)
+  if (model.pixel_sigma > 0 || model.moves_sprites())
     throw std::invalid_argument("the features baseline is the sparse path: no pixel noise, no jitter");
   const Sensor& first = cat.sensors[layout_.pooled.at(0)];
   W_ = first.width;

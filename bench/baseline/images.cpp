@@ -51,7 +51,7 @@ struct Layer {
 
 void render_images(const Catalogue& cat, const AssetSet& assets, const SceneBatch& batch, const ModelSettings& m,
                    BatchOutput& out) {
-  if (m.jitter > 0 || m.bilinear) throw std::invalid_argument("the image baseline places sprites on whole pixels only");
+  if (m.moves_sprites()) throw std::invalid_argument("the image baseline places sprites on whole pixels only");
   const size_t n = batch.size();
   const float alpha = static_cast<float>(cat.images.alpha), sigma = static_cast<float>(m.pixel_sigma);
   const int tile = cat.images.noise_size, patterns = static_cast<int>(cat.noise.size());

@@ -49,11 +49,32 @@ struct Painted {
 
 // Paints region + 1 over every pixel the placed sprite covers (coverage > 0) as the
 // reference's composite samples it: at integer placement the texel under the pixel; at
-// bilinear placement any of the four texels whose weight, computed as the reference
+// bilinear placement, and for randomised objects at the sprite point the reference's
+// inverse map gives, any of the four texels whose weight, computed as the reference
 // computes it, is non-zero.
-Painted paint(const reference::Placed& p, const Runs& runs, bool bilinear, int W, int H, uint8_t id, uint8_t* mask) {
+Painted paint(const reference::Placed& p, const Runs& runs, const ModelSettings& model, int W, int H, uint8_t id,
+              uint8_t* mask) {
   const Image& sp = *p.sprite;
+  const bool bilinear = model.bilinear;
   Painted out;
+  const auto cov = [&](int i, int j) { return i >= 0 && j >= 0 && i < sp.width && j < sp.height && sp.at(i, j, 1); };
+  if (model.transforms()) {
+    const reference::SpriteMap map = reference::sprite_map(p, bilinear);
+    for (int y = std::max(0, map.y0); y <= std::min(H - 1, map.y1); ++y) {
+      uint8_t* row = mask + static_cast<size_t>(y) * W;
+      for (int x = std::max(0, map.x0); x <= std::min(W - 1, map.x1); ++x) {
+        double sx, sy;
+        map.at(x, y, sx, sy);
+        const int i = static_cast<int>(std::floor(sx)), j = static_cast<int>(std::floor(sy));
+        const bool t = sx - i > 0, ty = sy - j > 0;
+        if (cov(i, j) || (t && cov(i + 1, j)) || (ty && cov(i, j + 1)) || (t && ty && cov(i + 1, j + 1))) {
+          row[x] = id;
+          out.add(x, x + 1, y);
+        }
+      }
+    }
+    return out;
+  }
   if (!bilinear) {
     const int ox = p.x0 + static_cast<int>(std::floor(p.dx + 0.5));
     const int oy = p.y0 + static_cast<int>(std::floor(p.dy + 0.5));
@@ -66,7 +87,6 @@ Painted paint(const reference::Placed& p, const Runs& runs, bool bilinear, int W
       }
     return out;
   }
-  const auto cov = [&](int i, int j) { return i >= 0 && j >= 0 && i < sp.width && j < sp.height && sp.at(i, j, 1); };
   const double fx = p.x0 + p.dx, fy = p.y0 + p.dy;
   const int xs = std::max(0, static_cast<int>(std::floor(fx)) - 1),
             xe = std::min(W, static_cast<int>(std::floor(fx)) + sp.width + 2);
@@ -156,7 +176,7 @@ void annotate(const Catalogue& cat, const AssetSet& assets, const ModelSettings&
           const int16_t v = s.objects[r];
           if (v == kNoObject || !sensor.sees(r)) continue;
           const reference::Placed& pl = vs.placed[p++];
-          painted.push_back(paint(pl, runs[k][v], model.bilinear, W, H, static_cast<uint8_t>(r + 1), mask));
+          painted.push_back(paint(pl, runs[k][v], model, W, H, static_cast<uint8_t>(r + 1), mask));
           if (const Painted& d = painted.back(); d.area)
             dirty.box[dirty.count++] = {static_cast<int16_t>(d.x0), static_cast<int16_t>(d.y0),
                                         static_cast<int16_t>(d.x1), static_cast<int16_t>(d.y1)};
@@ -168,6 +188,9 @@ void annotate(const Catalogue& cat, const AssetSet& assets, const ModelSettings&
           a.drawing = static_cast<int16_t>(cat.variant_list[v].variant);
           a.dx = model.bilinear ? pl.dx : std::floor(pl.dx + 0.5);
           a.dy = model.bilinear ? pl.dy : std::floor(pl.dy + 0.5);
+          a.rotation = pl.transform.rotation;
+          a.scale = pl.transform.scale;
+          a.flip = pl.transform.flip;
         }
         // What each object keeps: all it painted, unless a later object's box meets its
         // own; then its pixels are counted again inside its box.

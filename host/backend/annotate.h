@@ -5,7 +5,8 @@
 //
 // Visible: object k covers pixel p when its sprite's coverage (alpha) at p, sampled as
 // the composite stage samples it, is > 0: at integer placement the texel under p; at
-// bilinear placement any texel with a non-zero bilinear weight. Objects are composited in
+// bilinear placement (and for randomised objects, at the sprite point of the inverse
+// affine map) any texel with a non-zero bilinear weight. Objects are composited in
 // region order, so p belongs to the covering object of the highest region. The mask
 // holds that region's number (1..13), 0 for none. An object with no visible pixel (out of
 // the view, or covered whole) has no annotation.
@@ -28,6 +29,8 @@ struct Annotation {
   int x = 0, y = 0, w = 0, h = 0;  // tight box of the visible pixels
   uint32_t area = 0;               // visible pixels
   double dx = 0, dy = 0;           // the sprite's placement offset: whole pixels, or sub-pixel (bilinear)
+  double rotation = 0, scale = 1;  // randomised objects: degrees counter-clockwise, and the factor
+  bool flip = false;               // mirrored left to right
 };
 
 struct ViewAnnotations {

@@ -18,32 +18,46 @@ std::string format_number(double v) {
 
 Knob integer(std::string key, int lo, int hi, std::string unit, std::string help,
              std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key), KnobKind::integer, double(lo),    double(hi), {}, std::move(unit), std::move(help), false,
-              true,           std::move(set),    std::move(get)};
+  return Knob{
+      std::move(key), KnobKind::integer, double(lo),     double(hi), {}, std::move(unit), std::move(help), false,
+      true,           std::move(set),    std::move(get), false,      {}};
 }
 
 Knob number(std::string key, double lo, double hi, std::string unit, std::string help,
             std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key), KnobKind::number, lo, hi, {}, std::move(unit), std::move(help), false, true,
-              std::move(set), std::move(get)};
+  return Knob{std::move(key), KnobKind::number, lo,    hi, {}, std::move(unit), std::move(help), false, true,
+              std::move(set), std::move(get),   false, {}};
 }
 
 Knob on_off(std::string key, std::string help, bool fidelity, std::function<void(Plan&, double)> set,
             std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key), KnobKind::on_off, 0, 1, {"on", "off"}, "", std::move(help), fidelity, true,
-              std::move(set), std::move(get)};
+  return Knob{std::move(key), KnobKind::on_off, 0,     1, {"on", "off"}, "", std::move(help), fidelity, true,
+              std::move(set), std::move(get),   false, {}};
 }
 
 Knob grid(std::string key, int lo, int hi, std::string unit, std::string help, std::function<void(Plan&, double)> set,
           std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key), KnobKind::grid, double(lo),     double(hi),    {}, std::move(unit), std::move(help),
-              false,          true,           std::move(set), std::move(get)};
+  return Knob{std::move(key), KnobKind::grid, double(lo),     double(hi), {}, std::move(unit), std::move(help), false,
+              true,           std::move(set), std::move(get), false,      {}};
 }
 
 Knob choice(std::string key, std::vector<std::string> choices, std::string help, bool fidelity, bool identity,
             std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key), KnobKind::choice, 0, 0, std::move(choices), "", std::move(help), fidelity, identity,
-              std::move(set), std::move(get)};
+  return Knob{std::move(key), KnobKind::choice, 0,     0, std::move(choices), "", std::move(help), fidelity, identity,
+              std::move(set), std::move(get),   false, {}};
+}
+
+// A range A..B of numbers within [lo, hi]; `symmetric`: one number X means -X..X.
+Knob range(std::string key, double lo, double hi, bool symmetric, std::string unit, std::string help,
+           std::function<void(Plan&, double, double)> set, std::function<std::pair<double, double>(const Plan&)> get) {
+  Knob k{std::move(key), KnobKind::range, lo, hi, {}, std::move(unit), std::move(help), false, true, {}, {},
+         symmetric,      std::move(set)};
+  k.get = [get = std::move(get), symmetric](const Plan& p) -> nlohmann::json {
+    const auto [a, b] = get(p);
+    if (symmetric ? a == -b : a == b) return format_number(b);
+    return format_number(a) + ".." + format_number(b);
+  };
+  return k;
 }
 
 std::vector<Knob> declare() {
@@ -96,6 +110,26 @@ std::vector<Knob> declare() {
   k.push_back(number(
       "jitter", 0, 1000, "pixels", "move each object by up to this much in x and y",
       [](Plan& p, double v) { p.model.jitter = v; }, [](const Plan& p) { return p.model.jitter; }));
+  k.push_back(range(
+      "rotate", -180, 180, true, "degrees",
+      "turn each object about its centre by an angle drawn uniformly from the range (X: -X..X), "
+      "counter-clockwise in the image",
+      [](Plan& p, double a, double b) {
+        p.model.rotate_lo = a;
+        p.model.rotate_hi = b;
+      },
+      [](const Plan& p) { return std::pair(p.model.rotate_lo, p.model.rotate_hi); }));
+  k.push_back(range(
+      "scale", 0.1, 10, false, "",
+      "scale each object about its centre by a factor drawn uniformly from the range (X: X..X)",
+      [](Plan& p, double a, double b) {
+        p.model.scale_lo = a;
+        p.model.scale_hi = b;
+      },
+      [](const Plan& p) { return std::pair(p.model.scale_lo, p.model.scale_hi); }));
+  k.push_back(on_off(
+      "flip", "mirror each object left to right with probability 1/2", false,
+      [](Plan& p, double v) { p.model.flip = v != 0; }, [](const Plan& p) { return p.model.flip; }));
   k.push_back(choice(
       "palette", {"ironbow", "gray", "rainbow"},
       "how the IR temperature index is written as RGB: ironbow (the thesis's), gray (white hot), rainbow; "
@@ -147,6 +181,9 @@ std::string Knob::flag() const {
 std::string Knob::values() const {
   if (kind == KnobKind::grid)
     return "WxH, each " + format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit);
+  if (kind == KnobKind::range)
+    return std::string("X or A..B, each ") + format_number(min) + " .. " + format_number(max) +
+           (unit.empty() ? "" : " " + unit);
   if (kind == KnobKind::integer || kind == KnobKind::number)
     return format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit);
   std::string s;
@@ -192,6 +229,21 @@ void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::
         throw InputError(where + ": " + text + " is out of range [" + knob.values() + "]");
       v = w * 65536 + h;
       break;
+    }
+    case KnobKind::range: {
+      const size_t dots = text.find("..");
+      double a = 0, b = 0;
+      const bool one = dots == std::string::npos;
+      if (one ? !parse_number(text, b)
+              : !parse_number(text.substr(0, dots), a) || !parse_number(text.substr(dots + 2), b))
+        throw InputError(where + ": \"" + text + "\" is not " +
+                         (knob.symmetric ? "a number X (for -X..X) or a range A..B" : "a range A..B (or one number)"));
+      if (one) a = knob.symmetric ? -b : b;
+      if (!std::isfinite(a) || !std::isfinite(b) || a < knob.min || b > knob.max || a > b)
+        throw InputError(where + ": \"" + text + "\" must be A..B with " + format_number(knob.min) +
+                         " <= A <= B <= " + format_number(knob.max));
+      knob.set_range(plan, a, b);
+      return;
     }
     case KnobKind::choice: {
       size_t i = 0;

@@ -12,12 +12,12 @@
 
 namespace portalsim {
 
-enum class KnobKind { integer, number, on_off, choice, grid };
+enum class KnobKind { integer, number, on_off, choice, grid, range };
 
 struct Knob {
   std::string key;  // spec-file key and manifest entry; the flag is "--" + key with '-' for '_'
   KnobKind kind;
-  double min = 0, max = 0;           // integer and number; each side of a grid
+  double min = 0, max = 0;           // integer and number; each side of a grid; each end of a range
   std::vector<std::string> choices;  // choice
   std::string unit;                  // integer and number, for the help and the README
   std::string help;
@@ -28,9 +28,13 @@ struct Knob {
   std::function<void(Plan&, double)> set;
   // The knob's value in `plan`: a number, a bool (on_off) or the choice's name.
   std::function<nlohmann::json(const Plan&)> get;
+  // A range ("A..B", A <= B) is set by set_range instead of set; one number X means X..X,
+  // or -X..X for a symmetric range (get then gives the short form back where it applies).
+  bool symmetric = false;
+  std::function<void(Plan&, double, double)> set_range;
 
   std::string flag() const;
-  // "0 .. 1000 gray levels", "on, off", "fp32, fp64, fixed16".
+  // "0 .. 1000 gray levels", "on, off", "fp32, fp64, fixed16", "A..B, each 0.1 .. 10".
   std::string values() const;
 };
 

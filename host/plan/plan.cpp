@@ -5,8 +5,19 @@
 
 #include "base/error.h"
 #include "plan/knobs.h"
+#include "scene/philox.h"
 
 namespace portalsim {
+
+ObjectTransform object_transform(const ModelSettings& m, uint64_t index, int region) {
+  ObjectTransform t;
+  if (!m.transforms()) return t;
+  const Philox4 q = draw(m.seed, index, kStreamTransform, static_cast<uint32_t>(region));
+  t.rotation = m.rotate_lo + (m.rotate_hi - m.rotate_lo) * uniform24(q[0]);
+  t.scale = m.scale_lo + (m.scale_hi - m.scale_lo) * uniform24(q[1]);
+  t.flip = m.flip && (q[2] >> 31) != 0;
+  return t;
+}
 
 FeatureLayout FeatureLayout::of(const Catalogue& cat, int block) {
   FeatureLayout f;

@@ -7,6 +7,7 @@
 
 #include "assets/procedural.h"
 #include "scene/catalogue.h"
+#include "scene/scene.h"
 
 namespace portalsim {
 
@@ -23,14 +24,30 @@ struct ModelSettings {
   // sampling. The noise tiles stay where the unmoved sprite would be.
   bool bilinear = false;
   double jitter = 0.0;
+  // Randomised objects (README, "Randomised objects"): each object turns by an angle
+  // uniform in [rotate_lo, rotate_hi] degrees about its sprite's centre (counter-clockwise
+  // as seen in the image), scales by a factor uniform in [scale_lo, scale_hi], and with
+  // `flip` is mirrored left to right with probability 1/2; drawn per (scenario, region)
+  // from the counter generator (object_transform), the same in every view. Any of them
+  // on makes the composite sample sprites through the inverse affine map, bilinearly.
+  double rotate_lo = 0.0, rotate_hi = 0.0;
+  double scale_lo = 1.0, scale_hi = 1.0;
+  bool flip = false;
   // The physics model (README, "The physics model"); ignored by the thesis model.
   double illumination = 293.0;          // K: what the body and objects reflect (the room, indoors)
   double netd = 3.0;                    // K rms: MMW sensor noise per raw pixel
   int raw_width = 28, raw_height = 28;  // the MMW camera's raw grid over each view
   double worn_minutes = 5.0;            // how long the objects have been carried (their temperature)
   double ir_netd = 0.05;                // K rms: IR sensor noise per pixel
-  bool moves_sprites() const { return bilinear || jitter > 0; }
+  bool transforms() const { return rotate_lo != 0 || rotate_hi != 0 || scale_lo != 1 || scale_hi != 1 || flip; }
+  bool moves_sprites() const { return bilinear || jitter > 0 || transforms(); }
 };
+
+// The draw of the randomised-object knobs for scenario `index`'s object in region r
+// (0-based), identity when they are off: PS_STREAM_TRANSFORM, element r, words
+// 0 and 1 uniform (24 bits) for the angle and the scale, the top bit of word 2 for the flip.
+// kernels/composite.cl's place_view draws the same numbers on its own.
+ObjectTransform object_transform(const ModelSettings& m, uint64_t index, int region);
 
 // How block and region means are computed. Both give the same numbers to the bit
 // (under -cl-fast-relaxed-math, to the division's approximation); sparse is used for

@@ -1,5 +1,7 @@
 #include "scene/generator.h"
 
+#include <charconv>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -83,12 +85,14 @@ Scenario Generator::operator()(uint64_t index) const {
                    " draws; the rule is too rare for this pool");
 }
 
-std::vector<Scenario> read_scenario_file(const Catalogue& cat, const std::string& path) {
+std::vector<Scenario> read_scenario_file(const Catalogue& cat, const std::string& path,
+                                         std::vector<ListedTransforms>* transforms) {
   const std::string raw = io::read_file(path, "scenario file", io::kMaxTextBytes);
-  return parse_scenario_list(cat, raw, path);
+  return parse_scenario_list(cat, raw, path, transforms);
 }
 
-std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view raw, const std::string& path) {
+std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view raw, const std::string& path,
+                                          std::vector<ListedTransforms>* transforms) {
   // A BOM is allowed: spreadsheets write one. CRLF line ends are too.
   std::istringstream in(std::string(io::check_text(raw, path, io::Bom::skip)));
   std::string line;
@@ -124,6 +128,20 @@ std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view
   int col_subject = -1, col_label = -1;
   std::array<int, kRegions> col_region;
   col_region.fill(-1);
+  // Randomised objects: rotation, scale and flip columns per region.
+  const std::array<const char*, 3> kTransformColumns = {"rotation", "scale", "flip"};
+  std::array<std::array<int, kRegions>, 3> col_transform;
+  for (auto& c : col_transform) c.fill(-1);
+  int transform_columns = 0;
+  // "region", "rotation", ... followed by 1..13: the region (1-based), 0 for another name,
+  // -1 for a number out of range.
+  const auto numbered = [](const std::string& h, const std::string& stem) {
+    if (h.rfind(stem, 0) != 0 || h.size() <= stem.size() || h.size() > stem.size() + 2 ||
+        h.find_first_not_of("0123456789", stem.size()) != std::string::npos)
+      return 0;
+    const int r = std::stoi(h.substr(stem.size()));
+    return r >= 1 && r <= kRegions ? r : -1;
+  };
   for (size_t c = 0; c < header.size(); ++c) {
     const std::string h = normalise_name(header[c]);
     for (size_t d = 0; d < c; ++d)
@@ -134,20 +152,33 @@ std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view
       col_subject = static_cast<int>(c);
     else if (h == "label" || h == "class" || h == "threat")
       col_label = static_cast<int>(c);
-    else if (h.rfind("region", 0) == 0 && h.size() > 6 && h.size() <= 8 &&
-             h.find_first_not_of("0123456789", 6) == std::string::npos) {
-      const int r = std::stoi(h.substr(6));
-      if (r >= 1 && r <= kRegions)
-        col_region[r - 1] = static_cast<int>(c);
-      else
+    else if (int r = numbered(h, "region"); r != 0) {
+      if (r < 0)
         throw InputError(path + ":" + std::to_string(lineno) + ": column " + std::to_string(c + 1) + " \"" + header[c] +
                          "\": there are regions 1 to 13 only");
+      col_region[r - 1] = static_cast<int>(c);
     } else if (h == "index") {
+    } else if (
+        int t = 0, tr = 0; [&] {
+          for (t = 0; t < 3; ++t)
+            if ((tr = numbered(h, kTransformColumns[t])) != 0) return true;
+          return false;
+        }()) {
+      if (tr < 0)
+        throw InputError(path + ":" + std::to_string(lineno) + ": column " + std::to_string(c + 1) + " \"" + header[c] +
+                         "\": there are regions 1 to 13 only");
+      col_transform[t][tr - 1] = static_cast<int>(c);
+      ++transform_columns;
     } else {
       throw InputError(path + ":" + std::to_string(lineno) + ": column " + std::to_string(c + 1) + " \"" + header[c] +
                        "\": unknown column (expected subject, region1..region13, label)");
     }
   }
+  if (transform_columns != 0 && transform_columns != 3 * kRegions)
+    throw InputError(path + ":" + std::to_string(lineno) +
+                     ": header: the randomised objects' columns come together: rotation1..13, scale1..13 and "
+                     "flip1..13 (found " +
+                     std::to_string(transform_columns) + " of 39)");
   if (col_subject < 0) throw InputError(path + ":" + std::to_string(lineno) + ": header: no \"subject\" column");
   for (int r = 0; r < kRegions; ++r)
     if (col_region[r] < 0)
@@ -183,6 +214,30 @@ std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view
         throw InputError(at + ": label: \"" + f[col_label] + "\" is not yes/no");
     } else {
       s.label = -1;  // the caller's rule decides
+    }
+    if (transform_columns) {
+      ListedTransforms lt{at, {}};
+      for (int r = 0; r < kRegions; ++r) {
+        const std::array<const std::string*, 3> v = {&f[col_transform[0][r]], &f[col_transform[1][r]],
+                                                     &f[col_transform[2][r]]};
+        const std::string name = ": region" + std::to_string(r + 1) + " ";
+        if (s.objects[r] == kNoObject) {
+          for (int t = 0; t < 3; ++t)
+            if (!v[t]->empty())
+              throw InputError(at + name + kTransformColumns[t] + ": \"" + *v[t] + "\" for an empty region");
+          continue;
+        }
+        double num[2] = {0, 0};
+        for (int t = 0; t < 2; ++t) {
+          const char* end = v[t]->data() + v[t]->size();
+          const auto res = std::from_chars(v[t]->data(), end, num[t]);
+          if (v[t]->empty() || res.ec != std::errc() || res.ptr != end || !std::isfinite(num[t]))
+            throw InputError(at + name + kTransformColumns[t] + ": \"" + *v[t] + "\" is not a number");
+        }
+        if (*v[2] != "0" && *v[2] != "1") throw InputError(at + name + "flip: \"" + *v[2] + "\" is not 0 or 1");
+        lt.t[r] = ObjectTransform{num[0], num[1], *v[2] == "1"};
+      }
+      if (transforms) transforms->push_back(lt);
     }
     out.push_back(s);
     if (out.size() > 100000000) throw InputError(path + ": more than 100 million scenarios");

@@ -38,6 +38,7 @@ enum Stream : uint32_t {
   kStreamJitter = PS_STREAM_JITTER,
   kStreamRawNoise = PS_STREAM_RAW_NOISE,
   kStreamIrNoise = PS_STREAM_IR_NOISE,
+  kStreamTransform = PS_STREAM_TRANSFORM,
   kStreamGenerate = PS_STREAM_GENERATE,
 };
 

@@ -18,6 +18,14 @@ struct Scenario {
   Scenario() { objects.fill(kNoObject); }
 };
 
+// A randomised object's turn, scale and mirror (plan.h, object_transform draws it).
+struct ObjectTransform {
+  double rotation = 0.0;  // degrees, counter-clockwise in the image
+  double scale = 1.0;
+  bool flip = false;  // mirrored left to right (before the rotation)
+  bool operator==(const ObjectTransform&) const = default;
+};
+
 // n scenarios with global indices first_index .. first_index + n - 1. The index, not the
 // position in the batch, feeds the random generator, so results never depend on batching.
 struct SceneBatch {

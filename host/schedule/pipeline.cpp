@@ -107,8 +107,19 @@ class ScenarioSource {
   ScenarioSource(const RunSpec& spec, const Catalogue& cat) {
     if (!spec.rule.empty()) rule_.emplace(cat, spec.rule, "--rule");
     if (!spec.scenarios.empty()) {
-      listed_ = read_scenario_file(cat, spec.scenarios);
+      std::vector<ListedTransforms> recorded;
+      listed_ = read_scenario_file(cat, spec.scenarios, &recorded);
       total_ = listed_.size();
+      // Randomised objects are re-made from (seed, index, knobs), like every draw: a list
+      // that records them must be re-made with the seed and knobs that drew them.
+      const ModelSettings model = spec.settings().model;
+      for (size_t i = 0; i < recorded.size(); ++i)
+        for (int r = 0; r < kRegions; ++r)
+          if (listed_[i].objects[r] != kNoObject && object_transform(model, i, r) != recorded[i].t[r])
+            throw InputError(recorded[i].where + ": region" + std::to_string(r + 1) +
+                             ": its rotation, scale and flip are not what scenario " + std::to_string(i) +
+                             " of this run draws; re-make a list with the --seed, --rotate, --scale and --flip of "
+                             "the run that wrote it, from its first scenario");
     } else {
       generator_.emplace(cat, generator_spec(spec, cat), spec.seed);
       total_ = spec.count;
@@ -429,6 +440,7 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   ctx.layout = FeatureLayout::of(cat, plan.model.block);
   ctx.rows = res.end - res.begin;
   ctx.threads = threads;
+  ctx.model = plan.model;
   ctx.image_format = spec.image_format;
   ctx.palette = procedural::ir_palette(plan.palette);
   std::vector<std::unique_ptr<Sink>> sinks = open_sinks(spec, plan, ctx, source.rule(), identity, start, first);

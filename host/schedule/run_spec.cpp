@@ -111,6 +111,11 @@ std::string knob_value(const Knob& k, const toml::node& n, const std::string& at
     case KnobKind::on_off:
       if (!n.is_boolean()) throw InputError(at + ": expected true or false");
       return n.as_boolean()->get() ? "on" : "off";
+    case KnobKind::range:  // 30 or "-10..20"
+      if (n.is_integer()) return std::to_string(n.as_integer()->get());
+      if (n.is_floating_point()) return knob_text(n.as_floating_point()->get());
+      if (!n.is_string()) throw InputError(at + ": expected a number or a string (" + k.values() + ")");
+      return n.as_string()->get();
     case KnobKind::grid:
     case KnobKind::choice:
       if (!n.is_string()) throw InputError(at + ": expected a string (" + k.values() + ")");

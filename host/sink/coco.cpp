@@ -190,7 +190,11 @@ class CocoSink final : public Sink {
         num(an, x.dx);
         an += ",\"dy\":";
         num(an, x.dy);
-        an += '}';
+        an += ",\"rotation\":";  // randomised objects: degrees counter-clockwise, factor, mirrored
+        num(an, x.rotation);
+        an += ",\"scale\":";
+        num(an, x.scale);
+        an += x.flip ? ",\"flip\":true}" : ",\"flip\":false}";
       }
     }
   }

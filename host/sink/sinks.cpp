@@ -1,5 +1,7 @@
 #include "sink/sinks.h"
 
+#include <array>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -103,6 +105,9 @@ class ScenarioListSink final : public Sink {
     if (!resume) {
       std::string h = "index,subject";
       for (int r = 1; r <= kRegions; ++r) h += ",region" + std::to_string(r);
+      if (ctx.model.transforms())
+        for (const char* what : {",rotation", ",scale", ",flip"})
+          for (int r = 1; r <= kRegions; ++r) h += what + std::to_string(r);
       file_.append(h + ",label\n");
     }
     for (size_t v = 0; v < ctx.cat->variant_list.size(); ++v)
@@ -119,6 +124,26 @@ class ScenarioListSink final : public Sink {
         s += ',';
         const int16_t v = scenes.objects[i * kRegions + r];
         s += v == kNoObject ? std::string("none") : names_[v];
+      }
+      if (ctx_.model.transforms()) {
+        // Each object's draw (plan.h, object_transform), exactly: the shortest text that
+        // reads back as the same double. Empty where a region has no object.
+        std::array<ObjectTransform, kRegions> t;
+        for (int r = 0; r < kRegions; ++r)
+          if (scenes.objects[i * kRegions + r] != kNoObject)
+            t[r] = object_transform(ctx_.model, scenes.first_index + i, r);
+        for (int what = 0; what < 3; ++what)
+          for (int r = 0; r < kRegions; ++r) {
+            s += ',';
+            if (scenes.objects[i * kRegions + r] == kNoObject) continue;
+            if (what == 2) {
+              s += t[r].flip ? '1' : '0';
+              continue;
+            }
+            char buf[32];
+            const auto res = std::to_chars(buf, buf + sizeof buf, what == 0 ? t[r].rotation : t[r].scale);
+            s.append(buf, res.ptr);
+          }
       }
       s += scenes.label[i] == 1 ? ",yes\n" : ",no\n";
     }

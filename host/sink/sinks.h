@@ -2,7 +2,8 @@
 //   features.arff  WEKA's format (thesis 5.3, appendix D.4)
 //   features.csv   the same rows with a header
 //   features.npy   float32 matrix (features, 19 zones, class 1/0), names in features.columns.txt
-//   scenarios.csv  index, subject, region1..region13, label: re-runnable with --scenarios
+//   scenarios.csv  index, subject, region1..region13, label: re-runnable with --scenarios;
+//                  with randomised objects also rotation1..13, scale1..13, flip1..13
 //   images/<index>/ the folder `simulate` writes, per scenario
 #pragma once
 #include <memory>
@@ -31,6 +32,7 @@ struct SinkContext {
   FeatureLayout layout;
   uint64_t rows = 0;  // rows the finished table will hold (the npy header needs it)
   unsigned threads = 1;
+  ModelSettings model;  // the model's knobs (scenarios.csv records each object's randomised transform)
   std::string image_format = "png";
   Palette palette = procedural::ir_palette();  // the IR index as RGB (Plan::palette)
 };

@@ -337,9 +337,16 @@ class OpenCLBackend final : public Backend {
     L.patterns = static_cast<int32_t>(cat_.noise.size());
     L.tile_size = cat_.images.noise_size;
     L.flags = (s.pattern_noise && plan.model.pattern_noise ? PS_FLAG_PATTERN_NOISE : 0) |
-              (plan.pixel_noise_per_pixel() ? PS_FLAG_PIXEL_NOISE : 0) | (plan.model.bilinear ? PS_FLAG_BILINEAR : 0);
+              (plan.pixel_noise_per_pixel() ? PS_FLAG_PIXEL_NOISE : 0) | (plan.model.bilinear ? PS_FLAG_BILINEAR : 0) |
+              (plan.model.transforms() ? PS_FLAG_AFFINE : 0) | (plan.model.flip ? PS_FLAG_FLIP : 0);
     L.jitter_x = static_cast<float>(plan.model.jitter * s.jitter_scale_x);
     L.jitter_y = static_cast<float>(plan.model.jitter * s.jitter_scale_y);
+    L.rotate_lo = static_cast<float>(plan.model.rotate_lo);
+    L.rotate_hi = static_cast<float>(plan.model.rotate_hi);
+    L.scale_lo = static_cast<float>(plan.model.scale_lo);
+    L.scale_hi = static_cast<float>(plan.model.scale_hi);
+    const double ranges[4] = {plan.model.rotate_lo, plan.model.rotate_hi, plan.model.scale_lo, plan.model.scale_hi};
+    std::memcpy(L.ranges_fp64, ranges, sizeof ranges);  // little-endian host and device: low word first
     L.raw_width = plan.model.raw_width;
     L.raw_height = plan.model.raw_height;
     L.subjects = static_cast<int32_t>(cat_.subjects.size());

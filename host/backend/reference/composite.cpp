@@ -23,9 +23,47 @@ ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSe
       dx = m.jitter * sensor.jitter_scale_x * (2.0 * uniform24(q[0]) - 1.0);
       dy = m.jitter * sensor.jitter_scale_y * (2.0 * uniform24(q[1]) - 1.0);
     }
-    vs.placed.push_back({&sp, x0, y0, dx, dy, v});
+    vs.placed.push_back({&sp, x0, y0, dx, dy, v, object_transform(m, index, r)});
   }
   return vs;
+}
+
+// image = centre + scale R F (sprite - sprite centre), with R = [cos sin; -sin cos] (counter-
+// clockwise in the image, whose y runs down) and F = diag(flip, 1); so sprite = sprite
+// centre + F R^T (image - centre) / scale.
+SpriteMap sprite_map(const Placed& p, bool bilinear) {
+  const Image& sp = *p.sprite;
+  SpriteMap m{};
+  m.csx = (sp.width - 1) / 2.0;
+  m.csy = (sp.height - 1) / 2.0;
+  m.cx = p.x0 + (bilinear ? p.dx : std::floor(p.dx + 0.5)) + m.csx;
+  m.cy = p.y0 + (bilinear ? p.dy : std::floor(p.dy + 0.5)) + m.csy;
+  const double t = p.transform.rotation * (M_PI / 180.0);
+  const double c = std::cos(t), s = std::sin(t), f = p.transform.flip ? -1.0 : 1.0, scale = p.transform.scale;
+  m.a00 = f * c / scale;
+  m.a01 = -f * s / scale;
+  m.a10 = s / scale;
+  m.a11 = c / scale;
+  // The corners of the sprite's bilinear support, (-1, -1) .. (w, h), turned and scaled.
+  double lo_x = m.cx, hi_x = m.cx, lo_y = m.cy, hi_y = m.cy;
+  for (const double px : {-1.0 - m.csx, sp.width - m.csx})
+    for (const double py : {-1.0 - m.csy, sp.height - m.csy}) {
+      const double qx = f * px, qy = py;
+      const double x = m.cx + scale * (c * qx + s * qy);
+      const double y = m.cy + scale * (-s * qx + c * qy);
+      lo_x = std::min(lo_x, x), hi_x = std::max(hi_x, x), lo_y = std::min(lo_y, y), hi_y = std::max(hi_y, y);
+    }
+  m.x0 = static_cast<int>(std::floor(lo_x)) - 1;
+  m.y0 = static_cast<int>(std::floor(lo_y)) - 1;
+  m.x1 = static_cast<int>(std::ceil(hi_x)) + 1;
+  m.y1 = static_cast<int>(std::ceil(hi_y)) + 1;
+  return m;
+}
+
+void SpriteMap::at(int x, int y, double& sx, double& sy) const {
+  const double u = x - cx, v = y - cy;
+  sx = csx + a01 * v + a00 * u;
+  sy = csy + a11 * v + a10 * u;
 }
 
 void lay_objects(const ViewScene& vs, Field& f, double alpha,
@@ -33,6 +71,32 @@ void lay_objects(const ViewScene& vs, Field& f, double alpha,
   const int W = f.width, H = f.height;
   for (const Placed& p : vs.placed) {
     const Image& sp = *p.sprite;
+    if (vs.model.transforms()) {
+      // Randomised objects: each pixel of the map's box samples the sprite point it maps to,
+      // bilinearly on premultiplied coverage, as the sub-pixel branch below.
+      const SpriteMap map = sprite_map(p, vs.model.bilinear);
+      for (int y = std::max(0, map.y0); y <= std::min(H - 1, map.y1); ++y)
+        for (int x = std::max(0, map.x0); x <= std::min(W - 1, map.x1); ++x) {
+          double sx, sy;
+          map.at(x, y, sx, sy);
+          const int i0 = static_cast<int>(std::floor(sx)), j0 = static_cast<int>(std::floor(sy));
+          const double tx = sx - i0, ty = sy - j0;
+          double pv = 0, c = 0;
+          for (int j = 0; j < 2; ++j)
+            for (int i = 0; i < 2; ++i) {
+              const int ti = i0 + i, tj = j0 + j;
+              if (ti < 0 || tj < 0 || ti >= sp.width || tj >= sp.height) continue;
+              const double w = (i ? tx : 1 - tx) * (j ? ty : 1 - ty);
+              const double cov = sp.at(ti, tj, 1) / 255.0;
+              pv += w * cov * value(vs, p, ti, tj);
+              c += w * cov;
+            }
+          if (c == 0) continue;
+          double& v = f.at(x, y);
+          v = (1.0 - alpha * c) * v + alpha * pv;
+        }
+      continue;
+    }
     if (!vs.model.bilinear) {
       const int ox = p.x0 + static_cast<int>(std::floor(p.dx + 0.5));
       const int oy = p.y0 + static_cast<int>(std::floor(p.dy + 0.5));

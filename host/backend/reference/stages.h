@@ -27,8 +27,22 @@ struct Placed {
   const Image* sprite;
   int x0, y0;
   double dx, dy;
-  int variant;  // the object drawing
+  int variant;                // the object drawing
+  ObjectTransform transform;  // randomised objects (identity when off)
 };
+
+// Randomised objects: where pixel (x, y) samples a placed sprite, turned, scaled and
+// mirrored about its centre, and the box of pixels it can touch (inclusive, unclipped).
+struct SpriteMap {
+  double cx, cy;              // the sprite's centre in the image
+  double csx, csy;            // and in the sprite: ((w - 1) / 2, (h - 1) / 2)
+  double a00, a01, a10, a11;  // the inverse map: sprite - sprite centre = A (image - centre)
+  int x0, y0, x1, y1;
+  // The sprite point (sx, sy) of pixel (x, y).
+  void at(int x, int y, double& sx, double& sy) const;
+};
+// The map of `p` at integer (jitter rounded) or bilinear placement.
+SpriteMap sprite_map(const Placed& p, bool bilinear);
 
 // Everything a stage of one camera view reads for one scenario.
 struct ViewScene {
