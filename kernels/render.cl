@@ -292,10 +292,10 @@ kernel void render_view(VIEW_STAGE_ARGS) {
   global uchar* img = out + (size_t)i * H * W;
 
 #if defined(VECTOR_RENDER)
-  // The vector paths: integer placement, and rows of at least 16 pixels (with pixel
-  // noise, rows of at least 32 that start on a Box-Muller pair).
+  // The vector paths: integer placement (no sub-pixel or affine sprites), and rows of at
+  // least 16 pixels (with pixel noise, rows of at least 32 that start on a Box-Muller pair).
   const int noisy = (L.flags & PS_FLAG_PIXEL_NOISE) != 0;
-  if (!(L.flags & PS_FLAG_BILINEAR) && (noisy ? W >= 32 && (W & 1) == 0 : W >= 16)) {
+  if (!(L.flags & (PS_FLAG_BILINEAR | PS_FLAG_AFFINE)) && (noisy ? W >= 32 && (W & 1) == 0 : W >= 16)) {
     ViewLayers V;
     view_layers(&V, rec, noise_offsets, &L);
     const float gain = pattern_gain(rec, noise_gains);
