@@ -157,8 +157,10 @@ class OpenCLBackend final : public Backend {
   void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) override {
     const size_t n = batch.size();
     prepare_output(out, cat_, plan, n);
-    annotations(cat_, assets_, batch, plan, out);
-    if (n == 0) return;
+    if (n == 0) {
+      annotations(cat_, assets_, batch, plan, out);
+      return;
+    }
     const FeatureLayout& lay = out.layout;
 
     cl::Context& ctx = rt_->context();
@@ -193,10 +195,13 @@ class OpenCLBackend final : public Backend {
       for (size_t slot = 0; slot < lay.pooled.size(); ++slot)
         pool(K, lay, n, static_cast<int>(slot), rendered[lay.pooled[slot]], feats);
     }
-    if (plan.features) {
-      if (plan.model.pixel_sigma > 0 && !plan.pixel_noise_per_pixel()) analytic_noise(K, plan, n, seed, first, feats);
-      sync(feats, out.features);
-    }
+    if (plan.features && plan.model.pixel_sigma > 0 && !plan.pixel_noise_per_pixel())
+      analytic_noise(K, plan, n, seed, first, feats);
+    // The host's boxes and masks while PoCL's threads run what is queued (their outputs
+    // are apart); the maps below wait for the kernels.
+    q.flush();
+    annotations(cat_, assets_, batch, plan, out);
+    if (plan.features) sync(feats, out.features);
     for (size_t k = 0; k < cat_.sensors.size(); ++k)
       if (plan.image(static_cast<int>(k))) sync(rendered[k], out.views[k].pixels);
     if (plan.metal && plan.model.model == Model::physics) {
