@@ -247,14 +247,7 @@ TEST(Coco, ByteIdenticalForAnyBatchAndThreads) {
   EXPECT_NE(slurp(a / "manifest.json").find("annotations.json"), std::string::npos);
 }
 
-long long checkpoint_next(const fs::path& dir) {
-  std::error_code ec;
-  const fs::path p = dir / ".portalsim" / "checkpoint.json";
-  if (!fs::exists(p, ec)) return -1;
-  const json j = json::parse(slurp(p), nullptr, false);
-  if (j.is_discarded() || !j.contains("next") || !j["next"].is_number_unsigned()) return -1;
-  return static_cast<long long>(j["next"].get<uint64_t>());
-}
+using portalsim::test::checkpoint_next;
 
 TEST(Coco, ResumeAfterKill9IsExact) {
   portalsim::test::TempDir t;

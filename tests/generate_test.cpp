@@ -349,15 +349,7 @@ Npy parse_npy(const std::string& bytes) {
   return n;
 }
 
-// Reads DIR/.portalsim/checkpoint.json's "next" (-1 when absent or unreadable).
-long long checkpoint_next(const fs::path& dir) {
-  std::error_code ec;
-  const fs::path p = dir / ".portalsim" / "checkpoint.json";
-  if (!fs::exists(p, ec)) return -1;
-  const json j = json::parse(read_all(p), nullptr, false);
-  if (j.is_discarded() || !j.contains("next") || !j["next"].is_number_unsigned()) return -1;
-  return static_cast<long long>(j["next"].get<uint64_t>());
-}
+using portalsim::test::checkpoint_next;
 
 // Polls the run's checkpoint until "next" reaches `at_least` (-1: the checkpoint just exists).
 // False when the run ended first or 60 s passed.

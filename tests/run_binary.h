@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -72,6 +73,16 @@ inline std::string slurp(const std::filesystem::path& p) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// A run folder's .portalsim/checkpoint.json "next" (-1 when absent or unreadable).
+inline long long checkpoint_next(const std::filesystem::path& dir) {
+  std::error_code ec;
+  const std::filesystem::path p = dir / ".portalsim" / "checkpoint.json";
+  if (!std::filesystem::exists(p, ec)) return -1;
+  const nlohmann::json j = nlohmann::json::parse(slurp(p), nullptr, false);
+  if (j.is_discarded() || !j.contains("next") || !j["next"].is_number_unsigned()) return -1;
+  return static_cast<long long>(j["next"].get<uint64_t>());
 }
 
 inline void spit(const std::filesystem::path& p, const std::string& text) {

@@ -220,15 +220,7 @@ TEST(TensorsH5, ByteIdenticalForAnyBatchAndThreads) {
       << "--compress must make data.h5 smaller";
 }
 
-// "next" in the run's checkpoint, or -1.
-long long checkpoint_next(const fs::path& dir) {
-  std::error_code ec;
-  const fs::path p = dir / ".portalsim" / "checkpoint.json";
-  if (!fs::exists(p, ec)) return -1;
-  const nlohmann::json j = nlohmann::json::parse(slurp(p), nullptr, false);
-  if (j.is_discarded() || !j.contains("next") || !j["next"].is_number_unsigned()) return -1;
-  return static_cast<long long>(j["next"].get<uint64_t>());
-}
+using portalsim::test::checkpoint_next;
 
 // Runs `spec` to completion in ref/, and again in killed/ with kill -9 after its checkpoint
 // passes 300 scenarios; `after_kill` looks at (and may change) what the kill left; then

@@ -24,6 +24,17 @@ std::string xxh3_hex(uint64_t hash) {
   return hex;
 }
 
+void hash_range(int fd, uint64_t offset, uint64_t n, void* xxh3_state, const std::string& path) {
+  std::vector<char> buf(static_cast<size_t>(std::min<uint64_t>(n, 1u << 20)));
+  for (uint64_t at = 0; at < n;) {
+    const ssize_t r = ::pread(fd, buf.data(), static_cast<size_t>(std::min<uint64_t>(n - at, buf.size())),
+                              static_cast<off_t>(offset + at));
+    if (r <= 0) throw OutputError(path + ": cannot read back for resume: " + std::strerror(r < 0 ? errno : EIO));
+    XXH3_64bits_update(state_of(xxh3_state), buf.data(), static_cast<size_t>(r));
+    at += static_cast<uint64_t>(r);
+  }
+}
+
 FileState hash_file(const std::string& dir, const std::string& name) {
   const std::string path = (std::filesystem::path(dir) / name).string();
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
@@ -65,16 +76,10 @@ AppendFile::AppendFile(const std::string& dir, const std::string& name, const Fi
                         std::to_string(resume->bytes) + " bytes); the run cannot be resumed, start it again");
     if (::ftruncate(fd_, static_cast<off_t>(resume->bytes)) != 0)
       throw OutputError(partial_ + ": cannot truncate for resume: " + std::strerror(errno));
-    // Hash the kept prefix again: it must be what the checkpoint recorded.
-    std::vector<char> buf(1 << 20);
-    uint64_t left = resume->bytes;
-    ::lseek(fd_, 0, SEEK_SET);
-    while (left > 0) {
-      const ssize_t r = ::read(fd_, buf.data(), std::min<uint64_t>(left, buf.size()));
-      if (r <= 0) throw OutputError(partial_ + ": cannot read back for resume: " + std::strerror(errno));
-      XXH3_64bits_update(state_of(hash_), buf.data(), static_cast<size_t>(r));
-      left -= static_cast<uint64_t>(r);
-    }
+    // Hash the kept prefix again: it must be what the checkpoint recorded. Appends go on
+    // from its end.
+    hash_range(fd_, 0, resume->bytes, hash_, partial_);
+    ::lseek(fd_, static_cast<off_t>(resume->bytes), SEEK_SET);
     bytes_ = flushing_ = flushed_ = resume->bytes;
     if (XXH3_64bits_digest(state_of(hash_)) != resume->xxh3)
       throw OutputError(partial_ + ": its contents differ from the checkpoint; the run cannot be resumed");

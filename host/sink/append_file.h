@@ -16,6 +16,10 @@ struct FileState {
 // 16 lower-case hexadecimal digits, as manifests record an XXH3-64.
 std::string xxh3_hex(uint64_t hash);
 
+// Feeds bytes [offset, offset + n) of the open file `fd` to an XXH3-64 state
+// (XXH3_state_t*): a resumed run re-hashing what it keeps. Throws OutputError naming `path`.
+void hash_range(int fd, uint64_t offset, uint64_t n, void* xxh3_state, const std::string& path);
+
 // The state of a finished file dir/name (its size and XXH3-64). Throws OutputError.
 FileState hash_file(const std::string& dir, const std::string& name);
 

@@ -249,7 +249,6 @@ class TensorSink final : public Sink {
     }
     fd_ = ::open(partial_.c_str(), O_RDWR | O_CLOEXEC);
     if (fd_ < 0) throw OutputError(partial_ + ": cannot open: " + std::strerror(errno));
-    std::vector<char> buf;
     for (size_t k = 0; k < tensors_.size(); ++k) {
       Tensor& t = tensors_[k];
       t.offset = offsets[k];
@@ -266,13 +265,7 @@ class TensorSink final : public Sink {
         throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: " + in_place_name(t) + " records " +
                           std::to_string(it->second.bytes) + " bytes, not whole rows of every dataset");
       // The rows so far, hashed again: they must be what the checkpoint recorded.
-      for (uint64_t at = 0; at < it->second.bytes;) {
-        buf.resize(static_cast<size_t>(std::min<uint64_t>(it->second.bytes - at, 1u << 20)));
-        const ssize_t r = ::pread(fd_, buf.data(), buf.size(), static_cast<off_t>(t.offset + at));
-        if (r <= 0) throw OutputError(partial_ + ": cannot read back for resume: " + std::strerror(errno));
-        XXH3_64bits_update(t.hash.get(), buf.data(), static_cast<size_t>(r));
-        at += static_cast<uint64_t>(r);
-      }
+      hash_range(fd_, t.offset, it->second.bytes, t.hash.get(), partial_);
       t.bytes = it->second.bytes;
       if (XXH3_64bits_digest(t.hash.get()) != it->second.xxh3)
         throw OutputError(partial_ + ": dataset " + t.ds.name +
