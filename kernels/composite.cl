@@ -32,6 +32,15 @@
   (void)seed;                                                    \
   (void)index
 
+// The scenario of a work-item (stages that take a whole view per work-item).
+#define VIEW_STAGE_SCENARIO                                  \
+  const uint i = (uint)get_global_id(0);                     \
+  if (i >= L.n) return;                                      \
+  const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);          \
+  const ulong index = upsample(L.first_hi, L.first_lo) + i;  \
+  (void)seed;                                                \
+  (void)index
+
 // The scenario and raw-grid row of a work-item (physics stages on the MMW raw grid, one
 // per (scenario, raw row)); r points at that raw row.
 #define RAW_STAGE_ROW                                                                   \

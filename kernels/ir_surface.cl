@@ -21,32 +21,15 @@ kernel void stage_ir_surface(VIEW_STAGE_ARGS) {
   for (int x = 0; x < L.width; ++x) T[x] += gain * (preal)base[x] + offset;
 }
 
-// Stage "ir_netd": Gaussian noise of the IR NETD (kelvin rms) on every view pixel, from
-// the counter generator (PS_STREAM_IR_NOISE; Box-Muller pairs of pixels 2k, 2k + 1). fp32
-// and fixed16 builds draw 32 pixels at a time (gauss32), fp64 builds a pair at a time.
+// Stage "ir_netd": Gaussian noise of the IR NETD (kelvin rms) on every view pixel, a table
+// Gaussian each from the counter generator (PS_STREAM_IR_NOISE, PS_GAUSS_ELEMENT). One
+// work-item per scenario: fp32 builds draw 128 pixels at a time (gauss128).
 kernel void stage_ir_netd(VIEW_STAGE_ARGS) {
-  VIEW_STAGE_ROW;
+  VIEW_STAGE_SCENARIO;
   const preal sd = (preal)phys[PS_PHYS_NETD];
-  if (sd <= 0) return;
-  global preal* restrict T = (global preal*)field + row0;
-  const int p0 = y * L.width, p1 = p0 + L.width;
-#if defined(PRECISION_FP64)
-  for (int p = p0 & ~1; p < p1; p += 2) {
-    const greal2 g = gauss_pair_of(seed, index, PS_STREAM_IR_NOISE, L.view, p >> 1);
-    if (p >= p0) T[p - p0] += sd * (preal)g.x;
-    if (p + 1 < p1) T[p + 1 - p0] += sd * (preal)g.y;
-  }
-#else
-  for (int p = p0 & ~1; p < p1; p += 32) {
-    float16 g0, g1;
-    gauss32(seed, index, PS_STREAM_IR_NOISE, L.view, p >> 1, &g0, &g1);
-    float g[32];
-    vstore16(g0, 0, g);
-    vstore16(g1, 1, g);
-    const int lo = max(p0 - p, 0), hi = min(p1 - p, 32);
-    for (int j = lo; j < hi; ++j) T[p + j - p0] += sd * g[j];
-  }
-#endif
+  if (sd > 0)
+    add_gauss_cells((global preal*)field + (size_t)i * L.width * L.height, L.width * L.height, sd, seed, index,
+                    PS_STREAM_IR_NOISE, L.view, phys + L.phys_gauss);
 }
 
 // Stage "ir_display": the IR display window, kelvin to temperature index 0..255 (as

@@ -74,19 +74,5 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   }
 
   const preal sd = (preal)phys[PS_PHYS_NETD];
-  if (sd <= 0) return;
-  int p = 0;
-#if !defined(PRECISION_FP64)
-  for (; p + 32 <= cells; p += 32) {  // 16 Box-Muller pairs at once (kernels/sensor_noise.cl)
-    float16 g0, g1;
-    gauss32(seed, index, PS_STREAM_RAW_NOISE, L.view, p >> 1, &g0, &g1);
-    vstore16(vload16(0, r + p) + sd * g0, 0, r + p);
-    vstore16(vload16(0, r + p + 16) + sd * g1, 0, r + p + 16);
-  }
-#endif
-  for (; p < cells; p += 2) {
-    const greal2 g = gauss_pair_of(seed, index, PS_STREAM_RAW_NOISE, L.view, p >> 1);
-    r[p] += sd * (preal)g.x;
-    if (p + 1 < cells) r[p + 1] += sd * (preal)g.y;
-  }
+  if (sd > 0) add_gauss_cells(r, cells, sd, seed, index, PS_STREAM_RAW_NOISE, L.view, phys + L.phys_gauss);
 }

@@ -38,11 +38,21 @@
 #define PS_STREAM_PIXEL_NOISE 3u   /* per-pixel sensor noise; element = view << 28 | pixel / 2 */
 #define PS_STREAM_BLOCK_NOISE 4u   /* block-mean noise model; element = feature */
 #define PS_STREAM_JITTER 5u        /* sprite placement jitter; element = region */
-#define PS_STREAM_RAW_NOISE 6u     /* physics: MMW noise per raw pixel; element = view << 28 | raw pixel / 2 */
-#define PS_STREAM_IR_NOISE 7u      /* physics: IR noise per pixel; element = view << 28 | pixel / 2 */
+#define PS_STREAM_RAW_NOISE 6u     /* physics: MMW noise per raw pixel; element: PS_GAUSS_ELEMENT */
+#define PS_STREAM_IR_NOISE 7u      /* physics: IR noise per pixel; element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_TRANSFORM 8u     /* randomised objects: rotation, scale, flip; element = region */
 #define PS_STREAM_GENERATE 16u     /* scenario generators (host only) */
 #define PS_PIXEL_NOISE_VIEW_SHIFT 28
+/* The physics model's table Gaussians: cell p of a view's field (raw grid or pixels, row by
+ * row) reads element view << 28 | (16 (p / 128) + p % 16) of its stream, the 16-bit half
+ * (p / 16) % 2 (low first) of word (p % 128) / 32, and takes k to Phi^-1((k + 1/2) / 65536).
+ * So one draw of the generator gives 8 cells, and 16 draws side by side give 128 in runs of
+ * 16 (kernels/sensor_noise.cl, gauss128). */
+#define PS_GAUSS_ELEMENT(view, p) \
+  (((PS_U32)(view) << PS_PIXEL_NOISE_VIEW_SHIFT) | (PS_U32)(16 * ((p) >> 7) + ((p)&15)))
+#define PS_GAUSS_WORD(p) (((p)&127) >> 5)
+#define PS_GAUSS_SHIFT(p) ((((p) >> 4) & 1) * 16)
+#define PS_GAUSS_TABLE 65536
 
 /* Per-launch flags of the render kernels. */
 #define PS_FLAG_PATTERN_NOISE 1
@@ -105,6 +115,7 @@ typedef struct {
    * first and last raw column of each view column and raw row of each view row (2 per);
    * and each subject's bare raw grid (subjects x raw_height x raw_width). */
   PS_I32 phys_wx, phys_wy, phys_cband, phys_rband, phys_base;
+  PS_I32 phys_gauss; /* the PS_GAUSS_TABLE values of Phi^-1((k + 1/2) / 65536) in phys */
   /* Randomised objects (PS_FLAG_AFFINE): the ranges of the angle (degrees) and the scale,
    * as floats, and the same four as doubles (low word, high word) for fp64 builds. */
   PS_F32 rotate_lo, rotate_hi, scale_lo, scale_hi;

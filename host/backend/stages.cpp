@@ -25,7 +25,7 @@ const std::vector<ViewStage>& view_stages() {
        reference::heat_spread,
        {{"stage_optics_rows", K::view_rows}, {"stage_optics_columns", K::view_rows}}},
       {"ir_surface", reference::ir_surface, {{"stage_ir_surface", K::view_rows}}},
-      {"ir_netd", reference::ir_netd, {{"stage_ir_netd", K::view_rows}}},
+      {"ir_netd", reference::ir_netd, {{"stage_ir_netd", K::scenarios}}},
       {"ir_display", reference::ir_display, {{"stage_ir_display", K::view_rows}}, true},
   };
   return stages;

@@ -12,9 +12,9 @@
 
 namespace portalsim {
 
-// What one launch of a stage kernel covers: a work-item per (scenario, view row) or per
-// (scenario, raw-grid row).
-enum class StageItems { view_rows, raw_rows };
+// What one launch of a stage kernel covers: a work-item per (scenario, view row), per
+// (scenario, raw-grid row) or per scenario.
+enum class StageItems { view_rows, raw_rows, scenarios };
 
 struct StageKernel {
   std::string_view kernel;

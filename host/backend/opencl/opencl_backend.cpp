@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "backend/opencl/gauss_table.h"
 #include "backend/opencl/raw_grid_pooling.h"
 #include "backend/stages.h"
 #include "base/error.h"
@@ -399,9 +400,20 @@ class OpenCLBackend final : public Backend {
       if (!raw_only) launch(stage_kernel(K, "stage_mmw_display"), n * s.height);
       return;
     }
+    const auto per_scenario = [&](StageItems items) -> size_t {
+      switch (items) {
+        case StageItems::view_rows:
+          return static_cast<size_t>(s.height);
+        case StageItems::raw_rows:
+          return static_cast<size_t>(plan.model.raw_height);
+        case StageItems::scenarios:
+          return 1;
+      }
+      throw std::logic_error("unknown stage items");
+    };
     for (const std::string& name : chain)
       for (const StageKernel& sk : view_stage(name).kernels)
-        launch(stage_kernel(K, sk.kernel), n * (sk.items == StageItems::raw_rows ? plan.model.raw_height : s.height));
+        launch(stage_kernel(K, sk.kernel), n * per_scenario(sk.items));
   }
 
   static cl::Kernel& stage_kernel(Kernels& K, std::string_view name) {
@@ -416,7 +428,7 @@ class OpenCLBackend final : public Backend {
   // them. The same formulas as the reference's, written again here: the two never share
   // code. Kept per (view, knobs, precision): the bare raw grids cost a few milliseconds.
   cl::Buffer physics_params(const Kernels& K, const Plan& plan, int view, PsViewLaunch& L) {
-    L.psf_radius = L.phys_wx = L.phys_wy = L.phys_cband = L.phys_rband = L.phys_base = 0;
+    L.psf_radius = L.phys_wx = L.phys_wy = L.phys_cband = L.phys_rband = L.phys_base = L.phys_gauss = 0;
     if (plan.model.model != Model::physics) return physics_none_.at_least(rt_->context(), 16);
     const ModelSettings& m = plan.model;
     char key[200];
@@ -430,6 +442,7 @@ class OpenCLBackend final : public Backend {
     L.phys_cband = t.cband;
     L.phys_rband = t.rband;
     L.phys_base = t.base;
+    L.phys_gauss = t.gauss;
     if (!t.buffer()) {
       t.buffer = K.fp64 ? constant(rt_->context(), t.values)
                         : constant(rt_->context(), std::vector<cl_float>(t.values.begin(), t.values.end()));
@@ -439,7 +452,7 @@ class OpenCLBackend final : public Backend {
 
   struct PhysicsTables {
     std::vector<double> values;
-    int32_t radius = 0, wx = 0, wy = 0, cband = 0, rband = 0, base = 0;
+    int32_t radius = 0, wx = 0, wy = 0, cband = 0, rband = 0, base = 0, gauss = 0;
     cl::Buffer buffer;
   };
 
@@ -522,19 +535,20 @@ class OpenCLBackend final : public Backend {
                             : 1.02 * lambda / pc.aperture_m * pc.range_m / (span_m / s.width) / 2.3548200450309493;
     const size_t taps = p.size();
     append_gaussian_taps(p, sigma, t.radius);
-    if (ir) return t;
-    // The MMW fast path's tables (kernels/physics_raw.cl).
-    const int W = s.width, H = s.height, RW = m.raw_width, RH = m.raw_height;
     const std::vector<double> psf(p.begin() + static_cast<std::ptrdiff_t>(taps), p.end());
-    std::vector<double> wx, wy, cband, rband;
-    axis_weights(W, RW, psf.data(), t.radius, wx, cband);
-    axis_weights(H, RH, psf.data(), t.radius, wy, rband);
     const auto append = [&](const std::vector<double>& v) {
       if (p.size() + v.size() > 0x7fffffffu) throw std::runtime_error("physics tables exceed 2^31 values");
       const int32_t at = static_cast<int32_t>(p.size());
       p.insert(p.end(), v.begin(), v.end());
       return at;
     };
+    t.gauss = append(gauss_table());  // the sensor noise's table Gaussians
+    if (ir) return t;
+    // The MMW fast path's tables (kernels/physics_raw.cl).
+    const int W = s.width, H = s.height, RW = m.raw_width, RH = m.raw_height;
+    std::vector<double> wx, wy, cband, rband;
+    axis_weights(W, RW, psf.data(), t.radius, wx, cband);
+    axis_weights(H, RH, psf.data(), t.radius, wy, rband);
     t.wx = append(wx);
     t.wy = append(wy);
     t.cband = append(cband);
