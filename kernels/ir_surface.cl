@@ -28,8 +28,8 @@ kernel void stage_ir_netd(VIEW_STAGE_ARGS) {
   VIEW_STAGE_SCENARIO;
   const preal sd = (preal)phys[PS_PHYS_NETD];
   if (sd > 0)
-    add_gauss_cells((global preal*)field + (size_t)i * L.width * L.height, L.width * L.height, sd, seed, index,
-                    PS_STREAM_IR_NOISE, L.view, phys + L.phys_gauss);
+    gauss_cells_global((global preal*)field + (size_t)i * L.width * L.height, L.width * L.height, sd, true, seed, index,
+                PS_STREAM_IR_NOISE, L.view, phys + L.phys_gauss);
 }
 
 // Stage "ir_display": the IR display window, kelvin to temperature index 0..255 (as

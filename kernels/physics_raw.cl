@@ -4,6 +4,25 @@
 // plus, for each view row an object crosses, that row's change (composite minus bare, in
 // kelvin) projected through the folded weights: raw[r][c] += wy[r][y] sum_x wx[c][x] d(x, y).
 // Tested against the chain of stage kernels and the reference (tests/physics_test.cpp).
+// Whether a scenario's view is the sum of its objects' tabulated responses (features-only
+// runs, PS_FLAG_TABULATED): every object at its place (no jitter, no randomised transform)
+// and no two objects' boxes, widened by the bilinear fringe, meeting.
+inline bool physics_tabulated(global const int* rec, const PsViewLaunch* L) {
+  if (!(L->flags & PS_FLAG_TABULATED) || (L->flags & PS_FLAG_AFFINE) || L->jitter_x > 0.0f || L->jitter_y > 0.0f)
+    return false;
+  for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
+    global const int* a = rec + PS_REC_LAYERS + j * PS_LAYER_LEN;
+    for (int k = j + 1; k < rec[PS_REC_COUNT]; ++k) {
+      global const int* b = rec + PS_REC_LAYERS + k * PS_LAYER_LEN;
+      if (a[PS_LAYER_X0] - 2 < b[PS_LAYER_X0] + b[PS_LAYER_W] + 2 &&
+          b[PS_LAYER_X0] - 2 < a[PS_LAYER_X0] + a[PS_LAYER_W] + 2 &&
+          a[PS_LAYER_Y0] - 2 < b[PS_LAYER_Y0] + b[PS_LAYER_H] + 2 && b[PS_LAYER_Y0] - 2 < a[PS_LAYER_Y0] + a[PS_LAYER_H] + 2)
+        return false;
+    }
+  }
+  return true;
+}
+
 kernel void physics_raw(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
@@ -12,6 +31,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
   const ulong index = upsample(L.first_hi, L.first_lo) + i;
   global const int* rec = records + (size_t)i * PS_REC_LEN;
+  if (physics_tabulated(rec, &L)) return;  // physics_features sums its tables instead
   const int W = L.width, H = L.height, RW = L.raw_width, RH = L.raw_height, cells = RW * RH;
   global preal* r = (global preal*)raw + (size_t)i * cells;
   // Scratch: one view row's change per raw column, then its change per view pixel.
@@ -58,7 +78,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
       preal sum = 0;
 #if !defined(PRECISION_FP64)
       float16 part = 0.0f;
-      for (; x + 16 <= x_hi; x += 16) part += vload16(0, w + x) * vload16(0, d + x);
+      for (; x + 16 <= x_hi; x += 16) part += LOADF16(global, w + x) * LOADF16(global, d + x);
       const float8 p8 = part.lo + part.hi;
       const float4 p4 = p8.lo + p8.hi;
       const float2 p2 = p4.lo + p4.hi;
@@ -74,5 +94,5 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   }
 
   const preal sd = (preal)phys[PS_PHYS_NETD];
-  if (sd > 0) add_gauss_cells(r, cells, sd, seed, index, PS_STREAM_RAW_NOISE, L.view, phys + L.phys_gauss);
+  if (sd > 0) gauss_cells_global(r, cells, sd, true, seed, index, PS_STREAM_RAW_NOISE, L.view, phys + L.phys_gauss);
 }

@@ -3,6 +3,10 @@
 typedef uchar16 __attribute__((aligned(1))) uchar16_any;
 inline uchar16 load16(global const uchar* p) { return *(global const uchar16_any*)p; }
 inline void store16(uchar16 v, global uchar* p) { *(global uchar16_any*)p = v; }
+// The same for 16 floats (vload16 and vstore16 of floats are 16 scalar moves too).
+typedef float16 __attribute__((aligned(4))) float16_any;
+#define LOADF16(SPACE, p) (*(SPACE const float16_any*)(p))
+#define STOREF16(SPACE, v, p) (*(SPACE float16_any*)(p) = (v))
 
 // Round half to even (rint) as one instruction (vrndscaleps) where clang has the builtin;
 // PoCL's own rint on vectors is generic integer code. Exact either way, so the same values.

@@ -183,29 +183,38 @@ __attribute__((always_inline)) inline void gauss128(uint2 seed, ulong index, uin
 }
 #endif
 
-// Adds sd times the table Gaussians of cells [0, cells) to v (one scenario's field).
-inline void add_gauss_cells(global preal* restrict v, int cells, preal sd, uint2 seed, ulong index, uint stream,
-                            int view, global const param* table) {
+// Adds sd times the table Gaussians of cells [0, cells) to v (one scenario's field), or,
+// where !accumulate, writes them there: gauss_cells_global and gauss_cells_private.
 #if defined(PRECISION_FP64)
-  for (int p = 0; p < cells; ++p) v[p] += sd * gauss_cell(seed, index, stream, view, p, table);
+#define GAUSS_CELLS(SPACE)                                                                                         \
+  inline void gauss_cells_##SPACE(SPACE preal* restrict v, int cells, preal sd, bool accumulate, uint2 seed,     \
+                                  ulong index, uint stream, int view, global const param* table) {               \
+    for (int p = 0; p < cells; ++p)                                                                              \
+      v[p] = (accumulate ? v[p] : 0) + sd * gauss_cell(seed, index, stream, view, p, table);                     \
+  }
 #else
-  for (int p = 0; p < cells; p += 128) {
-    float16 g[8];
-    gauss128(seed, index, stream, view, p >> 7, table, g);
-    for (int j = 0; j < 8; ++j) {
-      const int q = p + 16 * j;
-      if (q + 16 <= cells) {
-        vstore16(vload16(0, v + q) + sd * g[j], 0, v + q);
-      } else {
-        float t[16];
-        vstore16(g[j], 0, t);
-        for (int k = q; k < cells; ++k) v[k] += sd * t[k - q];
-        break;
-      }
-    }
+#define GAUSS_CELLS(SPACE)                                                                                         \
+  inline void gauss_cells_##SPACE(SPACE preal* restrict v, int cells, preal sd, bool accumulate, uint2 seed,     \
+                                  ulong index, uint stream, int view, global const param* table) {               \
+    for (int p = 0; p < cells; p += 128) {                                                                       \
+      float16 g[8];                                                                                              \
+      gauss128(seed, index, stream, view, p >> 7, table, g);                                                     \
+      for (int j = 0; j < 8; ++j) {                                                                              \
+        const int q = p + 16 * j;                                                                                \
+        if (q + 16 <= cells) {                                                                                   \
+          STOREF16(SPACE, accumulate ? LOADF16(SPACE, v + q) + sd * g[j] : sd * g[j], v + q);                    \
+        } else {                                                                                                 \
+          float t[16];                                                                                           \
+          vstore16(g[j], 0, t);                                                                                  \
+          for (int k = q; k < cells; ++k) v[k] = (accumulate ? v[k] : 0) + sd * t[k - q];                        \
+          break;                                                                                                 \
+        }                                                                                                        \
+      }                                                                                                          \
+    }                                                                                                            \
   }
 #endif
-}
+GAUSS_CELLS(global)
+GAUSS_CELLS(private)
 
 // The Box-Muller pair of draws `pair` of a view's per-pixel noise stream.
 inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {

@@ -41,6 +41,7 @@
 #define PS_STREAM_RAW_NOISE 6u     /* physics: MMW noise per raw pixel; element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_IR_NOISE 7u      /* physics: IR noise per pixel; element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_TRANSFORM 8u     /* randomised objects: rotation, scale, flip; element = region */
+#define PS_STREAM_FEATURE_NOISE 9u /* physics features-only: NETD noise in feature space; PS_GAUSS_ELEMENT */
 #define PS_STREAM_GENERATE 16u     /* scenario generators (host only) */
 #define PS_PIXEL_NOISE_VIEW_SHIFT 28
 /* The physics model's table Gaussians: cell p of a view's field (raw grid or pixels, row by
@@ -53,6 +54,13 @@
 #define PS_GAUSS_WORD(p) (((p)&127) >> 5)
 #define PS_GAUSS_SHIFT(p) ((((p) >> 4) & 1) * 16)
 #define PS_GAUSS_TABLE 65536
+/* physics_features' work space per scenario, in values, from its dims (blocks_x, blocks_y,
+ * band_x, band_y, regions): the features, band_x zeros, the draws, band_y rows of zeros,
+ * Z Lx^T. Up to
+ * PS_FEATURE_NOISE_PRIVATE it lives in private memory (the work-item's stack, in cache);
+ * larger layouts (small blocks) use global scratch. */
+#define PS_FEATURE_SPACE(d) (3 * (d).s0 * (d).s1 + 2 * (d).s4 + (d).s2 + (d).s3 * (d).s0)
+#define PS_FEATURE_NOISE_PRIVATE 2048
 
 /* Per-launch flags of the render kernels. */
 #define PS_FLAG_PATTERN_NOISE 1
@@ -60,6 +68,7 @@
 #define PS_FLAG_BILINEAR 4
 #define PS_FLAG_AFFINE 8 /* randomised objects: sprites sampled through their inverse affine map */
 #define PS_FLAG_FLIP 16  /* with PS_FLAG_AFFINE: mirror each object with probability 1/2 */
+#define PS_FLAG_TABULATED 32 /* physics features-only: scenarios the object tables cover skip physics_raw */
 
 /* Footprint record of the sparse features path, per (variant, region), ints. */
 #define PS_FP_SPRITE_X0 0

@@ -28,7 +28,6 @@ inline Philox4 philox4x32_10(Philox4 ctr, std::array<uint32_t, 2> key) {
   return ctr;
 }
 
-// Streams: each kind of draw has its own, so adding one never shifts another.
 // Streams (kernels/shared.h): each kind of draw has its own, so adding one never shifts another.
 enum Stream : uint32_t {
   kStreamNoisePattern = PS_STREAM_NOISE_PATTERN,
@@ -39,6 +38,7 @@ enum Stream : uint32_t {
   kStreamRawNoise = PS_STREAM_RAW_NOISE,
   kStreamIrNoise = PS_STREAM_IR_NOISE,
   kStreamTransform = PS_STREAM_TRANSFORM,
+  kStreamFeatureNoise = PS_STREAM_FEATURE_NOISE,
   kStreamGenerate = PS_STREAM_GENERATE,
 };
 

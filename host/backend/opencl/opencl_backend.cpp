@@ -323,9 +323,12 @@ class OpenCLBackend final : public Backend {
 
   // One camera view for the batch: the fused kernel, or the chain of stage kernels over a
   // field buffer. Both take VIEW_STAGE_ARGS (kernels/composite.cl).
-  // raw_only: the physics MMW fast path's raw grid alone (into raw_), for raw_grid_features.
+  // raw_only: the physics MMW fast path's raw grid alone (into raw_), for raw_grid_features;
+  // tabulated: it skips the scenarios whose features come from tables (PS_FLAG_TABULATED).
+  // *launched: the launch's settings, for kernels that follow.
   void render(Kernels& K, const Plan& plan, int view, size_t n, cl::Buffer& subject, cl::Buffer& objects, cl_uint2 seed,
-              cl_uint2 first, cl::Buffer& dst, bool raw_only = false) {
+              cl_uint2 first, cl::Buffer& dst, bool raw_only = false, bool tabulated = false,
+              PsViewLaunch* launched = nullptr) {
     const Sensor& s = cat_.sensors[view];
     PsViewLaunch L{};
     L.n = static_cast<uint32_t>(n);
@@ -344,7 +347,8 @@ class OpenCLBackend final : public Backend {
     L.tile_size = cat_.images.noise_size;
     L.flags = (s.pattern_noise && plan.model.pattern_noise ? PS_FLAG_PATTERN_NOISE : 0) |
               (plan.pixel_noise_per_pixel() ? PS_FLAG_PIXEL_NOISE : 0) | (plan.model.bilinear ? PS_FLAG_BILINEAR : 0) |
-              (plan.model.transforms() ? PS_FLAG_AFFINE : 0) | (plan.model.flip ? PS_FLAG_FLIP : 0);
+              (plan.model.transforms() ? PS_FLAG_AFFINE : 0) | (plan.model.flip ? PS_FLAG_FLIP : 0) |
+              (tabulated ? PS_FLAG_TABULATED : 0);
     L.jitter_x = static_cast<float>(plan.model.jitter * s.jitter_scale_x);
     L.jitter_y = static_cast<float>(plan.model.jitter * s.jitter_scale_y);
     L.rotate_lo = static_cast<float>(plan.model.rotate_lo);
@@ -363,6 +367,7 @@ class OpenCLBackend final : public Backend {
     cl::Buffer field = fused || physics_fast ? dst : field_.at_least(ctx, n * s.pixels() * K.real_bytes);
     cl::Buffer& records = records_.at_least(ctx, n * PS_REC_LEN * sizeof(cl_int));
     cl::Buffer phys = physics_params(K, plan, view, L);
+    if (launched) *launched = L;
     const bool physics = plan.model.model == Model::physics;
     cl::Buffer& raw = raw_.at_least(ctx, physics ? n * plan.model.raw_width * plan.model.raw_height * K.real_bytes : 1);
     // Physics: a second field for the stage chain; physics_raw's per-scenario row sums.
@@ -656,30 +661,32 @@ class OpenCLBackend final : public Backend {
     return 0;
   }
 
-  // Physics features-only: each pooled view's raw grid (physics_raw, as the dense path
-  // makes it), then its features as tabulated sums of raw cells (raw_grid_pooling.h).
+  struct RawGridTables {
+    int count = 0;
+    cl::Buffer first, cells, weights, columns;
+    cl_int8 dims{};  // blocks_x, blocks_y, band_x, band_y, regions (RawGridNoise), the first block's column
+    cl::Buffer noise, base_features, object_first, object_feature, object_value;
+  };
+
+  // Physics features-only (raw_grid_pooling.h): per pooled view, the raw grid of the
+  // scenarios the tables do not cover (physics_raw, noise-free), then physics_features.
   void raw_grid_features(Kernels& K, const Plan& plan, size_t n, cl::Buffer& subject, cl::Buffer& objects,
                          cl_uint2 seed, cl_uint2 first, cl::Buffer& feats) {
     const FeatureLayout lay = FeatureLayout::of(cat_, plan.model.block);
-    const int RW = plan.model.raw_width, RH = plan.model.raw_height;
+    Plan quiet = plan;  // the raw grid without sensor noise: that is drawn per feature
+    quiet.model.netd = 0;
+    const bool tabulated = plan.model.jitter <= 0 && !plan.model.transforms();  // objects at their places
     cl::Context& ctx = rt_->context();
     for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
       const int view = lay.pooled[slot];
-      render(K, plan, view, n, subject, objects, seed, first, scratch_[view].at_least(ctx, 1), true);
+      RawGridTables& t = raw_grid_tables(K, quiet, lay, static_cast<int>(slot), tabulated);
       PsViewLaunch L{};
-      const cl::Buffer phys = physics_params(K, plan, view, L);
-      char key[96];
-      std::snprintf(key, sizeof key, "%d %d %d %d %d", view, lay.block, RW, RH, int(K.fp64));
-      RawGridTables& t = raw_grid_tables_[key];
-      if (!t.first()) {
-        const RawGridPooling p = raw_grid_pooling(cat_.sensors[view], lay, static_cast<int>(slot), RW, RH);
-        t.count = static_cast<int>(p.columns.size());
-        t.first = constant(ctx, p.first);
-        t.cells = constant(ctx, p.cells);
-        t.columns = constant(ctx, p.columns);
-        t.weights = K.fp64 ? constant(ctx, p.weights)
-                           : constant(ctx, std::vector<cl_float>(p.weights.begin(), p.weights.end()));
-      }
+      render(K, quiet, view, n, subject, objects, seed, first, scratch_[view].at_least(ctx, 1), true, tabulated, &L);
+      const cl::Buffer phys = physics_params(K, quiet, view, L);
+      const auto& d = t.dims.s;
+      const size_t per = 3 * static_cast<size_t>(d[0]) * d[1] + 2 * static_cast<size_t>(d[4]) + d[2] +
+                         static_cast<size_t>(d[3]) * d[0];  // PS_FEATURE_SPACE
+
       cl::Kernel& k = stage_kernel(K, "physics_features");
       int a = 0;
       k.setArg(a++, raw_.buf);
@@ -688,13 +695,129 @@ class OpenCLBackend final : public Backend {
       k.setArg(a++, t.weights);
       k.setArg(a++, t.columns);
       k.setArg(a++, static_cast<cl_int>(t.count));
-      k.setArg(a++, static_cast<cl_int>(RW * RH));
+      k.setArg(a++, static_cast<cl_int>(plan.model.raw_width * plan.model.raw_height));
       k.setArg(a++, phys);
-      k.setArg(a++, static_cast<cl_uint>(n));
       k.setArg(a++, static_cast<cl_int>(lay.image_features()));
       k.setArg(a++, feats);
-      rt_->queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(padded(n)), cl::NDRange(kLocalSize));
+      k.setArg(a++, sizeof(L), &L);
+      k.setArg(a++, records_.buf);
+      k.setArg(a++, subject);
+      k.setArg(a++, objects);
+      k.setArg(a++, t.base_features);
+      k.setArg(a++, t.object_first);
+      k.setArg(a++, t.object_feature);
+      k.setArg(a++, t.object_value);
+      set_param(K, k, a++, plan.model.netd);
+      k.setArg(a++, t.dims);
+      k.setArg(a++, t.noise);
+      // Work spaces too large for private memory take global scratch, 64 MiB at most: a
+      // launch per that many scenarios (the kernel indexes it from its launch's offset).
+      const size_t chunk =
+          per > PS_FEATURE_NOISE_PRIVATE
+              ? std::max<size_t>(kLocalSize, (size_t(64) << 20) / (per * K.real_bytes) / kLocalSize * kLocalSize)
+              : padded(n);
+      cl::Buffer& scratch = features_scratch_.at_least(
+          ctx, per > PS_FEATURE_NOISE_PRIVATE ? std::min(chunk, padded(n)) * per * K.real_bytes : 1);
+      k.setArg(a++, scratch);
+      for (size_t at = 0; at < n; at += chunk)
+        rt_->queue().enqueueNDRangeKernel(k, cl::NDRange(at), cl::NDRange(std::min(chunk, padded(n) - at)),
+                                          cl::NDRange(kLocalSize));
     }
+  }
+
+  // A pooled view's tables for physics_features, made once per (view, knobs, block, raw
+  // grid, precision): the pooling taps, the noise factors and, when `tabulated`, each
+  // subject's bare features and each (subject, variant, region)'s change to them, made by
+  // physics_raw itself on one scenario per object (so a tabulated scenario differs from
+  // its raw grid only in the order of float sums).
+  RawGridTables& raw_grid_tables(Kernels& K, const Plan& quiet, const FeatureLayout& lay, int slot, bool tabulated) {
+    const int view = lay.pooled[slot];
+    const Sensor& sv = cat_.sensors[view];
+    const ModelSettings& m = quiet.model;
+    const int RW = m.raw_width, RH = m.raw_height, cells = RW * RH;
+    char key[200];
+    std::snprintf(key, sizeof key, "%d %d %d %d %d %a %a %d %d", view, lay.block, RW, RH, int(K.fp64), m.illumination,
+                  m.worn_minutes, int(m.bilinear), int(tabulated));
+    RawGridTables& t = raw_grid_tables_[key];
+    if (t.first()) return t;
+    cl::Context& ctx = rt_->context();
+    const auto params = [&](const std::vector<double>& v) {
+      return K.fp64 ? constant(ctx, v) : constant(ctx, std::vector<cl_float>(v.begin(), v.end()));
+    };
+    const RawGridPooling p = raw_grid_pooling(sv, lay, slot, RW, RH);
+    t.count = static_cast<int>(p.columns.size());
+    t.first = constant(ctx, p.first);
+    t.cells = constant(ctx, p.cells);
+    t.columns = constant(ctx, p.columns);
+    t.weights = params(p.weights);
+    const RawGridNoise z = raw_grid_noise(sv, lay, RW, RH);
+    t.dims = {{z.blocks_x, z.blocks_y, z.band_x, z.band_y, z.regions, p.columns.empty() ? 0 : p.columns[0], 0, 0}};
+    std::vector<double> noise = z.dx;
+    for (const std::vector<double>* v : {&z.dy, &z.region_blocks, &z.region_own})
+      noise.insert(noise.end(), v->begin(), v->end());
+    t.noise = params(noise);
+    const int S = static_cast<int>(cat_.subjects.size()), V = static_cast<int>(cat_.variant_list.size());
+    std::vector<double> bare(static_cast<size_t>(S) * t.count, 0.0), values;
+    std::vector<cl_int> object_first(static_cast<size_t>(S) * V * kRegions + 1, 0), features;
+    if (tabulated) {
+      // One scenario per subject bare, then per (subject, variant, region seen) alone.
+      SceneBatch b;
+      for (int s = 0; s < S; ++s) {
+        Scenario sc;
+        sc.subject = s;
+        b.push(sc);
+        for (int v = 0; v < V; ++v)
+          for (int r = 0; r < kRegions; ++r)
+            if (sv.sees(r)) {
+              sc.objects.fill(kNoObject);
+              sc.objects[r] = static_cast<int16_t>(v);
+              b.push(sc);
+            }
+      }
+      const size_t N = b.size();
+      cl::Buffer subj = constant(ctx, b.subject), objs = constant(ctx, b.objects);
+      render(K, quiet, view, N, subj, objs, {{0, 0}}, {{0, 0}}, scratch_[view].at_least(ctx, 1), true);
+      std::vector<double> raw(N * cells);
+      if (K.fp64) {
+        rt_->queue().enqueueReadBuffer(raw_.buf, CL_TRUE, 0, N * cells * sizeof(cl_double), raw.data());
+      } else {
+        std::vector<cl_float> f(N * cells);
+        rt_->queue().enqueueReadBuffer(raw_.buf, CL_TRUE, 0, N * cells * sizeof(cl_float), f.data());
+        raw.assign(f.begin(), f.end());
+      }
+      const auto pool = [&](size_t scenario, size_t minus, int f) {
+        double sum = 0;
+        for (int k = p.first[f]; k < p.first[f + 1]; ++k)
+          sum += p.weights[k] *
+                 (raw[scenario * cells + p.cells[k]] - (minus == SIZE_MAX ? 0.0 : raw[minus * cells + p.cells[k]]));
+        return sum;
+      };
+      size_t at = 0;
+      for (int s = 0; s < S; ++s) {
+        const size_t bare_at = at++;
+        for (int f = 0; f < t.count; ++f) bare[static_cast<size_t>(s) * t.count + f] = pool(bare_at, SIZE_MAX, f);
+        for (int v = 0; v < V; ++v)
+          for (int r = 0; r < kRegions; ++r) {
+            const size_t combo = (static_cast<size_t>(s) * V + v) * kRegions + r;
+            object_first[combo] = static_cast<cl_int>(features.size());
+            if (sv.sees(r)) {
+              const size_t one = at++;
+              for (int f = 0; f < t.count; ++f) {
+                const double d = pool(one, bare_at, f);
+                if (d == 0) continue;
+                features.push_back(f);
+                values.push_back(d);
+              }
+            }
+            object_first[combo + 1] = static_cast<cl_int>(features.size());
+          }
+      }
+    }
+    t.base_features = params(bare);
+    t.object_first = constant(ctx, object_first);
+    t.object_feature = constant(ctx, features);
+    t.object_value = params(values);
+    return t;
   }
 
   // Block-mean noise model: each mean gets N(0, sigma^2 / pixels) from the generator.
@@ -888,12 +1011,9 @@ class OpenCLBackend final : public Backend {
       influence_, categories_, base_zones_, metal_zone_rec_, metal_region_rec_, metal_tensors_;
   const Sensor* metal_view_ = nullptr;  // the first MMW view: the metal model's pixel scale
   std::vector<cl::Buffer> view_rects_;  // per view: int4 per region
-  Grown subject_, objects_, patterns_, metal_out_, field_, records_, raw_, view_scratch_, physics_none_;
+  Grown subject_, objects_, patterns_, metal_out_, field_, records_, raw_, view_scratch_, physics_none_,
+      features_scratch_;
   std::map<std::string, PhysicsTables> physics_tables_;
-  struct RawGridTables {
-    int count = 0;
-    cl::Buffer first, cells, weights, columns;
-  };
   std::map<std::string, RawGridTables> raw_grid_tables_;  // per (view, block, raw grid, precision)
   std::vector<Grown> scratch_;                            // per view: images only pooled
 };

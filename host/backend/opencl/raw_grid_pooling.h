@@ -6,8 +6,12 @@
 // gray level, and its clamping to 0..255 (the mean is clamped instead). Rounding moves a
 // mean by well under a level; clamping matters where the window cuts pixels off, as it
 // does the room behind the body under sensor noise (the README gives the measured error).
-// The raw grid itself, noise included, is the dense path's to the bit (the same
-// physics_raw).
+// The noise-free raw grid is the dense path's to the bit (the same physics_raw), or, where
+// a scenario's objects stand at their places apart from each other, the sum of tabulated
+// responses (the subject's bare features plus each object's change, made once by
+// physics_raw itself). Sensor noise is drawn in feature space (RawGridNoise): the exact
+// joint distribution of the features that per-raw-pixel noise of the NETD gives, not the
+// same draws as the dense path.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -27,5 +31,25 @@ struct RawGridPooling {
 // The block means of pooled view `slot` (the view's Sensor `s`) and the means of the
 // regions it sees, on a raw grid of raw_width x raw_height cells.
 RawGridPooling raw_grid_pooling(const Sensor& s, const FeatureLayout& lay, int slot, int raw_width, int raw_height);
+
+// Unit-variance noise on every raw cell, as the features of one pooled view see it: the
+// blocks' covariance is the Kronecker product Gy (x) Gx of the axes' Gram matrices, so the
+// block noise is Ly Z Lx^T with Z independent standard normals and Ly, Lx their (banded)
+// Cholesky factors; each region's noise is then its regression on Z plus its own part,
+// r = B z + Lr z_r (B's rows separable, Lr the Cholesky factor of what is left). Singular
+// Gram matrices (more blocks than raw cells along an axis) are factored with a ridge of
+// 1e-10 of their scale. Z is laid out by block row, then the regions' own draws.
+struct RawGridNoise {
+  int blocks_x = 0, blocks_y = 0, band_x = 0, band_y = 0, regions = 0;
+  // Per block q = by blocks_x + bx, so that the kernel's loops run over all blocks at once:
+  std::vector<double> dx;             // (band_x + 1) x blocks: dx[d blocks + q] = Lx[bx][bx - d]
+  std::vector<double> dy;             // (band_y + 1) x blocks: dy[d blocks + q] = Ly[by][by - d]
+  std::vector<double> region_blocks;  // regions x (blocks_y blocks_x): B over Z's layout
+  std::vector<double> region_own;     // regions x regions, lower triangular: Lr
+  // The covariance of features f and g (indices into RawGridPooling's order) that unit
+  // raw-cell noise gives through the pooling: the exact value the draws must reproduce.
+  static double covariance(const RawGridPooling& p, int f, int g);
+};
+RawGridNoise raw_grid_noise(const Sensor& s, const FeatureLayout& lay, int raw_width, int raw_height);
 
 }  // namespace portalsim
