@@ -1,0 +1,154 @@
+// The physics IR camera's declared fast path: contact_shadow -> heat_spread -> ir_surface
+// in one work-item per scenario, leaving the surface in kelvin in `field` for the chain's
+// remaining stage kernels (ir_surface_fused), or, where only ir_display is left, showing
+// it straight away (ir_surface_display_fused). The shadow is zero outside the objects'
+// footprints, and the blur of zero is zero, so each row's shadow is drawn and blurred only
+// over its objects' span and the blur's reach; every other pixel is the bare surface.
+// Each value is the stage kernels' sum in their order with its zero terms left out (adding
+// +0 to a sum that starts at +0 changes no bit): the same bits (tests/ir_physics_test.cpp).
+
+#if !defined(PRECISION_FP64)
+inline float16 bare_kelvin16(global const uchar* base, float gain, float offset) {
+  return gain * convert_float16(load16(base)) + offset;
+}
+#endif
+
+// Pixels [a, b) of the surface: the bare surface (ir_surface's kelvin of the base image),
+// added to T's values there (add) or alone; into T, or with display through ir_display's
+// window into o. fp32 builds in explicit 16-lane vectors (LLVM's own stop at 8).
+inline void surface_span(global preal* restrict T, global uchar* restrict o, global const uchar* restrict base, int a,
+                         int b, preal gain, preal offset, bool add, bool display, preal lo, preal scale) {
+  int x = a;
+#if !defined(PRECISION_FP64)
+  if (display && !add)
+    for (; x + 64 <= b; x += 64)
+      store64(window_levels16(bare_kelvin16(base + x, gain, offset), lo, scale),
+              window_levels16(bare_kelvin16(base + x + 16, gain, offset), lo, scale),
+              window_levels16(bare_kelvin16(base + x + 32, gain, offset), lo, scale),
+              window_levels16(bare_kelvin16(base + x + 48, gain, offset), lo, scale), o + x);
+  for (; x + 16 <= b; x += 16) {
+    float16 t = bare_kelvin16(base + x, gain, offset);
+    if (add) t = vload16(0, T + x) + t;
+    if (display)
+      store16(window_levels16(t, lo, scale), o + x);
+    else
+      vstore16(t, 0, T + x);
+  }
+#endif
+  for (; x < b; ++x) {
+    preal t = gain * (preal)base[x] + offset;
+    if (add) t = T[x] + t;
+    if (display)
+      o[x] = (uchar)clamp(floor((t - lo) * scale + (preal)0.5), (preal)0, (preal)255);
+    else
+      T[x] = t;
+  }
+}
+
+// Scenario i's view. Scratch: the row blur, H x W, then each shadow row's blurred span
+// [a, b) as two arrays of H ints (empty: (W, 0)); with display, T holds only the blurred
+// rows, and the field's kelvin is never stored.
+inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* atlas, global const int* bases,
+                            global const uchar* subject, global const int* records, global real* field,
+                            global uchar* out, global const param* phys, global real* scratch, bool display) {
+  global const int* rec = records + (size_t)i * PS_REC_LEN;
+  const int W = L->width, H = L->height, R = L->psf_radius;
+  global preal* T = (global preal*)field + (size_t)i * H * W;
+  global uchar* o = out + (size_t)i * H * W;
+  global preal* S = (global preal*)scratch + (size_t)i * (H * W + 2 * H);
+  global int* span_a = (global int*)(S + H * W);
+  global int* span_b = span_a + H;
+  const int s = subject[i];
+  const preal gain = (preal)phys[PS_PHYS_SUBJECTS + 2 * s], offset = (preal)phys[PS_PHYS_SUBJECTS + 2 * s + 1];
+  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
+  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
+
+  // The rows the objects can touch.
+  int y_lo = H, y_hi = 0;
+  for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
+    const int2 rows = layer_rows(rec + PS_REC_LAYERS + j * PS_LAYER_LEN, L->flags);
+    y_lo = min(y_lo, max(rows.x, 0));
+    y_hi = max(y_hi, min(rows.y, H));
+  }
+
+  // contact_shadow over each row's span (into T), zero over the rest the row blur reads;
+  // then heat_spread along the row (T -> S) as stage_optics_rows, over the span's reach.
+  global const param* shadow = phys + PS_PHYS_VARIANTS(L->subjects);
+  global const param* taps = psf_taps(phys, L);
+  for (int y = y_lo; y < y_hi; ++y) {
+    Layers Ly;
+    composite_layers(&Ly, rec, L, y);
+    int a = W, b = 0;
+    for (int k = 0; k < Ly.count; ++k) {
+      a = min(a, max(Ly.x0[k], 0));
+      b = max(b, min(Ly.x0[k] + Ly.width[k], W));
+    }
+    if (a >= b) {
+      span_a[y] = W;
+      span_b[y] = 0;
+      continue;
+    }
+    global preal* restrict src = T + (size_t)y * W;
+    for (int x = max(a - 2 * R, 0); x < a; ++x) src[x] = 0;
+    for (int x = a; x < b; ++x) src[x] = lay_values(&Ly, atlas, x, shadow, (preal)0);
+    for (int x = b; x < min(b + 2 * R, W); ++x) src[x] = 0;
+    global preal* restrict dst = S + (size_t)y * W;
+    const int lo = max(a - R, 0), hi = min(b + R, W);
+    const int in_lo = clamp(R, lo, hi), in_hi = clamp(W - R, in_lo, hi);  // no tap leaves the row
+    for (int x = lo; x < hi; ++x) dst[x] = 0;
+    for (int d = -R; d <= R; ++d) {
+      const preal w = (preal)taps[d];
+      for (int x = lo; x < in_lo; ++x) dst[x] += w * src[clamp(x + d, 0, W - 1)];
+      for (int x = in_lo; x < in_hi; ++x) dst[x] += w * src[x + d];
+      for (int x = in_hi; x < hi; ++x) dst[x] += w * src[clamp(x + d, 0, W - 1)];
+    }
+    span_a[y] = lo;
+    span_b[y] = hi;
+  }
+
+  // heat_spread along columns (S -> T) as stage_optics_columns, each tap over its row's
+  // span; then ir_surface: plus the bare surface, which alone is every other pixel (runs
+  // of such rows at once: a view's rows lie one after another).
+  global const uchar* base = base_row(atlas, bases, subject, L, i, 0);
+  int bare_from = 0;
+  for (int y = 0; y <= H; ++y) {
+    int a = W, b = 0;
+    for (int row = max(y - R, y_lo); row <= min(y + R, y_hi - 1); ++row) {
+      a = min(a, span_a[row]);
+      b = max(b, span_b[row]);
+    }
+    if (a >= b && y < H) continue;
+    surface_span(T, o, base, bare_from * W, y * W, gain, offset, false, display, lo, scale);
+    bare_from = y + 1;
+    if (y == H) break;
+    global preal* restrict dst = T + (size_t)y * W;
+    for (int x = a; x < b; ++x) dst[x] = 0;
+    for (int d = -R; d <= R; ++d) {
+      const int row = clamp(y + d, 0, H - 1);
+      if (row < y_lo || row >= y_hi) continue;
+      const preal w = (preal)taps[d];
+      global const preal* restrict src = S + (size_t)row * W;
+      for (int x = span_a[row]; x < span_b[row]; ++x) dst[x] += w * src[x];
+    }
+    const size_t at = (size_t)y * W;
+    surface_span(T + at, o + at, base + at, 0, a, gain, offset, false, display, lo, scale);
+    surface_span(T + at, o + at, base + at, a, b, gain, offset, true, display, lo, scale);
+    surface_span(T + at, o + at, base + at, b, W, gain, offset, false, display, lo, scale);
+  }
+}
+
+kernel void ir_surface_fused(VIEW_STAGE_ARGS) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= L.n) return;
+  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
+      (void)raw;
+  ir_surface_view(i, &L, atlas, bases, subject, records, field, out, phys, scratch, false);
+}
+
+kernel void ir_surface_display_fused(VIEW_STAGE_ARGS) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= L.n) return;
+  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
+      (void)raw;
+  ir_surface_view(i, &L, atlas, bases, subject, records, field, out, phys, scratch, true);
+}
