@@ -50,23 +50,27 @@ kernel void stage_ir_netd(VIEW_STAGE_ARGS) {
 }
 
 // Stage "ir_display": the IR display window, kelvin to temperature index 0..255 (as
-// window_level). One work-item per scenario: the view's pixels are one run in memory.
+// window_level), over pixels [a, b) of a view's T into o; fp32 builds 64 at a time.
+inline void ir_window(global const preal* restrict T, global uchar* restrict o, global const param* phys, int a,
+                      int b) {
+  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
+  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
+  int p = a;
+#if !defined(PRECISION_FP64)
+  for (; p + 64 <= b; p += 64)
+    store64(window_levels16(vload16(0, T + p), lo, scale), window_levels16(vload16(1, T + p), lo, scale),
+            window_levels16(vload16(2, T + p), lo, scale), window_levels16(vload16(3, T + p), lo, scale), o + p);
+  for (; p + 16 <= b; p += 16) store16(window_levels16(vload16(0, T + p), lo, scale), o + p);
+#endif
+  for (; p < b; ++p) o[p] = (uchar)clamp(floor((T[p] - lo) * scale + (preal)0.5), (preal)0, (preal)255);
+}
+
+// One work-item per scenario: the view's pixels are one run in memory.
 kernel void stage_ir_display(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
   (void)atlas, (void)bases, (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)subject,
       (void)objects, (void)alpha, (void)sigma, (void)records, (void)raw, (void)scratch;
   const int pixels = L.width * L.height;
-  global const preal* restrict T = (global const preal*)field + (size_t)i * pixels;
-  global uchar* restrict o = out + (size_t)i * pixels;
-  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
-  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
-  int p = 0;
-#if !defined(PRECISION_FP64)
-  for (; p + 64 <= pixels; p += 64)
-    store64(window_levels16(vload16(0, T + p), lo, scale), window_levels16(vload16(1, T + p), lo, scale),
-            window_levels16(vload16(2, T + p), lo, scale), window_levels16(vload16(3, T + p), lo, scale), o + p);
-  for (; p + 16 <= pixels; p += 16) store16(window_levels16(vload16(0, T + p), lo, scale), o + p);
-#endif
-  for (; p < pixels; ++p) o[p] = (uchar)clamp(floor((T[p] - lo) * scale + (preal)0.5), (preal)0, (preal)255);
+  ir_window((global const preal*)field + (size_t)i * pixels, out + (size_t)i * pixels, phys, 0, pixels);
 }

@@ -7,47 +7,29 @@
 // Each value is the stage kernels' sum in their order with its zero terms left out (adding
 // +0 to a sum that starts at +0 changes no bit): the same bits (tests/ir_physics_test.cpp).
 
-#if !defined(PRECISION_FP64)
-inline float16 bare_kelvin16(global const uchar* base, float gain, float offset) {
-  return gain * convert_float16(load16(base)) + offset;
-}
-#endif
-
-// Pixels [a, b) of the surface: the bare surface (ir_surface's kelvin of the base image),
-// added to T's values there (add) or alone; into T, or with display through ir_display's
-// window into o. fp32 builds in explicit 16-lane vectors (LLVM's own stop at 8).
-inline void surface_span(global preal* restrict T, global uchar* restrict o, global const uchar* restrict base, int a,
-                         int b, preal gain, preal offset, bool add, bool display, preal lo, preal scale) {
+// Pixels [a, b) of row T: the bare surface (ir_surface's kelvin of the base image), added
+// to the values there (add) or alone, in stage_ir_surface's form (which
+// -cl-fast-relaxed-math then rewrites alike). fp32 builds in explicit 16-lane vectors
+// (LLVM's own stop at 8).
+inline void bare_surface(global preal* restrict T, global const uchar* restrict base, int a, int b, preal gain,
+                         preal offset, bool add) {
   int x = a;
 #if !defined(PRECISION_FP64)
-  if (display && !add)
-    for (; x + 64 <= b; x += 64)
-      store64(window_levels16(bare_kelvin16(base + x, gain, offset), lo, scale),
-              window_levels16(bare_kelvin16(base + x + 16, gain, offset), lo, scale),
-              window_levels16(bare_kelvin16(base + x + 32, gain, offset), lo, scale),
-              window_levels16(bare_kelvin16(base + x + 48, gain, offset), lo, scale), o + x);
-  for (; x + 16 <= b; x += 16) {
-    float16 t = bare_kelvin16(base + x, gain, offset);
-    if (add) t = vload16(0, T + x) + t;
-    if (display)
-      store16(window_levels16(t, lo, scale), o + x);
-    else
-      vstore16(t, 0, T + x);
-  }
+  if (add)
+    for (; x + 16 <= b; x += 16)
+      vstore16(vload16(0, T + x) + (gain * convert_float16(load16(base + x)) + offset), 0, T + x);
+  else
+    for (; x + 16 <= b; x += 16) vstore16(gain * convert_float16(load16(base + x)) + offset, 0, T + x);
 #endif
-  for (; x < b; ++x) {
-    preal t = gain * (preal)base[x] + offset;
-    if (add) t = T[x] + t;
-    if (display)
-      o[x] = (uchar)clamp(floor((t - lo) * scale + (preal)0.5), (preal)0, (preal)255);
-    else
-      T[x] = t;
-  }
+  if (add)
+    for (; x < b; ++x) T[x] += gain * (preal)base[x] + offset;
+  else
+    for (; x < b; ++x) T[x] = gain * (preal)base[x] + offset;
 }
 
 // Scenario i's view. Scratch: the row blur, H x W, then each shadow row's blurred span
-// [a, b) as two arrays of H ints (empty: (W, 0)); with display, T holds only the blurred
-// rows, and the field's kelvin is never stored.
+// [a, b) as two arrays of H ints (empty: (W, 0)). With display, each part of the field is
+// shown as soon as it is made, while it is in cache.
 inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* atlas, global const int* bases,
                             global const uchar* subject, global const int* records, global real* field,
                             global uchar* out, global const param* phys, global real* scratch, bool display) {
@@ -60,8 +42,6 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
   global int* span_b = span_a + H;
   const int s = subject[i];
   const preal gain = (preal)phys[PS_PHYS_SUBJECTS + 2 * s], offset = (preal)phys[PS_PHYS_SUBJECTS + 2 * s + 1];
-  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
-  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
 
   // The rows the objects can touch.
   int y_lo = H, y_hi = 0;
@@ -118,7 +98,8 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
       b = max(b, span_b[row]);
     }
     if (a >= b && y < H) continue;
-    surface_span(T, o, base, bare_from * W, y * W, gain, offset, false, display, lo, scale);
+    bare_surface(T, base, bare_from * W, y * W, gain, offset, false);
+    if (display) ir_window(T, o, phys, bare_from * W, y * W);
     bare_from = y + 1;
     if (y == H) break;
     global preal* restrict dst = T + (size_t)y * W;
@@ -130,10 +111,11 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
       global const preal* restrict src = S + (size_t)row * W;
       for (int x = span_a[row]; x < span_b[row]; ++x) dst[x] += w * src[x];
     }
-    const size_t at = (size_t)y * W;
-    surface_span(T + at, o + at, base + at, 0, a, gain, offset, false, display, lo, scale);
-    surface_span(T + at, o + at, base + at, a, b, gain, offset, true, display, lo, scale);
-    surface_span(T + at, o + at, base + at, b, W, gain, offset, false, display, lo, scale);
+    global const uchar* row_base = base + (size_t)y * W;
+    bare_surface(dst, row_base, 0, a, gain, offset, false);
+    bare_surface(dst, row_base, a, b, gain, offset, true);
+    bare_surface(dst, row_base, b, W, gain, offset, false);
+    if (display) ir_window(T, o, phys, y * W, (y + 1) * W);
   }
 }
 

@@ -109,26 +109,34 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
     for (int y = 0; y < H; ++y, r += RW, ob += W) store16(mmw_run_levels(&R, r, lo, scale), ob);
   }
   // The last W % 16 pixels interpolate along x first (their values on each raw row),
-  // then along y, as the fp64 build does every pixel.
-  const int x0 = 16 * runs, tail = W - x0;
-  if (tail == 0) return;
+  // then along y, as the fp64 build does every pixel; 16 lanes from xt, of which those
+  // before x0 keep the runs' levels.
+  const int x0 = 16 * runs, xt = max(W - 16, 0);
+  if (x0 == W) return;
   for (int j = 0; j < RH; ++j) {
     global const float* row = grid + j * RW;
     for (int k = 0; k < 16; ++k) {
-      const float u = raw_coordinate(min(x0 + k, W - 1), xstep, RW);
+      const float u = raw_coordinate(min(xt + k, W - 1), xstep, RW);
       const int i0 = (int)u, i1 = min(i0 + 1, RW - 1);
       const float tx = u - (float)i0;
       tail_rows[16 * j + k] = row[i0] + tx * (row[i1] - row[i0]);
     }
   }
+  const char16 keep = convert_char16((int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15) < x0 - xt);
   for (int y = 0; y < H; ++y) {
     const float v = raw_coordinate(y, ystep, RH);
     const int j0 = (int)v, j1 = min(j0 + 1, RH - 1);
     const float ty = v - (float)j0;
     const float16 t0 = vload16(0, tail_rows + 16 * j0), t1 = vload16(0, tail_rows + 16 * j1);
-    uchar level[16];
-    vstore16(window_levels16(t0 + ty * (t1 - t0), lo, scale), 0, level);
-    for (int k = 0; k < tail; ++k) o[(size_t)y * W + x0 + k] = level[k];
+    const uchar16 level = window_levels16(t0 + ty * (t1 - t0), lo, scale);
+    global uchar* ot = o + (size_t)y * W + xt;
+    if (W >= 16) {
+      store16(select(level, load16(ot), keep), ot);
+    } else {
+      uchar l[16];
+      vstore16(level, 0, l);
+      for (int k = 0; k < W; ++k) ot[k] = l[k];
+    }
   }
 #endif
 }
