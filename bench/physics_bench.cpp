@@ -75,7 +75,8 @@ void BM_IrImages(benchmark::State& state) {
 }
 
 // The IR physics chain's first `range(0)` stages, then ir_display: a stage's cost is the
-// difference from the prefix before it.
+// difference from the prefix before it, but from ir_surface on the prefix takes the fast
+// path (contact_shadow, heat_spread and ir_surface in ir_surface_fused).
 void BM_IrPhysicsStages(benchmark::State& state) {
   Catalogue cat = fx().cat;
   std::vector<std::string>& chain = cat.sensors[cat.sensor_index("ir")].physics_chain;

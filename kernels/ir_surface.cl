@@ -33,12 +33,27 @@ kernel void stage_ir_netd(VIEW_STAGE_ARGS) {
 }
 
 // Stage "ir_display": the IR display window, kelvin to temperature index 0..255 (as
-// window_level, its window read once: through restrict pointers the loop vectorises).
-kernel void stage_ir_display(VIEW_STAGE_ARGS) {
-  VIEW_STAGE_ROW;
-  global const preal* restrict T = (global const preal*)field + row0;
-  global uchar* restrict o = out + row0;
+// window_level), over pixels [a, b) of a view's T into o; fp32 builds 64 at a time.
+inline void ir_window(global const preal* restrict T, global uchar* restrict o, global const param* phys, int a,
+                      int b) {
   const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
   const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
-  for (int x = 0; x < L.width; ++x) o[x] = (uchar)clamp(floor((T[x] - lo) * scale + (preal)0.5), (preal)0, (preal)255);
+  int p = a;
+#if !defined(PRECISION_FP64)
+  for (; p + 64 <= b; p += 64)
+    store64(window_levels16(vload16(0, T + p), lo, scale), window_levels16(vload16(1, T + p), lo, scale),
+            window_levels16(vload16(2, T + p), lo, scale), window_levels16(vload16(3, T + p), lo, scale), o + p);
+  for (; p + 16 <= b; p += 16) store16(window_levels16(vload16(0, T + p), lo, scale), o + p);
+#endif
+  for (; p < b; ++p) o[p] = (uchar)clamp(floor((T[p] - lo) * scale + (preal)0.5), (preal)0, (preal)255);
+}
+
+// One work-item per scenario: the view's pixels are one run in memory.
+kernel void stage_ir_display(VIEW_STAGE_ARGS) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= L.n) return;
+  (void)atlas, (void)bases, (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)subject,
+      (void)objects, (void)alpha, (void)sigma, (void)records, (void)raw, (void)scratch;
+  const int pixels = L.width * L.height;
+  ir_window((global const preal*)field + (size_t)i * pixels, out + (size_t)i * pixels, phys, 0, pixels);
 }

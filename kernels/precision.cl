@@ -7,6 +7,20 @@ inline void store16(uchar16 v, global uchar* p) { *(global uchar16_any*)p = v; }
 typedef float16 __attribute__((aligned(4))) float16_any;
 #define LOADF16(SPACE, p) (*(SPACE const float16_any*)(p))
 #define STOREF16(SPACE, v, p) (*(SPACE float16_any*)(p) = (v))
+// 64 bytes at any address in one store: Zen 4 stores a narrowed vector (vpmovdb to
+// memory) slowly, so runs of levels are joined in registers first.
+typedef uchar uchar32_ __attribute__((ext_vector_type(32)));
+typedef uchar uchar64_ __attribute__((ext_vector_type(64)));
+typedef uchar64_ __attribute__((aligned(1))) uchar64_any;
+#define LANES16 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15
+#define LANES32 LANES16, 16, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26, 27, 28, 29, 30, 31
+#define LANES64                                                                                                        \
+  LANES32, 32, 33, 34, 35, 36, 37, 38, 39, 40, 41, 42, 43, 44, 45, 46, 47, 48, 49, 50, 51, 52, 53, 54, 55, 56, 57, 58, \
+      59, 60, 61, 62, 63
+inline void store64(uchar16 a, uchar16 b, uchar16 c, uchar16 d, global uchar* p) {
+  const uchar32_ ab = __builtin_shufflevector(a, b, LANES32), cd = __builtin_shufflevector(c, d, LANES32);
+  *(global uchar64_any*)p = __builtin_shufflevector(ab, cd, LANES64);
+}
 
 // Round half to even (rint) as one instruction (vrndscaleps) where clang has the builtin;
 // PoCL's own rint on vectors is generic integer code. Exact either way, so the same values.

@@ -119,6 +119,62 @@ TEST(IrPhysics, KernelsMatchTheReferenceInEveryTier) {
   }
 }
 
+// The declared fast path (contact_shadow -> heat_spread -> ir_surface in
+// ir_surface_fused; with only ir_display after it, ir_surface_display_fused) against the
+// chain of stage kernels: the same bits in every tier, -cl-fast-relaxed-math too (the
+// fast path writes each sum in the stage kernels' form). Integer, bilinear and randomised
+// placement, objects over the view's edges, no, the default and a wide heat spread, IR
+// NETD 0 (the display fused) and 0.05 K.
+TEST(IrPhysics, FastPathMatchesTheChainOfStageKernels) {
+  std::vector<Scenario> scenes;
+  for (size_t k = 0; k < 32; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
+  scenes.push_back(Scenario{});  // no object: no shadow at all
+  const SceneBatch batch = test::batch_of(scenes);
+  const World plain, wide(Edits{{"ir_spread_mm = 10.0", "ir_spread_mm = 40.0"}}),
+      sharp(Edits{{"ir_spread_mm = 10.0", "ir_spread_mm = 0.0"}});
+  struct Place {
+    const char* name;
+    bool bilinear;
+    double jitter, rotate, scale;
+  };
+  size_t shadowed = 0;
+  for (const World* w : {&plain, &wide, &sharp}) {
+    auto cl = make_opencl_backend(w->cat, w->assets, test::runtime());
+    for (Tier tier : {Tier::fast, Tier::standard, Tier::exact})
+      for (const Place& place : {Place{"integer", false, 0, 0, 1}, Place{"bilinear", true, 5, 0, 1},
+                                 Place{"over the edges", false, 60, 0, 1}, Place{"randomised", false, 4, 30, 1.4}})
+        for (double netd : {0.0, 0.05}) {
+          SCOPED_TRACE(std::string(tier_name(tier)) + " " + place.name + " spread " +
+                       std::to_string(w->cat.physics.ir_spread_mm) + " netd " + std::to_string(netd));
+          Plan plan = physics_plan(3);
+          plan.images = 1u << ir_view(w->cat);
+          plan.features = false;
+          plan.metal = false;
+          plan.fidelity = tier_fidelity(tier);
+          plan.model.bilinear = place.bilinear;
+          plan.model.jitter = place.jitter;
+          plan.model.rotate_lo = -place.rotate;
+          plan.model.rotate_hi = place.rotate;
+          plan.model.scale_hi = place.scale;
+          plan.model.worn_minutes = 0;
+          plan.model.ir_netd = netd;
+          BatchOutput fast, staged, bare;
+          cl->run(batch, plan, fast);
+          plan.fidelity.fused = false;
+          cl->run(batch, plan, staged);
+          const std::vector<uint8_t>& a = fast.view("ir").pixels;
+          const std::vector<uint8_t>& b = staged.view("ir").pixels;
+          ASSERT_EQ(a.size(), b.size());
+          EXPECT_EQ(a, b);
+          // The shadow shows: the path has something to get wrong.
+          plan.model.worn_minutes = 1440;
+          cl->run(batch, plan, bare);
+          for (size_t k = 0; k < a.size(); ++k) shadowed += std::abs(int(a[k]) - int(bare.view("ir").pixels[k])) > 3;
+        }
+  }
+  EXPECT_GT(shadowed, 50000u);
+}
+
 // Each stage that changes the image changes it in both backends alike; the model switches
 // the IR view too, while the thesis chain stays what it was.
 TEST(IrPhysics, EachStageOfTheChainDoesSomethingInBothBackends) {

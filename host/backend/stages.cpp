@@ -17,7 +17,7 @@ const std::vector<ViewStage>& view_stages() {
       {"optics", reference::optics, {{"stage_optics_rows", K::view_rows}, {"stage_optics_columns", K::view_rows}}},
       {"sample", reference::sample, {{"stage_sample", K::raw_rows}}},
       {"netd", reference::netd, {{"stage_netd", K::raw_rows}}},
-      {"mmw_display", reference::mmw_display, {{"stage_mmw_display", K::view_rows}}, true},
+      {"mmw_display", reference::mmw_display, {{"stage_mmw_display", K::scenarios}}, true},
       // The physics model's IR camera. Heat spreading is the PSF's separable Gaussian
       // kernels over the taps its launch passes.
       {"contact_shadow", reference::contact_shadow, {{"stage_contact_shadow", K::view_rows}}},
@@ -26,7 +26,7 @@ const std::vector<ViewStage>& view_stages() {
        {{"stage_optics_rows", K::view_rows}, {"stage_optics_columns", K::view_rows}}},
       {"ir_surface", reference::ir_surface, {{"stage_ir_surface", K::view_rows}}},
       {"ir_netd", reference::ir_netd, {{"stage_ir_netd", K::scenarios}}},
-      {"ir_display", reference::ir_display, {{"stage_ir_display", K::view_rows}}, true},
+      {"ir_display", reference::ir_display, {{"stage_ir_display", K::scenarios}}, true},
   };
   return stages;
 }
@@ -38,6 +38,11 @@ const std::vector<std::string>& fused_chain() {
 
 const std::vector<std::string>& physics_fused_chain() {
   static const std::vector<std::string> chain = {"radiometry", "optics", "sample", "netd", "mmw_display"};
+  return chain;
+}
+
+const std::vector<std::string>& ir_fused_chain() {
+  static const std::vector<std::string> chain = {"contact_shadow", "heat_spread", "ir_surface"};
   return chain;
 }
 

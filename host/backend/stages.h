@@ -13,7 +13,7 @@
 namespace portalsim {
 
 // What one launch of a stage kernel covers: a work-item per (scenario, view row), per
-// (scenario, raw-grid row) or per scenario.
+// (scenario, raw-grid row) or per scenario (the whole view).
 enum class StageItems { view_rows, raw_rows, scenarios };
 
 struct StageKernel {
@@ -35,6 +35,10 @@ const std::vector<ViewStage>& view_stages();
 const std::vector<std::string>& fused_chain();
 // The physics MMW chain the physics_raw fast path (then mmw_display) implements.
 const std::vector<std::string>& physics_fused_chain();
+// The first stages of the physics IR chain that the ir_surface_fused fast path
+// implements; the chain's later stages run as their kernels, or, where only ir_display
+// is left (ir_netd at 0 K is nothing), ir_surface_display_fused does it all.
+const std::vector<std::string>& ir_fused_chain();
 // Throws std::logic_error unless every stage of each of the view's chains is registered
 // and each chain ends with a stage that makes pixels, and no other stage does.
 void check_chain(const Sensor& view);

@@ -363,6 +363,9 @@ class OpenCLBackend final : public Backend {
     const std::vector<std::string>& chain = s.chain_for(plan.model.model);
     const bool fused = plan.fidelity.fused && chain == fused_chain();
     const bool physics_fast = plan.fidelity.fused && chain == physics_fused_chain();
+    const std::vector<std::string>& ir_prefix = ir_fused_chain();
+    const bool ir_fast = plan.fidelity.fused && chain.size() > ir_prefix.size() &&
+                         std::equal(ir_prefix.begin(), ir_prefix.end(), chain.begin());
     cl::Context& ctx = rt_->context();
     cl::Buffer field = fused || physics_fast ? dst : field_.at_least(ctx, n * s.pixels() * K.real_bytes);
     cl::Buffer& records = records_.at_least(ctx, n * PS_REC_LEN * sizeof(cl_int));
@@ -370,8 +373,11 @@ class OpenCLBackend final : public Backend {
     if (launched) *launched = L;
     const bool physics = plan.model.model == Model::physics;
     cl::Buffer& raw = raw_.at_least(ctx, physics ? n * plan.model.raw_width * plan.model.raw_height * K.real_bytes : 1);
-    // Physics: a second field for the stage chain; physics_raw's per-scenario row sums.
-    const size_t scratch_values = std::max<size_t>(s.pixels(), size_t(s.width) + plan.model.raw_width);
+    // Physics, per scenario: a second field for the stage chain; physics_raw's row sums;
+    // stage_mmw_display's interpolated rows; ir_surface_fused's row blur and row spans.
+    const size_t scratch_values = std::max({s.pixels(), size_t(s.width) + plan.model.raw_width,
+                                            mmw_display_scratch(s, plan.model.raw_width, plan.model.raw_height),
+                                            s.pixels() + 2 * size_t(s.height)});
     cl::Buffer& scratch = view_scratch_.at_least(ctx, physics ? n * scratch_values * K.real_bytes : 1);
     const auto launch = [&](cl::Kernel& k, size_t items) {
       int a = 0;
@@ -402,7 +408,7 @@ class OpenCLBackend final : public Backend {
     if (raw_only && !physics_fast) throw std::logic_error("the raw grid alone needs the physics fast path");
     if (physics_fast) {
       launch(stage_kernel(K, "physics_raw"), n);
-      if (!raw_only) launch(stage_kernel(K, "stage_mmw_display"), n * s.height);
+      if (!raw_only) launch(stage_kernel(K, "stage_mmw_display"), n);
       return;
     }
     const auto per_scenario = [&](StageItems items) -> size_t {
@@ -416,9 +422,28 @@ class OpenCLBackend final : public Backend {
       }
       throw std::logic_error("unknown stage items");
     };
-    for (const std::string& name : chain)
-      for (const StageKernel& sk : view_stage(name).kernels)
+    size_t from = 0;
+    if (ir_fast) {
+      // Where the chain leaves only ir_display (ir_netd at 0 K draws nothing), the fast
+      // path shows the surface itself.
+      std::vector<std::string> rest(chain.begin() + static_cast<std::ptrdiff_t>(ir_prefix.size()), chain.end());
+      if (plan.model.ir_netd == 0) std::erase(rest, "ir_netd");
+      if (rest == std::vector<std::string>{"ir_display"}) {
+        launch(stage_kernel(K, "ir_surface_display_fused"), n);
+        return;
+      }
+      launch(stage_kernel(K, "ir_surface_fused"), n);
+      from = ir_prefix.size();
+    }
+    for (size_t k = from; k < chain.size(); ++k)
+      for (const StageKernel& sk : view_stage(chain[k]).kernels)
         launch(stage_kernel(K, sk.kernel), n * per_scenario(sk.items));
+  }
+
+  // stage_mmw_display's scratch values per scenario: each view row's vertically
+  // interpolated raw row, then 16 values per raw row for the pixels after the last run of 16.
+  static size_t mmw_display_scratch(const Sensor& s, int raw_width, int raw_height) {
+    return size_t(s.height) * raw_width + 16 * size_t(raw_height);
   }
 
   static cl::Kernel& stage_kernel(Kernels& K, std::string_view name) {

@@ -1,0 +1,136 @@
+// The physics IR camera's declared fast path: contact_shadow -> heat_spread -> ir_surface
+// in one work-item per scenario, leaving the surface in kelvin in `field` for the chain's
+// remaining stage kernels (ir_surface_fused), or, where only ir_display is left, showing
+// it straight away (ir_surface_display_fused). The shadow is zero outside the objects'
+// footprints, and the blur of zero is zero, so each row's shadow is drawn and blurred only
+// over its objects' span and the blur's reach; every other pixel is the bare surface.
+// Each value is the stage kernels' sum in their order with its zero terms left out (adding
+// +0 to a sum that starts at +0 changes no bit): the same bits (tests/ir_physics_test.cpp).
+
+// Pixels [a, b) of row T: the bare surface (ir_surface's kelvin of the base image), added
+// to the values there (add) or alone, in stage_ir_surface's form (which
+// -cl-fast-relaxed-math then rewrites alike). fp32 builds in explicit 16-lane vectors
+// (LLVM's own stop at 8).
+inline void bare_surface(global preal* restrict T, global const uchar* restrict base, int a, int b, preal gain,
+                         preal offset, bool add) {
+  int x = a;
+#if !defined(PRECISION_FP64)
+  if (add)
+    for (; x + 16 <= b; x += 16)
+      vstore16(vload16(0, T + x) + (gain * convert_float16(load16(base + x)) + offset), 0, T + x);
+  else
+    for (; x + 16 <= b; x += 16) vstore16(gain * convert_float16(load16(base + x)) + offset, 0, T + x);
+#endif
+  if (add)
+    for (; x < b; ++x) T[x] += gain * (preal)base[x] + offset;
+  else
+    for (; x < b; ++x) T[x] = gain * (preal)base[x] + offset;
+}
+
+// Scenario i's view. Scratch: the row blur, H x W, then each shadow row's blurred span
+// [a, b) as two arrays of H ints (empty: (W, 0)). With display, each part of the field is
+// shown as soon as it is made, while it is in cache.
+inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* atlas, global const int* bases,
+                            global const uchar* subject, global const int* records, global real* field,
+                            global uchar* out, global const param* phys, global real* scratch, bool display) {
+  global const int* rec = records + (size_t)i * PS_REC_LEN;
+  const int W = L->width, H = L->height, R = L->psf_radius;
+  global preal* T = (global preal*)field + (size_t)i * H * W;
+  global uchar* o = out + (size_t)i * H * W;
+  global preal* S = (global preal*)scratch + (size_t)i * (H * W + 2 * H);
+  global int* span_a = (global int*)(S + H * W);
+  global int* span_b = span_a + H;
+  const int s = subject[i];
+  const preal gain = (preal)phys[PS_PHYS_SUBJECTS + 2 * s], offset = (preal)phys[PS_PHYS_SUBJECTS + 2 * s + 1];
+
+  // The rows the objects can touch.
+  int y_lo = H, y_hi = 0;
+  for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
+    const int2 rows = layer_rows(rec + PS_REC_LAYERS + j * PS_LAYER_LEN, L->flags);
+    y_lo = min(y_lo, max(rows.x, 0));
+    y_hi = max(y_hi, min(rows.y, H));
+  }
+
+  // contact_shadow over each row's span (into T), zero over the rest the row blur reads;
+  // then heat_spread along the row (T -> S) as stage_optics_rows, over the span's reach.
+  global const param* shadow = phys + PS_PHYS_VARIANTS(L->subjects);
+  global const param* taps = psf_taps(phys, L);
+  for (int y = y_lo; y < y_hi; ++y) {
+    Layers Ly;
+    composite_layers(&Ly, rec, L, y);
+    int a = W, b = 0;
+    for (int k = 0; k < Ly.count; ++k) {
+      a = min(a, max(Ly.x0[k], 0));
+      b = max(b, min(Ly.x0[k] + Ly.width[k], W));
+    }
+    if (a >= b) {
+      span_a[y] = W;
+      span_b[y] = 0;
+      continue;
+    }
+    global preal* restrict src = T + (size_t)y * W;
+    for (int x = max(a - 2 * R, 0); x < a; ++x) src[x] = 0;
+    for (int x = a; x < b; ++x) src[x] = lay_values(&Ly, atlas, x, shadow, (preal)0);
+    for (int x = b; x < min(b + 2 * R, W); ++x) src[x] = 0;
+    global preal* restrict dst = S + (size_t)y * W;
+    const int lo = max(a - R, 0), hi = min(b + R, W);
+    const int in_lo = clamp(R, lo, hi), in_hi = clamp(W - R, in_lo, hi);  // no tap leaves the row
+    for (int x = lo; x < hi; ++x) dst[x] = 0;
+    for (int d = -R; d <= R; ++d) {
+      const preal w = (preal)taps[d];
+      for (int x = lo; x < in_lo; ++x) dst[x] += w * src[clamp(x + d, 0, W - 1)];
+      for (int x = in_lo; x < in_hi; ++x) dst[x] += w * src[x + d];
+      for (int x = in_hi; x < hi; ++x) dst[x] += w * src[clamp(x + d, 0, W - 1)];
+    }
+    span_a[y] = lo;
+    span_b[y] = hi;
+  }
+
+  // heat_spread along columns (S -> T) as stage_optics_columns, each tap over its row's
+  // span; then ir_surface: plus the bare surface, which alone is every other pixel (runs
+  // of such rows at once: a view's rows lie one after another).
+  global const uchar* base = base_row(atlas, bases, subject, L, i, 0);
+  int bare_from = 0;
+  for (int y = 0; y <= H; ++y) {
+    int a = W, b = 0;
+    for (int row = max(y - R, y_lo); row <= min(y + R, y_hi - 1); ++row) {
+      a = min(a, span_a[row]);
+      b = max(b, span_b[row]);
+    }
+    if (a >= b && y < H) continue;
+    bare_surface(T, base, bare_from * W, y * W, gain, offset, false);
+    if (display) ir_window(T, o, phys, bare_from * W, y * W);
+    bare_from = y + 1;
+    if (y == H) break;
+    global preal* restrict dst = T + (size_t)y * W;
+    for (int x = a; x < b; ++x) dst[x] = 0;
+    for (int d = -R; d <= R; ++d) {
+      const int row = clamp(y + d, 0, H - 1);
+      if (row < y_lo || row >= y_hi) continue;
+      const preal w = (preal)taps[d];
+      global const preal* restrict src = S + (size_t)row * W;
+      for (int x = span_a[row]; x < span_b[row]; ++x) dst[x] += w * src[x];
+    }
+    global const uchar* row_base = base + (size_t)y * W;
+    bare_surface(dst, row_base, 0, a, gain, offset, false);
+    bare_surface(dst, row_base, a, b, gain, offset, true);
+    bare_surface(dst, row_base, b, W, gain, offset, false);
+    if (display) ir_window(T, o, phys, y * W, (y + 1) * W);
+  }
+}
+
+kernel void ir_surface_fused(VIEW_STAGE_ARGS) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= L.n) return;
+  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
+      (void)raw;
+  ir_surface_view(i, &L, atlas, bases, subject, records, field, out, phys, scratch, false);
+}
+
+kernel void ir_surface_display_fused(VIEW_STAGE_ARGS) {
+  const uint i = (uint)get_global_id(0);
+  if (i >= L.n) return;
+  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
+      (void)raw;
+  ir_surface_view(i, &L, atlas, bases, subject, records, field, out, phys, scratch, true);
+}
