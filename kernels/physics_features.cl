@@ -1,7 +1,9 @@
 // Features-only runs of the physics model from the MMW raw grid (host/backend/opencl/
 // raw_grid_pooling.h), one work-item per scenario and pooled view. Each feature, in kelvin
-// before the display window, is summed in its column of the row: the scenario's tables
-// (the subject's bare features and each object's change, where physics_tabulated holds),
+// before the display window: the scenario's tables where physics_tabulated holds (the
+// subject's bare features, each object's change alone, and each meeting pair's correction;
+// object_range: per (subject, variant, region), then per (subject, variant, region,
+// variant, region), its entries [x, y)),
 // or else its weighted sum of the raw cells physics_raw wrote; then the NETD's noise drawn
 // in feature space (Ly Z Lx^T for the blocks, B z + Lr z_r for the regions); then the
 // window, clamped to 0..255: the mean of its unrounded, unclamped pixels.
@@ -73,20 +75,32 @@ FEATURE_NOISE(private)
                                     global const param* weights, global const int* columns, int count,           \
                                     int raw_cells, global const param* phys, global const int* records,          \
                                     global const uchar* subject, global const short* objects,                    \
-                                    global const param* base_features, global const int* object_first,           \
+                                    global const param* base_features, global const int2* object_range,           \
                                     global const int* object_feature, global const param* object_value,          \
                                     preal sd, int8 dims, global const param* noise) {                           \
     const int blocks = dims.s0 * dims.s1;                                                                      \
-    if (physics_tabulated(records + (size_t)i * PS_REC_LEN, L)) {                                              \
+    global const int* rec = records + (size_t)i * PS_REC_LEN;                                                  \
+    if (physics_tabulated(rec, L)) {                                                                           \
       const int s = subject[i];                                                                                \
       global const param* restrict bare = base_features + (size_t)s * count;                                   \
       for (int f = 0; f < count; ++f) acc[f] = (preal)bare[f];                                                 \
+      int tab[PS_MAX_LAYERS], n = 0; /* each layer's (variant, region) */                                      \
       for (int r = 0; r < PS_REGIONS; ++r) {                                                                   \
         const int v = objects[(size_t)i * PS_REGIONS + r];                                                     \
         if (v < 0 || !((L->region_mask >> r) & 1u)) continue;                                                  \
-        const int t = (s * L->variants + v) * PS_REGIONS + r;                                                  \
-        for (int e = object_first[t]; e < object_first[t + 1]; ++e) acc[object_feature[e]] += object_value[e]; \
+        const int t = v * PS_REGIONS + r;                                                                      \
+        tab[n++] = t;                                                                                          \
+        const int u = s * L->variants * PS_REGIONS + t;                                                        \
+        for (int e = object_range[u].x; e < object_range[u].y; ++e) acc[object_feature[e]] += object_value[e];   \
       }                                                                                                        \
+      const int combos = L->variants * PS_REGIONS, pairs0 = L->subjects * combos;                              \
+      for (int j = 0; j < n; ++j)                                                                              \
+        for (int k = j + 1; k < n; ++k) {                                                                      \
+          if (!layers_meet(rec + PS_REC_LAYERS + j * PS_LAYER_LEN, rec + PS_REC_LAYERS + k * PS_LAYER_LEN))    \
+            continue;                                                                                          \
+          const int u = pairs0 + (s * combos + tab[j]) * combos + tab[k];                                      \
+          for (int e = object_range[u].x; e < object_range[u].y; ++e) acc[object_feature[e]] += object_value[e];   \
+        }                                                                                                      \
     } else {                                                                                                   \
       global const preal* grid = raw + (size_t)i * raw_cells;                                                  \
       for (int f = 0; f < count; ++f) {                                                                        \
@@ -111,7 +125,7 @@ kernel void physics_features(global const preal* raw, global const int* first, g
                              global const param* weights, global const int* columns, int count, int raw_cells,
                              global const param* phys, int row_len, global float* features, PsViewLaunch L,
                              global const int* records, global const uchar* subject, global const short* objects,
-                             global const param* base_features, global const int* object_first,
+                             global const param* base_features, global const int2* object_range,
                              global const int* object_feature, global const param* object_value, param sd,
                              int8 dims, global const param* noise, global preal* scratch) {
   const uint i = (uint)get_global_id(0);
@@ -123,12 +137,12 @@ kernel void physics_features(global const preal* raw, global const int* first, g
     view_features_private(work, work + count + band_x, work + count + band_x + zlen + band_y * dims.s0, row, i, &L,
                           raw, first, cells,
                           weights, columns, count, raw_cells, phys, records, subject, objects, base_features,
-                          object_first, object_feature, object_value, sd, dims, noise);
+                          object_range, object_feature, object_value, sd, dims, noise);
   } else {
     global preal* work = scratch + (size_t)(i - get_global_offset(0)) * space;  // a launch per chunk
     view_features_global(work, work + count + band_x, work + count + band_x + zlen + band_y * dims.s0, row, i, &L,
                          raw, first, cells,
                          weights, columns, count, raw_cells, phys, records, subject, objects, base_features,
-                         object_first, object_feature, object_value, sd, dims, noise);
+                         object_range, object_feature, object_value, sd, dims, noise);
   }
 }

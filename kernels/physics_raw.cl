@@ -4,21 +4,24 @@
 // plus, for each view row an object crosses, that row's change (composite minus bare, in
 // kelvin) projected through the folded weights: raw[r][c] += wy[r][y] sum_x wx[c][x] d(x, y).
 // Tested against the chain of stage kernels and the reference (tests/physics_test.cpp).
-// Whether a scenario's view is the sum of its objects' tabulated responses (features-only
-// runs, PS_FLAG_TABULATED): every object at its place (no jitter, no randomised transform)
-// and no two objects' boxes, widened by the bilinear fringe, meeting.
+// Whether two layers' boxes, widened by the bilinear fringe, meet.
+inline bool layers_meet(global const int* a, global const int* b) {
+  return a[PS_LAYER_X0] - 2 < b[PS_LAYER_X0] + b[PS_LAYER_W] + 2 && b[PS_LAYER_X0] - 2 < a[PS_LAYER_X0] + a[PS_LAYER_W] + 2 &&
+         a[PS_LAYER_Y0] - 2 < b[PS_LAYER_Y0] + b[PS_LAYER_H] + 2 && b[PS_LAYER_Y0] - 2 < a[PS_LAYER_Y0] + a[PS_LAYER_H] + 2;
+}
+
+// Whether a scenario's view is its tabulated responses (features-only runs,
+// PS_FLAG_TABULATED): each object's alone, plus a pair's correction where two boxes meet.
+// That is exact when every object stands at its place (no jitter, no randomised
+// transform) and meets at most one other (so no pixel lies under three).
 inline bool physics_tabulated(global const int* rec, const PsViewLaunch* L) {
   if (!(L->flags & PS_FLAG_TABULATED) || (L->flags & PS_FLAG_AFFINE) || L->jitter_x > 0.0f || L->jitter_y > 0.0f)
     return false;
   for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
-    global const int* a = rec + PS_REC_LAYERS + j * PS_LAYER_LEN;
-    for (int k = j + 1; k < rec[PS_REC_COUNT]; ++k) {
-      global const int* b = rec + PS_REC_LAYERS + k * PS_LAYER_LEN;
-      if (a[PS_LAYER_X0] - 2 < b[PS_LAYER_X0] + b[PS_LAYER_W] + 2 &&
-          b[PS_LAYER_X0] - 2 < a[PS_LAYER_X0] + a[PS_LAYER_W] + 2 &&
-          a[PS_LAYER_Y0] - 2 < b[PS_LAYER_Y0] + b[PS_LAYER_H] + 2 && b[PS_LAYER_Y0] - 2 < a[PS_LAYER_Y0] + a[PS_LAYER_H] + 2)
-        return false;
-    }
+    int meets = 0;
+    for (int k = 0; k < rec[PS_REC_COUNT]; ++k)
+      meets += k != j && layers_meet(rec + PS_REC_LAYERS + j * PS_LAYER_LEN, rec + PS_REC_LAYERS + k * PS_LAYER_LEN);
+    if (meets > 1) return false;
   }
   return true;
 }

@@ -42,6 +42,18 @@ cl::Buffer constant(cl::Context& ctx, const std::vector<T>& v) {
 
 cl_int4 rect4(const Rect& r) { return {{r.x, r.y, r.w, r.h}}; }
 
+// A sprite centred in its region's rectangle of a view (>> 1 floors negative differences
+// too): where place_view lays it without jitter.
+Rect sprite_box(const Sensor& s, const Image& sprite, int region) {
+  const Rect& rc = s.rects[region];
+  return {rc.x + ((rc.w - sprite.width) >> 1), rc.y + ((rc.h - sprite.height) >> 1), sprite.width, sprite.height};
+}
+
+// Whether two boxes, widened by the bilinear fringe, meet (kernels/physics_raw.cl, layers_meet).
+bool boxes_meet(const Rect& a, const Rect& b) {
+  return a.x - 2 < b.x + b.w + 2 && b.x - 2 < a.x + a.w + 2 && a.y - 2 < b.y + b.h + 2 && b.y - 2 < a.y + a.h + 2;
+}
+
 class OpenCLBackend final : public Backend {
  public:
   OpenCLBackend(const Catalogue& cat, const AssetSet& assets, std::shared_ptr<OpenCLRuntime> rt)
@@ -85,16 +97,15 @@ class OpenCLBackend final : public Backend {
         const int plain = add(sp);
         sprites[c * V + v] = {{plain, sp.width, sp.height, add_padded_sprite(sp)}};
       }
-    // Each sprite centred in its region's rectangle of each view; >> 1 floors negative
-    // differences too.
+    // Each sprite centred in its region's rectangle of each view.
     std::vector<cl_int2> places(views * V * kRegions);
     for (size_t k = 0; k < views; ++k) {
       const Sensor& s = cat.sensors[k];
       for (size_t v = 0; v < V; ++v) {
         const Image& sp = assets.sprite(s.camera, static_cast<int>(v));
         for (int r = 0; r < kRegions; ++r) {
-          const Rect& rc = s.rects[r];
-          places[(k * V + v) * kRegions + r] = {{rc.x + ((rc.w - sp.width) >> 1), rc.y + ((rc.h - sp.height) >> 1)}};
+          const Rect box = sprite_box(s, sp, r);
+          places[(k * V + v) * kRegions + r] = {{box.x, box.y}};
         }
       }
     }
@@ -690,7 +701,7 @@ class OpenCLBackend final : public Backend {
     int count = 0;
     cl::Buffer first, cells, weights, columns;
     cl_int8 dims{};  // blocks_x, blocks_y, band_x, band_y, regions (RawGridNoise), the first block's column
-    cl::Buffer noise, base_features, object_first, object_feature, object_value;
+    cl::Buffer noise, base_features, object_range, object_feature, object_value;
   };
 
   // Physics features-only (raw_grid_pooling.h): per pooled view, the raw grid of the
@@ -729,7 +740,7 @@ class OpenCLBackend final : public Backend {
       k.setArg(a++, subject);
       k.setArg(a++, objects);
       k.setArg(a++, t.base_features);
-      k.setArg(a++, t.object_first);
+      k.setArg(a++, t.object_range);
       k.setArg(a++, t.object_feature);
       k.setArg(a++, t.object_value);
       set_param(K, k, a++, plan.model.netd);
@@ -783,10 +794,21 @@ class OpenCLBackend final : public Backend {
     t.noise = params(noise);
     const int S = static_cast<int>(cat_.subjects.size()), V = static_cast<int>(cat_.variant_list.size());
     std::vector<double> bare(static_cast<size_t>(S) * t.count, 0.0), values;
-    std::vector<cl_int> object_first(static_cast<size_t>(S) * V * kRegions + 1, 0), features;
+    const size_t combos = static_cast<size_t>(V) * kRegions;
+    std::vector<cl_int2> object_range(S * combos + S * combos * combos, cl_int2{{0, 0}});  // [begin, end)
+    std::vector<cl_int> features;
     if (tabulated) {
-      // One scenario per subject bare, then per (subject, variant, region seen) alone.
+      // One scenario per subject bare, per (subject, variant, region seen) alone, and per
+      // pair of those whose boxes meet.
+      const auto box = [&](int v, int r) { return sprite_box(sv, assets_.sprite(sv.camera, v), r); };
       SceneBatch b;
+      std::vector<std::array<int, 4>> pairs;  // va, ra, vb, rb with ra < rb
+      for (int ra = 0; ra < kRegions; ++ra)
+        for (int rb = ra + 1; rb < kRegions; ++rb)
+          if (sv.sees(ra) && sv.sees(rb))
+            for (int va = 0; va < V; ++va)
+              for (int vb = 0; vb < V; ++vb)
+                if (boxes_meet(box(va, ra), box(vb, rb))) pairs.push_back({va, ra, vb, rb});
       for (int s = 0; s < S; ++s) {
         Scenario sc;
         sc.subject = s;
@@ -798,6 +820,12 @@ class OpenCLBackend final : public Backend {
               sc.objects[r] = static_cast<int16_t>(v);
               b.push(sc);
             }
+        for (const auto& [va, ra, vb, rb] : pairs) {
+          sc.objects.fill(kNoObject);
+          sc.objects[ra] = static_cast<int16_t>(va);
+          sc.objects[rb] = static_cast<int16_t>(vb);
+          b.push(sc);
+        }
       }
       const size_t N = b.size();
       cl::Buffer subj = constant(ctx, b.subject), objs = constant(ctx, b.objects);
@@ -810,36 +838,48 @@ class OpenCLBackend final : public Backend {
         rt_->queue().enqueueReadBuffer(raw_.buf, CL_TRUE, 0, N * cells * sizeof(cl_float), f.data());
         raw.assign(f.begin(), f.end());
       }
-      const auto pool = [&](size_t scenario, size_t minus, int f) {
-        double sum = 0;
-        for (int k = p.first[f]; k < p.first[f + 1]; ++k)
-          sum += p.weights[k] *
-                 (raw[scenario * cells + p.cells[k]] - (minus == SIZE_MAX ? 0.0 : raw[minus * cells + p.cells[k]]));
-        return sum;
+      // The features of sum_k sign_k raw[scenario_k], kept where not zero.
+      std::vector<double> grid(cells);
+      const auto entries = [&](size_t u, std::initializer_list<std::pair<size_t, double>> terms) {
+        std::fill(grid.begin(), grid.end(), 0.0);
+        for (const auto& [scenario, sign] : terms)
+          for (int c = 0; c < cells; ++c) grid[c] += sign * raw[scenario * cells + c];
+        object_range[u].s[0] = static_cast<cl_int>(features.size());
+        for (int f = 0; f < t.count; ++f) {
+          double d = 0;
+          for (int k = p.first[f]; k < p.first[f + 1]; ++k) d += p.weights[k] * grid[p.cells[k]];
+          if (d == 0) continue;
+          features.push_back(f);
+          values.push_back(d);
+        }
+        object_range[u].s[1] = static_cast<cl_int>(features.size());
+        if (features.size() > INT32_MAX) throw std::runtime_error("physics feature tables exceed 2^31 entries");
       };
       size_t at = 0;
+      std::vector<size_t> alone(combos);
       for (int s = 0; s < S; ++s) {
         const size_t bare_at = at++;
-        for (int f = 0; f < t.count; ++f) bare[static_cast<size_t>(s) * t.count + f] = pool(bare_at, SIZE_MAX, f);
+        for (int f = 0; f < t.count; ++f)
+          for (int k = p.first[f]; k < p.first[f + 1]; ++k)
+            bare[static_cast<size_t>(s) * t.count + f] += p.weights[k] * raw[bare_at * cells + p.cells[k]];
         for (int v = 0; v < V; ++v)
           for (int r = 0; r < kRegions; ++r) {
-            const size_t combo = (static_cast<size_t>(s) * V + v) * kRegions + r;
-            object_first[combo] = static_cast<cl_int>(features.size());
+            const size_t c = static_cast<size_t>(v) * kRegions + r;
             if (sv.sees(r)) {
-              const size_t one = at++;
-              for (int f = 0; f < t.count; ++f) {
-                const double d = pool(one, bare_at, f);
-                if (d == 0) continue;
-                features.push_back(f);
-                values.push_back(d);
-              }
+              alone[c] = at++;
+              entries(s * combos + c, {{alone[c], 1.0}, {bare_at, -1.0}});
             }
-            object_first[combo + 1] = static_cast<cl_int>(features.size());
           }
+        // Pairs: both together less each alone, plus the bare grid counted twice over.
+        for (const auto& [va, ra, vb, rb] : pairs) {
+          const size_t a = static_cast<size_t>(va) * kRegions + ra, c = static_cast<size_t>(vb) * kRegions + rb;
+          entries(S * combos + (s * combos + a) * combos + c,
+                  {{at++, 1.0}, {alone[a], -1.0}, {alone[c], -1.0}, {bare_at, 1.0}});
+        }
       }
     }
     t.base_features = params(bare);
-    t.object_first = constant(ctx, object_first);
+    t.object_range = constant(ctx, object_range);
     t.object_feature = constant(ctx, features);
     t.object_value = params(values);
     return t;
