@@ -235,10 +235,12 @@ int tradeoff(TradeoffOptions& o) {
         // The tier's stated tolerance for this model (plan/tolerance.h), on images and features.
         const Tolerance tol = model_tolerance(m, *tier);
         // The features-only run holds no images. Its feature bounds hold without the
-        // block-mean noise model, which draws each mean's noise directly.
+        // block-mean noise model, which draws each mean's noise directly (the thesis's
+        // pixel noise; the physics model's NETD in feature space).
         OutputDiff feat_checked;
         feat_checked.metal_exact = feat_err.metal_exact;
-        if (f.noise != NoiseModel::block_mean || model.pixel_sigma == 0) {
+        const bool noise_per_mean = model.pixel_sigma > 0 || (m == Model::physics && model.netd > 0);
+        if (f.noise != NoiseModel::block_mean || !noise_per_mean) {
           feat_checked.feature_max_abs = feat_err.feature_max_abs;
           feat_checked.feature_mean_abs = feat_err.feature_mean_abs;
         }

@@ -156,7 +156,8 @@ std::vector<Knob> declare() {
   k.push_back(choice(
       "noise_model", {"per-pixel", "block-mean"},
       "in features-only runs with pixel noise: draw every pixel's noise, or give each mean over c "
-      "pixels one draw of N(0, sigma^2/c) (ignores rounding and clipping of single pixels, keeps the sparse path)",
+      "pixels one draw of N(0, sigma^2/c) (ignores rounding and clipping of single pixels, keeps the sparse path); "
+      "physics: draw the NETD per feature with the covariance per-raw-pixel noise gives",
       true, true, [](Plan& p, double v) { p.fidelity.noise = static_cast<NoiseModel>(v); },
       [](const Plan& p) { return p.fidelity.noise == NoiseModel::block_mean ? "block-mean" : "per-pixel"; }));
   return k;

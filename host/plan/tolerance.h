@@ -39,9 +39,10 @@ inline Tolerance tier_tolerance(Tier t) {
 // those pixels, on average within 0.005 (plus float rounding). Its other sensors still run
 // the thesis's chains, so pixels keep the tier's bounds where those are wider. The fast
 // tier's features-only runs take the raw-grid path, which leaves each pixel's rounding
-// and clamping out (backend/opencl/raw_grid_pooling.h): where the display window clamps
-// noisy pixels a mean may be off by many levels, so only the mean error is bounded
-// (0.031 measured on 2,000 scenarios at NETD 3 K).
+// and clamping out (backend/opencl/raw_grid_pooling.h) and draws the NETD per feature
+// (its distribution is tested, not its draws, so these bounds are for NETD 0): where the
+// display window clamps a mean may be off by many levels, so only the mean error is
+// bounded.
 inline Tolerance model_tolerance(Model m, Tier t) {
   const Tolerance thesis = tier_tolerance(t);
   if (m == Model::thesis) return thesis;
