@@ -7,6 +7,7 @@
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 
+#include "backend/annotate.h"
 #include "backend/stages.h"
 #include "fixture.h"
 
@@ -84,10 +85,31 @@ void BM_ImagesAnnotations(benchmark::State& state) {
       benchmark::Counter(bench::process_cpu_ms() - cpu0, benchmark::Counter::kAvgIterations);
 }
 
+// annotate() alone on one host thread, default model, batches of 1,024: the same batch
+// each time as above (Arg 0), or two batches in turn as in a run (Arg 1; the last batch's
+// objects are cleared elsewhere than the new ones are painted).
+void BM_Annotate(benchmark::State& state) {
+  const size_t n = 1024;
+  GeneratorSpec spec;
+  Generator gen(fx().cat, spec, 1);
+  SceneBatch batches[2];
+  for (size_t i = 0; i < 2 * n; ++i) batches[i / n].push(gen(i));
+  batches[1].first_index = n;
+  std::vector<ViewAnnotations> out;
+  annotate(fx().cat, fx().assets, ModelSettings{}, batches[0], out);
+  size_t turn = 0;
+  for (auto _ : state) {
+    annotate(fx().cat, fx().assets, ModelSettings{}, batches[state.range(0) ? ++turn % 2 : 0], out);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+}
+
 BENCHMARK(BM_StageOpenCL)->DenseRange(1, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_StageReference)->DenseRange(1, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ChainFusedOrStaged)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ImagesAnnotations)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Annotate)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace portalsim

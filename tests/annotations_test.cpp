@@ -163,27 +163,38 @@ TEST(Annotations, MasksAndBoxesAgreeWithTheReferenceComposite) {
 }
 
 // annotate() clears a reused buffer only where it painted before: batches of other sizes
-// and scenes through one buffer must give what fresh buffers give.
+// and scenes through one buffer must give what fresh buffers give, with sprites that move
+// and that do not (placed once per call), on one worker and on two (from 256 scenarios).
 TEST(Annotations, ReusedBuffersGiveWhatFreshOnesGive) {
   const Catalogue& cat = test::catalogue();
-  ModelSettings m;
-  m.jitter = 20;
-  std::vector<ViewAnnotations> reused;
-  size_t compared = 0;
-  for (const auto& [first, n] : std::vector<std::pair<uint64_t, size_t>>{{0, 50}, {300, 20}, {900, 70}, {40, 70}}) {
-    std::vector<Scenario> scenes;
-    for (uint64_t k = 0; k < n; ++k) scenes.push_back(test::random_scenario(cat, first + k));
-    const SceneBatch b = test::batch_of(scenes, first);
-    std::vector<ViewAnnotations> fresh;
-    annotate(cat, test::assets(), m, b, fresh, 2);
-    annotate(cat, test::assets(), m, b, reused, 2);
-    for (size_t k = 0; k < fresh.size(); ++k) {
-      ASSERT_EQ(fresh[k].masks, reused[k].masks) << "batch at " << first << " view " << k;
-      EXPECT_EQ(fresh[k].first, reused[k].first);
-      compared += fresh[k].items.size();
+  for (const double jitter : {20.0, 0.0}) {
+    ModelSettings m;
+    m.jitter = jitter;
+    std::vector<ViewAnnotations> reused;
+    size_t compared = 0;
+    for (const auto& [first, n] :
+         std::vector<std::pair<uint64_t, size_t>>{{0, 50}, {300, 20}, {900, 300}, {40, 70}, {2000, 260}}) {
+      std::vector<Scenario> scenes;
+      for (uint64_t k = 0; k < n; ++k) scenes.push_back(test::random_scenario(cat, first + k));
+      const SceneBatch b = test::batch_of(scenes, first);
+      std::vector<ViewAnnotations> fresh;
+      annotate(cat, test::assets(), m, b, fresh, 1);
+      annotate(cat, test::assets(), m, b, reused, 2);
+      for (size_t k = 0; k < fresh.size(); ++k) {
+        ASSERT_EQ(fresh[k].masks, reused[k].masks) << "batch at " << first << " view " << k << " jitter " << jitter;
+        EXPECT_EQ(fresh[k].first, reused[k].first);
+        ASSERT_EQ(fresh[k].items.size(), reused[k].items.size());
+        for (size_t t = 0; t < fresh[k].items.size(); ++t) {
+          const Annotation &a = fresh[k].items[t], &c = reused[k].items[t];
+          EXPECT_TRUE(a.scenario == c.scenario && a.region == c.region && a.x == c.x && a.y == c.y && a.w == c.w &&
+                      a.h == c.h && a.area == c.area)
+              << "item " << t << " view " << k;
+        }
+        compared += fresh[k].items.size();
+      }
     }
+    EXPECT_GT(compared, 1000u);
   }
-  EXPECT_GT(compared, 300u);
 }
 
 // The kernels' images of white sprites on black: a pixel is lit exactly where the mask

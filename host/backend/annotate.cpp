@@ -3,7 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <map>
+#include <mutex>
+#include <optional>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "backend/reference/stages.h"
 #include "base/parallel.h"
@@ -12,10 +19,98 @@ namespace portalsim {
 
 namespace {
 
-// A sprite's covered texels (alpha > 0) as runs [a, b) per row.
+// Sets bytes [p, p + n) to v with a few overlapping stores: rows of objects' boxes are a
+// few dozen bytes, where a call to memset (which GCC makes of any loop of stores) costs more.
+inline void fill(uint8_t* p, uint8_t v, int n) {
+  using Bytes16 = uint8_t __attribute__((vector_size(16)));
+  if (n >= 16) {
+    if (n > 64) {
+      std::memset(p, v, static_cast<size_t>(n));
+      return;
+    }
+    const Bytes16 w = Bytes16{} + v;
+    std::memcpy(p, &w, 16);
+    std::memcpy(p + n - 16, &w, 16);
+    if (n > 32) {
+      std::memcpy(p + 16, &w, 16);
+      std::memcpy(p + n - 32, &w, 16);
+    }
+  } else if (n >= 4) {
+    const uint64_t w = 0x0101010101010101ull * v;
+    if (n >= 8) {
+      std::memcpy(p, &w, 8);
+      std::memcpy(p + n - 8, &w, 8);
+    } else {
+      std::memcpy(p, &w, 4);
+      std::memcpy(p + n - 4, &w, 4);
+    }
+  } else {
+    for (int i = 0; i < n; ++i) p[i] = v;
+  }
+}
+
+// Sets bytes [p, p + n) to cover[i] & v (cover is 0 or 0xff), with overlapping stores
+// as fill.
+inline void paint_row(uint8_t* p, const uint8_t* cover, uint8_t v, int n) {
+  using Bytes16 = uint8_t __attribute__((vector_size(16)));
+  if (n >= 16) {
+    const Bytes16 w = Bytes16{} + v;
+    Bytes16 c;
+    for (int o = 0; o < n - 16; o += 16) {
+      std::memcpy(&c, cover + o, 16);
+      c &= w;
+      std::memcpy(p + o, &c, 16);
+    }
+    std::memcpy(&c, cover + n - 16, 16);
+    c &= w;
+    std::memcpy(p + n - 16, &c, 16);
+  } else if (n >= 8) {
+    const uint64_t w = 0x0101010101010101ull * v;
+    uint64_t c;
+    std::memcpy(&c, cover, 8);
+    c &= w;
+    std::memcpy(p, &c, 8);
+    std::memcpy(&c, cover + n - 8, 8);
+    c &= w;
+    std::memcpy(p + n - 8, &c, 8);
+  } else {
+    for (int i = 0; i < n; ++i) p[i] = cover[i] & v;
+  }
+}
+
+// What one object keeps: its visible pixels' count and box (inclusive).
+struct Painted {
+  uint32_t area = 0;
+  int x0 = INT32_MAX, y0 = INT32_MAX, x1 = -1, y1 = -1;
+  void add(int xa, int xb, int y, uint32_t count) {  // `count` pixels within [xa, xb] of row y
+    area += count;
+    x0 = std::min(x0, xa);
+    x1 = std::max(x1, xb);
+    y0 = std::min(y0, y);
+    y1 = std::max(y1, y);
+  }
+};
+
+// One row's painted pixels, gathered pixel by pixel and added to a Painted once.
+struct RowSpan {
+  int lo = INT32_MAX, hi = -1;
+  uint32_t count = 0;
+  void add(int x) {
+    lo = std::min(lo, x);
+    hi = x;
+    ++count;
+  }
+  void to(Painted& p, int y) const {
+    if (count) p.add(lo, hi, y, count);
+  }
+};
+
+// A sprite's covered texels (alpha > 0) as runs [a, b) per row, and their box and count.
 struct Runs {
   std::vector<uint32_t> first;  // height + 1: row j's runs are [first[j], first[j + 1])
   std::vector<std::pair<int, int>> runs;
+  Painted all;                 // in sprite coordinates
+  std::vector<uint8_t> cover;  // all's box, row by row: 0xff where covered, else 0
   explicit Runs(const Image& sp) {
     for (int j = 0; j < sp.height; ++j) {
       first.push_back(static_cast<uint32_t>(runs.size()));
@@ -27,95 +122,237 @@ struct Runs {
         const int a = i;
         while (i < sp.width && sp.at(i, j, 1)) ++i;
         runs.emplace_back(a, i);
+        all.add(a, i - 1, j, static_cast<uint32_t>(i - a));
       }
     }
     first.push_back(static_cast<uint32_t>(runs.size()));
+    if (!all.area) return;
+    const int w = all.x1 - all.x0 + 1;
+    cover.assign(static_cast<size_t>(w) * (all.y1 - all.y0 + 1), 0);
+    for (int j = all.y0; j <= all.y1; ++j)
+      for (uint32_t k = first[j]; k < first[j + 1]; ++k)
+        std::fill_n(cover.begin() + (j - all.y0) * w + (runs[k].first - all.x0), runs[k].second - runs[k].first, 0xff);
   }
 };
 
-// What one object painted: its pixels' count and box (inclusive), before later objects.
-struct Painted {
-  uint32_t area = 0;
-  int x0 = INT32_MAX, y0 = INT32_MAX, x1 = -1, y1 = -1;
-  void add(int xa, int xb, int y) {  // pixels [xa, xb) of row y
-    area += static_cast<uint32_t>(xb - xa);
-    x0 = std::min(x0, xa);
-    x1 = std::max(x1, xb - 1);
-    y0 = std::min(y0, y);
-    y1 = std::max(y1, y);
+// One placed object in one view: which pixels it covers (coverage > 0) as the reference's
+// composite samples it: at integer placement the texel under the pixel; at bilinear
+// placement, and for randomised objects at the sprite point the reference's inverse map
+// gives, any of the four texels whose weight, computed as the reference computes it, is
+// non-zero. `reach` bounds those pixels (inclusive, within the view; empty when x0 > x1).
+class Placement {
+ public:
+  Placement(const reference::Placed& p, const Runs& runs, const ModelSettings& model, int W, int H)
+      : sprite_(p.sprite), runs_(&runs), W_(W), H_(H), bilinear_(model.bilinear), transforms_(model.transforms()) {
+    const Image& sp = *p.sprite;
+    if (transforms_) {
+      map_ = reference::sprite_map(p, bilinear_);
+      reach = {0, std::max(0, map_.x0), std::max(0, map_.y0), std::min(W - 1, map_.x1), std::min(H - 1, map_.y1)};
+    } else if (!bilinear_) {
+      ox_ = p.x0 + static_cast<int>(std::floor(p.dx + 0.5));
+      oy_ = p.y0 + static_cast<int>(std::floor(p.dy + 0.5));
+      const Painted& a = runs.all;
+      if (a.area)
+        reach = {0, std::max(0, ox_ + a.x0), std::max(0, oy_ + a.y0), std::min(W - 1, ox_ + a.x1),
+                 std::min(H - 1, oy_ + a.y1)};
+      whole_ = a.area && ox_ + a.x0 >= 0 && oy_ + a.y0 >= 0 && ox_ + a.x1 < W && oy_ + a.y1 < H;
+    } else {
+      fx_ = p.x0 + p.dx;
+      fy_ = p.y0 + p.dy;
+      const int ix = static_cast<int>(std::floor(fx_)), iy = static_cast<int>(std::floor(fy_));
+      reach = {0, std::max(0, ix - 1), std::max(0, iy - 1), std::min(W, ix + sp.width + 2) - 1,
+               std::min(H, iy + sp.height + 2) - 1};
+    }
   }
-  bool meets(const Painted& o) const { return area && o.area && x0 <= o.x1 && o.x0 <= x1 && y0 <= o.y1 && o.y0 <= y1; }
-};
 
-// Paints region + 1 over every pixel the placed sprite covers (coverage > 0) as the
-// reference's composite samples it: at integer placement the texel under the pixel; at
-// bilinear placement, and for randomised objects at the sprite point the reference's
-// inverse map gives, any of the four texels whose weight, computed as the reference
-// computes it, is non-zero.
-Painted paint(const reference::Placed& p, const Runs& runs, const ModelSettings& model, int W, int H, uint8_t id,
-              uint8_t* mask) {
-  const Image& sp = *p.sprite;
-  const bool bilinear = model.bilinear;
-  Painted out;
-  const auto cov = [&](int i, int j) { return i >= 0 && j >= 0 && i < sp.width && j < sp.height && sp.at(i, j, 1); };
-  if (model.transforms()) {
-    const reference::SpriteMap map = reference::sprite_map(p, bilinear);
-    for (int y = std::max(0, map.y0); y <= std::min(H - 1, map.y1); ++y) {
-      uint8_t* row = mask + static_cast<size_t>(y) * W;
-      for (int x = std::max(0, map.x0); x <= std::min(W - 1, map.x1); ++x) {
+  Painted reach;
+
+  // Paints id over the pixels it covers, only over 0s when `over_zero` (pixels that objects
+  // of higher regions, painted first, own stay theirs), and returns what it painted.
+  template <bool over_zero>
+  Painted paint(uint8_t id, uint8_t* mask) const {
+    if (reach.x0 > reach.x1 || reach.y0 > reach.y1) return {};
+    if (transforms_) return paint_mapped<over_zero>(id, mask);
+    if (bilinear_) return paint_bilinear<over_zero>(id, mask);
+    return paint_runs<over_zero>(id, mask);
+  }
+
+ private:
+  bool cov(int i, int j) const {
+    const Image& sp = *sprite_;
+    return i >= 0 && j >= 0 && i < sp.width && j < sp.height && sp.at(i, j, 1);
+  }
+
+  template <bool over_zero>
+  Painted paint_runs(uint8_t id, uint8_t* mask) const {
+    Painted out;
+    if (!over_zero && whole_) {  // all of the sprite's coverage, moved: the box is 0 till now
+      const Painted& a = runs_->all;
+      const int w = a.x1 - a.x0 + 1;
+      uint8_t* row = mask + static_cast<size_t>(oy_ + a.y0) * W_ + ox_ + a.x0;
+      for (int j = 0; j <= a.y1 - a.y0; ++j) paint_row(row + static_cast<size_t>(j) * W_, &runs_->cover[j * w], id, w);
+      out = runs_->all;
+      out.x0 += ox_, out.x1 += ox_, out.y0 += oy_, out.y1 += oy_;
+      return out;
+    }
+    for (int j = std::max(runs_->all.y0, -oy_); j <= std::min(runs_->all.y1, H_ - 1 - oy_); ++j) {
+      uint8_t* row = mask + static_cast<size_t>(oy_ + j) * W_;
+      RowSpan span;
+      for (uint32_t k = runs_->first[j]; k < runs_->first[j + 1]; ++k) {
+        const int xa = std::max(0, ox_ + runs_->runs[k].first), xb = std::min(W_, ox_ + runs_->runs[k].second);
+        if (xa >= xb) continue;
+        if constexpr (over_zero) {
+          for (int x = xa; x < xb; ++x)
+            if (!row[x]) {
+              row[x] = id;
+              span.add(x);
+            }
+        } else {
+          fill(row + xa, id, xb - xa);
+          span.lo = std::min(span.lo, xa);
+          span.hi = xb - 1;
+          span.count += static_cast<uint32_t>(xb - xa);
+        }
+      }
+      span.to(out, oy_ + j);
+    }
+    return out;
+  }
+
+  template <bool over_zero>
+  Painted paint_mapped(uint8_t id, uint8_t* mask) const {
+    Painted out;
+    for (int y = reach.y0; y <= reach.y1; ++y) {
+      uint8_t* row = mask + static_cast<size_t>(y) * W_;
+      RowSpan span;
+      for (int x = reach.x0; x <= reach.x1; ++x) {
+        if (over_zero && row[x]) continue;
         double sx, sy;
-        map.at(x, y, sx, sy);
+        map_.at(x, y, sx, sy);
         const int i = static_cast<int>(std::floor(sx)), j = static_cast<int>(std::floor(sy));
         const bool t = sx - i > 0, ty = sy - j > 0;
         if (cov(i, j) || (t && cov(i + 1, j)) || (ty && cov(i, j + 1)) || (t && ty && cov(i + 1, j + 1))) {
           row[x] = id;
-          out.add(x, x + 1, y);
+          span.add(x);
         }
       }
+      span.to(out, y);
     }
     return out;
   }
-  if (!bilinear) {
-    const int ox = p.x0 + static_cast<int>(std::floor(p.dx + 0.5));
-    const int oy = p.y0 + static_cast<int>(std::floor(p.dy + 0.5));
-    for (int j = std::max(0, -oy); j < std::min(sp.height, H - oy); ++j)
-      for (uint32_t k = runs.first[j]; k < runs.first[j + 1]; ++k) {
-        const int xa = std::max(0, ox + runs.runs[k].first), xb = std::min(W, ox + runs.runs[k].second);
-        if (xa >= xb) continue;
-        std::memset(mask + static_cast<size_t>(oy + j) * W + xa, id, static_cast<size_t>(xb - xa));
-        out.add(xa, xb, oy + j);
-      }
-    return out;
-  }
-  const double fx = p.x0 + p.dx, fy = p.y0 + p.dy;
-  const int xs = std::max(0, static_cast<int>(std::floor(fx)) - 1),
-            xe = std::min(W, static_cast<int>(std::floor(fx)) + sp.width + 2);
-  // Per column, the texel column and whether its right neighbour has weight.
-  std::vector<int> i0(static_cast<size_t>(std::max(0, xe - xs)));
-  std::vector<char> tx(i0.size());
-  for (int x = xs; x < xe; ++x) {
-    const double sx = x - fx;
-    i0[x - xs] = static_cast<int>(std::floor(sx));
-    tx[x - xs] = sx - i0[x - xs] > 0;
-  }
-  for (int y = std::max(0, static_cast<int>(std::floor(fy)) - 1);
-       y < std::min(H, static_cast<int>(std::floor(fy)) + sp.height + 2); ++y) {
-    const double sy = y - fy;
-    const int j0 = static_cast<int>(std::floor(sy));
-    const bool ty = sy - j0 > 0;
-    if (j0 < -1 || j0 >= sp.height) continue;
-    uint8_t* row = mask + static_cast<size_t>(y) * W;
+
+  template <bool over_zero>
+  Painted paint_bilinear(uint8_t id, uint8_t* mask) const {
+    Painted out;
+    const int xs = reach.x0, xe = reach.x1 + 1;
+    // Per column, the texel column and whether its right neighbour has weight.
+    std::vector<int> i0(static_cast<size_t>(xe - xs));
+    std::vector<char> tx(i0.size());
     for (int x = xs; x < xe; ++x) {
-      const int i = i0[x - xs];
-      const bool t = tx[x - xs];
-      if (cov(i, j0) || (t && cov(i + 1, j0)) || (ty && cov(i, j0 + 1)) || (t && ty && cov(i + 1, j0 + 1))) {
-        row[x] = id;
-        out.add(x, x + 1, y);
+      const double sx = x - fx_;
+      i0[x - xs] = static_cast<int>(std::floor(sx));
+      tx[x - xs] = sx - i0[x - xs] > 0;
+    }
+    const Image& sp = *sprite_;
+    for (int y = reach.y0; y <= reach.y1; ++y) {
+      const double sy = y - fy_;
+      const int j0 = static_cast<int>(std::floor(sy));
+      const bool ty = sy - j0 > 0;
+      if (j0 < -1 || j0 >= sp.height) continue;
+      uint8_t* row = mask + static_cast<size_t>(y) * W_;
+      RowSpan span;
+      for (int x = xs; x < xe; ++x) {
+        if (over_zero && row[x]) continue;
+        const int i = i0[x - xs];
+        const bool t = tx[x - xs];
+        if (cov(i, j0) || (t && cov(i + 1, j0)) || (ty && cov(i, j0 + 1)) || (t && ty && cov(i + 1, j0 + 1))) {
+          row[x] = id;
+          span.add(x);
+        }
       }
+      span.to(out, y);
+    }
+    return out;
+  }
+
+  const Image* sprite_;
+  const Runs* runs_;
+  int W_, H_;
+  bool bilinear_, transforms_;
+  reference::SpriteMap map_{};
+  int ox_ = 0, oy_ = 0;
+  bool whole_ = false;  // integer placement with all of the sprite's coverage inside the view
+  double fx_ = 0, fy_ = 0;
+};
+
+// Copies the lines of a scratch mask that a box touches into the mask, whole:
+// streaming stores write a whole line without reading it first, where a store into part
+// of one waits for it to come from memory (the masks are megabytes; each scenario touches
+// a few dozen scattered lines). Lines that stick out of the mask are copied in part, by
+// plain stores.
+class Lines {
+ public:
+  Lines(uint8_t* mask, const uint8_t* scratch, int W, size_t pixels)
+      : mask_(reinterpret_cast<uintptr_t>(mask)),
+        scratch_(reinterpret_cast<uintptr_t>(scratch)),
+        W_(W),
+        pixels_(pixels),
+        phase_(mask_ & 63) {}
+
+  // Copies the lines box (inclusive) touches to the mask.
+  void copy(int x0, int y0, int x1, int y1) const {
+    // Offsets from the start of the line the mask starts in.
+    size_t a = static_cast<size_t>(y0) * W_ + x0 + phase_, b = a + (x1 - x0);
+    const size_t last = (static_cast<size_t>(y1) * W_ + x1 + phase_) | 63;
+    const bool inside = a >= 64 && last < pixels_ + phase_;  // no line sticks out of the mask
+    size_t next = 0;                                         // rows may share a line
+    for (int y = y0; y <= y1; ++y, a += W_, b += W_) {
+      for (size_t line = std::max(a & ~size_t{63}, next); line <= b; line += 64) {
+        if (inside || (line >= phase_ && line + 64 <= pixels_ + phase_)) {
+          stream(mask_ - phase_ + line, scratch_ - phase_ + line);
+        } else {
+          const size_t s = std::max(line, phase_) - phase_, e = std::min(line + 64, pixels_ + phase_) - phase_;
+          std::memcpy(reinterpret_cast<uint8_t*>(mask_ + s), reinterpret_cast<const uint8_t*>(scratch_ + s), e - s);
+        }
+      }
+      next = (b | 63) + 1;
     }
   }
-  return out;
+  // Orders the streaming stores before what follows (other threads' reads).
+  static void fence() {
+#if defined(__SSE2__)
+    _mm_sfence();
+#endif
+  }
+
+ private:
+  static void stream(uintptr_t dst, uintptr_t src) {  // dst 64-byte aligned
+#if defined(__SSE2__)
+    for (int q = 0; q < 4; ++q)
+      _mm_stream_si128(reinterpret_cast<__m128i*>(dst) + q, _mm_loadu_si128(reinterpret_cast<const __m128i*>(src) + q));
+#else
+    std::memcpy(reinterpret_cast<uint8_t*>(dst), reinterpret_cast<const uint8_t*>(src), 64);
+#endif
+  }
+  uintptr_t mask_, scratch_;
+  int W_;
+  size_t pixels_, phase_;
+};
+
+// Asks for huge pages under [p, p + bytes) before it is first touched: the masks are
+// megabytes touched a few lines per page, where each 4 KiB page costs a page walk.
+void huge_pages(void* p, size_t bytes) {
+#if defined(MADV_HUGEPAGE)
+  constexpr uintptr_t kHuge = uintptr_t{2} << 20;
+  const uintptr_t a = (reinterpret_cast<uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1),
+                  e = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(kHuge - 1);
+  if (e > a) ::madvise(reinterpret_cast<void*>(a), e - a, MADV_HUGEPAGE);  // a hint: failure is harmless
+#else
+  (void)p, (void)bytes;
+#endif
 }
+
+bool meets(const Painted& a, const Painted& b) { return a.x0 <= b.x1 && b.x0 <= a.x1 && a.y0 <= b.y1 && b.y0 <= a.y1; }
 
 }  // namespace
 
@@ -130,10 +367,14 @@ void annotate(const Catalogue& cat, const AssetSet& assets, const ModelSettings&
     // Masks left by the last batch are cleared where they were painted (below); new
     // ones come zeroed.
     const size_t px = sensor.pixels();
-    if (va.width == sensor.width && va.height == sensor.height && va.painted.size() * px == va.masks.size()) {
+    if (va.width == sensor.width && va.height == sensor.height && va.painted.size() * px == va.masks.size() &&
+        n * px <= va.masks.capacity()) {
       va.masks.resize(n * px);
       va.painted.resize(n);
     } else {
+      va.masks = {};
+      va.masks.reserve(n * px);
+      huge_pages(va.masks.data(), n * px);
       va.masks.assign(n * px, 0);
       va.painted.assign(n, {});
     }
@@ -142,95 +383,174 @@ void annotate(const Catalogue& cat, const AssetSet& assets, const ModelSettings&
     for (size_t v = 0; v < cat.variant_list.size(); ++v)
       runs[k].emplace_back(assets.sprite(sensor.camera, static_cast<int>(v)));
   }
-  // Up to one annotation per region, by scenario, then view; no allocation per image.
-  // Kept between calls: a fresh megabyte per batch would cost page faults each time.
-  // (Named through references: inside the workers' lambda a thread_local would be theirs.)
-  static thread_local std::vector<std::array<Annotation, kRegions>> per_kept;
-  static thread_local std::vector<uint8_t> count_kept;
-  std::vector<std::array<Annotation, kRegions>>& per = per_kept;
-  std::vector<uint8_t>& count = count_kept;
-  per.resize(n * views);
-  count.assign(n * views, 0);
+  // Sprites that do not move sit where their variant, region and view put them, the same
+  // in every scenario: placed once here, from one scene per view and variant that holds
+  // the variant in every region.
+  struct Fixed {
+    reference::Placed placed{};
+    std::optional<Placement> at;
+  };
+  std::vector<std::vector<Fixed>> fixed;
+  if (!model.moves_sprites()) {
+    fixed.resize(views);
+    for (size_t k = 0; k < views; ++k) {
+      const Sensor& sensor = cat.sensors[k];
+      fixed[k].resize(cat.variant_list.size() * kRegions);
+      for (size_t v = 0; v < cat.variant_list.size(); ++v) {
+        Scenario every;
+        every.objects.fill(static_cast<int16_t>(v));
+        const reference::ViewScene vs = reference::view_scene(cat, assets, model, static_cast<int>(k), every, 0);
+        size_t p = 0;
+        for (int r = 0; r < kRegions; ++r) {
+          if (!sensor.sees(r)) continue;
+          Fixed& f = fixed[k][v * kRegions + r];
+          f.placed = vs.placed[p++];
+          f.at.emplace(f.placed, runs[k][v], model, sensor.width, sensor.height);
+        }
+      }
+    }
+  }
+  // Each worker's annotations in a list of its own, by scenario, then view (count says how
+  // many each image has), joined below in the order of the workers' first scenarios.
+  std::vector<uint8_t> count(n * views, 0);
+  // What a worker writes besides the masks, kept for the next call (fresh, its pages
+  // would fault in each time): its annotations, and per view the scratch mask that the
+  // objects are painted into first (zero between uses; see Lines).
+  struct Work {
+    std::vector<Annotation> items;
+    std::vector<std::vector<uint8_t>> scratch;
+  };
+  // (Named through a reference: inside the workers' lambda a thread_local would be theirs.)
+  static thread_local std::vector<Work> spare_kept;
+  std::vector<Work>& spare = spare_kept;
+  std::vector<std::pair<size_t, Work>> done;  // by first scenario
+  std::mutex work_mutex;
   parallel_for(n, n >= 256 ? threads : 1, [&](size_t lo, size_t hi) {
-    std::vector<Painted> painted;
+    Work work;
+    {
+      const std::lock_guard<std::mutex> lock(work_mutex);
+      if (!spare.empty()) {
+        work = std::move(spare.back());
+        spare.pop_back();
+      }
+    }
+    std::vector<Annotation>& mine = work.items;
+    mine.clear();
+    std::vector<std::vector<uint8_t>>& scratch = work.scratch;
+    scratch.resize(views);
+    for (size_t k = 0; k < views; ++k)
+      if (scratch[k].size() != cat.sensors[k].pixels()) scratch[k].assign(cat.sensors[k].pixels(), 0);
+    std::vector<reference::Placed> moved;  // this view's objects, where sprites move
+    std::vector<Placement> moved_at;
+    std::array<const reference::Placed*, kRegions> placed;
+    std::array<const Placement*, kRegions> at;
+    std::array<int, kRegions> regions;
+    std::array<Painted, kRegions> kept;
     for (size_t i = lo; i < hi; ++i) {
       const Scenario s = batch.at(i);
       for (size_t k = 0; k < views; ++k) {
         const Sensor& sensor = cat.sensors[k];
-        const int W = sensor.width, H = sensor.height;
-        const reference::ViewScene vs =
-            reference::view_scene(cat, assets, model, static_cast<int>(k), s, batch.first_index + i);
-        uint8_t* mask = out[k].masks.data() + i * sensor.pixels();
-        ViewAnnotations::Painted& dirty = out[k].painted[i];
-        for (int b = 0; b < dirty.count; ++b) {
-          const auto& [x0, y0, x1, y1] = dirty.box[b];
-          for (int y = y0; y <= y1; ++y)
-            std::memset(mask + static_cast<size_t>(y) * W + x0, 0, static_cast<size_t>(x1 - x0 + 1));
-        }
-        dirty.count = 0;
-        std::array<Annotation, kRegions>& items = per[i * views + k];
+        const int W = sensor.width;
+        uint8_t* scr = scratch[k].data();
         size_t m = 0;
-        painted.clear();
-        size_t p = 0;
+        if (fixed.empty()) {
+          moved = reference::view_scene(cat, assets, model, static_cast<int>(k), s, batch.first_index + i).placed;
+          moved_at.clear();
+          for (const reference::Placed& pl : moved)
+            moved_at.emplace_back(pl, runs[k][pl.variant], model, W, sensor.height);
+        }
         for (int r = 0; r < kRegions; ++r) {
           const int16_t v = s.objects[r];
           if (v == kNoObject || !sensor.sees(r)) continue;
-          const reference::Placed& pl = vs.placed[p++];
-          painted.push_back(paint(pl, runs[k][v], model, W, H, static_cast<uint8_t>(r + 1), mask));
-          if (const Painted& d = painted.back(); d.area)
+          if (fixed.empty()) {
+            placed[m] = &moved[m];
+            at[m] = &moved_at[m];
+          } else {
+            const Fixed& f = fixed[k][static_cast<size_t>(v) * kRegions + r];
+            placed[m] = &f.placed;
+            at[m] = &*f.at;
+          }
+          regions[m++] = r;
+        }
+        // Highest region first, so that each object paints only the pixels it keeps and
+        // its box and area come from that one pass; one that may reach a pixel an object
+        // above it kept paints over 0s only.
+        for (size_t t = m; t-- > 0;) {
+          bool under = false;
+          for (size_t u = t + 1; u < m && !under; ++u) under = kept[u].area && meets(at[t]->reach, kept[u]);
+          const uint8_t id = static_cast<uint8_t>(regions[t] + 1);
+          kept[t] = under ? at[t]->paint<true>(id, scr) : at[t]->paint<false>(id, scr);
+        }
+        // The mask's non-zero pixels lie in the boxes painted last time: copying the lines
+        // of those (unless a new box holds one) and of the new boxes from the scratch mask
+        // clears the old and writes the new.
+        ViewAnnotations::Painted& dirty = out[k].painted[i];
+        const Lines lines(out[k].masks.data() + i * sensor.pixels(), scr, W, sensor.pixels());
+        for (int b = 0; b < dirty.count; ++b) {
+          const auto& [x0, y0, x1, y1] = dirty.box[b];
+          bool held = false;
+          for (size_t t = 0; t < m && !held; ++t)
+            held = kept[t].area && kept[t].x0 <= x0 && kept[t].y0 <= y0 && x1 <= kept[t].x1 && y1 <= kept[t].y1;
+          if (!held) lines.copy(x0, y0, x1, y1);
+        }
+        dirty.count = 0;
+        for (size_t t = 0; t < m; ++t)
+          if (const Painted& d = kept[t]; d.area) {
+            lines.copy(d.x0, d.y0, d.x1, d.y1);
             dirty.box[dirty.count++] = {static_cast<int16_t>(d.x0), static_cast<int16_t>(d.y0),
                                         static_cast<int16_t>(d.x1), static_cast<int16_t>(d.y1)};
-          Annotation& a = items[m++];
-          a = Annotation{};
-          a.scenario = static_cast<uint32_t>(i);
-          a.region = static_cast<uint8_t>(r);
-          a.object = static_cast<int16_t>(cat.variant_list[v].object);
-          a.drawing = static_cast<int16_t>(cat.variant_list[v].variant);
-          a.dx = model.bilinear ? pl.dx : std::floor(pl.dx + 0.5);
-          a.dy = model.bilinear ? pl.dy : std::floor(pl.dy + 0.5);
-          a.rotation = pl.transform.rotation;
-          a.scale = pl.transform.scale;
-          a.flip = pl.transform.flip;
-        }
-        // What each object keeps: all it painted, unless a later object's box meets its
-        // own; then its pixels are counted again inside its box.
+          }
+        for (size_t t = 0; t < m; ++t)
+          for (int y = kept[t].y0; y <= kept[t].y1; ++y)
+            fill(scr + static_cast<size_t>(y) * W + kept[t].x0, 0, kept[t].x1 - kept[t].x0 + 1);
+
         size_t kept_count = 0;
         for (size_t t = 0; t < m; ++t) {
-          Painted kept = painted[t];
-          bool covered = false;
-          for (size_t u = t + 1; u < m && !covered; ++u) covered = painted[t].meets(painted[u]);
-          if (covered) {
-            const uint8_t id = static_cast<uint8_t>(items[t].region + 1);
-            kept = Painted{};
-            for (int y = painted[t].y0; y <= painted[t].y1; ++y) {
-              const uint8_t* row = mask + static_cast<size_t>(y) * W;
-              for (int x = painted[t].x0; x <= painted[t].x1; ++x)
-                if (row[x] == id) kept.add(x, x + 1, y);
-            }
-          }
-          if (!kept.area) continue;  // nothing visible: no annotation
-          Annotation& a = items[kept_count++];
-          a = items[t];
-          a.area = kept.area;
-          a.x = kept.x0;
-          a.y = kept.y0;
-          a.w = kept.x1 - kept.x0 + 1;
-          a.h = kept.y1 - kept.y0 + 1;
+          if (!kept[t].area) continue;  // nothing visible: no annotation
+          const reference::Placed& pl = *placed[t];
+          const VariantRef& v = cat.variant_list[pl.variant];
+          Annotation& an = mine.emplace_back();
+          an.scenario = static_cast<uint32_t>(i);
+          an.region = static_cast<uint8_t>(regions[t]);
+          an.object = static_cast<int16_t>(v.object);
+          an.drawing = static_cast<int16_t>(v.variant);
+          an.x = kept[t].x0;
+          an.y = kept[t].y0;
+          an.w = kept[t].x1 - kept[t].x0 + 1;
+          an.h = kept[t].y1 - kept[t].y0 + 1;
+          an.area = kept[t].area;
+          an.dx = model.bilinear ? pl.dx : std::floor(pl.dx + 0.5);
+          an.dy = model.bilinear ? pl.dy : std::floor(pl.dy + 0.5);
+          an.rotation = pl.transform.rotation;
+          an.scale = pl.transform.scale;
+          an.flip = pl.transform.flip;
+          ++kept_count;
         }
         count[i * views + k] = static_cast<uint8_t>(kept_count);
       }
     }
+    Lines::fence();
+    const std::lock_guard<std::mutex> lock(work_mutex);
+    done.emplace_back(lo, std::move(work));
   });
-  for (size_t k = 0; k < views; ++k) {
-    ViewAnnotations& va = out[k];
+  std::sort(done.begin(), done.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (ViewAnnotations& va : out) {
     va.items.clear();
     va.first.assign(n + 1, 0);
-    for (size_t i = 0; i < n; ++i) {
-      va.first[i] = static_cast<uint32_t>(va.items.size());
-      va.items.insert(va.items.end(), per[i * views + k].begin(), per[i * views + k].begin() + count[i * views + k]);
-    }
-    va.first[n] = static_cast<uint32_t>(va.items.size());
   }
+  size_t part = 0, at = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (part + 1 < done.size() && done[part + 1].first == i) ++part, at = 0;
+    for (size_t k = 0; k < views; ++k) {
+      ViewAnnotations& va = out[k];
+      va.first[i] = static_cast<uint32_t>(va.items.size());
+      const auto from = done[part].second.items.begin() + static_cast<ptrdiff_t>(at);
+      va.items.insert(va.items.end(), from, from + count[i * views + k]);
+      at += count[i * views + k];
+    }
+  }
+  for (ViewAnnotations& va : out) va.first[n] = static_cast<uint32_t>(va.items.size());
+  for (auto& d : done) spare.push_back(std::move(d.second));
 }
 
 }  // namespace portalsim
