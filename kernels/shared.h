@@ -49,8 +49,7 @@
  * (p / 16) % 2 (low first) of word (p % 128) / 32, and takes k to Phi^-1((k + 1/2) / 65536).
  * So one draw of the generator gives 8 cells, and 16 draws side by side give 128 in runs of
  * 16 (kernels/sensor_noise.cl, gauss128). */
-#define PS_GAUSS_ELEMENT(view, p) \
-  (((PS_U32)(view) << PS_PIXEL_NOISE_VIEW_SHIFT) | (PS_U32)(16 * ((p) >> 7) + ((p)&15)))
+#define PS_GAUSS_ELEMENT(view, p) (((PS_U32)(view) << PS_PIXEL_NOISE_VIEW_SHIFT) | (PS_U32)(16 * ((p) >> 7) + ((p)&15)))
 #define PS_GAUSS_WORD(p) (((p)&127) >> 5)
 #define PS_GAUSS_SHIFT(p) ((((p) >> 4) & 1) * 16)
 #define PS_GAUSS_TABLE 65536
@@ -66,8 +65,8 @@
 #define PS_FLAG_PATTERN_NOISE 1
 #define PS_FLAG_PIXEL_NOISE 2
 #define PS_FLAG_BILINEAR 4
-#define PS_FLAG_AFFINE 8 /* randomised objects: sprites sampled through their inverse affine map */
-#define PS_FLAG_FLIP 16  /* with PS_FLAG_AFFINE: mirror each object with probability 1/2 */
+#define PS_FLAG_AFFINE 8     /* randomised objects: sprites sampled through their inverse affine map */
+#define PS_FLAG_FLIP 16      /* with PS_FLAG_AFFINE: mirror each object with probability 1/2 */
 #define PS_FLAG_TABULATED 32 /* physics features-only: scenarios the object tables cover skip physics_raw */
 
 /* Footprint record of the sparse features path, per (variant, region), ints. */
