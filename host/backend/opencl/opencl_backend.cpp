@@ -711,7 +711,11 @@ class OpenCLBackend final : public Backend {
     const FeatureLayout lay = FeatureLayout::of(cat_, plan.model.block);
     Plan quiet = plan;  // the raw grid without sensor noise: that is drawn per feature
     quiet.model.netd = 0;
-    const bool tabulated = plan.model.jitter <= 0 && !plan.model.transforms();  // objects at their places
+    // Tables where objects stand at their places, and while the pairs' index (subjects x
+    // (variants x regions)^2) stays small.
+    const size_t combos = cat_.variant_list.size() * kRegions;
+    const bool tabulated = plan.model.jitter <= 0 && !plan.model.transforms() &&
+                           cat_.subjects.size() * combos * combos <= (size_t(1) << 26);
     cl::Context& ctx = rt_->context();
     for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
       const int view = lay.pooled[slot];
@@ -772,8 +776,10 @@ class OpenCLBackend final : public Backend {
     const ModelSettings& m = quiet.model;
     const int RW = m.raw_width, RH = m.raw_height, cells = RW * RH;
     char key[200];
-    std::snprintf(key, sizeof key, "%d %d %d %d %d %a %a %d %d", view, lay.block, RW, RH, int(K.fp64), m.illumination,
-                  m.worn_minutes, int(m.bilinear), int(tabulated));
+    // Per program variant too (&K): tables made by another variant's arithmetic (fast math)
+    // would make a run's features depend on what ran before it.
+    std::snprintf(key, sizeof key, "%p %d %d %d %d %a %a %d %d", static_cast<const void*>(&K), view, lay.block, RW, RH,
+                  m.illumination, m.worn_minutes, int(m.bilinear), int(tabulated));
     RawGridTables& t = raw_grid_tables_[key];
     if (t.first()) return t;
     cl::Context& ctx = rt_->context();
