@@ -131,7 +131,8 @@ kernel void physics_features(global const preal* raw, global const int* first, g
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
   global float* row = features + (size_t)i * row_len;
-  const int band_x = dims.s2, band_y = dims.s3, zlen = dims.s0 * dims.s1 + dims.s4, space = PS_FEATURE_SPACE(dims);
+  const int band_x = dims.s2, band_y = dims.s3, zlen = dims.s0 * dims.s1 + dims.s4;
+  const int space = PS_FEATURE_SPACE(dims.s0, dims.s1, band_x, band_y, dims.s4);
   if (space <= PS_FEATURE_NOISE_PRIVATE) {
     preal work[PS_FEATURE_NOISE_PRIVATE];
     view_features_private(work, work + count + band_x, work + count + band_x + zlen + band_y * dims.s0, row, i, &L,

@@ -53,12 +53,11 @@
 #define PS_GAUSS_WORD(p) (((p)&127) >> 5)
 #define PS_GAUSS_SHIFT(p) ((((p) >> 4) & 1) * 16)
 #define PS_GAUSS_TABLE 65536
-/* physics_features' work space per scenario, in values, from its dims (blocks_x, blocks_y,
- * band_x, band_y, regions): the features, band_x zeros, the draws, band_y rows of zeros,
- * Z Lx^T. Up to
- * PS_FEATURE_NOISE_PRIVATE it lives in private memory (the work-item's stack, in cache);
- * larger layouts (small blocks) use global scratch. */
-#define PS_FEATURE_SPACE(d) (3 * (d).s0 * (d).s1 + 2 * (d).s4 + (d).s2 + (d).s3 * (d).s0)
+/* physics_features' work space per scenario, in values: the features, band_x zeros, the
+ * draws, band_y rows of zeros, Z Lx^T. Up to PS_FEATURE_NOISE_PRIVATE it lives in private
+ * memory (the work-item's stack, in cache); larger layouts (small blocks) use global
+ * scratch. */
+#define PS_FEATURE_SPACE(bx, by, band_x, band_y, regions) (3 * (bx) * (by) + 2 * (regions) + (band_x) + (band_y) * (bx))
 #define PS_FEATURE_NOISE_PRIVATE 2048
 
 /* Per-launch flags of the render kernels. */

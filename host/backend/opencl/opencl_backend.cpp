@@ -724,8 +724,7 @@ class OpenCLBackend final : public Backend {
       render(K, quiet, view, n, subject, objects, seed, first, scratch_[view].at_least(ctx, 1), true, tabulated, &L);
       const cl::Buffer phys = physics_params(K, quiet, view, L);
       const auto& d = t.dims.s;
-      const size_t per = 3 * static_cast<size_t>(d[0]) * d[1] + 2 * static_cast<size_t>(d[4]) + d[2] +
-                         static_cast<size_t>(d[3]) * d[0];  // PS_FEATURE_SPACE
+      const size_t per = PS_FEATURE_SPACE(size_t(d[0]), size_t(d[1]), size_t(d[2]), size_t(d[3]), size_t(d[4]));
 
       cl::Kernel& k = stage_kernel(K, "physics_features");
       int a = 0;
@@ -844,6 +843,12 @@ class OpenCLBackend final : public Backend {
         rt_->queue().enqueueReadBuffer(raw_.buf, CL_TRUE, 0, N * cells * sizeof(cl_float), f.data());
         raw.assign(f.begin(), f.end());
       }
+      // Feature f of a raw grid: its taps' weighted sum.
+      const auto pooled = [&](const double* g, int f) {
+        double d = 0;
+        for (int k = p.first[f]; k < p.first[f + 1]; ++k) d += p.weights[k] * g[p.cells[k]];
+        return d;
+      };
       // The features of sum_k sign_k raw[scenario_k], kept where not zero.
       std::vector<double> grid(cells);
       const auto entries = [&](size_t u, std::initializer_list<std::pair<size_t, double>> terms) {
@@ -852,8 +857,7 @@ class OpenCLBackend final : public Backend {
           for (int c = 0; c < cells; ++c) grid[c] += sign * raw[scenario * cells + c];
         object_range[u].s[0] = static_cast<cl_int>(features.size());
         for (int f = 0; f < t.count; ++f) {
-          double d = 0;
-          for (int k = p.first[f]; k < p.first[f + 1]; ++k) d += p.weights[k] * grid[p.cells[k]];
+          const double d = pooled(grid.data(), f);
           if (d == 0) continue;
           features.push_back(f);
           values.push_back(d);
@@ -865,9 +869,7 @@ class OpenCLBackend final : public Backend {
       std::vector<size_t> alone(combos);
       for (int s = 0; s < S; ++s) {
         const size_t bare_at = at++;
-        for (int f = 0; f < t.count; ++f)
-          for (int k = p.first[f]; k < p.first[f + 1]; ++k)
-            bare[static_cast<size_t>(s) * t.count + f] += p.weights[k] * raw[bare_at * cells + p.cells[k]];
+        for (int f = 0; f < t.count; ++f) bare[static_cast<size_t>(s) * t.count + f] = pooled(&raw[bare_at * cells], f);
         for (int v = 0; v < V; ++v)
           for (int r = 0; r < kRegions; ++r) {
             const size_t c = static_cast<size_t>(v) * kRegions + r;
