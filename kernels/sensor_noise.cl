@@ -151,13 +151,13 @@ __attribute__((always_inline)) inline void gauss64(uint2 seed, ulong index, uint
 
 // The physics model's sensor noise (kernels/shared.h, PS_GAUSS_ELEMENT): a table Gaussian
 // per cell, eight cells to one draw of the generator where Box-Muller takes two, and no
-// log or sincos. The table (phys + L.phys_gauss, built on the host) holds the 65,536
-// equally likely values Phi^-1((k + 1/2) / 65536): |g| <= 4.325, sd 1 - 1e-5.
+// log or sincos. The table (phys + L.phys_gauss, built on the host) holds the 4,096
+// equally likely values Phi^-1((k + 1/2) / 4096): |g| <= 3.67, sd 1 - 1.6e-4.
 inline preal gauss_cell(uint2 seed, ulong index, uint stream, int view, int p, global const param* table) {
   const uint4 r = draw(seed, index, stream, PS_GAUSS_ELEMENT(view, p));
   const int w = PS_GAUSS_WORD(p);
   const uint word = w == 0 ? r.x : w == 1 ? r.y : w == 2 ? r.z : r.w;
-  return (preal)table[(word >> PS_GAUSS_SHIFT(p)) & 0xffffu];
+  return (preal)table[PS_GAUSS_INDEX(word, p)];
 }
 
 #if !defined(PRECISION_FP64)
@@ -176,7 +176,7 @@ __attribute__((always_inline)) inline void gauss128(uint2 seed, ulong index, uin
   philox16(&c[0], &c[1], &c[2], &c[3], seed);
 #pragma unroll
   for (int w = 0; w < 4; ++w) {
-    const uint16 lo = c[w] & 0xffffu, hi = c[w] >> 16;
+    const uint16 lo = (c[w] >> (16 - PS_GAUSS_BITS)) & (PS_GAUSS_TABLE - 1), hi = c[w] >> (32 - PS_GAUSS_BITS);
     g[2 * w] = GATHER16(table, lo);
     g[2 * w + 1] = GATHER16(table, hi);
   }

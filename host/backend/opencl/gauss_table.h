@@ -1,6 +1,6 @@
 // The kernels' table Gaussians (kernels/shared.h, PS_GAUSS_ELEMENT): entry k is
-// Phi^-1((k + 1/2) / 65536), the standard normal quantile at the middle of the k-th of
-// 65,536 equally likely slices.
+// Phi^-1((k + 1/2) / PS_GAUSS_TABLE), the standard normal quantile at the middle of the
+// k-th of PS_GAUSS_TABLE (4,096) equally likely slices.
 #pragma once
 #include <vector>
 

@@ -36,13 +36,13 @@ double normal_quantile(double q) {
 }
 
 // Gaussian noise of `sd` kelvin rms on each value of f: cell p's table Gaussian of the
-// counter generator's `stream` (kernels/shared.h, PS_GAUSS_ELEMENT): the 16-bit half of a
-// draw's word as k, then Phi^-1((k + 1/2) / 65536).
+// counter generator's `stream` (kernels/shared.h, PS_GAUSS_ELEMENT): the top PS_GAUSS_BITS
+// of a 16-bit half of a draw's word as k, then Phi^-1((k + 1/2) / PS_GAUSS_TABLE).
 void add_noise(const ViewScene& vs, Field& f, double sd, uint32_t stream) {
   if (sd <= 0) return;
   for (int p = 0; p < f.width * f.height; ++p) {
     const Philox4 q = draw(vs.model.seed, vs.index, stream, PS_GAUSS_ELEMENT(vs.view, p));
-    const uint32_t k = (q[PS_GAUSS_WORD(p)] >> PS_GAUSS_SHIFT(p)) & 0xffffu;
+    const uint32_t k = PS_GAUSS_INDEX(q[PS_GAUSS_WORD(p)], p);
     f.v[p] += sd * normal_quantile((k + 0.5) / PS_GAUSS_TABLE);
   }
 }
