@@ -18,6 +18,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "plan/plan.h"
 #include "sink/h5_file.h"
 #include "sink/output_folder.h"
 
@@ -159,6 +160,23 @@ class TensorSink final : public Sink {
               }
             return std::string_view(buf);
           });
+      if (ctx.model.transforms()) {
+        // Each object's randomised draw (plan.h, object_transform), the numbers scenarios.csv
+        // records: float64 so they are the same doubles; identity where a region is empty.
+        add("region_rotation", TensorType::f64, {kRegions},
+            [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+              return per_transform<double>(b, lo, hi, buf, 0.0, [](const ObjectTransform& x) { return x.rotation; });
+            });
+        add("region_scale", TensorType::f64, {kRegions},
+            [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+              return per_transform<double>(b, lo, hi, buf, 1.0, [](const ObjectTransform& x) { return x.scale; });
+            });
+        add("region_flip", TensorType::u8, {kRegions},
+            [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+              return per_transform<uint8_t>(b, lo, hi, buf, 0,
+                                            [](const ObjectTransform& x) { return uint8_t(x.flip); });
+            });
+      }
     }
     if (in_place())
       open_in_place(resume);
@@ -403,6 +421,19 @@ class TensorSink final : public Sink {
       const int16_t v = f(b.objects[i]);
       std::memcpy(&buf[(i - lo * kRegions) * sizeof(int16_t)], &v, sizeof v);
     }
+    return buf;
+  }
+
+  // Scenario i's region r: `of(object_transform(...))`, or `none` where the region is empty.
+  template <class T, class F>
+  std::string_view per_transform(const SceneBatch& b, size_t lo, size_t hi, std::string& buf, T none, F of) const {
+    buf.resize((hi - lo) * kRegions * sizeof(T));
+    for (size_t i = lo; i < hi; ++i)
+      for (int r = 0; r < kRegions; ++r) {
+        const T v =
+            b.objects[i * kRegions + r] == kNoObject ? none : of(object_transform(ctx_.model, b.first_index + i, r));
+        std::memcpy(&buf[((i - lo) * kRegions + r) * sizeof(T)], &v, sizeof v);
+      }
     return buf;
   }
 
