@@ -62,10 +62,11 @@ void ExpectSameBytes(const fs::path& whole, const fs::path& other) {
                               << " in " << other;
 }
 
-// Every output kind: the four tables and data.h5; image folders; image tensors as .npy.
+// Every output kind: the four tables and data.h5 (with randomised objects' transforms);
+// image folders; image tensors as .npy.
 const std::vector<Args> kSpecs{
     {"--count", "240", "--seed", "7", "--rule", "gun", "--what", "both", "--format", "arff,csv,npy,h5", "--batch", "32",
-     "--quiet"},
+     "--rotate", "-20..20", "--scale", "0.9..1.1", "--flip", "on", "--quiet"},
     {"--count", "90", "--seed", "8", "--rule", "iron-rod", "--what", "both", "--format", "csv", "--batch", "16",
      "--quiet"},
     {"--count", "120", "--seed", "9", "--what", "images", "--format", "npy", "--batch", "16", "--quiet"}};

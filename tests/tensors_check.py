@@ -6,8 +6,10 @@
 Generates a small balanced gun set with --format h5, checks every dataset's shape and
 dtype and the attributes with h5py, reads items through tools/portalsim_dataset.py, and
 runs tools/train_example.py on it: fails if the file cannot be read or if the model's
-held-out accuracy is not clearly above chance.
+held-out accuracy is not clearly above chance. Also checks a randomised set's transforms
+(the loader's transforms() against scenarios.csv) and an annotated set's mask targets.
 """
+import csv
 import json
 import pathlib
 import shutil
@@ -78,6 +80,36 @@ def main():
     ir = PortalsimDataset(out / "data.h5", views=("ir",), target="region_label")
     x, y = ir[0]
     expect(tuple(x.shape) == (3, 200, 100) and tuple(y.shape) == (13,), f"ir item {tuple(x.shape)}, {tuple(y.shape)}")
+
+    expect(not ds.has_transforms, "a set without --rotate/--scale/--flip claims transforms")
+
+    # Randomised objects: the transforms in data.h5 are scenarios.csv's numbers, exactly.
+    rnd = work / "randomised"
+    subprocess.run([portalsim, "generate", "--count", "60", "--seed", "4", "--objects", "1..4", "--rotate", "-30..30",
+                    "--scale", "0.8..1.2", "--flip", "on", "--what", "images", "--format", "h5", "--out", str(rnd),
+                    "--quiet"], check=True)
+    with h5py.File(rnd / "data.h5", "r") as f:
+        for name, dtype in (("region_rotation", np.float64), ("region_scale", np.float64), ("region_flip", np.uint8)):
+            expect(f[name].shape == (60, 13) and f[name].dtype == dtype, f"data.h5: {name} is {f[name].dtype} "
+                   f"{f[name].shape}, expected {np.dtype(dtype)} (60, 13)")
+    tds = PortalsimDataset(rnd / "data.h5", views=("upper", "lower"))
+    expect(tds.has_transforms, "the loader does not see the transforms")
+    with open(rnd / "scenarios.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    checked = 0
+    for i, row in enumerate(rows):
+        t = tds.transforms(i)
+        for r in range(13):
+            n = str(r + 1)
+            if row["region" + n] == "none":
+                expect(t["object"][r] == -1 and t["rotation"][r] == 0 and t["scale"][r] == 1 and t["flip"][r] == 0,
+                       f"scenario {i} region {n}: an empty region is not the identity transform")
+                continue
+            got = (float(t["rotation"][r]), float(t["scale"][r]), str(int(t["flip"][r])))
+            want = (float(row["rotation" + n]), float(row["scale" + n]), row["flip" + n])
+            expect(got == want, f"scenario {i} region {n}: data.h5 has {got}, scenarios.csv {want}")
+            checked += 1
+    expect(checked >= 60, f"only {checked} objects in 60 scenarios of 1..4 objects")
 
     # Mask targets: a small annotated set; the loader's masks and boxes are annotations.json's.
     ann = work / "annotated"

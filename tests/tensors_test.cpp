@@ -1,6 +1,7 @@
 // generate --format h5 and --what images --format npy: the tensors read back with libhdf5
-// and compared against the PNG folders and feature table of the same spec; byte identity
-// across --batch and --threads; exact resume after kill -9.
+// and compared against the PNG folders, feature table and scenarios.csv of the same spec
+// (randomised objects' transforms); byte identity across --batch and --threads; exact
+// resume after kill -9.
 #include <gtest/gtest.h>
 #include <hdf5.h>
 #include <sys/wait.h>
@@ -11,7 +12,10 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -182,6 +186,115 @@ TEST(TensorsH5, RoundTripMatchesImageFoldersAndFeatureTable) {
   EXPECT_EQ(read_h5_string(file, "region_label_rule"), "gun");
 }
 
+// The cells of a CSV file with a header line: header name -> column, and the rows.
+struct Csv {
+  std::map<std::string, size_t> column;
+  std::vector<std::vector<std::string>> rows;
+};
+Csv read_csv(const fs::path& p) {
+  Csv c;
+  std::istringstream in(slurp(p));
+  std::string line;
+  bool header = true;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::string cell;
+    std::istringstream l(line);
+    while (std::getline(l, cell, ',')) cells.push_back(cell);
+    if (!line.empty() && line.back() == ',') cells.push_back("");
+    if (header) {
+      for (size_t k = 0; k < cells.size(); ++k) c.column[cells[k]] = k;
+      header = false;
+    } else {
+      c.rows.push_back(cells);
+    }
+  }
+  return c;
+}
+
+const Args kTransforms{"--rotate", "-40..35", "--scale", "0.7..1.3", "--flip", "on"};
+
+TEST(TensorsH5, TransformsAreWhatScenariosCsvRecords) {
+  portalsim::test::TempDir t;
+  const Args spec = plus(
+      {"--count", "120", "--seed", "12", "--rule", "gun", "--objects", "0..5", "--what", "images", "--format", "h5"},
+      kTransforms);
+  const fs::path dir = t.w() / "h5";
+  ExpectOk(run(t, plus(spec, {"--batch", "50"}), dir));
+  const fs::path file = dir / "data.h5";
+  const size_t N = 120;
+  const Dataset rot = read_h5(file, "region_rotation", H5T_NATIVE_DOUBLE);
+  const Dataset scale = read_h5(file, "region_scale", H5T_NATIVE_DOUBLE);
+  const Dataset flip = read_h5(file, "region_flip", H5T_NATIVE_UINT8);
+  const Dataset obj = read_h5(file, "region_object", H5T_NATIVE_INT16);
+  for (const Dataset* d : {&rot, &scale, &flip}) ASSERT_EQ(d->dims, (std::vector<hsize_t>{N, 13}));
+  // Stored as float64, as the file holds them (not converted on reading).
+  {
+    const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    const hid_t ds = H5Dopen2(f, "region_rotation", H5P_DEFAULT);
+    const hid_t type = H5Dget_type(ds);
+    EXPECT_EQ(H5Tget_class(type), H5T_FLOAT);
+    EXPECT_EQ(H5Tget_size(type), 8u);
+    H5Tclose(type);
+    H5Dclose(ds);
+    H5Fclose(f);
+  }
+  const auto* r = reinterpret_cast<const double*>(rot.bytes.data());
+  const auto* s = reinterpret_cast<const double*>(scale.bytes.data());
+  const auto* o = reinterpret_cast<const int16_t*>(obj.bytes.data());
+  const Csv csv = read_csv(dir / "scenarios.csv");
+  ASSERT_EQ(csv.rows.size(), N);
+  size_t objects = 0, flipped = 0;
+  std::set<double> angles;
+  for (size_t i = 0; i < N; ++i)
+    for (size_t k = 0; k < 13; ++k) {
+      const std::string n = std::to_string(k + 1);
+      const std::vector<std::string>& row = csv.rows[i];
+      ASSERT_EQ(row.size(), csv.column.size()) << "scenarios.csv row " << i;
+      const size_t at = i * 13 + k;
+      if (row[csv.column.at("region" + n)] == "none") {
+        EXPECT_EQ(o[at], -1) << i << " region " << n;
+        EXPECT_EQ(row[csv.column.at("rotation" + n)], "") << i;
+        EXPECT_EQ(r[at], 0.0) << i << " region " << n << ": an empty region is the identity";
+        EXPECT_EQ(s[at], 1.0) << i << " region " << n;
+        EXPECT_EQ(flip.bytes[at], 0) << i << " region " << n;
+        continue;
+      }
+      ++objects;
+      // Exactly the recorded doubles: the text reads back as the stored number, bit for bit.
+      EXPECT_EQ(std::stod(row[csv.column.at("rotation" + n)]), r[at]) << i << " region " << n;
+      EXPECT_EQ(std::stod(row[csv.column.at("scale" + n)]), s[at]) << i << " region " << n;
+      EXPECT_EQ(row[csv.column.at("flip" + n)], flip.bytes[at] ? "1" : "0") << i << " region " << n;
+      EXPECT_GE(r[at], -40.0);
+      EXPECT_LE(r[at], 35.0);
+      EXPECT_GE(s[at], 0.7);
+      EXPECT_LE(s[at], 1.3);
+      flipped += flip.bytes[at];
+      angles.insert(r[at]);
+    }
+  EXPECT_GT(objects, 100u);
+  EXPECT_GT(flipped, objects / 4) << "about half the objects are mirrored";
+  EXPECT_LT(flipped, objects * 3 / 4);
+  EXPECT_GT(angles.size(), objects / 2) << "the angles are drawn per object";
+
+  // Byte-identical for another --batch and --threads, compressed or not; and without
+  // randomised objects there are no transform datasets (scenarios.csv has no such columns).
+  const fs::path other = t.w() / "other", plain = t.w() / "plain", z = t.w() / "z";
+  ExpectOk(run(t, plus(spec, {"--batch", "7", "--threads", "1"}), other));
+  EXPECT_TRUE(slurp(file) == slurp(other / "data.h5")) << "--batch 50 and --batch 7 --threads 1 differ";
+  ExpectOk(run(t, plus(spec, {"--compress"}), z));
+  for (const char* name : {"region_rotation", "region_scale"})
+    EXPECT_TRUE(read_h5(z / "data.h5", name, H5T_NATIVE_DOUBLE).bytes == read_h5(file, name, H5T_NATIVE_DOUBLE).bytes)
+        << name << " differs under --compress";
+  EXPECT_TRUE(read_h5(z / "data.h5", "region_flip", H5T_NATIVE_UINT8).bytes == flip.bytes);
+  ExpectOk(run(t, {"--count", "20", "--seed", "12", "--what", "images", "--format", "h5"}, plain));
+  const hid_t f = H5Fopen((plain / "data.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  for (const char* name : {"region_rotation", "region_scale", "region_flip"})
+    EXPECT_EQ(H5Lexists(f, name, H5P_DEFAULT), 0) << name << " in a run without randomised objects";
+  H5Fclose(f);
+}
+
 TEST(TensorsNpy, ImageTensorsEqualTheH5Datasets) {
   portalsim::test::TempDir t;
   const Args spec{"--count", "30", "--seed", "8", "--rule", "gun", "--what", "images"};
@@ -255,7 +368,9 @@ void expect_same_run(const fs::path& ref, const fs::path& dir) {
 
 TEST(TensorsH5, ResumeAfterKill9IsExact) {
   portalsim::test::TempDir t;
-  const Args spec{"--count", "4000", "--seed", "10", "--rule", "gun", "--what", "both", "--format", "h5,csv"};
+  // With randomised objects: their transform datasets are resumed like every other.
+  const Args spec =
+      plus({"--count", "4000", "--seed", "10", "--rule", "gun", "--what", "both", "--format", "h5,csv"}, kTransforms);
   const portalsim::test::Result r = kill_then_resume(t, spec, [](const fs::path& dir) {
     // Laid out before the first row was written: what the kill left is an HDF5 file
     // that HDF5 opens, with every dataset at its full length.
@@ -277,18 +392,23 @@ TEST(TensorsH5, ResumeAfterKill9IsExact) {
   });
   ExpectOk(r);
   expect_same_run(t.w() / "ref", t.w() / "killed");
+  EXPECT_EQ(read_h5(t.w() / "killed" / "data.h5", "region_rotation", H5T_NATIVE_DOUBLE).dims,
+            (std::vector<hsize_t>{4000, 13}));
 }
 
 TEST(TensorsH5, CompressedResumeAfterKill9IsExact) {
   portalsim::test::TempDir t;
-  const Args spec{"--count", "1500", "--seed",   "10",     "--rule",    "gun",
-                  "--what",  "both", "--format", "h5,csv", "--compress"};
+  const Args spec =
+      plus({"--count", "1500", "--seed", "10", "--rule", "gun", "--what", "both", "--format", "h5,csv", "--compress"},
+           kTransforms);
   const portalsim::test::Result r = kill_then_resume(t, spec, [](const fs::path& dir) {
     EXPECT_TRUE(fs::exists(dir / ".portalsim" / "tensors")) << "compressed, the batches are .npy files until the end";
     EXPECT_FALSE(fs::exists(dir / "data.h5.partial"));
   });
   ExpectOk(r);
   expect_same_run(t.w() / "ref", t.w() / "killed");
+  EXPECT_EQ(read_h5(t.w() / "killed" / "data.h5", "region_flip", H5T_NATIVE_UINT8).dims,
+            (std::vector<hsize_t>{1500, 13}));
 }
 
 TEST(TensorsH5, ResumeRefusesRowsChangedSinceTheCheckpoint) {

@@ -9,7 +9,9 @@ are 200x200; ir is 200x100x3 and comes alone, channels first). `target` is "labe
 class per scenario), "region_label" (13 per-region threat labels, float32) or "mask" (the
 instance masks of the chosen views, int64 (V, H, W): each pixel the region 1-13 whose
 object covers it, 0 none; needs a set made with --annotations). For detection, `boxes()`
-gives an item's boxes from its masks. The file is
+gives an item's boxes from its masks. With randomised objects (--rotate, --scale, --flip),
+`transforms(i)` gives item i's per-region rotation, scale and flip, as scenarios.csv
+records them (`has_transforms` says whether the file has them). The file is
 opened lazily in each worker process, so the dataset works with DataLoader(num_workers>0).
 Needs Debian python3-torch, python3-h5py, python3-numpy.
 """
@@ -32,6 +34,7 @@ class PortalsimDataset(Dataset):
                 raise KeyError(f"{self.path}: no dataset {', '.join(missing)} "
                                f"(it has {', '.join(sorted(f.keys()))}; images need --what images|both)")
             self.length = f[self._targets[0]].shape[0]
+            self.has_transforms = all(k in f for k in self.TRANSFORMS.values())
             self.class_names = [str(c) for c in f.attrs["class_names"]]
             self.spec = f.attrs["spec"]
             shapes = {f[v].shape[1:3] for v in self.views}
@@ -44,6 +47,21 @@ class PortalsimDataset(Dataset):
         if in_memory:
             with h5py.File(self.path, "r") as f:
                 self._cache = {k: f[k][:][self.indices] for k in (*self.views, *self._targets)}
+
+    # transforms() keys and the datasets they come from (each N x 13).
+    TRANSFORMS = {"rotation": "region_rotation", "scale": "region_scale", "flip": "region_flip"}
+
+    def transforms(self, i):
+        """Item i's randomised-object transforms, one value per region (13): "rotation"
+        (float64 degrees, counter-clockwise in the image), "scale" (float64 factor), "flip"
+        (uint8, 1 = mirrored left to right), and "object" (int16, -1 where the region is
+        empty, which has rotation 0, scale 1, flip 0)."""
+        if not self.has_transforms:
+            raise KeyError(f"{self.path}: no transforms (the set was made without --rotate, --scale or --flip)")
+        f, j = self._h5(), int(self.indices[i])
+        out = {k: f[name][j] for k, name in self.TRANSFORMS.items()}
+        out["object"] = f["region_object"][j]
+        return out
 
     def __len__(self):
         return len(self.indices)

@@ -168,7 +168,7 @@ std::function<int()> add_generate(CLI::App& app) {
   sub->add_option("--image-format", o->spec.image_format, "png or jpg (default png)");
   sub->add_option("--scenarios", o->spec.scenarios, "explicit scenario list (CSV: subject, region1..13, label)");
   add_knob_options(*sub, o->spec.tier, o->knobs);
-  sub->add_option("--batch", o->batch, "scenarios per kernel launch (default: about 64 MiB of outputs)");
+  sub->add_option("--batch", o->batch, "scenarios per kernel launch (default: about 16 MiB of outputs)");
   sub->add_option("--threads", o->threads, "host threads for generating and writing (default: all cores)");
   sub->add_option("--shard", o->shard, "i/k: make only part i (0-based) of k of the index range");
   sub->add_flag("--resume", o->resume, "continue an interrupted run in --out");

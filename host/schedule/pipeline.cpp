@@ -359,13 +359,16 @@ void write_manifest(const std::string& dir, std::vector<std::unique_ptr<Sink>>& 
 
 }  // namespace
 
+// About 16 MiB of outputs: the batch being written and the next being computed fit in a
+// 32 MiB last-level cache together, so the writer mostly reads the kernels' output from the
+// cache rather than from memory (README, "Tensors for deep learning", Speed).
 size_t default_batch(const Plan& plan, const Catalogue& cat) {
   size_t bytes = 64 + kZones;
   for (size_t k = 0; k < cat.sensors.size(); ++k)
     if (plan.renders(cat.sensors[k], static_cast<int>(k))) bytes += cat.sensors[k].pixels();
   if (plan.sparse_features()) bytes = 64 + kZones;  // no images, on the device either
   if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
-  return std::clamp<size_t>((64u << 20) / bytes, 64, 16384);
+  return std::clamp<size_t>((16u << 20) / bytes, 64, 16384);
 }
 
 bool holds_finished_run(const RunSpec& spec, const Catalogue& cat, const std::string& dir, bool resume) {

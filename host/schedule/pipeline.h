@@ -14,7 +14,7 @@
 namespace portalsim {
 
 struct PipelineOptions {
-  size_t batch = 0;      // 0 = sized from the outputs (about 64 MiB per batch)
+  size_t batch = 0;      // 0 = sized from the outputs (about 16 MiB per batch)
   unsigned threads = 0;  // host threads for generating and writing; 0 = all cores
   uint64_t shard = 0, shards = 1;
   bool resume = false;
@@ -39,7 +39,7 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
 // parameters differ (naming every key that does).
 bool holds_finished_run(const RunSpec& spec, const Catalogue& cat, const std::string& dir, bool resume);
 
-// Scenarios per batch for a plan: about 64 MiB of outputs, between 64 and 16384.
+// Scenarios per batch for a plan: about 16 MiB of outputs, between 64 and 16384.
 size_t default_batch(const Plan& plan, const Catalogue& cat);
 
 }  // namespace portalsim

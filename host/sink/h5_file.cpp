@@ -18,8 +18,32 @@ namespace portalsim {
 
 namespace fs = std::filesystem;
 
-size_t type_size(TensorType t) { return t == TensorType::u8 ? 1 : t == TensorType::i16 ? 2 : 4; }
-const char* npy_descr(TensorType t) { return t == TensorType::u8 ? "|u1" : t == TensorType::i16 ? "<i2" : "<f4"; }
+size_t type_size(TensorType t) {
+  switch (t) {
+    case TensorType::u8:
+      return 1;
+    case TensorType::i16:
+      return 2;
+    case TensorType::f32:
+      return 4;
+    case TensorType::f64:
+      return 8;
+  }
+  return 0;
+}
+const char* npy_descr(TensorType t) {
+  switch (t) {
+    case TensorType::u8:
+      return "|u1";
+    case TensorType::i16:
+      return "<i2";
+    case TensorType::f32:
+      return "<f4";
+    case TensorType::f64:
+      return "<f8";
+  }
+  return "";
+}
 
 size_t H5Dataset::row_bytes() const {
   size_t b = type_size(type);
@@ -86,10 +110,30 @@ H5Attribute read_strings(hid_t obj, const char* name, const std::string& path) {
 }
 
 hid_t file_type_of(TensorType t) {
-  return t == TensorType::u8 ? H5T_STD_U8LE : t == TensorType::i16 ? H5T_STD_I16LE : H5T_IEEE_F32LE;
+  switch (t) {
+    case TensorType::u8:
+      return H5T_STD_U8LE;
+    case TensorType::i16:
+      return H5T_STD_I16LE;
+    case TensorType::f32:
+      return H5T_IEEE_F32LE;
+    case TensorType::f64:
+      return H5T_IEEE_F64LE;
+  }
+  return H5T_STD_U8LE;
 }
 hid_t memory_type_of(TensorType t) {
-  return t == TensorType::u8 ? H5T_NATIVE_UINT8 : t == TensorType::i16 ? H5T_NATIVE_INT16 : H5T_NATIVE_FLOAT;
+  switch (t) {
+    case TensorType::u8:
+      return H5T_NATIVE_UINT8;
+    case TensorType::i16:
+      return H5T_NATIVE_INT16;
+    case TensorType::f32:
+      return H5T_NATIVE_FLOAT;
+    case TensorType::f64:
+      return H5T_NATIVE_DOUBLE;
+  }
+  return H5T_NATIVE_UINT8;
 }
 
 // Creates `path` with the layout's attributes and datasets (no modification times
@@ -298,6 +342,8 @@ H5Layout read_h5_layout(const std::string& path) {
       t.type = TensorType::i16;
     else if (cls == H5T_FLOAT && size == 4)
       t.type = TensorType::f32;
+    else if (cls == H5T_FLOAT && size == 8)
+      t.type = TensorType::f64;
     else
       throw InputError(path + ": dataset " + name + " has an element type portalsim does not write");
     const hid_t space = d.keep(H5Dget_space(ds), H5Sclose);

@@ -11,9 +11,9 @@
 
 namespace portalsim {
 
-enum class TensorType { u8, i16, f32 };
+enum class TensorType { u8, i16, f32, f64 };
 size_t type_size(TensorType t);
-const char* npy_descr(TensorType t);  // "|u1", "<i2", "<f4"
+const char* npy_descr(TensorType t);  // "|u1", "<i2", "<f4", "<f8"
 
 // A dataset: name, element type, per-row shape (after N) and, for features, column names.
 struct H5Dataset {

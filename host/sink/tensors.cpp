@@ -6,15 +6,19 @@
 
 #include <array>
 #include <cerrno>
+#include <condition_variable>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <string_view>
+#include <thread>
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "plan/plan.h"
 #include "sink/h5_file.h"
 #include "sink/output_folder.h"
 
@@ -39,22 +43,28 @@ std::string npy_array_header(const std::string& descr, const std::vector<uint64_
 
 namespace {
 
+// Rows [lo, hi) of `v`, whose rows are `row` elements each.
 template <class T>
-std::string_view bytes_of(const std::vector<T>& v) {
-  return {reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T)};
+std::string_view rows_of(const std::vector<T>& v, size_t row, size_t lo, size_t hi) {
+  return {reinterpret_cast<const char*>(v.data() + lo * row), (hi - lo) * row * sizeof(T)};
 }
 
 // One tensor: its dataset description and how a batch fills it; then either its .npy file
 // or, for data.h5 written in place, where its rows start and the hash of those written.
 struct Tensor {
   H5Dataset ds;
-  // The batch's rows: a view of the batch's own memory, or of `scratch` filled here.
-  std::function<std::string_view(const SceneBatch&, const BatchOutput&, std::string& scratch)> fill;
-  std::string scratch;  // kept from batch to batch, so its pages are touched once
+  // The batch's rows [lo, hi): a view of the batch's own memory, or of `scratch` filled here.
+  std::function<std::string_view(const SceneBatch&, const BatchOutput&, size_t lo, size_t hi, std::string& scratch)>
+      fill;
   std::unique_ptr<AppendFile> file;
   uint64_t offset = 0, bytes = 0;
   std::unique_ptr<XXH3_state_t, XXH_errorcode (*)(XXH3_state_t*)> hash{nullptr, XXH3_freeState};
 };
+
+// About the bytes of one piece of a tensor's rows (TensorSink::write), well inside a core's
+// L2 cache, and how many pieces of data.h5 may be made before they are written.
+constexpr size_t kPieceBytes = 256u << 10;
+constexpr size_t kSlots = 4;
 
 class TensorSink final : public Sink {
  public:
@@ -74,67 +84,99 @@ class TensorSink final : public Sink {
           // Through the palette as 4-byte words, each store overlapping the next pixel's.
           std::array<uint32_t, 256> rgb{};
           for (size_t i = 0; i < rgb.size(); ++i) std::memcpy(&rgb[i], ctx_.palette[i].data(), 3);
-          add(s.name, TensorType::u8, {h, w, 3}, [k, rgb](const SceneBatch& b, const BatchOutput& o, std::string& buf) {
-            const ViewImages& v = o.views[k];
-            const size_t n = b.size() * v.pixels_per_image();
-            buf.resize(n * 3 + 1);
-            char* d = buf.data();
-            for (size_t i = 0; i < n; ++i) std::memcpy(d + i * 3, &rgb[v.pixels[i]], 4);
-            return std::string_view(buf.data(), n * 3);
-          });
+          add(s.name, TensorType::u8, {h, w, 3},
+              [k, rgb](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string& buf) {
+                const ViewImages& v = o.views[k];
+                const size_t per = v.pixels_per_image(), n = (hi - lo) * per;
+                const uint8_t* p = v.pixels.data() + lo * per;
+                buf.resize(n * 3 + 1);
+                char* d = buf.data();
+                for (size_t i = 0; i < n; ++i) std::memcpy(d + i * 3, &rgb[p[i]], 4);
+                return std::string_view(buf.data(), n * 3);
+              });
           add(s.name + "_index", TensorType::u8, {h, w},
-              [k](const SceneBatch&, const BatchOutput& o, std::string&) { return bytes_of(o.views[k].pixels); });
+              [k](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+                return rows_of(o.views[k].pixels, o.views[k].pixels_per_image(), lo, hi);
+              });
         } else {
           add(s.name, TensorType::u8, {h, w},
-              [k](const SceneBatch&, const BatchOutput& o, std::string&) { return bytes_of(o.views[k].pixels); });
+              [k](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+                return rows_of(o.views[k].pixels, o.views[k].pixels_per_image(), lo, hi);
+              });
         }
       }
     if (opt.annotations)
       for (size_t k = 0; k < cat.sensors.size(); ++k) {
         const Sensor& s = cat.sensors[k];
         add("mask_" + s.name, TensorType::u8, {static_cast<uint64_t>(s.height), static_cast<uint64_t>(s.width)},
-            [k](const SceneBatch&, const BatchOutput& o, std::string&) { return bytes_of(o.annotations[k].masks); });
+            [k, per = static_cast<size_t>(s.pixels())](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi,
+                                                       std::string&) {
+              return rows_of(o.annotations[k].masks, per, lo, hi);
+            });
       }
     if (opt.features)
       add("features", TensorType::f32, {static_cast<uint64_t>(ctx.layout.image_features())},
-          [](const SceneBatch&, const BatchOutput& o, std::string&) { return bytes_of(o.features); });
+          [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+            return rows_of(o.features, static_cast<size_t>(o.layout.image_features()), lo, hi);
+          });
     if (opt.scenario) {
       add("metal", TensorType::u8, {kZones},
-          [](const SceneBatch&, const BatchOutput& o, std::string&) { return bytes_of(o.metal); });
-      add("label", TensorType::u8, {},
-          [](const SceneBatch& b, const BatchOutput&, std::string&) { return bytes_of(b.label); });
-      add("subject", TensorType::u8, {}, [](const SceneBatch& b, const BatchOutput&, std::string& buf) {
-        buf.resize(b.size());
-        for (size_t i = 0; i < b.size(); ++i) buf[i] = static_cast<char>(b.subject[i] + 1);
-        return std::string_view(buf);
+          [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+            return rows_of(o.metal, kZones, lo, hi);
+          });
+      add("label", TensorType::u8, {}, [](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string&) {
+        return rows_of(b.label, 1, lo, hi);
       });
+      add("subject", TensorType::u8, {},
+          [](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+            buf.resize(hi - lo);
+            for (size_t i = lo; i < hi; ++i) buf[i - lo] = static_cast<char>(b.subject[i] + 1);
+            return std::string_view(buf);
+          });
       add("region_object", TensorType::i16, {kRegions},
-          [this](const SceneBatch& b, const BatchOutput&, std::string& buf) {
-            return per_region(b, buf, [&](int16_t v) {
+          [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+            return per_region(b, lo, hi, buf, [&](int16_t v) {
               return v == kNoObject ? int16_t(-1) : int16_t(ctx_.cat->variant_list[v].object);
             });
           });
       add("region_orientation", TensorType::i16, {kRegions},
-          [this](const SceneBatch& b, const BatchOutput&, std::string& buf) {
-            return per_region(b, buf, [&](int16_t v) {
+          [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+            return per_region(b, lo, hi, buf, [&](int16_t v) {
               return v == kNoObject ? int16_t(-1) : int16_t(ctx_.cat->variant_list[v].variant);
             });
           });
       add("region_label", TensorType::u8, {kRegions},
-          [this](const SceneBatch& b, const BatchOutput&, std::string& buf) {
-            buf.assign(b.size() * kRegions, '\0');
+          [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+            buf.assign((hi - lo) * kRegions, '\0');
             if (!opt_.rule) return std::string_view(buf);
-            for (size_t i = 0; i < b.size(); ++i)
+            for (size_t i = lo; i < hi; ++i)
               for (int r = 0; r < kRegions; ++r) {
                 const int16_t v = b.objects[i * kRegions + r];
                 if (v == kNoObject) continue;
                 Scenario alone;
                 alone.subject = b.subject[i];
                 alone.objects[r] = v;
-                buf[i * kRegions + r] = (*opt_.rule)(alone) ? 1 : 0;
+                buf[(i - lo) * kRegions + r] = (*opt_.rule)(alone) ? 1 : 0;
               }
             return std::string_view(buf);
           });
+      if (ctx.model.transforms()) {
+        // Each object's randomised draw (plan.h, object_transform), the numbers scenarios.csv
+        // records: float64 so they are the same doubles; identity where a region is empty.
+        add("region_rotation", TensorType::f64, {kRegions},
+            [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+              return per_transform<double>(b, lo, hi, buf, 0.0, [](const ObjectTransform& x) { return x.rotation; });
+            });
+        add("region_scale", TensorType::f64, {kRegions},
+            [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+              return per_transform<double>(b, lo, hi, buf, 1.0, [](const ObjectTransform& x) { return x.scale; });
+            });
+        add("region_flip", TensorType::u8, {kRegions},
+            [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+              return per_transform<uint8_t>(b, lo, hi, buf, 0,
+                                            [](const ObjectTransform& x) { return uint8_t(x.flip); });
+            });
+      }
     }
     if (in_place())
       open_in_place(resume);
@@ -159,29 +201,112 @@ class TensorSink final : public Sink {
     if (fd_ >= 0) ::close(fd_);
   }
 
+  // Each tensor's rows go out in pieces of about kPieceBytes: made (the IR palette), hashed
+  // and written while they are in the cache, where passes over whole batches would read
+  // each batch from memory again for every step.
   void write(const SceneBatch& scenes, const BatchOutput& out) override {
-    std::vector<std::string_view> rows(tensors_.size());
-    const unsigned threads = std::min<unsigned>(ctx_.threads, static_cast<unsigned>(tensors_.size()));
-    parallel_for(tensors_.size(), threads, [&](size_t b, size_t e) {
-      for (size_t k = b; k < e; ++k) rows[k] = tensors_[k].fill(scenes, out, tensors_[k].scratch);
-    });
+    const size_t n = scenes.size();
+    struct Piece {
+      Tensor* t;
+      size_t lo, hi;
+      std::string_view rows;  // once made
+    };
+    std::vector<Piece> pieces;
+    for (Tensor& t : tensors_) {
+      const size_t step = std::max<size_t>(1, kPieceBytes / std::max<size_t>(1, t.ds.row_bytes()));
+      for (size_t lo = 0; lo < n; lo += step) pieces.push_back({&t, lo, std::min(n, lo + step), {}});
+    }
     if (!in_place()) {
-      for (size_t k = 0; k < tensors_.size(); ++k) tensors_[k].file->append(rows[k]);
+      // One file per tensor: the tensors are shared out among the threads, dealt in turn
+      // (the camera views, most of the bytes, come first).
+      const unsigned threads = std::min<unsigned>(ctx_.threads, static_cast<unsigned>(tensors_.size()));
+      if (scratch_.size() < threads) scratch_.resize(threads);
+      parallel_for(threads, threads, [&](size_t first, size_t) {
+        for (size_t k = first; k < tensors_.size(); k += threads)
+          for (const Piece& p : pieces)
+            if (p.t == &tensors_[k]) p.t->file->append(p.t->fill(scenes, out, p.lo, p.hi, scratch_[first]));
+      });
       return;
     }
-    // Each thread writes its share of every tensor's rows: the bytes, not the tensors, are
-    // split evenly (the camera views are most of them).
-    const size_t n = scenes.size();
-    parallel_for(n, ctx_.threads, [&](size_t b, size_t e) {
-      for (size_t k = 0; k < tensors_.size(); ++k) {
-        const Tensor& t = tensors_[k];
-        const size_t row = t.ds.row_bytes();
-        write_at(fd_, rows[k].data() + b * row, (e - b) * row, t.offset + (rows_ + b) * row, partial_);
+    // data.h5: this thread makes and hashes each piece while a second thread writes the
+    // pieces before it (a write into one file holds its inode's lock on tmpfs and ext4, so
+    // more writers would only wait for it). The piece made here lands in one of kSlots
+    // buffers, which the writer must be done with.
+    const auto make = [&](size_t i) {
+      Piece& p = pieces[i];
+      p.rows = p.t->fill(scenes, out, p.lo, p.hi, slots_[i % kSlots]);
+      XXH3_64bits_update(p.t->hash.get(), p.rows.data(), p.rows.size());
+    };
+    const auto put = [&](const Piece& p) {
+      write_at(fd_, p.rows.data(), p.rows.size(), p.t->offset + (rows_ + p.lo) * p.t->ds.row_bytes(), partial_);
+    };
+    if (ctx_.threads < 2) {
+      for (size_t i = 0; i < pieces.size(); ++i) {
+        make(i);
+        put(pieces[i]);
       }
-    });
-    for (size_t k = 0; k < tensors_.size(); ++k) {
-      XXH3_64bits_update(tensors_[k].hash.get(), rows[k].data(), rows[k].size());
-      tensors_[k].bytes += rows[k].size();
+    } else {
+      std::mutex m;
+      std::condition_variable cv;
+      size_t made = 0, written = 0;
+      bool failed = false;
+      std::exception_ptr error;
+      const auto fail = [&](std::exception_ptr e) {
+        {
+          std::lock_guard<std::mutex> lock(m);
+          if (!error) error = e;
+          failed = true;
+        }
+        cv.notify_all();
+      };
+      std::thread writer([&] {
+        try {
+          for (size_t i = 0; i < pieces.size(); ++i) {
+            {
+              std::unique_lock<std::mutex> lock(m);
+              cv.wait(lock, [&] { return made > i || failed; });
+              if (failed) return;
+            }
+            put(pieces[i]);
+            {
+              std::lock_guard<std::mutex> lock(m);
+              written = i + 1;
+            }
+            cv.notify_all();
+          }
+        } catch (...) {
+          fail(std::current_exception());
+        }
+      });
+      try {
+        for (size_t i = 0; i < pieces.size(); ++i) {
+          {
+            std::unique_lock<std::mutex> lock(m);
+            cv.wait(lock, [&] { return written + kSlots > i || failed; });
+            if (failed) break;
+          }
+          make(i);
+          {
+            std::lock_guard<std::mutex> lock(m);
+            made = i + 1;
+          }
+          cv.notify_all();
+        }
+      } catch (...) {
+        fail(std::current_exception());
+      }
+      writer.join();
+      if (error) std::rethrow_exception(error);
+    }
+    // On a disk, start the writeback of the rows just written (a hint, as in AppendFile), so
+    // that it goes on while the run does and finish()'s fsync has little left to wait for.
+    // The pages stay cached for finish()'s hash of the whole file.
+    for (Tensor& t : tensors_) {
+      const uint64_t row = t.ds.row_bytes();
+      if (n * row > 0)
+        ::sync_file_range(fd_, static_cast<off_t>(t.offset + rows_ * row), static_cast<off_t>(n * row),
+                          SYNC_FILE_RANGE_WRITE);
+      t.bytes += n * row;
     }
     rows_ += n;
   }
@@ -218,6 +343,9 @@ class TensorSink final : public Sink {
   std::string partial_;  // data.h5 in place: its name while the run goes
   int fd_ = -1;
   uint64_t rows_ = 0;  // rows written so far
+  // Where write() makes pieces, kept from batch to batch: data.h5's, and each thread's for .npy files.
+  std::array<std::string, kSlots> slots_;
+  std::vector<std::string> scratch_;
 
   // Uncompressed data.h5 is laid out at the start and its rows written in place; compressed,
   // it is built at the end from .npy files (HDF5 writes the chunks).
@@ -277,7 +405,7 @@ class TensorSink final : public Sink {
     return opt_.h5 ? std::string(kStateDir) + "/tensors/" + tensor + ".npy" : tensor + ".npy";
   }
   void add(const std::string& name, TensorType type, std::vector<uint64_t> dims,
-           std::function<std::string_view(const SceneBatch&, const BatchOutput&, std::string&)> fill) {
+           std::function<std::string_view(const SceneBatch&, const BatchOutput&, size_t, size_t, std::string&)> fill) {
     Tensor t;
     t.ds.name = name;
     t.ds.type = type;
@@ -287,12 +415,25 @@ class TensorSink final : public Sink {
     tensors_.push_back(std::move(t));
   }
   template <class F>
-  static std::string_view per_region(const SceneBatch& b, std::string& buf, F f) {
-    buf.resize(b.size() * kRegions * sizeof(int16_t));
-    for (size_t i = 0; i < b.size() * kRegions; ++i) {
+  static std::string_view per_region(const SceneBatch& b, size_t lo, size_t hi, std::string& buf, F f) {
+    buf.resize((hi - lo) * kRegions * sizeof(int16_t));
+    for (size_t i = lo * kRegions; i < hi * kRegions; ++i) {
       const int16_t v = f(b.objects[i]);
-      std::memcpy(&buf[i * sizeof(int16_t)], &v, sizeof v);
+      std::memcpy(&buf[(i - lo * kRegions) * sizeof(int16_t)], &v, sizeof v);
     }
+    return buf;
+  }
+
+  // Scenario i's region r: `of(object_transform(...))`, or `none` where the region is empty.
+  template <class T, class F>
+  std::string_view per_transform(const SceneBatch& b, size_t lo, size_t hi, std::string& buf, T none, F of) const {
+    buf.resize((hi - lo) * kRegions * sizeof(T));
+    for (size_t i = lo; i < hi; ++i)
+      for (int r = 0; r < kRegions; ++r) {
+        const T v =
+            b.objects[i * kRegions + r] == kNoObject ? none : of(object_transform(ctx_.model, b.first_index + i, r));
+        std::memcpy(&buf[((i - lo) * kRegions + r) * sizeof(T)], &v, sizeof v);
+      }
     return buf;
   }
 

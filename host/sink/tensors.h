@@ -10,8 +10,10 @@
 // palette) and ir_index uint8 NxHxW (temperature index); metal uint8 Nx19; features
 // float32 NxF (image features, when computed); label, subject uint8 N; region_object,
 // region_orientation int16 Nx13 (object and drawing index, -1 for none); region_label
-// uint8 Nx13 (the rule applied to each region's object on its own); with annotations,
-// mask_<view> uint8 NxHxW (instance masks: the region number, 0 none).
+// uint8 Nx13 (the rule applied to each region's object on its own); with randomised
+// objects only, region_rotation, region_scale float64 Nx13 and region_flip uint8 Nx13 (each
+// object's transform, the numbers scenarios.csv records; 0, 1, 0 where a region is empty);
+// with annotations, mask_<view> uint8 NxHxW (instance masks: the region number, 0 none).
 #pragma once
 #include <map>
 #include <memory>
