@@ -96,10 +96,11 @@ void BM_Annotate(benchmark::State& state) {
   for (size_t i = 0; i < 2 * n; ++i) batches[i / n].push(gen(i));
   batches[1].first_index = n;
   std::vector<ViewAnnotations> out;
-  annotate(fx().cat, fx().assets, ModelSettings{}, batches[0], out);
+  Annotator annotate(fx().cat, fx().assets);  // as a backend keeps one
+  annotate(ModelSettings{}, batches[0], out);
   size_t turn = 0;
   for (auto _ : state) {
-    annotate(fx().cat, fx().assets, ModelSettings{}, batches[state.range(0) ? ++turn % 2 : 0], out);
+    annotate(ModelSettings{}, batches[state.range(0) ? ++turn % 2 : 0], out);
     benchmark::DoNotOptimize(out.data());
   }
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));

@@ -162,12 +162,15 @@ TEST(Annotations, MasksAndBoxesAgreeWithTheReferenceComposite) {
   EXPECT_EQ(checked, 2 * 2 * 3 * 40 * static_cast<int>(cat.sensors.size()));
 }
 
-// annotate() clears a reused buffer only where it painted before: batches of other sizes
-// and scenes through one buffer must give what fresh buffers give, with sprites that move
-// and that do not (placed once per call), on one worker and on two (from 256 scenarios).
+// annotate() clears a reused buffer only where it painted before, and an Annotator keeps
+// its sprite tables, unmoved sprites' placements and workers' scratch masks between
+// batches: batches of other sizes and scenes through one buffer and one Annotator must
+// give what fresh ones give, with sprites that do not move (placed on the first such
+// batch), that move, and again that do not, on one worker and on two (from 256 scenarios).
 TEST(Annotations, ReusedBuffersGiveWhatFreshOnesGive) {
   const Catalogue& cat = test::catalogue();
-  for (const double jitter : {20.0, 0.0}) {
+  Annotator kept(cat, test::assets());
+  for (const double jitter : {0.0, 20.0, 0.0}) {
     ModelSettings m;
     m.jitter = jitter;
     std::vector<ViewAnnotations> reused;
@@ -179,7 +182,7 @@ TEST(Annotations, ReusedBuffersGiveWhatFreshOnesGive) {
       const SceneBatch b = test::batch_of(scenes, first);
       std::vector<ViewAnnotations> fresh;
       annotate(cat, test::assets(), m, b, fresh, 1);
-      annotate(cat, test::assets(), m, b, reused, 2);
+      kept(m, b, reused, 2);
       for (size_t k = 0; k < fresh.size(); ++k) {
         ASSERT_EQ(fresh[k].masks, reused[k].masks) << "batch at " << first << " view " << k << " jitter " << jitter;
         EXPECT_EQ(fresh[k].first, reused[k].first);

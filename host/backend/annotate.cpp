@@ -354,13 +354,54 @@ void huge_pages(void* p, size_t bytes) {
 
 bool meets(const Painted& a, const Painted& b) { return a.x0 <= b.x1 && b.x0 <= a.x1 && a.y0 <= b.y1 && b.y0 <= a.y1; }
 
+// Where a sprite that does not move sits for its variant, region and view: the same in
+// every scenario.
+struct Fixed {
+  reference::Placed placed{};
+  std::optional<Placement> at;
+};
+
+// What a worker writes besides the masks, kept for the next call (fresh, its pages would
+// fault in each time): its annotations, and per view the scratch mask that the objects
+// are painted into first (zero between uses; see Lines).
+struct Work {
+  std::vector<Annotation> items;
+  std::vector<std::vector<uint8_t>> scratch;
+};
+
 }  // namespace
+
+// Each view's sprites' covered texels (by variant), where unmoved sprites sit (built on
+// the first batch that has them), and the workers' buffers between batches.
+struct Annotator::Kept {
+  const Catalogue& cat;
+  const AssetSet& assets;
+  std::vector<std::vector<Runs>> runs;
+  std::vector<std::vector<Fixed>> fixed;  // per view, variant * kRegions + region
+  std::vector<Work> spare;
+};
+
+Annotator::Annotator(const Catalogue& cat, const AssetSet& assets) : kept_(new Kept{cat, assets, {}, {}, {}}) {
+  kept_->runs.resize(cat.sensors.size());
+  for (size_t k = 0; k < cat.sensors.size(); ++k)
+    for (size_t v = 0; v < cat.variant_list.size(); ++v)
+      kept_->runs[k].emplace_back(assets.sprite(cat.sensors[k].camera, static_cast<int>(v)));
+}
+
+Annotator::~Annotator() = default;
 
 void annotate(const Catalogue& cat, const AssetSet& assets, const ModelSettings& model, const SceneBatch& batch,
               std::vector<ViewAnnotations>& out, unsigned threads) {
+  Annotator(cat, assets)(model, batch, out, threads);
+}
+
+void Annotator::operator()(const ModelSettings& model, const SceneBatch& batch, std::vector<ViewAnnotations>& out,
+                           unsigned threads) {
+  const Catalogue& cat = kept_->cat;
+  const AssetSet& assets = kept_->assets;
+  const std::vector<std::vector<Runs>>& runs = kept_->runs;
   const size_t n = batch.size(), views = cat.sensors.size();
   out.resize(views);
-  std::vector<std::vector<Runs>> runs(views);
   for (size_t k = 0; k < views; ++k) {
     const Sensor& sensor = cat.sensors[k];
     ViewAnnotations& va = out[k];
@@ -380,18 +421,13 @@ void annotate(const Catalogue& cat, const AssetSet& assets, const ModelSettings&
     }
     va.width = sensor.width;
     va.height = sensor.height;
-    for (size_t v = 0; v < cat.variant_list.size(); ++v)
-      runs[k].emplace_back(assets.sprite(sensor.camera, static_cast<int>(v)));
   }
   // Sprites that do not move sit where their variant, region and view put them, the same
-  // in every scenario: placed once here, from one scene per view and variant that holds
-  // the variant in every region.
-  struct Fixed {
-    reference::Placed placed{};
-    std::optional<Placement> at;
-  };
-  std::vector<std::vector<Fixed>> fixed;
-  if (!model.moves_sprites()) {
+  // in every scenario and for any model that does not move them: placed once, from one
+  // scene per view and variant that holds the variant in every region.
+  std::vector<std::vector<Fixed>>& fixed = kept_->fixed;
+  const bool moves = model.moves_sprites();
+  if (!moves && fixed.empty()) {
     fixed.resize(views);
     for (size_t k = 0; k < views; ++k) {
       const Sensor& sensor = cat.sensors[k];
@@ -413,16 +449,7 @@ void annotate(const Catalogue& cat, const AssetSet& assets, const ModelSettings&
   // Each worker's annotations in a list of its own, by scenario, then view (count says how
   // many each image has), joined below in the order of the workers' first scenarios.
   std::vector<uint8_t> count(n * views, 0);
-  // What a worker writes besides the masks, kept for the next call (fresh, its pages
-  // would fault in each time): its annotations, and per view the scratch mask that the
-  // objects are painted into first (zero between uses; see Lines).
-  struct Work {
-    std::vector<Annotation> items;
-    std::vector<std::vector<uint8_t>> scratch;
-  };
-  // (Named through a reference: inside the workers' lambda a thread_local would be theirs.)
-  static thread_local std::vector<Work> spare_kept;
-  std::vector<Work>& spare = spare_kept;
+  std::vector<Work>& spare = kept_->spare;
   std::vector<std::pair<size_t, Work>> done;  // by first scenario
   std::mutex work_mutex;
   parallel_for(n, n >= 256 ? threads : 1, [&](size_t lo, size_t hi) {
@@ -453,7 +480,7 @@ void annotate(const Catalogue& cat, const AssetSet& assets, const ModelSettings&
         const int W = sensor.width;
         uint8_t* scr = scratch[k].data();
         size_t m = 0;
-        if (fixed.empty()) {
+        if (moves) {
           moved = reference::view_scene(cat, assets, model, static_cast<int>(k), s, batch.first_index + i).placed;
           moved_at.clear();
           for (const reference::Placed& pl : moved)
@@ -462,7 +489,7 @@ void annotate(const Catalogue& cat, const AssetSet& assets, const ModelSettings&
         for (int r = 0; r < kRegions; ++r) {
           const int16_t v = s.objects[r];
           if (v == kNoObject || !sensor.sees(r)) continue;
-          if (fixed.empty()) {
+          if (moves) {
             placed[m] = &moved[m];
             at[m] = &moved_at[m];
           } else {

@@ -13,6 +13,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "assets/assets.h"
@@ -49,7 +50,26 @@ struct ViewAnnotations {
   std::vector<Painted> painted;
 };
 
-// One ViewAnnotations per camera view (Catalogue::sensors order) for the batch.
+// Annotates batches of one catalogue and asset set, keeping between batches what does
+// not change: each sprite's covered texels, where sprites that do not move sit, and the
+// workers' scratch masks and lists (the backends hold one). `cat` and `assets` must
+// outlive it; one batch at a time.
+class Annotator {
+ public:
+  Annotator(const Catalogue& cat, const AssetSet& assets);
+  ~Annotator();
+  Annotator(const Annotator&) = delete;
+  Annotator& operator=(const Annotator&) = delete;
+  // One ViewAnnotations per camera view (Catalogue::sensors order) for the batch.
+  void operator()(const ModelSettings& model, const SceneBatch& batch, std::vector<ViewAnnotations>& out,
+                  unsigned threads = 1);
+
+ private:
+  struct Kept;
+  std::unique_ptr<Kept> kept_;
+};
+
+// The same with an Annotator of its own: for one batch.
 void annotate(const Catalogue& cat, const AssetSet& assets, const ModelSettings& model, const SceneBatch& batch,
               std::vector<ViewAnnotations>& out, unsigned threads = 1);
 

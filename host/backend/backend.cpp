@@ -26,9 +26,10 @@ void prepare_output(BatchOutput& out, const Catalogue& cat, const Plan& plan, si
 
 void Backend::annotations(const Catalogue& cat, const AssetSet& assets, const SceneBatch& batch, const Plan& plan,
                           BatchOutput& out) {
-  if (plan.annotations)
-    annotate(cat, assets, plan.model, batch, out.annotations, default_threads());
-  else
+  if (plan.annotations) {
+    if (!annotator_) annotator_ = std::make_unique<Annotator>(cat, assets);
+    (*annotator_)(plan.model, batch, out.annotations, default_threads());
+  } else
     out.annotations.clear();
 }
 

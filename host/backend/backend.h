@@ -59,8 +59,12 @@ class Backend {
 
  protected:
   // The annotations `plan` asks for (the same function for every backend), or none.
-  static void annotations(const Catalogue& cat, const AssetSet& assets, const SceneBatch& batch, const Plan& plan,
-                          BatchOutput& out);
+  // `cat` and `assets` are the backend's own, the same in every call.
+  void annotations(const Catalogue& cat, const AssetSet& assets, const SceneBatch& batch, const Plan& plan,
+                   BatchOutput& out);
+
+ private:
+  std::unique_ptr<Annotator> annotator_;  // made on the first batch with annotations
 };
 
 std::unique_ptr<Backend> make_reference_backend(const Catalogue& cat, const AssetSet& assets);
