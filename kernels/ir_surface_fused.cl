@@ -119,6 +119,57 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
   }
 }
 
+// The noisy kelvin as a value of its own, which fast math may not reassociate with the
+// window's subtraction: stage_ir_netd stores it, and stage_ir_display reads it back.
+#if __has_builtin(__arithmetic_fence)
+#define IR_NOISY(t) __arithmetic_fence(t)
+#else
+#define IR_NOISY(t) (t)
+#endif
+
+// ir_netd then ir_display over a view's whole surface T into o, in one pass: each pixel's
+// kelvin plus sd times its table Gaussian (stage_ir_netd's sum, in its form) goes through
+// the display window (ir_window) in registers, and no noisy field is written or read back.
+// fp32 builds draw 128 pixels at a time (gauss128) and store 64 levels at once; like the
+// stage kernels, the last pixels past a whole 16 go one by one.
+inline void ir_noisy_window(global const preal* restrict T, global uchar* restrict o, global const param* phys,
+                            int pixels, preal sd, uint2 seed, ulong index, int view, global const param* table) {
+  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
+  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
+#if defined(PRECISION_FP64)
+  for (int p = 0; p < pixels; ++p) {
+    const preal t = IR_NOISY(T[p] + sd * gauss_cell(seed, index, PS_STREAM_IR_NOISE, view, p, table));
+    o[p] = (uchar)clamp(floor((t - lo) * scale + (preal)0.5), (preal)0, (preal)255);
+  }
+#else
+  for (int p = 0; p < pixels; p += 128) {
+    float16 g[8];
+    gauss128(seed, index, PS_STREAM_IR_NOISE, view, p >> 7, table, g);
+    if (p + 128 <= pixels) {
+      uchar16 l[8];
+#pragma unroll
+      for (int j = 0; j < 8; ++j)
+        l[j] = window_levels16(IR_NOISY(LOADF16(global, T + p + 16 * j) + sd * g[j]), lo, scale);
+      store64(l[0], l[1], l[2], l[3], o + p);
+      store64(l[4], l[5], l[6], l[7], o + p + 64);
+      continue;
+    }
+    for (int j = 0; j < 8; ++j) {
+      const int q = p + 16 * j;
+      if (q + 16 <= pixels) {
+        store16(window_levels16(IR_NOISY(LOADF16(global, T + q) + sd * g[j]), lo, scale), o + q);
+      } else {
+        float t[16];
+        vstore16(g[j], 0, t);
+        for (int k = q; k < pixels; ++k)
+          o[k] = (uchar)clamp(floor((IR_NOISY(T[k] + sd * t[k - q]) - lo) * scale + 0.5f), 0.0f, 255.0f);
+        break;
+      }
+    }
+  }
+#endif
+}
+
 kernel void ir_surface_fused(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
@@ -133,4 +184,21 @@ kernel void ir_surface_display_fused(VIEW_STAGE_ARGS) {
   (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
       (void)raw;
   ir_surface_view(i, &L, atlas, bases, subject, records, field, out, phys, scratch, true);
+}
+
+// The whole chain with noise: the surface as ir_surface_fused, then ir_netd and ir_display
+// in one pass over it (ir_noisy_window), while it is in cache.
+kernel void ir_surface_noise_display_fused(VIEW_STAGE_ARGS) {
+  VIEW_STAGE_SCENARIO;
+  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
+      (void)raw;
+  ir_surface_view(i, &L, atlas, bases, subject, records, field, out, phys, scratch, false);
+  const int pixels = L.width * L.height;
+  global const preal* T = (global const preal*)field + (size_t)i * pixels;
+  global uchar* o = out + (size_t)i * pixels;
+  const preal sd = (preal)phys[PS_PHYS_NETD];
+  if (sd > 0)
+    ir_noisy_window(T, o, phys, pixels, sd, seed, index, L.view, phys + L.phys_gauss);
+  else
+    ir_window(T, o, phys, 0, pixels);
 }

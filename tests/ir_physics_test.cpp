@@ -120,11 +120,12 @@ TEST(IrPhysics, KernelsMatchTheReferenceInEveryTier) {
 }
 
 // The declared fast path (contact_shadow -> heat_spread -> ir_surface in
-// ir_surface_fused; with only ir_display after it, ir_surface_display_fused) against the
-// chain of stage kernels: the same bits in every tier, -cl-fast-relaxed-math too (the
-// fast path writes each sum in the stage kernels' form). Integer, bilinear and randomised
-// placement, objects over the view's edges, no, the default and a wide heat spread, IR
-// NETD 0 (the display fused) and 0.05 K.
+// ir_surface_fused; with only ir_display after it, ir_surface_display_fused; with ir_netd
+// then ir_display, ir_surface_noise_display_fused) against the chain of stage kernels:
+// the same bits in every tier, -cl-fast-relaxed-math too (the fast path writes each sum
+// in the stage kernels' form). Integer, bilinear and randomised placement, objects over
+// the view's edges, no, the default and a wide heat spread, IR NETD 0 (the display fused)
+// and 0.05 K (noise and display fused).
 TEST(IrPhysics, FastPathMatchesTheChainOfStageKernels) {
   std::vector<Scenario> scenes;
   for (size_t k = 0; k < 32; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));

@@ -37,7 +37,8 @@ const std::vector<std::string>& fused_chain();
 const std::vector<std::string>& physics_fused_chain();
 // The first stages of the physics IR chain that the ir_surface_fused fast path
 // implements; the chain's later stages run as their kernels, or, where only ir_display
-// is left (ir_netd at 0 K is nothing), ir_surface_display_fused does it all.
+// is left (ir_netd at 0 K is nothing), ir_surface_display_fused does it all, and where
+// ir_netd then ir_display are left, ir_surface_noise_display_fused.
 const std::vector<std::string>& ir_fused_chain();
 // Throws std::logic_error unless every stage of each of the view's chains is registered
 // and each chain ends with a stage that makes pixels, and no other stage does.

@@ -436,11 +436,16 @@ class OpenCLBackend final : public Backend {
     size_t from = 0;
     if (ir_fast) {
       // Where the chain leaves only ir_display (ir_netd at 0 K draws nothing), the fast
-      // path shows the surface itself.
+      // path shows the surface itself; where it leaves ir_netd then ir_display, it draws
+      // the noise and shows it in one pass too.
       std::vector<std::string> rest(chain.begin() + static_cast<std::ptrdiff_t>(ir_prefix.size()), chain.end());
       if (plan.model.ir_netd == 0) std::erase(rest, "ir_netd");
       if (rest == std::vector<std::string>{"ir_display"}) {
         launch(stage_kernel(K, "ir_surface_display_fused"), n);
+        return;
+      }
+      if (rest == std::vector<std::string>{"ir_netd", "ir_display"}) {
+        launch(stage_kernel(K, "ir_surface_noise_display_fused"), n);
         return;
       }
       launch(stage_kernel(K, "ir_surface_fused"), n);
