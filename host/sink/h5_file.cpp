@@ -18,32 +18,32 @@ namespace portalsim {
 
 namespace fs = std::filesystem;
 
-size_t type_size(TensorType t) {
+namespace {
+
+// Each element type's size, .npy descriptor and HDF5 file and memory types.
+struct TypeInfo {
+  size_t size;
+  const char* npy;
+  hid_t file, memory;
+};
+TypeInfo type_info(TensorType t) {
   switch (t) {
     case TensorType::u8:
-      return 1;
+      break;
     case TensorType::i16:
-      return 2;
+      return {2, "<i2", H5T_STD_I16LE, H5T_NATIVE_INT16};
     case TensorType::f32:
-      return 4;
+      return {4, "<f4", H5T_IEEE_F32LE, H5T_NATIVE_FLOAT};
     case TensorType::f64:
-      return 8;
+      return {8, "<f8", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE};
   }
-  return 0;
+  return {1, "|u1", H5T_STD_U8LE, H5T_NATIVE_UINT8};
 }
-const char* npy_descr(TensorType t) {
-  switch (t) {
-    case TensorType::u8:
-      return "|u1";
-    case TensorType::i16:
-      return "<i2";
-    case TensorType::f32:
-      return "<f4";
-    case TensorType::f64:
-      return "<f8";
-  }
-  return "";
-}
+
+}  // namespace
+
+size_t type_size(TensorType t) { return type_info(t).size; }
+const char* npy_descr(TensorType t) { return type_info(t).npy; }
 
 size_t H5Dataset::row_bytes() const {
   size_t b = type_size(type);
@@ -109,33 +109,6 @@ H5Attribute read_strings(hid_t obj, const char* name, const std::string& path) {
   return a;
 }
 
-hid_t file_type_of(TensorType t) {
-  switch (t) {
-    case TensorType::u8:
-      return H5T_STD_U8LE;
-    case TensorType::i16:
-      return H5T_STD_I16LE;
-    case TensorType::f32:
-      return H5T_IEEE_F32LE;
-    case TensorType::f64:
-      return H5T_IEEE_F64LE;
-  }
-  return H5T_STD_U8LE;
-}
-hid_t memory_type_of(TensorType t) {
-  switch (t) {
-    case TensorType::u8:
-      return H5T_NATIVE_UINT8;
-    case TensorType::i16:
-      return H5T_NATIVE_INT16;
-    case TensorType::f32:
-      return H5T_NATIVE_FLOAT;
-    case TensorType::f64:
-      return H5T_NATIVE_DOUBLE;
-  }
-  return H5T_NATIVE_UINT8;
-}
-
 // Creates `path` with the layout's attributes and datasets (no modification times
 // anywhere: the file's bytes depend on the data alone) and calls `each(k, dataset)` while
 // dataset k is open. Uncompressed datasets are contiguous, allocated at creation and never
@@ -177,7 +150,7 @@ void create_file(const std::string& path, const H5Layout& layout, const std::fun
       H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER);
     }
     const hid_t ds =
-        dset.keep(check(H5Dcreate2(file, t.name.c_str(), file_type_of(t.type), space, H5P_DEFAULT, dcpl, H5P_DEFAULT),
+        dset.keep(check(H5Dcreate2(file, t.name.c_str(), type_info(t.type).file, space, H5P_DEFAULT, dcpl, H5P_DEFAULT),
                         path, what),
                   H5Dclose);
     if (!t.columns.empty()) write_strings(ds, H5Attribute{"columns", t.columns, false}, path);
@@ -292,7 +265,7 @@ void write_h5(const std::string& dir, const H5Layout& layout, const std::vector<
         const hid_t fspace = io.keep(check(H5Dget_space(ds), tmp, "write dataset " + t.name), H5Sclose);
         H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
         const hid_t mspace = io.keep(H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr), H5Sclose);
-        if (H5Dwrite(ds, memory_type_of(t.type), mspace, fspace, H5P_DEFAULT, buf.data()) < 0)
+        if (H5Dwrite(ds, type_info(t.type).memory, mspace, fspace, H5P_DEFAULT, buf.data()) < 0)
           throw OutputError(tmp + ": HDF5 could not write dataset " + t.name + " (disk full?)");
       });
     });
@@ -376,7 +349,7 @@ void read_h5_rows(const std::string& path, const H5Dataset& t, uint64_t first, u
   const hid_t fspace = ids.keep(H5Dget_space(ds), H5Sclose);
   H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
   const hid_t mspace = ids.keep(H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr), H5Sclose);
-  if (H5Dread(ds, memory_type_of(t.type), mspace, fspace, H5P_DEFAULT, out) < 0)
+  if (H5Dread(ds, type_info(t.type).memory, mspace, fspace, H5P_DEFAULT, out) < 0)
     throw InputError(path + ": dataset " + t.name + ": cannot read rows " + std::to_string(first) + ".." +
                      std::to_string(first + n));
 }
