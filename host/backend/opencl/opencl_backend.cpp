@@ -948,47 +948,50 @@ class OpenCLBackend final : public Backend {
     if (tables_.block == block && tables_.noise == noise) return;
     const int S = static_cast<int>(cat_.subjects.size()), V = static_cast<int>(cat_.variant_list.size());
     const int P = noise ? static_cast<int>(cat_.noise.size()) : 1;
-    std::vector<cl_int> fps(static_cast<size_t>(V) * kRegions * PS_FP_LEN, 0);
+    // A footprint per (variant, region, subject): the place moves with the subject's height.
+    std::vector<cl_int> fps(static_cast<size_t>(V) * kRegions * S * PS_FP_LEN, 0);
     cl_int offset = 0;
     for (int v = 0; v < V; ++v)
-      for (int r = 0; r < kRegions; ++r) {
-        const Image& sp = assets_.sprite(Camera::mmw, v);
-        const Rect& rc = cat_.sensors[lay.pooled[region_slot(lay, r)]].rects[r];
-        cl_int* f = &fps[(static_cast<size_t>(v) * kRegions + r) * PS_FP_LEN];
-        f[PS_FP_SPRITE_X0] = rc.x + ((rc.w - sp.width) >> 1);
-        f[PS_FP_SPRITE_Y0] = rc.y + ((rc.h - sp.height) >> 1);
-        f[PS_FP_SPRITE_W] = sp.width;
-        f[PS_FP_SPRITE_H] = sp.height;
-        f[PS_FP_SPRITE_OFFSET] = mmw_sprites_[v].s[0];
-        f[PS_FP_SPRITE_PADDED] = mmw_sprites_[v].s[3];
-        f[PS_FP_TILE_X0] = f[PS_FP_SPRITE_X0] + (sp.width >> 1) - (N >> 1);
-        f[PS_FP_TILE_Y0] = f[PS_FP_SPRITE_Y0] + (sp.height >> 1) - (N >> 1);
-        int x0 = f[PS_FP_SPRITE_X0], y0 = f[PS_FP_SPRITE_Y0], x1 = f[PS_FP_SPRITE_X0] + f[PS_FP_SPRITE_W],
-            y1 = f[PS_FP_SPRITE_Y0] + f[PS_FP_SPRITE_H];
-        if (noise) {
-          x0 = std::min(x0, f[PS_FP_TILE_X0]);
-          y0 = std::min(y0, f[PS_FP_TILE_Y0]);
-          x1 = std::max(x1, f[PS_FP_TILE_X0] + N);
-          y1 = std::max(y1, f[PS_FP_TILE_Y0] + N);
+      for (int r = 0; r < kRegions; ++r)
+        for (int s = 0; s < S; ++s) {
+          const Image& sp = assets_.sprite(Camera::mmw, v);
+          const Rect rc = cat_.sensors[lay.pooled[region_slot(lay, r)]].place(s, r);
+          cl_int* f = &fps[((static_cast<size_t>(v) * kRegions + r) * S + s) * PS_FP_LEN];
+          f[PS_FP_SPRITE_X0] = rc.x + ((rc.w - sp.width) >> 1);
+          f[PS_FP_SPRITE_Y0] = rc.y + ((rc.h - sp.height) >> 1);
+          f[PS_FP_SPRITE_W] = sp.width;
+          f[PS_FP_SPRITE_H] = sp.height;
+          f[PS_FP_SPRITE_OFFSET] = mmw_sprites_[v].s[0];
+          f[PS_FP_SPRITE_PADDED] = mmw_sprites_[v].s[3];
+          f[PS_FP_TILE_X0] = f[PS_FP_SPRITE_X0] + (sp.width >> 1) - (N >> 1);
+          f[PS_FP_TILE_Y0] = f[PS_FP_SPRITE_Y0] + (sp.height >> 1) - (N >> 1);
+          int x0 = f[PS_FP_SPRITE_X0], y0 = f[PS_FP_SPRITE_Y0], x1 = f[PS_FP_SPRITE_X0] + f[PS_FP_SPRITE_W],
+              y1 = f[PS_FP_SPRITE_Y0] + f[PS_FP_SPRITE_H];
+          if (noise) {
+            x0 = std::min(x0, f[PS_FP_TILE_X0]);
+            y0 = std::min(y0, f[PS_FP_TILE_Y0]);
+            x1 = std::max(x1, f[PS_FP_TILE_X0] + N);
+            y1 = std::max(y1, f[PS_FP_TILE_Y0] + N);
+          }
+          x0 = std::max(x0, 0);
+          y0 = std::max(y0, 0);
+          x1 = std::min(x1, W);
+          y1 = std::min(y1, H);
+          if (x0 >= x1 || y0 >= y1) x0 = y0 = x1 = y1 = 0;  // wholly outside: touches nothing
+          f[PS_FP_X0] = x0;
+          f[PS_FP_Y0] = y0;
+          f[PS_FP_X1] = x1;
+          f[PS_FP_Y1] = y1;
+          f[PS_FP_BLOCK_X0] = x0 / block;
+          f[PS_FP_BLOCK_Y0] = y0 / block;
+          f[PS_FP_BLOCKS_W] = x1 > x0 ? (x1 - 1) / block - f[PS_FP_BLOCK_X0] + 1 : 0;
+          f[PS_FP_BLOCKS_H] = y1 > y0 ? (y1 - 1) / block - f[PS_FP_BLOCK_Y0] + 1 : 0;
+          f[PS_FP_DELTAS] = offset;
+          const int64_t next = offset + static_cast<int64_t>(P) * f[PS_FP_BLOCKS_W] * f[PS_FP_BLOCKS_H];
+          if (next > INT32_MAX)
+            throw std::runtime_error("sparse feature tables exceed 2^31 entries; use --block larger");
+          offset = static_cast<cl_int>(next);
         }
-        x0 = std::max(x0, 0);
-        y0 = std::max(y0, 0);
-        x1 = std::min(x1, W);
-        y1 = std::min(y1, H);
-        if (x0 >= x1 || y0 >= y1) x0 = y0 = x1 = y1 = 0;  // wholly outside: touches nothing
-        f[PS_FP_X0] = x0;
-        f[PS_FP_Y0] = y0;
-        f[PS_FP_X1] = x1;
-        f[PS_FP_Y1] = y1;
-        f[PS_FP_BLOCK_X0] = x0 / block;
-        f[PS_FP_BLOCK_Y0] = y0 / block;
-        f[PS_FP_BLOCKS_W] = x1 > x0 ? (x1 - 1) / block - f[PS_FP_BLOCK_X0] + 1 : 0;
-        f[PS_FP_BLOCKS_H] = y1 > y0 ? (y1 - 1) / block - f[PS_FP_BLOCK_Y0] + 1 : 0;
-        f[PS_FP_DELTAS] = offset;
-        const int64_t next = offset + static_cast<int64_t>(S) * P * f[PS_FP_BLOCKS_W] * f[PS_FP_BLOCKS_H];
-        if (next > INT32_MAX) throw std::runtime_error("sparse feature tables exceed 2^31 entries; use --block larger");
-        offset = static_cast<cl_int>(next);
-      }
     cl::Context& ctx = rt_->context();
     cl::CommandQueue& q = rt_->queue();
     const int row_len = lay.image_features(), combos = V * kRegions * S * P;
