@@ -7,7 +7,9 @@
 // render_view, in one order, so the host sets them in one place.
 //   sprites: int4 (atlas offset, width, height, padded offset) per (sprite set, variant)
 //   noise_offsets: atlas offset of each noise pattern, then of its padded copy
-//   places:  int2 (x0, y0) per (view, variant, region), the sprite centred in its region
+//   places:  int2 (x0, y0) per (view, variant, region), the sprite centred in its region;
+//            then int2 (0, dy) per (subject, view, region), its place's move with the
+//            subject's height (Sensor::subject_dy)
 //   records: the view's placement record per scenario (kernels/shared.h, PS_REC_*)
 //   field:   the view's values before display, n * height * width, at the build's precision
 //   phys:    the physics model's parameters (kernels/shared.h, PS_PHYS_*)
@@ -137,8 +139,7 @@ inline void place_affine(global int* ly, const PsViewLaunch* L, uint2 seed, ulon
 kernel void place_view(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
-  (void)atlas, (void)bases, (void)subject, (void)alpha, (void)sigma, (void)field, (void)out, (void)phys, (void)raw,
-      (void)scratch;
+  (void)atlas, (void)bases, (void)alpha, (void)sigma, (void)field, (void)out, (void)phys, (void)raw, (void)scratch;
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
   const ulong index = upsample(L.first_hi, L.first_lo) + i;
   global const short* objs = objects + (size_t)i * PS_REGIONS;
@@ -151,7 +152,9 @@ kernel void place_view(VIEW_STAGE_ARGS) {
     const int v = objs[r];
     if (v < 0 || !((L.region_mask >> r) & 1u)) continue;
     const int4 sp = sprites[L.sprite_set * L.variants + v];
-    const int2 pl = places[((size_t)L.view * L.variants + v) * PS_REGIONS + r];
+    // The region's place for this view and variant, moved with the subject's height.
+    const int2 pl = places[((size_t)L.view * L.variants + v) * PS_REGIONS + r] +
+                    places[((size_t)L.views * L.variants + (size_t)subject[i] * L.views + L.view) * PS_REGIONS + r];
     float dx = 0.0f, dy = 0.0f;
     if (L.jitter_x > 0.0f || L.jitter_y > 0.0f) {
       const uint4 q = draw(seed, index, PS_STREAM_JITTER, (uint)r);

@@ -36,7 +36,9 @@ kernel void metal_physics(global const double* zone_rec, global const double* re
       dx = jitter_x * (2.0 * ((double)(q.x >> 8) * (1.0 / 16777216.0)) - 1.0);
       dy = jitter_y * (2.0 * ((double)(q.y >> 8) * (1.0 / 16777216.0)) - 1.0);
     }
-    const double col = region_rec[r * PS_MR_LEN + PS_MR_COL], row = region_rec[r * PS_MR_LEN + PS_MR_ROW];
+    // The region's centre on this subject (its place moves with the subject's height).
+    global const double* rr = region_rec + ((size_t)subject[i] * PS_REGIONS + r) * PS_MR_LEN;
+    const double col = rr[PS_MR_COL], row = rr[PS_MR_ROW];
     px[count] = (col + dx - half_width) * scale;
     pz[count] = body_height - (row + dy) * scale;
     variant[count] = v;

@@ -6,7 +6,8 @@
 // per scenario. Every value is the dense path's to the bit: the same blend() and noise
 // arithmetic, integer sums, and the same final division.
 //
-// The footprint record per (variant, region) is laid out in kernels/shared.h (PS_FP_*).
+// The footprint record per (variant, region, subject: the place moves with its height)
+// is laid out in kernels/shared.h (PS_FP_*).
 // Pooled views: `pooled[k]` is the camera view of the k-th pooled view (its blocks are
 // the k-th run of the row); `region_slot[r]` is the pooled view region r lies in, and
 // rects[r] its rectangle there.
@@ -76,10 +77,10 @@ kernel void footprint_deltas(global const uchar* atlas, global const int* bases,
   const int g = (int)get_global_id(0);
   if (g >= combos) return;
   const int p = g % P, s = (g / P) % S, vr = g / (P * S), r = vr % PS_REGIONS;
-  global const int* fp = fps + vr * FP_LEN;
+  global const int* fp = fps + (vr * S + s) * FP_LEN;  // the place on this subject
   const int slot = region_slot[r];
   global const uchar* base = atlas + bases[s * views + pooled[slot]];
-  global int* d = deltas + fp[PS_FP_DELTAS] + (s * P + p) * fp[PS_FP_BLOCKS_W] * fp[PS_FP_BLOCKS_H];
+  global int* d = deltas + fp[PS_FP_DELTAS] + p * fp[PS_FP_BLOCKS_W] * fp[PS_FP_BLOCKS_H];
   for (int k = 0; k < fp[PS_FP_BLOCKS_W] * fp[PS_FP_BLOCKS_H]; ++k) d[k] = 0;
   int reg[PS_REGIONS];
   for (int k = 0; k < PS_REGIONS; ++k) reg[k] = 0;
@@ -166,7 +167,7 @@ kernel void features_sparse(global const uchar* restrict atlas, global const int
     for (int r = 0; r < PS_REGIONS; ++r) {
       const int v = objs[r];
       if (v < 0 || region_slot[r] != slot) continue;
-      for (int q = 0; q < FP_LEN; ++q) fp[cnt][q] = fps[(v * PS_REGIONS + r) * FP_LEN + q];
+      for (int q = 0; q < FP_LEN; ++q) fp[cnt][q] = fps[((v * PS_REGIONS + r) * S + s) * FP_LEN + q];
       comb[cnt] = (v * PS_REGIONS + r) * S * P + s * P + p;
       ++cnt;
     }
@@ -181,7 +182,7 @@ kernel void features_sparse(global const uchar* restrict atlas, global const int
         for (int bx = fp[k][PS_FP_BLOCK_X0]; bx < fp[k][PS_FP_BLOCK_X0] + fp[k][PS_FP_BLOCKS_W]; ++bx)
           vrow[by * bx_count + bx] = (float)vbs[by * bx_count + bx];
     for (int k = 0; k < cnt; ++k) {
-      global const int* d = deltas + fp[k][PS_FP_DELTAS] + (s * P + p) * fp[k][PS_FP_BLOCKS_W] * fp[k][PS_FP_BLOCKS_H];
+      global const int* d = deltas + fp[k][PS_FP_DELTAS] + p * fp[k][PS_FP_BLOCKS_W] * fp[k][PS_FP_BLOCKS_H];
       for (int by = 0; by < fp[k][PS_FP_BLOCKS_H]; ++by)
         for (int bx = 0; bx < fp[k][PS_FP_BLOCKS_W]; ++bx)
           vrow[(fp[k][PS_FP_BLOCK_Y0] + by) * bx_count + fp[k][PS_FP_BLOCK_X0] + bx] += (float)d[by * fp[k][PS_FP_BLOCKS_W] + bx];

@@ -72,7 +72,7 @@
 #define PS_FLAG_FLIP 16      /* with PS_FLAG_AFFINE: mirror each object with probability 1/2 */
 #define PS_FLAG_TABULATED 32 /* physics features-only: scenarios the object tables cover skip physics_raw */
 
-/* Footprint record of the sparse features path, per (variant, region), ints. */
+/* Footprint record of the sparse features path, per (variant, region, subject), ints. */
 #define PS_FP_SPRITE_X0 0
 #define PS_FP_SPRITE_Y0 1
 #define PS_FP_SPRITE_W 2

@@ -70,6 +70,7 @@ AssetSet build_assets(const Catalogue& cat) {
     procedural::Body body;
     body.subject = static_cast<int>(s);
     body.build = sub.build;
+    body.height = sub.height;
     body.mmw_level = sub.mmw_level;
     body.ir_core = sub.ir_core;
     body.ir_limb = sub.ir_limb;

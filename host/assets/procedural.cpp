@@ -175,6 +175,7 @@ class BodyModel {
  public:
   explicit BodyModel(const Body& body) {
     b_ = std::isfinite(body.build) ? std::clamp(body.build, 0.5, 1.6) : 1.0;
+    h_ = std::isfinite(body.height) ? std::clamp(body.height, 0.5, 2.0) : 1.0;
     seed_ = mix64(static_cast<uint64_t>(static_cast<int64_t>(body.subject)) + 0x5eed);
     auto var = [&](int k) { return hash01(k, 0, seed_); };
     arm_spread_ = 4.0 * var(1);
@@ -185,6 +186,11 @@ class BodyModel {
   }
 
   uint64_t seed() const { return seed_; }
+
+  // The body's own row drawn at image row y of the whole-body frame (0..400, floor at 400):
+  // the stature scaled about the floor. Exactly y at height 1.
+  double body_row(double y) const { return h_ == 1.0 ? y : kFloor - (kFloor - y) / h_; }
+  static constexpr double kFloor = 400.0;
 
   BodyField eval(double u, double y) const {
     BodyField f{};
@@ -290,7 +296,7 @@ class BodyModel {
     return smin(smin(thigh, shin, 2.0), foot, 4.0);
   }
 
-  double b_ = 1.0;
+  double b_ = 1.0, h_ = 1.0;
   uint64_t seed_ = 0;
   double arm_spread_ = 0, shoulder_dy_ = 0, stance_ = 0, lean_ = 0, arm_off_ = 64.5;
 };
@@ -678,7 +684,8 @@ Image mmw_body(const Body& body, bool upper, int width, int height) {
   const uint64_t seed = model.seed();
   for (int y = 0; y < height; ++y) {
     const double v = (y + 0.5) * pv + (upper ? 0.0 : 200.0);
-    int next = 0;  // pixels before `next` are known to be clear of the body
+    const double vb = model.body_row(v);  // the body drawn here; the room stays at v
+    int next = 0;                         // pixels before `next` are known to be clear of the body
     for (int x = 0; x < width; ++x) {
       const double u = (x + 0.5) * pu;
       const double back = bg + 2.0 * value_noise(u / 9.0, v / 9.0, seed + 2) + 1.5 * hash_signed(x, y, seed + 3);
@@ -687,13 +694,13 @@ Image mmw_body(const Body& body, bool upper, int width, int height) {
         img.at(x, y) = to_u8(val);
         continue;
       }
-      const BodyField f = model.eval(u, v);
+      const BodyField f = model.eval(u, vb);
       next = x + 1 + skip_pixels(f.d - e, pu, width);
       const double c = coverage(f.d, e);
       if (c > 0.0) {
         const double depth = clamp01(-f.d / 26.0);
         const double s = 1.0 - (1.0 - depth) * (1.0 - depth);
-        const double skin = level + 34.0 * (s - 0.7) + 4.0 * fbm(u / 22.0, v / 22.0, seed + 4) +
+        const double skin = level + 34.0 * (s - 0.7) + 4.0 * fbm(u / 22.0, vb / 22.0, seed + 4) +
                             2.5 * hash_signed(x, y, seed + 5) - 18.0 * f.chin * f.chin;
         val = lerp(back, skin, c);
       }
@@ -713,6 +720,7 @@ Image ir_body(const Body& body, int width, int height) {
   const uint64_t seed = model.seed();
   for (int y = 0; y < height; ++y) {
     const double v = (y + 0.5) * pv;
+    const double vb = model.body_row(v);  // the body drawn here; the room stays at v
     int next = 0;
     for (int x = 0; x < width; ++x) {
       const double u = (x + 0.5) * pu;
@@ -722,18 +730,18 @@ Image ir_body(const Body& body, int width, int height) {
         img.at(x, y) = to_u8(val);
         continue;
       }
-      const BodyField f = model.eval(u, v);
+      const BodyField f = model.eval(u, vb);
       next = x + 1 + skip_pixels(f.d - e, pu, width);
       const double c = coverage(f.d, e);
       if (c > 0.0) {
         // Each part's own temperature, blended by how close the point is to each part.
-        const double sa = clamp01((v - 45.0) / 147.0), sl = clamp01((v - 240.0) / 158.0);
+        const double sa = clamp01((vb - 45.0) / 147.0), sl = clamp01((vb - 240.0) / 158.0);
         const double t_core = core - 8.0 * (1.0 - clamp01(-f.d_core / 20.0));
         const double t_head = limb + 0.55 * (core - limb);
         const double t_arm = limb + 0.4 * (core - limb) * (1.0 - sa) * (1.0 - sa) - 26.0 * sa * sa;
         const double t_leg = limb + 0.55 * (core - limb) * (1.0 - sl) * (1.0 - sl) - 30.0 * sl * sl;
         // Trunk and legs are one piece: a gradient down from the hips, not a seam.
-        const double t_trunk = lerp(t_core, t_leg, smoothstep(225.0, 320.0, v));
+        const double t_trunk = lerp(t_core, t_leg, smoothstep(225.0, 320.0, vb));
         const double d_trunk = std::min(f.d_core, f.d_leg);
         const double dm = std::min({d_trunk, f.d_head, f.d_arm});
         auto weight = [&](double d) { return smooth(1.0 - (d - dm) / 14.0); };
@@ -741,7 +749,7 @@ Image ir_body(const Body& body, int width, int height) {
         double t = (wc * t_trunk + wh * t_head + wa * t_arm) / (wc + wh + wa);
         const double depth = clamp01(-f.d / 9.0);
         t -= 16.0 * (1.0 - depth) * (1.0 - depth);  // the surface turns away at the edges
-        t += 1.5 * fbm(u / 15.0, v / 15.0, seed + 7);
+        t += 1.5 * fbm(u / 15.0, vb / 15.0, seed + 7);
         val = lerp(back, t, c);
       }
       img.at(x, y) = to_u8(val);

@@ -377,11 +377,25 @@ struct Annotator::Kept {
   const Catalogue& cat;
   const AssetSet& assets;
   std::vector<std::vector<Runs>> runs;
-  std::vector<std::vector<Fixed>> fixed;  // per view, variant * kRegions + region
+  // Subjects whose places are the same (Sensor::subject_dy in every view) share a body:
+  // body[subject] indexes `shape`, which names one such subject.
+  std::vector<int> body, shape;
+  std::vector<std::vector<Fixed>> fixed;  // per view, (body * variants + variant) * kRegions + region
   std::vector<Work> spare;
 };
 
-Annotator::Annotator(const Catalogue& cat, const AssetSet& assets) : kept_(new Kept{cat, assets, {}, {}, {}}) {
+Annotator::Annotator(const Catalogue& cat, const AssetSet& assets) : kept_(new Kept{cat, assets, {}, {}, {}, {}, {}}) {
+  for (size_t j = 0; j < cat.subjects.size(); ++j) {
+    size_t b = 0;
+    const auto same = [&](int other) {
+      for (const Sensor& s : cat.sensors)
+        if (s.subject_dy[j] != s.subject_dy[other]) return false;
+      return true;
+    };
+    while (b < kept_->shape.size() && !same(kept_->shape[b])) ++b;
+    if (b == kept_->shape.size()) kept_->shape.push_back(static_cast<int>(j));
+    kept_->body.push_back(static_cast<int>(b));
+  }
   kept_->runs.resize(cat.sensors.size());
   for (size_t k = 0; k < cat.sensors.size(); ++k)
     for (size_t v = 0; v < cat.variant_list.size(); ++v)
@@ -422,28 +436,32 @@ void Annotator::operator()(const ModelSettings& model, const SceneBatch& batch, 
     va.width = sensor.width;
     va.height = sensor.height;
   }
-  // Sprites that do not move sit where their variant, region and view put them, the same
-  // in every scenario and for any model that does not move them: placed once, from one
-  // scene per view and variant that holds the variant in every region.
+  // Sprites that do not move sit where their variant, region, view and subject's body put
+  // them, the same in every scenario and for any model that does not move them: placed
+  // once, from one scene per body, view and variant that holds the variant in every region.
   std::vector<std::vector<Fixed>>& fixed = kept_->fixed;
+  const std::vector<int>& body = kept_->body;
+  const size_t V = cat.variant_list.size();
   const bool moves = model.moves_sprites();
   if (!moves && fixed.empty()) {
     fixed.resize(views);
     for (size_t k = 0; k < views; ++k) {
       const Sensor& sensor = cat.sensors[k];
-      fixed[k].resize(cat.variant_list.size() * kRegions);
-      for (size_t v = 0; v < cat.variant_list.size(); ++v) {
-        Scenario every;
-        every.objects.fill(static_cast<int16_t>(v));
-        const reference::ViewScene vs = reference::view_scene(cat, assets, model, static_cast<int>(k), every, 0);
-        size_t p = 0;
-        for (int r = 0; r < kRegions; ++r) {
-          if (!sensor.sees(r)) continue;
-          Fixed& f = fixed[k][v * kRegions + r];
-          f.placed = vs.placed[p++];
-          f.at.emplace(f.placed, runs[k][v], model, sensor.width, sensor.height);
+      fixed[k].resize(kept_->shape.size() * V * kRegions);
+      for (size_t b = 0; b < kept_->shape.size(); ++b)
+        for (size_t v = 0; v < V; ++v) {
+          Scenario every;
+          every.subject = kept_->shape[b];
+          every.objects.fill(static_cast<int16_t>(v));
+          const reference::ViewScene vs = reference::view_scene(cat, assets, model, static_cast<int>(k), every, 0);
+          size_t p = 0;
+          for (int r = 0; r < kRegions; ++r) {
+            if (!sensor.sees(r)) continue;
+            Fixed& f = fixed[k][(b * V + v) * kRegions + r];
+            f.placed = vs.placed[p++];
+            f.at.emplace(f.placed, runs[k][v], model, sensor.width, sensor.height);
+          }
         }
-      }
     }
   }
   // Each worker's annotations in a list of its own, by scenario, then view (count says how
@@ -493,7 +511,7 @@ void Annotator::operator()(const ModelSettings& model, const SceneBatch& batch, 
             placed[m] = &moved[m];
             at[m] = &moved_at[m];
           } else {
-            const Fixed& f = fixed[k][static_cast<size_t>(v) * kRegions + r];
+            const Fixed& f = fixed[k][(static_cast<size_t>(body[s.subject]) * V + v) * kRegions + r];
             placed[m] = &f.placed;
             at[m] = &*f.at;
           }

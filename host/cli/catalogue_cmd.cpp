@@ -24,7 +24,9 @@ int list(CatalogueOptions& o) {
     std::printf(" %s %s %dx%d;", v.name.c_str(), camera_name(v.camera), v.width, v.height);
   std::printf(" alpha %.3g\n", c.images.alpha);
   std::printf("\nsubjects:\n");
-  for (size_t i = 0; i < c.subjects.size(); ++i) std::printf("  %zu  %s\n", i + 1, c.subjects[i].name.c_str());
+  for (size_t i = 0; i < c.subjects.size(); ++i)  // what the body is drawn as: width and stature scales
+    std::printf("  %zu  %s  build %g  height %g\n", i + 1, c.subjects[i].name.c_str(), c.subjects[i].build,
+                c.subjects[i].height);
   std::printf("\nregions:\n");
   for (const Region& r : c.regions)
     std::printf("  %2d  %-15s %s\n", r.id, r.name.c_str(), r.view == View::upper ? "upper" : "lower");

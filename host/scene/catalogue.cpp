@@ -310,11 +310,15 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     const toml::table& t = *subjects.get(i)->as_table();
     const std::string f = "subjects[" + std::to_string(i + 1) + "]";
     io::reject_unknown_keys(
-        t, {"name", "build", "mmw_level", "ir_core", "ir_limb", "base_zones", "mmw_upper", "mmw_lower", "ir"},
+        t, {"name", "build", "height", "mmw_level", "ir_core", "ir_limb", "base_zones", "mmw_upper", "mmw_lower", "ir"},
         source_name, f);
     Subject s;
     s.name = rd.string(t, "name", f);
     s.build = rd.number(t, "build", f, 0.5, 1.5, 1.0);
+    // Stature about the 1.75 m body of [metal.physics]: 0.85..1.15 is about 1.49 m to
+    // 2.01 m, most adults. Within it the drawn head stays below the upper view's top edge
+    // and every region's place stays in its own view (README, "Subjects").
+    s.height = rd.number(t, "height", f, 0.85, 1.15, 1.0);
     s.mmw_level = rd.integer(t, "mmw_level", f, 0, 255, 150);
     s.ir_core = rd.integer(t, "ir_core", f, 0, 255, 215);
     s.ir_limb = rd.integer(t, "ir_limb", f, 0, 255, 175);
@@ -323,6 +327,11 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     s.mmw_upper = rd.image(t, "mmw_upper", f);
     s.mmw_lower = rd.image(t, "mmw_lower", f);
     s.ir = rd.image(t, "ir", f);
+    // Objects move with the stature; an image file's body would not.
+    if (s.height != 1.0 && (!s.mmw_upper.path.empty() || !s.mmw_lower.path.empty() || !s.ir.path.empty()))
+      rd.fail(t.get("height"), f + ".height",
+              "only a procedural body can be drawn at another height; this subject names image files "
+              "(mmw_upper, mmw_lower or ir)");
     cat.subjects.push_back(std::move(s));
   }
 

@@ -22,7 +22,8 @@ struct ImageSource {
 
 struct Subject {
   std::string name;
-  double build = 1.0;
+  double build = 1.0;   // body width scale (procedural::Body::build)
+  double height = 1.0;  // stature scale about the floor (procedural::Body::height)
   int mmw_level = 150, ir_core = 215, ir_limb = 175;
   std::array<int, kZones> base_zones{};
   ImageSource mmw_upper, mmw_lower, ir;

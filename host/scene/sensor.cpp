@@ -1,5 +1,7 @@
 #include "scene/sensor.h"
 
+#include <cmath>
+
 #include "scene/catalogue.h"
 
 namespace portalsim {
@@ -42,6 +44,20 @@ std::vector<Sensor> camera_sensors(const Catalogue& cat) {
   ir.jitter_scale_x = static_cast<double>(ic.ir_width) / ic.mmw_width;
   ir.jitter_scale_y = static_cast<double>(ic.ir_height) / (2.0 * ic.mmw_height);
   out.push_back(ir);
+  out[0].floor_row = 2.0 * ic.mmw_height;
+  out[1].floor_row = ic.mmw_height;
+  out[2].floor_row = ic.ir_height;
+  // A region's place follows the body drawn for the subject (procedural::Body::height): a
+  // point c rows above the floor is drawn c * height rows above it. Whole pixels, so that
+  // integer placement stays integer and height 1 moves nothing.
+  for (Sensor& s : out) {
+    s.subject_dy.assign(cat.subjects.size(), {});
+    for (size_t k = 0; k < cat.subjects.size(); ++k)
+      for (int r = 0; r < kRegions; ++r) {
+        const double c = s.rects[r].y + s.rects[r].h / 2.0;
+        s.subject_dy[k][r] = static_cast<int>(std::lround((1.0 - cat.subjects[k].height) * (s.floor_row - c)));
+      }
+  }
   return out;
 }
 

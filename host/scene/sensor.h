@@ -41,6 +41,13 @@ struct Sensor {
   bool palette = false;        // stored as a temperature index, written through the palette
   // Jitter is given in MMW pixels; this view's pixels per MMW pixel.
   double jitter_scale_x = 1.0, jitter_scale_y = 1.0;
+  // The floor's row in this view's pixel coordinates (the bottom edge of the lower MMW
+  // view; for the upper view one view height below its own bottom).
+  double floor_row = 0.0;
+  // Per subject, how many whole pixels down each region's place moves with the subject's
+  // stature (Subject::height, scaled about the floor): round((1 - height) (floor_row - c)),
+  // c the region's centre row. Zero for height 1.
+  std::vector<std::array<int, kRegions>> subject_dy;
   // The stages of its chain under each model, in order (names registered in
   // backend/stages.cpp).
   std::vector<std::string> chain{"composite", "pattern_noise", "sensor_noise", "display"};
@@ -48,6 +55,14 @@ struct Sensor {
   const std::vector<std::string>& chain_for(Model m) const { return m == Model::physics ? physics_chain : chain; }
 
   bool sees(int region) const { return (region_mask >> region) & 1u; }
+  // Where region `region` holds an object on subject `subject`: its rectangle, moved with
+  // the subject's body. Object placement (both backends, annotations, metal positions)
+  // goes through this; pooling uses `rects` as they are.
+  Rect place(int subject, int region) const {
+    Rect r = rects[region];
+    r.y += subject_dy[subject][region];
+    return r;
+  }
   size_t pixels() const { return static_cast<size_t>(width) * height; }
 };
 

@@ -42,10 +42,9 @@ cl::Buffer constant(cl::Context& ctx, const std::vector<T>& v) {
 
 cl_int4 rect4(const Rect& r) { return {{r.x, r.y, r.w, r.h}}; }
 
-// A sprite centred in its region's rectangle of a view (>> 1 floors negative differences
-// too): where place_view lays it without jitter.
-Rect sprite_box(const Sensor& s, const Image& sprite, int region) {
-  const Rect& rc = s.rects[region];
+// A sprite centred in a region's rectangle (>> 1 floors negative differences too): where
+// place_view lays it without jitter, given the region's place on the subject.
+Rect sprite_box(const Rect& rc, const Image& sprite) {
   return {rc.x + ((rc.w - sprite.width) >> 1), rc.y + ((rc.h - sprite.height) >> 1), sprite.width, sprite.height};
 }
 
@@ -97,17 +96,23 @@ class OpenCLBackend final : public Backend {
         const int plain = add(sp);
         sprites[c * V + v] = {{plain, sp.width, sp.height, add_padded_sprite(sp)}};
       }
-    // Each sprite centred in its region's rectangle of each view.
-    std::vector<cl_int2> places(views * V * kRegions);
+    // Each sprite centred in its region's rectangle of each view; then, per subject and
+    // view, how far each region's place moves with the subject's height (Sensor::place),
+    // which place_view adds.
+    const size_t S = cat.subjects.size();
+    std::vector<cl_int2> places((views * V + S * views) * kRegions);
     for (size_t k = 0; k < views; ++k) {
       const Sensor& s = cat.sensors[k];
       for (size_t v = 0; v < V; ++v) {
         const Image& sp = assets.sprite(s.camera, static_cast<int>(v));
         for (int r = 0; r < kRegions; ++r) {
-          const Rect box = sprite_box(s, sp, r);
+          const Rect box = sprite_box(s.rects[r], sp);
           places[(k * V + v) * kRegions + r] = {{box.x, box.y}};
         }
       }
+      for (size_t j = 0; j < S; ++j)
+        for (int r = 0; r < kRegions; ++r)
+          places[(views * V + j * views + k) * kRegions + r] = {{0, s.subject_dy[j][r]}};
     }
     std::vector<cl_int> noise_offsets;
     std::vector<cl_float> noise_gains;
@@ -260,7 +265,8 @@ class OpenCLBackend final : public Backend {
   // polarizability tensor, as the reference computes them.
   void metal_physics_tables(cl::Context& ctx) {
     const MetalPhysics& mp = cat_.metal_physics;
-    std::vector<cl_double> zones(kZones * PS_MZ_LEN, 0.0), regions(kRegions * PS_MR_LEN, 0.0), tensors;
+    const size_t S = cat_.subjects.size();
+    std::vector<cl_double> zones(kZones * PS_MZ_LEN, 0.0), regions(S * kRegions * PS_MR_LEN, 0.0), tensors;
     for (int z = 0; z < kZones; ++z) {
       const double side = z < PS_METAL_PANEL_A_ZONES ? -1.0 : 1.0;
       cl_double* rec = &zones[z * PS_MZ_LEN];
@@ -276,11 +282,15 @@ class OpenCLBackend final : public Backend {
     for (const Sensor& s : cat_.sensors) {
       if (s.camera != Camera::mmw) continue;
       if (!metal_view_) metal_view_ = &s;
-      for (int r = 0; r < kRegions; ++r)
-        if (s.sees(r)) {
-          regions[r * PS_MR_LEN + PS_MR_COL] = s.rects[r].x + s.rects[r].w / 2.0;
-          regions[r * PS_MR_LEN + PS_MR_ROW] = row_offset + s.rects[r].y + s.rects[r].h / 2.0;
-        }
+      // Each subject's region centres: the places, moved with its height.
+      for (size_t j = 0; j < S; ++j)
+        for (int r = 0; r < kRegions; ++r)
+          if (s.sees(r)) {
+            const Rect rc = s.place(static_cast<int>(j), r);
+            cl_double* rec = &regions[(j * kRegions + r) * PS_MR_LEN];
+            rec[PS_MR_COL] = rc.x + rc.w / 2.0;
+            rec[PS_MR_ROW] = row_offset + rc.y + rc.h / 2.0;
+          }
       row_offset += s.height;
     }
     for (size_t v = 0; v < cat_.variant_list.size(); ++v)
@@ -810,7 +820,13 @@ class OpenCLBackend final : public Backend {
     if (tabulated) {
       // One scenario per subject bare, per (subject, variant, region seen) alone, and per
       // pair of those whose boxes meet.
-      const auto box = [&](int v, int r) { return sprite_box(sv, assets_.sprite(sv.camera, v), r); };
+      // A pair counts where its boxes meet on any subject (places move with the height).
+      const auto meet = [&](int va, int ra, int vb, int rb) {
+        const Image &a = assets_.sprite(sv.camera, va), &b = assets_.sprite(sv.camera, vb);
+        for (int s = 0; s < S; ++s)
+          if (boxes_meet(sprite_box(sv.place(s, ra), a), sprite_box(sv.place(s, rb), b))) return true;
+        return false;
+      };
       SceneBatch b;
       std::vector<std::array<int, 4>> pairs;  // va, ra, vb, rb with ra < rb
       for (int ra = 0; ra < kRegions; ++ra)
@@ -818,7 +834,7 @@ class OpenCLBackend final : public Backend {
           if (sv.sees(ra) && sv.sees(rb))
             for (int va = 0; va < V; ++va)
               for (int vb = 0; vb < V; ++vb)
-                if (boxes_meet(box(va, ra), box(vb, rb))) pairs.push_back({va, ra, vb, rb});
+                if (meet(va, ra, vb, rb)) pairs.push_back({va, ra, vb, rb});
       for (int s = 0; s < S; ++s) {
         Scenario sc;
         sc.subject = s;
@@ -932,47 +948,50 @@ class OpenCLBackend final : public Backend {
     if (tables_.block == block && tables_.noise == noise) return;
     const int S = static_cast<int>(cat_.subjects.size()), V = static_cast<int>(cat_.variant_list.size());
     const int P = noise ? static_cast<int>(cat_.noise.size()) : 1;
-    std::vector<cl_int> fps(static_cast<size_t>(V) * kRegions * PS_FP_LEN, 0);
+    // A footprint per (variant, region, subject): the place moves with the subject's height.
+    std::vector<cl_int> fps(static_cast<size_t>(V) * kRegions * S * PS_FP_LEN, 0);
     cl_int offset = 0;
     for (int v = 0; v < V; ++v)
-      for (int r = 0; r < kRegions; ++r) {
-        const Image& sp = assets_.sprite(Camera::mmw, v);
-        const Rect& rc = cat_.sensors[lay.pooled[region_slot(lay, r)]].rects[r];
-        cl_int* f = &fps[(static_cast<size_t>(v) * kRegions + r) * PS_FP_LEN];
-        f[PS_FP_SPRITE_X0] = rc.x + ((rc.w - sp.width) >> 1);
-        f[PS_FP_SPRITE_Y0] = rc.y + ((rc.h - sp.height) >> 1);
-        f[PS_FP_SPRITE_W] = sp.width;
-        f[PS_FP_SPRITE_H] = sp.height;
-        f[PS_FP_SPRITE_OFFSET] = mmw_sprites_[v].s[0];
-        f[PS_FP_SPRITE_PADDED] = mmw_sprites_[v].s[3];
-        f[PS_FP_TILE_X0] = f[PS_FP_SPRITE_X0] + (sp.width >> 1) - (N >> 1);
-        f[PS_FP_TILE_Y0] = f[PS_FP_SPRITE_Y0] + (sp.height >> 1) - (N >> 1);
-        int x0 = f[PS_FP_SPRITE_X0], y0 = f[PS_FP_SPRITE_Y0], x1 = f[PS_FP_SPRITE_X0] + f[PS_FP_SPRITE_W],
-            y1 = f[PS_FP_SPRITE_Y0] + f[PS_FP_SPRITE_H];
-        if (noise) {
-          x0 = std::min(x0, f[PS_FP_TILE_X0]);
-          y0 = std::min(y0, f[PS_FP_TILE_Y0]);
-          x1 = std::max(x1, f[PS_FP_TILE_X0] + N);
-          y1 = std::max(y1, f[PS_FP_TILE_Y0] + N);
+      for (int r = 0; r < kRegions; ++r)
+        for (int s = 0; s < S; ++s) {
+          const Image& sp = assets_.sprite(Camera::mmw, v);
+          const Rect rc = cat_.sensors[lay.pooled[region_slot(lay, r)]].place(s, r);
+          cl_int* f = &fps[((static_cast<size_t>(v) * kRegions + r) * S + s) * PS_FP_LEN];
+          f[PS_FP_SPRITE_X0] = rc.x + ((rc.w - sp.width) >> 1);
+          f[PS_FP_SPRITE_Y0] = rc.y + ((rc.h - sp.height) >> 1);
+          f[PS_FP_SPRITE_W] = sp.width;
+          f[PS_FP_SPRITE_H] = sp.height;
+          f[PS_FP_SPRITE_OFFSET] = mmw_sprites_[v].s[0];
+          f[PS_FP_SPRITE_PADDED] = mmw_sprites_[v].s[3];
+          f[PS_FP_TILE_X0] = f[PS_FP_SPRITE_X0] + (sp.width >> 1) - (N >> 1);
+          f[PS_FP_TILE_Y0] = f[PS_FP_SPRITE_Y0] + (sp.height >> 1) - (N >> 1);
+          int x0 = f[PS_FP_SPRITE_X0], y0 = f[PS_FP_SPRITE_Y0], x1 = f[PS_FP_SPRITE_X0] + f[PS_FP_SPRITE_W],
+              y1 = f[PS_FP_SPRITE_Y0] + f[PS_FP_SPRITE_H];
+          if (noise) {
+            x0 = std::min(x0, f[PS_FP_TILE_X0]);
+            y0 = std::min(y0, f[PS_FP_TILE_Y0]);
+            x1 = std::max(x1, f[PS_FP_TILE_X0] + N);
+            y1 = std::max(y1, f[PS_FP_TILE_Y0] + N);
+          }
+          x0 = std::max(x0, 0);
+          y0 = std::max(y0, 0);
+          x1 = std::min(x1, W);
+          y1 = std::min(y1, H);
+          if (x0 >= x1 || y0 >= y1) x0 = y0 = x1 = y1 = 0;  // wholly outside: touches nothing
+          f[PS_FP_X0] = x0;
+          f[PS_FP_Y0] = y0;
+          f[PS_FP_X1] = x1;
+          f[PS_FP_Y1] = y1;
+          f[PS_FP_BLOCK_X0] = x0 / block;
+          f[PS_FP_BLOCK_Y0] = y0 / block;
+          f[PS_FP_BLOCKS_W] = x1 > x0 ? (x1 - 1) / block - f[PS_FP_BLOCK_X0] + 1 : 0;
+          f[PS_FP_BLOCKS_H] = y1 > y0 ? (y1 - 1) / block - f[PS_FP_BLOCK_Y0] + 1 : 0;
+          f[PS_FP_DELTAS] = offset;
+          const int64_t next = offset + static_cast<int64_t>(P) * f[PS_FP_BLOCKS_W] * f[PS_FP_BLOCKS_H];
+          if (next > INT32_MAX)
+            throw std::runtime_error("sparse feature tables exceed 2^31 entries; use --block larger");
+          offset = static_cast<cl_int>(next);
         }
-        x0 = std::max(x0, 0);
-        y0 = std::max(y0, 0);
-        x1 = std::min(x1, W);
-        y1 = std::min(y1, H);
-        if (x0 >= x1 || y0 >= y1) x0 = y0 = x1 = y1 = 0;  // wholly outside: touches nothing
-        f[PS_FP_X0] = x0;
-        f[PS_FP_Y0] = y0;
-        f[PS_FP_X1] = x1;
-        f[PS_FP_Y1] = y1;
-        f[PS_FP_BLOCK_X0] = x0 / block;
-        f[PS_FP_BLOCK_Y0] = y0 / block;
-        f[PS_FP_BLOCKS_W] = x1 > x0 ? (x1 - 1) / block - f[PS_FP_BLOCK_X0] + 1 : 0;
-        f[PS_FP_BLOCKS_H] = y1 > y0 ? (y1 - 1) / block - f[PS_FP_BLOCK_Y0] + 1 : 0;
-        f[PS_FP_DELTAS] = offset;
-        const int64_t next = offset + static_cast<int64_t>(S) * P * f[PS_FP_BLOCKS_W] * f[PS_FP_BLOCKS_H];
-        if (next > INT32_MAX) throw std::runtime_error("sparse feature tables exceed 2^31 entries; use --block larger");
-        offset = static_cast<cl_int>(next);
-      }
     cl::Context& ctx = rt_->context();
     cl::CommandQueue& q = rt_->queue();
     const int row_len = lay.image_features(), combos = V * kRegions * S * P;

@@ -43,7 +43,7 @@ std::vector<MetalObject> metal_objects(const Catalogue& cat, const AssetSet& ass
     for (int r = 0; r < kRegions; ++r) {
       if (s.objects[r] == kNoObject || !sensor.sees(r)) continue;
       const Placed& p = vs.placed[next++];
-      const Rect& rc = sensor.rects[r];
+      const Rect rc = sensor.place(s.subject, r);
       const double col = rc.x + rc.w / 2.0, row = row_offset + rc.y + rc.h / 2.0;
       out.push_back({cat.polarizability(s.objects[r]), (col + p.dx - sensor.width / 2.0) * scale,
                      mp.body_height - (row + p.dy) * scale});

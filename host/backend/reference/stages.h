@@ -105,8 +105,9 @@ void metal(const Catalogue& cat, const ModelSettings& m, const Scenario& s, uint
 void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m, const Scenario& s,
                    uint64_t index, uint8_t* zones);
 // A metal object as the coils see it: polarizability tensor (cm^3) and position (metres,
-// x across the portal, z up; y = 0), its region's centre in the stacked MMW views plus
-// the composite's placement jitter.
+// x across the portal, z up; y = 0), its region's centre in the stacked MMW views, moved
+// with the subject's height as the composite's place (Sensor::place), plus the
+// composite's placement jitter.
 struct MetalObject {
   std::array<double, 9> tensor;
   double x, z;
