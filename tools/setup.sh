@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(build-essential cmake pkg-config
+packages=(build-essential cmake ninja-build pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
   libopenimageio-dev openimageio-tools
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
@@ -28,6 +28,10 @@ elif [ ${#missing[@]} -ne 0 ]; then
 fi
 
 build_dir=${PORTALSIM_BUILD_DIR:-build}
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release ${PORTALSIM_CMAKE_ARGS:-} >/dev/null
+# A new build folder uses Ninja (it runs the test files' compiles beside the library's);
+# one configured before keeps its generator.
+generator=()
+[ -f "$build_dir/CMakeCache.txt" ] || ! command -v ninja >/dev/null || generator=(-G Ninja)
+cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release ${PORTALSIM_CMAKE_ARGS:-} >/dev/null
 # PORTALSIM_TARGET builds one target (the main job needs only portalsim).
 cmake --build "$build_dir" -j "$(nproc)" ${PORTALSIM_TARGET:+--target "$PORTALSIM_TARGET"}

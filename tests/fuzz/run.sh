@@ -6,7 +6,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 seconds=${1:-50}
-CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPORTALSIM_FUZZ=ON \
+generator=()
+[ -f build-fuzz/CMakeCache.txt ] || ! command -v ninja >/dev/null || generator=(-G Ninja)
+CC=clang CXX=clang++ cmake -S . -B build-fuzz "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPORTALSIM_FUZZ=ON \
   -DPORTALSIM_TESTS=OFF -DPORTALSIM_BENCH=OFF ${PORTALSIM_CMAKE_ARGS:-} >/dev/null
 cmake --build build-fuzz -j "$(nproc)" --target fuzz_catalogue fuzz_spec fuzz_scenarios fuzz_feature_table fuzz_image
 for target in catalogue spec scenarios feature_table image; do
