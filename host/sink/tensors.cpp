@@ -64,7 +64,7 @@ struct Tensor {
 // About the bytes of one piece of a tensor's rows (TensorSink::write), well inside a core's
 // L2 cache, and how many pieces of data.h5 may be made before they are written.
 constexpr size_t kPieceBytes = 256u << 10;
-constexpr size_t kSlots = 4;
+constexpr size_t kSlots = 8;
 
 class TensorSink final : public Sink {
  public:
@@ -231,7 +231,10 @@ class TensorSink final : public Sink {
     // data.h5: this thread makes and hashes each piece while a second thread writes the
     // pieces before it (a write into one file holds its inode's lock on tmpfs and ext4, so
     // more writers would only wait for it). The piece made here lands in one of kSlots
-    // buffers, which the writer must be done with.
+    // buffers, which the writer must be done with. Each thread wakes the other only when it
+    // sleeps, and this one sleeps until half the slots are free: a woken thread often runs
+    // on the CPU of the one that woke it and takes it from the writer, which waking this one
+    // after every piece did about a hundred times a batch.
     const auto make = [&](size_t i) {
       Piece& p = pieces[i];
       p.rows = p.t->fill(scenes, out, p.lo, p.hi, slots_[i % kSlots]);
@@ -247,9 +250,10 @@ class TensorSink final : public Sink {
       }
     } else {
       std::mutex m;
-      std::condition_variable cv;
+      std::condition_variable made_cv, written_cv;
       size_t made = 0, written = 0;
-      bool failed = false;
+      size_t maker_waits_for = 0;  // the writer wakes this thread once `written` reaches it; 0: awake
+      bool writer_waits = false, failed = false;
       std::exception_ptr error;
       const auto fail = [&](std::exception_ptr e) {
         {
@@ -257,22 +261,32 @@ class TensorSink final : public Sink {
           if (!error) error = e;
           failed = true;
         }
-        cv.notify_all();
+        made_cv.notify_all();
+        written_cv.notify_all();
       };
       std::thread writer([&] {
         try {
           for (size_t i = 0; i < pieces.size(); ++i) {
             {
               std::unique_lock<std::mutex> lock(m);
-              cv.wait(lock, [&] { return made > i || failed; });
+              if (made <= i && !failed) {
+                writer_waits = true;
+                made_cv.wait(lock, [&] { return made > i || failed; });
+                writer_waits = false;
+              }
               if (failed) return;
             }
             put(pieces[i]);
+            bool wake = false;
             {
               std::lock_guard<std::mutex> lock(m);
               written = i + 1;
+              if (maker_waits_for && written >= maker_waits_for) {
+                maker_waits_for = 0;
+                wake = true;
+              }
             }
-            cv.notify_all();
+            if (wake) written_cv.notify_all();
           }
         } catch (...) {
           fail(std::current_exception());
@@ -282,15 +296,20 @@ class TensorSink final : public Sink {
         for (size_t i = 0; i < pieces.size(); ++i) {
           {
             std::unique_lock<std::mutex> lock(m);
-            cv.wait(lock, [&] { return written + kSlots > i || failed; });
+            if (written + kSlots <= i && !failed) {
+              maker_waits_for = i + 1 - kSlots / 2;  // half the slots free
+              written_cv.wait(lock, [&] { return maker_waits_for == 0 || failed; });
+            }
             if (failed) break;
           }
           make(i);
+          bool wake = false;
           {
             std::lock_guard<std::mutex> lock(m);
             made = i + 1;
+            wake = writer_waits;
           }
-          cv.notify_all();
+          if (wake) made_cv.notify_all();
         }
       } catch (...) {
         fail(std::current_exception());
@@ -328,7 +347,7 @@ class TensorSink final : public Sink {
       std::error_code ec;
       fs::rename(partial_, fs::path(ctx_.dir) / "data.h5", ec);
       if (ec) throw OutputError(ctx_.dir + "/data.h5: cannot move into place: " + ec.message());
-      h5_state_ = hash_file(ctx_.dir, "data.h5");
+      h5_state_ = hash_file(ctx_.dir, "data.h5", ctx_.threads);
       return;
     }
     for (Tensor& t : tensors_) t.file->finish();
@@ -393,7 +412,7 @@ class TensorSink final : public Sink {
         throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: " + in_place_name(t) + " records " +
                           std::to_string(it->second.bytes) + " bytes, not whole rows of every dataset");
       // The rows so far, hashed again: they must be what the checkpoint recorded.
-      hash_range(fd_, t.offset, it->second.bytes, t.hash.get(), partial_);
+      hash_range(fd_, t.offset, it->second.bytes, t.hash.get(), partial_, ctx_.threads);
       t.bytes = it->second.bytes;
       if (XXH3_64bits_digest(t.hash.get()) != it->second.xxh3)
         throw OutputError(partial_ + ": dataset " + t.ds.name +
@@ -442,7 +461,7 @@ class TensorSink final : public Sink {
     std::vector<std::string> paths;
     for (const Tensor& t : tensors_) paths.push_back((fs::path(ctx_.dir) / file_name(t.ds.name)).string());
     write_h5(ctx_.dir, h5_layout(), paths);
-    h5_state_ = hash_file(ctx_.dir, "data.h5");
+    h5_state_ = hash_file(ctx_.dir, "data.h5", ctx_.threads);
   }
 
   std::vector<std::string> feature_names() const {
