@@ -1,6 +1,7 @@
 #include "sink/tensors.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <xxhash.h>
 
@@ -239,6 +240,7 @@ class TensorSink final : public Sink {
       Piece& p = pieces[i];
       p.rows = p.t->fill(scenes, out, p.lo, p.hi, slots_[i % kSlots]);
       XXH3_64bits_update(p.t->hash.get(), p.rows.data(), p.rows.size());
+      if (p.t == streamed_) XXH3_64bits_update(file_hash_.get(), p.rows.data(), p.rows.size());
     };
     const auto put = [&](const Piece& p) {
       write_at(fd_, p.rows.data(), p.rows.size(), p.t->offset + (rows_ + p.lo) * p.t->ds.row_bytes(), partial_);
@@ -342,12 +344,19 @@ class TensorSink final : public Sink {
   void finish() override {
     if (in_place()) {
       if (::fsync(fd_) != 0) throw OutputError(partial_ + ": fsync failed: " + std::strerror(errno));
+      const std::string final_path = (fs::path(ctx_.dir) / "data.h5").string();
+      std::error_code ec;
+      fs::rename(partial_, final_path, ec);
+      if (ec) throw OutputError(final_path + ": cannot move into place: " + ec.message());
+      // The manifest's hash of data.h5: the file in order from where file_hash_ stands.
+      struct stat st {};
+      const uint64_t from = streamed_ ? streamed_->offset + streamed_->bytes : 0;
+      if (::fstat(fd_, &st) != 0 || static_cast<uint64_t>(st.st_size) < from)
+        throw OutputError(final_path + ": cannot read back to hash it");
+      hash_range(fd_, from, static_cast<uint64_t>(st.st_size) - from, file_hash_.get(), final_path, ctx_.threads);
+      h5_state_ = FileState{"data.h5", static_cast<uint64_t>(st.st_size), XXH3_64bits_digest(file_hash_.get())};
       ::close(fd_);
       fd_ = -1;
-      std::error_code ec;
-      fs::rename(partial_, fs::path(ctx_.dir) / "data.h5", ec);
-      if (ec) throw OutputError(ctx_.dir + "/data.h5: cannot move into place: " + ec.message());
-      h5_state_ = hash_file(ctx_.dir, "data.h5", ctx_.threads);
       return;
     }
     for (Tensor& t : tensors_) t.file->finish();
@@ -361,6 +370,13 @@ class TensorSink final : public Sink {
   std::optional<FileState> h5_state_;
   std::string partial_;  // data.h5 in place: its name while the run goes
   int fd_ = -1;
+  // data.h5 in place: the XXH3-64 of the file in order, for the manifest, from its start to
+  // the end of the rows written so far of the dataset stored first (`streamed_`, whose rows
+  // are written in file order), fed as they are made; finish() hashes the rest of the file.
+  // A dataset's rows go out a batch at a time, interleaved with the other datasets', so the
+  // rest can only be read back once all are written.
+  std::unique_ptr<XXH3_state_t, XXH_errorcode (*)(XXH3_state_t*)> file_hash_{nullptr, XXH3_freeState};
+  Tensor* streamed_ = nullptr;
   uint64_t rows_ = 0;  // rows written so far
   // Where write() makes pieces, kept from batch to batch: data.h5's, and each thread's for .npy files.
   std::array<std::string, kSlots> slots_;
@@ -396,6 +412,15 @@ class TensorSink final : public Sink {
     }
     fd_ = ::open(partial_.c_str(), O_RDWR | O_CLOEXEC);
     if (fd_ < 0) throw OutputError(partial_ + ": cannot open: " + std::strerror(errno));
+    file_hash_.reset(XXH3_createState());
+    if (!file_hash_) throw std::bad_alloc();
+    XXH3_64bits_reset(file_hash_.get());
+    for (size_t k = 0; k < tensors_.size(); ++k)
+      if (tensors_[k].ds.row_bytes() * ctx_.rows > 0 && (!streamed_ || offsets[k] < streamed_->offset)) {
+        streamed_ = &tensors_[k];
+        streamed_->offset = offsets[k];
+      }
+    if (streamed_) hash_range(fd_, 0, streamed_->offset, file_hash_.get(), partial_);  // HDF5's metadata
     for (size_t k = 0; k < tensors_.size(); ++k) {
       Tensor& t = tensors_[k];
       t.offset = offsets[k];
@@ -413,6 +438,7 @@ class TensorSink final : public Sink {
                           std::to_string(it->second.bytes) + " bytes, not whole rows of every dataset");
       // The rows so far, hashed again: they must be what the checkpoint recorded.
       hash_range(fd_, t.offset, it->second.bytes, t.hash.get(), partial_, ctx_.threads);
+      if (&t == streamed_) hash_range(fd_, t.offset, it->second.bytes, file_hash_.get(), partial_, ctx_.threads);
       t.bytes = it->second.bytes;
       if (XXH3_64bits_digest(t.hash.get()) != it->second.xxh3)
         throw OutputError(partial_ + ": dataset " + t.ds.name +
