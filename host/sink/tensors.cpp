@@ -343,18 +343,39 @@ class TensorSink final : public Sink {
 
   void finish() override {
     if (in_place()) {
-      if (::fsync(fd_) != 0) throw OutputError(partial_ + ": fsync failed: " + std::strerror(errno));
+      // The manifest's hash of data.h5: the file in order from where file_hash_ stands. It
+      // reads the page cache while a second thread waits for the sync to the disk; the file
+      // takes its final name once both are done.
+      const auto hash_rest = [&] {
+        struct stat st {};
+        const uint64_t from = streamed_ ? streamed_->offset + streamed_->bytes : 0;
+        if (::fstat(fd_, &st) != 0 || static_cast<uint64_t>(st.st_size) < from)
+          throw OutputError(partial_ + ": cannot read back to hash it");
+        hash_range(fd_, from, static_cast<uint64_t>(st.st_size) - from, file_hash_.get(), partial_, ctx_.threads);
+        return FileState{"data.h5", static_cast<uint64_t>(st.st_size), XXH3_64bits_digest(file_hash_.get())};
+      };
+      int sync_error = 0;
+      const auto sync = [&] { sync_error = ::fsync(fd_) == 0 ? 0 : errno; };
+      FileState state;
+      if (ctx_.threads < 2) {
+        sync();
+        if (!sync_error) state = hash_rest();
+      } else {
+        std::thread syncer(sync);
+        try {
+          state = hash_rest();
+        } catch (...) {
+          syncer.join();
+          throw;
+        }
+        syncer.join();
+      }
+      if (sync_error) throw OutputError(partial_ + ": fsync failed: " + std::strerror(sync_error));
       const std::string final_path = (fs::path(ctx_.dir) / "data.h5").string();
       std::error_code ec;
       fs::rename(partial_, final_path, ec);
       if (ec) throw OutputError(final_path + ": cannot move into place: " + ec.message());
-      // The manifest's hash of data.h5: the file in order from where file_hash_ stands.
-      struct stat st {};
-      const uint64_t from = streamed_ ? streamed_->offset + streamed_->bytes : 0;
-      if (::fstat(fd_, &st) != 0 || static_cast<uint64_t>(st.st_size) < from)
-        throw OutputError(final_path + ": cannot read back to hash it");
-      hash_range(fd_, from, static_cast<uint64_t>(st.st_size) - from, file_hash_.get(), final_path, ctx_.threads);
-      h5_state_ = FileState{"data.h5", static_cast<uint64_t>(st.st_size), XXH3_64bits_digest(file_hash_.get())};
+      h5_state_ = state;
       ::close(fd_);
       fd_ = -1;
       return;
