@@ -4,7 +4,8 @@
 Each round runs, interleaved: `dd` writing fresh bytes to the destination (oflag=direct
 unless it is a tmpfs, which has no direct I/O), then every given build's `generate` into a
 new folder there. Prints a markdown table of medians: the run's scenarios/s from its
-summary line, its bytes/s, the whole command's wall time, and its share of dd's rate.
+summary line, its bytes/s, its share of dd's rate, and the whole command's wall and CPU time
+(user + system, every thread; the figure that other jobs on the machine disturb least).
 
   python3 bench/end_to_end.py --dest /dev/shm --count 5000 --rounds 3 \\
       --build new=build/portalsim --build old=OLD/portalsim \\
@@ -13,6 +14,7 @@ summary line, its bytes/s, the whole command's wall time, and its share of dd's 
 import argparse
 import os
 import re
+import resource
 import shutil
 import statistics
 import subprocess
@@ -49,10 +51,13 @@ def dd_rate(dest, mb):
 def run_generate(binary, dest, count, extra):
     out = tempfile.mkdtemp(prefix="portalsim-e2e-", dir=dest)
     shutil.rmtree(out)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.monotonic()
     p = subprocess.run([binary, "generate", "--count", str(count), "--out", out] + extra,
                        capture_output=True, text=True)
     wall = time.monotonic() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     if p.returncode != 0:
         raise SystemExit("%s failed (%d): %s" % (binary, p.returncode, p.stderr[-2000:]))
     m = re.search(r"([0-9.]+) scenarios/s", p.stdout + p.stderr)
@@ -60,7 +65,7 @@ def run_generate(binary, dest, count, extra):
         raise SystemExit("%s: no scenarios/s in its summary line" % binary)
     size = folder_bytes(out)
     shutil.rmtree(out)
-    return float(m.group(1)), wall, size
+    return float(m.group(1)), wall, cpu, size
 
 
 def main():
@@ -74,27 +79,32 @@ def main():
     a = ap.parse_args()
     extra = [x for x in a.generate_args if x != "--"] + ["--quiet"]
     builds = [b.split("=", 1) for b in a.build]
-    dd, rates, walls, sizes = [], {l: [] for l, _ in builds}, {l: [] for l, _ in builds}, {}
+    dd, sizes, loads = [], {}, []
+    rates, walls, cpus = ({l: [] for l, _ in builds} for _ in range(3))
     for _ in range(a.rounds):
+        loads.append(os.getloadavg()[0])
         dd.append(dd_rate(a.dest, a.dd_mb))
         for label, path in builds:
-            r, w, s = run_generate(path, a.dest, a.count, extra)
+            r, w, c, s = run_generate(path, a.dest, a.count, extra)
             rates[label].append(r)
             walls[label].append(w)
+            cpus[label].append(c)
             sizes[label] = s
-    load = os.getloadavg()[0]
+    loads.append(os.getloadavg()[0])
     dd_med = statistics.median(dd)
     kind = "tmpfs" if is_tmpfs(a.dest) else "direct I/O"
-    print("%s (%s), %d scenarios, medians of %d rounds, load average %.1f at the end; "
-          "dd writes fresh bytes at %.2f GB/s" % (a.dest, kind, a.count, a.rounds, load, dd_med / 1e9))
+    print("%s (%s), %d scenarios, medians of %d rounds, load average %.1f to %.1f; "
+          "dd writes fresh bytes at %.2f GB/s" % (a.dest, kind, a.count, a.rounds, min(loads), max(loads), dd_med / 1e9))
     print()
-    print("| build | scenarios/s | bytes per scenario | GB/s written | share of dd | wall, whole command |")
-    print("|---|---|---|---|---|---|")
+    print("| build | scenarios/s | bytes per scenario | GB/s written | share of dd | wall, whole command "
+          "| CPU, whole command |")
+    print("|---|---|---|---|---|---|---|")
     for label, _ in builds:
         r = statistics.median(rates[label])
         per = sizes[label] / a.count
-        print("| %s | %s | %s | %.2f | %.0f%% | %.2f s |" % (label, f"{r:,.0f}", f"{per:,.0f}", r * per / 1e9,
-                                                            100 * r * per / dd_med, statistics.median(walls[label])))
+        print("| %s | %s | %s | %.2f | %.0f%% | %.2f s | %.2f s |" %
+              (label, f"{r:,.0f}", f"{per:,.0f}", r * per / 1e9, 100 * r * per / dd_med,
+               statistics.median(walls[label]), statistics.median(cpus[label])))
 
 
 if __name__ == "__main__":

@@ -7,9 +7,14 @@
 #include <xxhash.h>
 
 #include <cerrno>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
+#include <deque>
+#include <exception>
 #include <filesystem>
+#include <mutex>
+#include <thread>
 #include <vector>
 
 #include "base/error.h"
@@ -28,42 +33,114 @@ std::string xxh3_hex(uint64_t hash) {
 
 namespace {
 
-// Feeds bytes [offset, offset + n) of `fd` to `h`, mapped a window at a time: the hash reads
-// the page cache in place, without read()'s copy (read() where the file cannot be mapped).
-// Throws OutputError naming `path` (`what` says why it was read).
-void hash_mapped(int fd, uint64_t offset, uint64_t n, XXH3_state_t* h, const std::string& path, const char* what) {
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || static_cast<uint64_t>(st.st_size) < offset + n)
-    throw OutputError(path + ": cannot read back " + what + ": shorter than " + std::to_string(offset + n) + " bytes");
-  constexpr uint64_t kWindow = 64ull << 20;  // a multiple of the page size
-  const uint64_t page = static_cast<uint64_t>(::sysconf(_SC_PAGESIZE));
-  std::vector<char> buf;
-  for (uint64_t at = offset; at < offset + n;) {
-    const uint64_t start = at / page * page, end = std::min(offset + n, start + kWindow);
-    void* m = ::mmap(nullptr, static_cast<size_t>(end - start), PROT_READ, MAP_SHARED | MAP_POPULATE, fd,
-                     static_cast<off_t>(start));
-    if (m != MAP_FAILED) {
-      XXH3_64bits_update(h, static_cast<const char*>(m) + (at - start), static_cast<size_t>(end - at));
-      ::munmap(m, static_cast<size_t>(end - start));
-      at = end;
-      continue;
-    }
-    buf.resize(1u << 20);
-    const ssize_t r =
-        ::pread(fd, buf.data(), static_cast<size_t>(std::min<uint64_t>(end - at, buf.size())), static_cast<off_t>(at));
+// Bytes [at, end) of `fd` mapped and populated (MAP_POPULATE), `base` the page it starts
+// in; null where the file cannot be mapped.
+struct Window {
+  uint64_t base = 0, at = 0, end = 0;
+  void* map = nullptr;
+};
+
+Window map_window(int fd, uint64_t at, uint64_t end) {
+  static const uint64_t page = static_cast<uint64_t>(::sysconf(_SC_PAGESIZE));
+  Window w{at / page * page, at, end, nullptr};
+  void* m = ::mmap(nullptr, static_cast<size_t>(end - w.base), PROT_READ, MAP_SHARED | MAP_POPULATE, fd,
+                   static_cast<off_t>(w.base));
+  if (m != MAP_FAILED) w.map = m;
+  return w;
+}
+
+// Feeds window `w` to `h` and unmaps it; read() where it could not be mapped.
+void hash_window(int fd, const Window& w, XXH3_state_t* h, std::vector<char>& buf, const std::string& path,
+                 const char* what) {
+  if (w.map) {
+    XXH3_64bits_update(h, static_cast<const char*>(w.map) + (w.at - w.base), static_cast<size_t>(w.end - w.at));
+    ::munmap(w.map, static_cast<size_t>(w.end - w.base));
+    return;
+  }
+  buf.resize(1u << 20);
+  for (uint64_t at = w.at; at < w.end;) {
+    const ssize_t r = ::pread(fd, buf.data(), static_cast<size_t>(std::min<uint64_t>(w.end - at, buf.size())),
+                              static_cast<off_t>(at));
+    if (r < 0 && errno == EINTR) continue;
     if (r <= 0) throw OutputError(path + ": cannot read back " + what + ": " + std::strerror(r < 0 ? errno : EIO));
     XXH3_64bits_update(h, buf.data(), static_cast<size_t>(r));
     at += static_cast<uint64_t>(r);
   }
 }
 
-}  // namespace
-
-void hash_range(int fd, uint64_t offset, uint64_t n, void* xxh3_state, const std::string& path) {
-  hash_mapped(fd, offset, n, state_of(xxh3_state), path, "for resume");
+// Feeds bytes [offset, offset + n) of `fd` to `h`, mapped a window at a time: the hash reads
+// the page cache in place, without read()'s copy (read() where the file cannot be mapped).
+// Mapping a window (the kernel filling its page table) costs about twice what hashing it
+// does, so with `threads` >= 2 a second thread maps the windows ahead while this one hashes
+// and unmaps them. Throws OutputError naming `path` (`what` says why it was read).
+void hash_mapped(int fd, uint64_t offset, uint64_t n, XXH3_state_t* h, const std::string& path, const char* what,
+                 unsigned threads) {
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || static_cast<uint64_t>(st.st_size) < offset + n)
+    throw OutputError(path + ": cannot read back " + what + ": shorter than " + std::to_string(offset + n) + " bytes");
+  constexpr uint64_t kWindow = 8ull << 20;  // a multiple of the page size
+  constexpr size_t kAhead = 4;              // windows mapped and not yet hashed, at most
+  std::vector<char> buf;
+  const uint64_t end = offset + n;
+  const auto window_end = [&](uint64_t at) { return std::min(end, (at / kWindow + 1) * kWindow); };
+  if (threads < 2 || n <= 2 * kWindow) {
+    for (uint64_t at = offset; at < end; at = window_end(at))
+      hash_window(fd, map_window(fd, at, window_end(at)), h, buf, path, what);
+    return;
+  }
+  std::mutex m;
+  std::condition_variable cv;
+  std::deque<Window> ready;
+  bool stop = false;
+  std::thread mapper([&] {
+    for (uint64_t at = offset; at < end; at = window_end(at)) {
+      {
+        std::unique_lock<std::mutex> lock(m);
+        cv.wait(lock, [&] { return ready.size() < kAhead || stop; });
+        if (stop) return;
+      }
+      const Window w = map_window(fd, at, window_end(at));
+      {
+        std::lock_guard<std::mutex> lock(m);
+        ready.push_back(w);
+      }
+      cv.notify_all();
+    }
+  });
+  std::exception_ptr error;
+  try {
+    for (uint64_t at = offset; at < end; at = window_end(at)) {
+      Window w;
+      {
+        std::unique_lock<std::mutex> lock(m);
+        cv.wait(lock, [&] { return !ready.empty(); });
+        w = ready.front();
+        ready.pop_front();
+      }
+      cv.notify_all();
+      hash_window(fd, w, h, buf, path, what);
+    }
+  } catch (...) {
+    error = std::current_exception();
+  }
+  {
+    std::lock_guard<std::mutex> lock(m);
+    stop = true;
+  }
+  cv.notify_all();
+  mapper.join();
+  for (const Window& w : ready)
+    if (w.map) ::munmap(w.map, static_cast<size_t>(w.end - w.base));
+  if (error) std::rethrow_exception(error);
 }
 
-FileState hash_file(const std::string& dir, const std::string& name) {
+}  // namespace
+
+void hash_range(int fd, uint64_t offset, uint64_t n, void* xxh3_state, const std::string& path, unsigned threads) {
+  hash_mapped(fd, offset, n, state_of(xxh3_state), path, "for resume", threads);
+}
+
+FileState hash_file(const std::string& dir, const std::string& name, unsigned threads) {
   const std::string path = (std::filesystem::path(dir) / name).string();
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) throw OutputError(path + ": cannot open: " + std::strerror(errno));
@@ -81,7 +158,7 @@ FileState hash_file(const std::string& dir, const std::string& name) {
   XXH3_64bits_reset(h);
   FileState s{name, static_cast<uint64_t>(st.st_size), 0};
   try {
-    hash_mapped(fd, 0, s.bytes, h, path, "to hash it");
+    hash_mapped(fd, 0, s.bytes, h, path, "to hash it", threads);
   } catch (...) {
     ::close(fd);
     XXH3_freeState(h);

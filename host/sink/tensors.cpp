@@ -1,6 +1,7 @@
 #include "sink/tensors.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <xxhash.h>
 
@@ -64,7 +65,7 @@ struct Tensor {
 // About the bytes of one piece of a tensor's rows (TensorSink::write), well inside a core's
 // L2 cache, and how many pieces of data.h5 may be made before they are written.
 constexpr size_t kPieceBytes = 256u << 10;
-constexpr size_t kSlots = 4;
+constexpr size_t kSlots = 8;
 
 class TensorSink final : public Sink {
  public:
@@ -231,11 +232,15 @@ class TensorSink final : public Sink {
     // data.h5: this thread makes and hashes each piece while a second thread writes the
     // pieces before it (a write into one file holds its inode's lock on tmpfs and ext4, so
     // more writers would only wait for it). The piece made here lands in one of kSlots
-    // buffers, which the writer must be done with.
+    // buffers, which the writer must be done with. Each thread wakes the other only when it
+    // sleeps, and this one sleeps until half the slots are free: a woken thread often runs
+    // on the CPU of the one that woke it and takes it from the writer, which waking this one
+    // after every piece did about a hundred times a batch.
     const auto make = [&](size_t i) {
       Piece& p = pieces[i];
       p.rows = p.t->fill(scenes, out, p.lo, p.hi, slots_[i % kSlots]);
       XXH3_64bits_update(p.t->hash.get(), p.rows.data(), p.rows.size());
+      if (p.t == streamed_) XXH3_64bits_update(file_hash_.get(), p.rows.data(), p.rows.size());
     };
     const auto put = [&](const Piece& p) {
       write_at(fd_, p.rows.data(), p.rows.size(), p.t->offset + (rows_ + p.lo) * p.t->ds.row_bytes(), partial_);
@@ -247,9 +252,10 @@ class TensorSink final : public Sink {
       }
     } else {
       std::mutex m;
-      std::condition_variable cv;
+      std::condition_variable made_cv, written_cv;
       size_t made = 0, written = 0;
-      bool failed = false;
+      size_t maker_waits_for = 0;  // the writer wakes this thread once `written` reaches it; 0: awake
+      bool writer_waits = false, failed = false;
       std::exception_ptr error;
       const auto fail = [&](std::exception_ptr e) {
         {
@@ -257,22 +263,32 @@ class TensorSink final : public Sink {
           if (!error) error = e;
           failed = true;
         }
-        cv.notify_all();
+        made_cv.notify_all();
+        written_cv.notify_all();
       };
       std::thread writer([&] {
         try {
           for (size_t i = 0; i < pieces.size(); ++i) {
             {
               std::unique_lock<std::mutex> lock(m);
-              cv.wait(lock, [&] { return made > i || failed; });
+              if (made <= i && !failed) {
+                writer_waits = true;
+                made_cv.wait(lock, [&] { return made > i || failed; });
+                writer_waits = false;
+              }
               if (failed) return;
             }
             put(pieces[i]);
+            bool wake = false;
             {
               std::lock_guard<std::mutex> lock(m);
               written = i + 1;
+              if (maker_waits_for && written >= maker_waits_for) {
+                maker_waits_for = 0;
+                wake = true;
+              }
             }
-            cv.notify_all();
+            if (wake) written_cv.notify_all();
           }
         } catch (...) {
           fail(std::current_exception());
@@ -282,15 +298,20 @@ class TensorSink final : public Sink {
         for (size_t i = 0; i < pieces.size(); ++i) {
           {
             std::unique_lock<std::mutex> lock(m);
-            cv.wait(lock, [&] { return written + kSlots > i || failed; });
+            if (written + kSlots <= i && !failed) {
+              maker_waits_for = i + 1 - kSlots / 2;  // half the slots free
+              written_cv.wait(lock, [&] { return maker_waits_for == 0 || failed; });
+            }
             if (failed) break;
           }
           make(i);
+          bool wake = false;
           {
             std::lock_guard<std::mutex> lock(m);
             made = i + 1;
+            wake = writer_waits;
           }
-          cv.notify_all();
+          if (wake) made_cv.notify_all();
         }
       } catch (...) {
         fail(std::current_exception());
@@ -322,13 +343,41 @@ class TensorSink final : public Sink {
 
   void finish() override {
     if (in_place()) {
-      if (::fsync(fd_) != 0) throw OutputError(partial_ + ": fsync failed: " + std::strerror(errno));
+      // The manifest's hash of data.h5: the file in order from where file_hash_ stands. It
+      // reads the page cache while a second thread waits for the sync to the disk; the file
+      // takes its final name once both are done.
+      const auto hash_rest = [&] {
+        struct stat st {};
+        const uint64_t from = streamed_ ? streamed_->offset + streamed_->bytes : 0;
+        if (::fstat(fd_, &st) != 0 || static_cast<uint64_t>(st.st_size) < from)
+          throw OutputError(partial_ + ": cannot read back to hash it");
+        hash_range(fd_, from, static_cast<uint64_t>(st.st_size) - from, file_hash_.get(), partial_, ctx_.threads);
+        return FileState{"data.h5", static_cast<uint64_t>(st.st_size), XXH3_64bits_digest(file_hash_.get())};
+      };
+      int sync_error = 0;
+      const auto sync = [&] { sync_error = ::fsync(fd_) == 0 ? 0 : errno; };
+      FileState state;
+      if (ctx_.threads < 2) {
+        sync();
+        if (!sync_error) state = hash_rest();
+      } else {
+        std::thread syncer(sync);
+        try {
+          state = hash_rest();
+        } catch (...) {
+          syncer.join();
+          throw;
+        }
+        syncer.join();
+      }
+      if (sync_error) throw OutputError(partial_ + ": fsync failed: " + std::strerror(sync_error));
+      const std::string final_path = (fs::path(ctx_.dir) / "data.h5").string();
+      std::error_code ec;
+      fs::rename(partial_, final_path, ec);
+      if (ec) throw OutputError(final_path + ": cannot move into place: " + ec.message());
+      h5_state_ = state;
       ::close(fd_);
       fd_ = -1;
-      std::error_code ec;
-      fs::rename(partial_, fs::path(ctx_.dir) / "data.h5", ec);
-      if (ec) throw OutputError(ctx_.dir + "/data.h5: cannot move into place: " + ec.message());
-      h5_state_ = hash_file(ctx_.dir, "data.h5");
       return;
     }
     for (Tensor& t : tensors_) t.file->finish();
@@ -342,6 +391,13 @@ class TensorSink final : public Sink {
   std::optional<FileState> h5_state_;
   std::string partial_;  // data.h5 in place: its name while the run goes
   int fd_ = -1;
+  // data.h5 in place: the XXH3-64 of the file in order, for the manifest, from its start to
+  // the end of the rows written so far of the dataset stored first (`streamed_`, whose rows
+  // are written in file order), fed as they are made; finish() hashes the rest of the file.
+  // A dataset's rows go out a batch at a time, interleaved with the other datasets', so the
+  // rest can only be read back once all are written.
+  std::unique_ptr<XXH3_state_t, XXH_errorcode (*)(XXH3_state_t*)> file_hash_{nullptr, XXH3_freeState};
+  Tensor* streamed_ = nullptr;
   uint64_t rows_ = 0;  // rows written so far
   // Where write() makes pieces, kept from batch to batch: data.h5's, and each thread's for .npy files.
   std::array<std::string, kSlots> slots_;
@@ -377,6 +433,15 @@ class TensorSink final : public Sink {
     }
     fd_ = ::open(partial_.c_str(), O_RDWR | O_CLOEXEC);
     if (fd_ < 0) throw OutputError(partial_ + ": cannot open: " + std::strerror(errno));
+    file_hash_.reset(XXH3_createState());
+    if (!file_hash_) throw std::bad_alloc();
+    XXH3_64bits_reset(file_hash_.get());
+    for (size_t k = 0; k < tensors_.size(); ++k)
+      if (tensors_[k].ds.row_bytes() * ctx_.rows > 0 && (!streamed_ || offsets[k] < streamed_->offset)) {
+        streamed_ = &tensors_[k];
+        streamed_->offset = offsets[k];
+      }
+    if (streamed_) hash_range(fd_, 0, streamed_->offset, file_hash_.get(), partial_);  // HDF5's metadata
     for (size_t k = 0; k < tensors_.size(); ++k) {
       Tensor& t = tensors_[k];
       t.offset = offsets[k];
@@ -393,7 +458,8 @@ class TensorSink final : public Sink {
         throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: " + in_place_name(t) + " records " +
                           std::to_string(it->second.bytes) + " bytes, not whole rows of every dataset");
       // The rows so far, hashed again: they must be what the checkpoint recorded.
-      hash_range(fd_, t.offset, it->second.bytes, t.hash.get(), partial_);
+      hash_range(fd_, t.offset, it->second.bytes, t.hash.get(), partial_, ctx_.threads);
+      if (&t == streamed_) hash_range(fd_, t.offset, it->second.bytes, file_hash_.get(), partial_, ctx_.threads);
       t.bytes = it->second.bytes;
       if (XXH3_64bits_digest(t.hash.get()) != it->second.xxh3)
         throw OutputError(partial_ + ": dataset " + t.ds.name +
@@ -442,7 +508,7 @@ class TensorSink final : public Sink {
     std::vector<std::string> paths;
     for (const Tensor& t : tensors_) paths.push_back((fs::path(ctx_.dir) / file_name(t.ds.name)).string());
     write_h5(ctx_.dir, h5_layout(), paths);
-    h5_state_ = hash_file(ctx_.dir, "data.h5");
+    h5_state_ = hash_file(ctx_.dir, "data.h5", ctx_.threads);
   }
 
   std::vector<std::string> feature_names() const {
