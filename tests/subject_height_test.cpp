@@ -284,10 +284,7 @@ TEST(SubjectHeight, BothBackendsAgreeAndMetalFollows) {
   cl->run(batch, p, s);
   cl->run(batch, dense, dn);
   ASSERT_EQ(s.features.size(), dn.features.size());
-  double max_abs = 0;
-  for (size_t j = 0; j < s.features.size(); ++j)
-    max_abs = std::max(max_abs, std::abs(double(s.features[j]) - dn.features[j]));
-  EXPECT_LE(max_abs, 0.5);
+  EXPECT_LE(compare_outputs(s, dn).feature_max_abs, 0.5);
 }
 
 // Height 1 moves nothing: every place is the region's rectangle.
