@@ -457,9 +457,10 @@ class TensorSink final : public Sink {
       if ((row && it->second.bytes % row) || rows != rows_ || rows > ctx_.rows)
         throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: " + in_place_name(t) + " records " +
                           std::to_string(it->second.bytes) + " bytes, not whole rows of every dataset");
-      // The rows so far, hashed again: they must be what the checkpoint recorded.
-      hash_range(fd_, t.offset, it->second.bytes, t.hash.get(), partial_, ctx_.threads);
-      if (&t == streamed_) hash_range(fd_, t.offset, it->second.bytes, file_hash_.get(), partial_, ctx_.threads);
+      // The rows so far, hashed again (for the first dataset, into the file's hash too, in
+      // the same pass): they must be what the checkpoint recorded.
+      hash_range(fd_, t.offset, it->second.bytes, t.hash.get(), partial_, ctx_.threads,
+                 &t == streamed_ ? file_hash_.get() : nullptr);
       t.bytes = it->second.bytes;
       if (XXH3_64bits_digest(t.hash.get()) != it->second.xxh3)
         throw OutputError(partial_ + ": dataset " + t.ds.name +
