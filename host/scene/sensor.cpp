@@ -18,6 +18,7 @@ std::vector<Sensor> camera_sensors(const Catalogue& cat) {
     s.camera = Camera::mmw;
     s.width = ic.mmw_width;
     s.height = ic.mmw_height;
+    s.floor_row = view == View::upper ? 2.0 * ic.mmw_height : ic.mmw_height;
     for (const Region& r : cat.regions)
       if (r.view == view) {
         s.rects[r.id - 1] = r.mmw;
@@ -35,6 +36,7 @@ std::vector<Sensor> camera_sensors(const Catalogue& cat) {
   ir.camera = Camera::ir;
   ir.width = ic.ir_width;
   ir.height = ic.ir_height;
+  ir.floor_row = ic.ir_height;
   for (const Region& r : cat.regions) {
     ir.rects[r.id - 1] = r.ir;
     ir.region_mask |= 1u << (r.id - 1);
@@ -44,9 +46,6 @@ std::vector<Sensor> camera_sensors(const Catalogue& cat) {
   ir.jitter_scale_x = static_cast<double>(ic.ir_width) / ic.mmw_width;
   ir.jitter_scale_y = static_cast<double>(ic.ir_height) / (2.0 * ic.mmw_height);
   out.push_back(ir);
-  out[0].floor_row = 2.0 * ic.mmw_height;
-  out[1].floor_row = ic.mmw_height;
-  out[2].floor_row = ic.ir_height;
   // A region's place follows the body drawn for the subject (procedural::Body::height): a
   // point c rows above the floor is drawn c * height rows above it. Whole pixels, so that
   // integer placement stays integer and height 1 moves nothing.

@@ -955,12 +955,12 @@ class OpenCLBackend final : public Backend {
       for (int r = 0; r < kRegions; ++r)
         for (int s = 0; s < S; ++s) {
           const Image& sp = assets_.sprite(Camera::mmw, v);
-          const Rect rc = cat_.sensors[lay.pooled[region_slot(lay, r)]].place(s, r);
+          const Rect box = sprite_box(cat_.sensors[lay.pooled[region_slot(lay, r)]].place(s, r), sp);
           cl_int* f = &fps[((static_cast<size_t>(v) * kRegions + r) * S + s) * PS_FP_LEN];
-          f[PS_FP_SPRITE_X0] = rc.x + ((rc.w - sp.width) >> 1);
-          f[PS_FP_SPRITE_Y0] = rc.y + ((rc.h - sp.height) >> 1);
-          f[PS_FP_SPRITE_W] = sp.width;
-          f[PS_FP_SPRITE_H] = sp.height;
+          f[PS_FP_SPRITE_X0] = box.x;
+          f[PS_FP_SPRITE_Y0] = box.y;
+          f[PS_FP_SPRITE_W] = box.w;
+          f[PS_FP_SPRITE_H] = box.h;
           f[PS_FP_SPRITE_OFFSET] = mmw_sprites_[v].s[0];
           f[PS_FP_SPRITE_PADDED] = mmw_sprites_[v].s[3];
           f[PS_FP_TILE_X0] = f[PS_FP_SPRITE_X0] + (sp.width >> 1) - (N >> 1);
