@@ -22,6 +22,9 @@
 
 #include "assets/image_io.h"
 #include "run_binary.h"
+#include "schedule/pipeline.h"
+#include "sink/h5_file.h"
+#include "support.h"
 
 namespace {
 
@@ -415,13 +418,17 @@ TEST(TensorsH5, ResumeRefusesRowsChangedSinceTheCheckpoint) {
   portalsim::test::TempDir t;
   const Args spec{"--count", "4000", "--seed", "10", "--rule", "gun", "--what", "images", "--format", "h5"};
   const portalsim::test::Result r = kill_then_resume(t, spec, [](const fs::path& dir) {
-    // Flip the first written pixel of `upper` (its rows start where HDF5 says).
+    // Flip the first written pixel of `upper` (its first chunk is where HDF5 says).
     const fs::path partial = dir / "data.h5.partial";
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
     const hid_t f = H5Fopen(partial.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
     ASSERT_GE(f, 0);
     const hid_t ds = H5Dopen2(f, "upper", H5P_DEFAULT);
-    const haddr_t at = H5Dget_offset(ds);
+    const hsize_t origin[3] = {0, 0, 0};
+    unsigned filters = 0;
+    haddr_t at = HADDR_UNDEF;
+    hsize_t size = 0;
+    EXPECT_GE(H5Dget_chunk_info_by_coord(ds, origin, &filters, &at, &size), 0);
     H5Dclose(ds);
     H5Fclose(f);
     ASSERT_NE(at, HADDR_UNDEF);
@@ -436,6 +443,23 @@ TEST(TensorsH5, ResumeRefusesRowsChangedSinceTheCheckpoint) {
   EXPECT_TRUE(r.exited && r.status != 0) << portalsim::test::describe(r);
   EXPECT_NE(r.err.find("data.h5.partial"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("upper"), std::string::npos) << r.err;
+}
+
+// The default batch ends where a chunk of data.h5 does (a batch that ends inside one holds
+// the other datasets' part of it in memory until the next batch).
+TEST(TensorsH5, DefaultBatchEndsWhereAChunkDoes) {
+  const portalsim::Catalogue& cat = portalsim::test::catalogue();
+  for (const bool features : {false, true})
+    for (const uint32_t images : {0u, portalsim::kAllViews}) {
+      portalsim::Plan plan;
+      plan.features = features;
+      plan.images = images;
+      plan.metal = true;
+      const size_t b = portalsim::default_batch(plan, cat);
+      EXPECT_EQ(b % portalsim::kH5ChunkRows, 0u) << "features " << features << ", images " << images;
+      EXPECT_GE(b, portalsim::kH5ChunkRows);
+      EXPECT_LE(b, 16384u);
+    }
 }
 
 TEST(TensorsH5, CompressWithoutH5IsRefusedNamingTheFlag) {

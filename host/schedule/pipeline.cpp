@@ -16,6 +16,7 @@
 #include "base/parallel.h"
 #include "schedule/identity.h"
 #include "sink/coco.h"
+#include "sink/h5_file.h"
 #include "sink/output_folder.h"
 #include "sink/sinks.h"
 #include "sink/staging.h"
@@ -368,7 +369,10 @@ size_t default_batch(const Plan& plan, const Catalogue& cat) {
     if (plan.renders(cat.sensors[k], static_cast<int>(k))) bytes += cat.sensors[k].pixels();
   if (plan.sparse_features()) bytes = 64 + kZones;  // no images, on the device either
   if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
-  return std::clamp<size_t>((16u << 20) / bytes, 64, 16384);
+  // A multiple of data.h5's chunk rows: a batch ends where a chunk does, so no piece of it
+  // waits in memory for the next batch before the file's hash can take it (file_order_hash.h).
+  const size_t rows = std::clamp<size_t>((16u << 20) / bytes, kH5ChunkRows, 16384);
+  return (rows + kH5ChunkRows / 2) / kH5ChunkRows * kH5ChunkRows;
 }
 
 bool holds_finished_run(const RunSpec& spec, const Catalogue& cat, const std::string& dir, bool resume) {

@@ -1,9 +1,11 @@
 // data.h5 through libhdf5, and read back (a merge reads its parts' datasets and
-// attributes). Uncompressed, the file is laid out first (attributes, contiguous datasets
-// allocated in full) and closed, then rows are written in place at their offsets: HDF5's
-// metadata is final before any row is, so a kill -9 mid-run leaves a valid file to resume
-// into. Compressed, it is built through HDF5 from per-tensor .npy files at the end. One
-// layout, so the bytes of data.h5 depend only on its contents and their order.
+// attributes). Datasets are chunked 64 rows along N. Uncompressed, the file is laid out
+// first (attributes, and every chunk allocated, chunk 0 of each dataset, then chunk 1 of
+// each, and so on, so that rows written in order fill the file nearly in order) and
+// closed, then rows are written in place at their chunks' addresses: HDF5's metadata is
+// final before any row is, so a kill -9 mid-run leaves a valid file to resume into.
+// Compressed, it is built through HDF5 from per-tensor .npy files at the end. One layout,
+// so the bytes of data.h5 depend only on its contents and their order.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -31,6 +33,9 @@ struct H5Attribute {
   bool scalar = true;
 };
 
+// Rows per chunk along N (fewer when the file has fewer rows).
+constexpr uint64_t kH5ChunkRows = 64;
+
 struct H5Layout {
   uint64_t rows = 0;
   bool compress = false;                // shuffle + gzip 4
@@ -43,12 +48,27 @@ struct H5Layout {
 // (Uncompressed: create_h5_in_place, then the rows written at their offsets.)
 void write_h5(const std::string& dir, const H5Layout& layout, const std::vector<std::string>& npy_paths);
 
-// Creates `path` laid out for `layout` (not compressed) and returns the file offset where
-// each dataset's rows start; rows are then written there with write_at. Throws OutputError.
-std::vector<uint64_t> create_h5_in_place(const std::string& path, const H5Layout& layout);
-// The same offsets of a file create_h5_in_place made, after checking its datasets are
-// `layout`'s (resuming a run). Throws OutputError naming the file.
-std::vector<uint64_t> h5_data_offsets(const std::string& path, const H5Layout& layout);
+// Where an uncompressed data.h5's rows go: row r of dataset k is at
+// address[k][r / chunk_rows] + (r % chunk_rows) * row_bytes. The chunks lie in the file in
+// the order chunk 0 of every dataset, chunk 1 of every dataset, ...; the last chunk's rows
+// past the end are never written (zeros).
+struct H5InPlace {
+  uint64_t chunk_rows = 1;
+  std::vector<std::vector<uint64_t>> address;  // [dataset][chunk]
+  uint64_t file_size = 0;
+  uint64_t at(size_t k, uint64_t row, size_t row_bytes) const {
+    return address[k][row / chunk_rows] + (row % chunk_rows) * row_bytes;
+  }
+};
+
+// Creates `path` laid out for `layout` (not compressed), closes it and says where its rows
+// go; they are then written there with write_at. Throws OutputError.
+H5InPlace create_h5_in_place(const std::string& path, const H5Layout& layout);
+// The same of a file create_h5_in_place made (resuming a run): checks its datasets are
+// `layout`'s, lays the layout out again in `scratch` (removed after) and checks that every
+// byte of the file outside the chunks, and its size, are the same. Throws OutputError
+// naming the file.
+H5InPlace h5_in_place_layout(const std::string& path, const H5Layout& layout, const std::string& scratch);
 // pwrite all of [data, data + n) at `offset`. Throws OutputError naming `path`.
 void write_at(int fd, const char* data, size_t n, uint64_t offset, const std::string& path);
 

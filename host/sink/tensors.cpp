@@ -3,8 +3,8 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <xxhash.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <condition_variable>
@@ -20,6 +20,7 @@
 #include "base/error.h"
 #include "base/parallel.h"
 #include "plan/plan.h"
+#include "sink/file_order_hash.h"
 #include "sink/h5_file.h"
 #include "sink/output_folder.h"
 
@@ -50,16 +51,14 @@ std::string_view rows_of(const std::vector<T>& v, size_t row, size_t lo, size_t 
   return {reinterpret_cast<const char*>(v.data() + lo * row), (hi - lo) * row * sizeof(T)};
 }
 
-// One tensor: its dataset description and how a batch fills it; then either its .npy file
-// or, for data.h5 written in place, where its rows start and the hash of those written.
+// One tensor: its dataset description, how a batch fills it and, unless data.h5 is written
+// in place, its .npy file.
 struct Tensor {
   H5Dataset ds;
   // The batch's rows [lo, hi): a view of the batch's own memory, or of `scratch` filled here.
   std::function<std::string_view(const SceneBatch&, const BatchOutput&, size_t lo, size_t hi, std::string& scratch)>
       fill;
   std::unique_ptr<AppendFile> file;
-  uint64_t offset = 0, bytes = 0;
-  std::unique_ptr<XXH3_state_t, XXH_errorcode (*)(XXH3_state_t*)> hash{nullptr, XXH3_freeState};
 };
 
 // About the bytes of one piece of a tensor's rows (TensorSink::write), well inside a core's
@@ -209,13 +208,36 @@ class TensorSink final : public Sink {
     const size_t n = scenes.size();
     struct Piece {
       Tensor* t;
-      size_t lo, hi;
+      size_t lo, hi;          // the batch's rows
+      size_t extent = 0;      // data.h5: the chunk's place in the file order (FileOrderHash)
+      uint64_t at = 0;        // where in the chunk they go
+      uint64_t file_at = 0;   // and in the file
       std::string_view rows;  // once made
     };
     std::vector<Piece> pieces;
-    for (Tensor& t : tensors_) {
-      const size_t step = std::max<size_t>(1, kPieceBytes / std::max<size_t>(1, t.ds.row_bytes()));
-      for (size_t lo = 0; lo < n; lo += step) pieces.push_back({&t, lo, std::min(n, lo + step), {}});
+    if (!in_place()) {
+      for (Tensor& t : tensors_) {
+        const size_t step = std::max<size_t>(1, kPieceBytes / std::max<size_t>(1, t.ds.row_bytes()));
+        for (size_t lo = 0; lo < n; lo += step) pieces.push_back({&t, lo, std::min(n, lo + step), 0, 0, 0, {}});
+      }
+    } else {
+      // Chunk by chunk, each dataset's part of it in turn: the order of the file.
+      const uint64_t chunk_rows = place_.chunk_rows, end = rows_ + n;
+      for (uint64_t c = rows_ / chunk_rows; c * chunk_rows < end; ++c) {
+        const uint64_t from = std::max(rows_, c * chunk_rows), to = std::min(end, (c + 1) * chunk_rows);
+        for (size_t k = 0; k < tensors_.size(); ++k) {
+          const size_t row = std::max<size_t>(1, tensors_[k].ds.row_bytes());
+          const size_t step = std::max<size_t>(1, kPieceBytes / row);
+          for (uint64_t r = from; r < to; r += step)
+            pieces.push_back({&tensors_[k],
+                              static_cast<size_t>(r - rows_),
+                              static_cast<size_t>(std::min<uint64_t>(to, r + step) - rows_),
+                              static_cast<size_t>(c * tensors_.size() + k),
+                              (r - c * chunk_rows) * row,
+                              place_.at(k, r, row),
+                              {}});
+        }
+      }
     }
     if (!in_place()) {
       // One file per tensor: the tensors are shared out among the threads, dealt in turn
@@ -229,8 +251,8 @@ class TensorSink final : public Sink {
       });
       return;
     }
-    // data.h5: this thread makes and hashes each piece while a second thread writes the
-    // pieces before it (a write into one file holds its inode's lock on tmpfs and ext4, so
+    // data.h5: this thread makes each piece and feeds it to the file's hash while a second
+    // thread writes the pieces before it (a write into one file holds its inode's lock on tmpfs and ext4, so
     // more writers would only wait for it). The piece made here lands in one of kSlots
     // buffers, which the writer must be done with. Each thread wakes the other only when it
     // sleeps, and this one sleeps until half the slots are free: a woken thread often runs
@@ -239,12 +261,9 @@ class TensorSink final : public Sink {
     const auto make = [&](size_t i) {
       Piece& p = pieces[i];
       p.rows = p.t->fill(scenes, out, p.lo, p.hi, slots_[i % kSlots]);
-      XXH3_64bits_update(p.t->hash.get(), p.rows.data(), p.rows.size());
-      if (p.t == streamed_) XXH3_64bits_update(file_hash_.get(), p.rows.data(), p.rows.size());
+      order_->feed(p.extent, p.at, p.rows);
     };
-    const auto put = [&](const Piece& p) {
-      write_at(fd_, p.rows.data(), p.rows.size(), p.t->offset + (rows_ + p.lo) * p.t->ds.row_bytes(), partial_);
-    };
+    const auto put = [&](const Piece& p) { write_at(fd_, p.rows.data(), p.rows.size(), p.file_at, partial_); };
     if (ctx_.threads < 2) {
       for (size_t i = 0; i < pieces.size(); ++i) {
         make(i);
@@ -321,61 +340,36 @@ class TensorSink final : public Sink {
     }
     // On a disk, start the writeback of the rows just written (a hint, as in AppendFile), so
     // that it goes on while the run does and finish()'s fsync has little left to wait for.
-    // The pages stay cached for finish()'s hash of the whole file.
-    for (Tensor& t : tensors_) {
-      const uint64_t row = t.ds.row_bytes();
-      if (n * row > 0)
-        ::sync_file_range(fd_, static_cast<off_t>(t.offset + rows_ * row), static_cast<off_t>(n * row),
-                          SYNC_FILE_RANGE_WRITE);
-      t.bytes += n * row;
+    if (!pieces.empty()) {
+      const uint64_t from = pieces.front().file_at, to = pieces.back().file_at + pieces.back().rows.size();
+      if (to > from)
+        ::sync_file_range(fd_, static_cast<off_t>(from), static_cast<off_t>(to - from), SYNC_FILE_RANGE_WRITE);
     }
     rows_ += n;
   }
 
   std::vector<FileState> files() const override {
     if (h5_state_) return {*h5_state_};
+    // data.h5 in place: the file in order as far as it is written, and the pieces fed ahead of that.
+    if (in_place()) return {FileState{kWrittenState, order_->position(), order_->digest()}, order_->held(kHeldState)};
     std::vector<FileState> f;
-    for (const Tensor& t : tensors_)
-      f.push_back(in_place() ? FileState{in_place_name(t), t.bytes, XXH3_64bits_digest(t.hash.get())}
-                             : t.file->state());
+    for (const Tensor& t : tensors_) f.push_back(t.file->state());
     return f;
   }
 
   void finish() override {
     if (in_place()) {
-      // The manifest's hash of data.h5: the file in order from where file_hash_ stands. It
-      // reads the page cache while a second thread waits for the sync to the disk; the file
-      // takes its final name once both are done.
-      const auto hash_rest = [&] {
-        struct stat st {};
-        const uint64_t from = streamed_ ? streamed_->offset + streamed_->bytes : 0;
-        if (::fstat(fd_, &st) != 0 || static_cast<uint64_t>(st.st_size) < from)
-          throw OutputError(partial_ + ": cannot read back to hash it");
-        hash_range(fd_, from, static_cast<uint64_t>(st.st_size) - from, file_hash_.get(), partial_, ctx_.threads);
-        return FileState{"data.h5", static_cast<uint64_t>(st.st_size), XXH3_64bits_digest(file_hash_.get())};
-      };
-      int sync_error = 0;
-      const auto sync = [&] { sync_error = ::fsync(fd_) == 0 ? 0 : errno; };
-      FileState state;
-      if (ctx_.threads < 2) {
-        sync();
-        if (!sync_error) state = hash_rest();
-      } else {
-        std::thread syncer(sync);
-        try {
-          state = hash_rest();
-        } catch (...) {
-          syncer.join();
-          throw;
-        }
-        syncer.join();
-      }
-      if (sync_error) throw OutputError(partial_ + ": fsync failed: " + std::strerror(sync_error));
+      // The manifest's hash of data.h5 is the file-order hash, complete now.
+      const uint64_t hash = order_->finish();
+      struct stat st {};
+      if (::fstat(fd_, &st) != 0 || static_cast<uint64_t>(st.st_size) != place_.file_size)
+        throw OutputError(partial_ + ": not the size it was laid out at");
+      if (::fsync(fd_) != 0) throw OutputError(partial_ + ": fsync failed: " + std::strerror(errno));
       const std::string final_path = (fs::path(ctx_.dir) / "data.h5").string();
       std::error_code ec;
       fs::rename(partial_, final_path, ec);
       if (ec) throw OutputError(final_path + ": cannot move into place: " + ec.message());
-      h5_state_ = state;
+      h5_state_ = FileState{"data.h5", place_.file_size, hash};
       ::close(fd_);
       fd_ = -1;
       return;
@@ -391,13 +385,12 @@ class TensorSink final : public Sink {
   std::optional<FileState> h5_state_;
   std::string partial_;  // data.h5 in place: its name while the run goes
   int fd_ = -1;
-  // data.h5 in place: the XXH3-64 of the file in order, for the manifest, from its start to
-  // the end of the rows written so far of the dataset stored first (`streamed_`, whose rows
-  // are written in file order), fed as they are made; finish() hashes the rest of the file.
-  // A dataset's rows go out a batch at a time, interleaved with the other datasets', so the
-  // rest can only be read back once all are written.
-  std::unique_ptr<XXH3_state_t, XXH_errorcode (*)(XXH3_state_t*)> file_hash_{nullptr, XXH3_freeState};
-  Tensor* streamed_ = nullptr;
+  // data.h5 in place: where its chunks are, and the XXH3-64 of the file in order (the
+  // manifest's, and the checkpoint's as far as it goes), fed as the pieces are made.
+  H5InPlace place_;
+  std::unique_ptr<FileOrderHash> order_;
+  static constexpr const char* kWrittenState = "data.h5#written";
+  static constexpr const char* kHeldState = "data.h5#held";
   uint64_t rows_ = 0;  // rows written so far
   // Where write() makes pieces, kept from batch to batch: data.h5's, and each thread's for .npy files.
   std::array<std::string, kSlots> slots_;
@@ -406,7 +399,6 @@ class TensorSink final : public Sink {
   // Uncompressed data.h5 is laid out at the start and its rows written in place; compressed,
   // it is built at the end from .npy files (HDF5 writes the chunks).
   bool in_place() const { return opt_.h5 && !opt_.compress; }
-  static std::string in_place_name(const Tensor& t) { return "data.h5#" + t.ds.name; }
 
   H5Layout h5_layout() const {
     H5Layout layout;
@@ -417,54 +409,86 @@ class TensorSink final : public Sink {
     return layout;
   }
 
-  // Lays data.h5.partial out (a new run), or takes it back and checks that every dataset's
-  // rows so far are what the checkpoint recorded (a resumed run).
+  // Lays data.h5.partial out (a new run), or takes it back and checks that the file so far
+  // is what the checkpoint recorded (a resumed run).
   void open_in_place(const std::map<std::string, FileState>* resume) {
     partial_ = (fs::path(ctx_.dir) / "data.h5.partial").string();
     const H5Layout layout = h5_layout();
-    std::vector<uint64_t> offsets;
     if (!resume) {
-      offsets = create_h5_in_place(partial_, layout);
+      place_ = create_h5_in_place(partial_, layout);
     } else {
       std::error_code ec;  // a run that died while renaming its finished file
       const fs::path final_path = fs::path(ctx_.dir) / "data.h5";
       if (!fs::exists(partial_, ec) && fs::exists(final_path, ec)) fs::rename(final_path, partial_, ec);
-      offsets = h5_data_offsets(partial_, layout);
+      place_ = h5_in_place_layout(partial_, layout, (fs::path(ctx_.dir) / kStateDir / "layout.h5").string());
     }
     fd_ = ::open(partial_.c_str(), O_RDWR | O_CLOEXEC);
     if (fd_ < 0) throw OutputError(partial_ + ": cannot open: " + std::strerror(errno));
-    file_hash_.reset(XXH3_createState());
-    if (!file_hash_) throw std::bad_alloc();
-    XXH3_64bits_reset(file_hash_.get());
-    for (size_t k = 0; k < tensors_.size(); ++k)
-      if (tensors_[k].ds.row_bytes() * ctx_.rows > 0 && (!streamed_ || offsets[k] < streamed_->offset)) {
-        streamed_ = &tensors_[k];
-        streamed_->offset = offsets[k];
+    const uint64_t chunk_rows = place_.chunk_rows, chunks = (ctx_.rows + chunk_rows - 1) / chunk_rows;
+    std::vector<FileExtent> extents;
+    for (uint64_t c = 0; c < chunks; ++c)
+      for (size_t k = 0; k < tensors_.size(); ++k) {
+        const uint64_t row = tensors_[k].ds.row_bytes();
+        extents.push_back({place_.address[k][c], chunk_rows * row,
+                           (std::min(ctx_.rows, (c + 1) * chunk_rows) - c * chunk_rows) * row});
       }
-    if (streamed_) hash_range(fd_, 0, streamed_->offset, file_hash_.get(), partial_);  // HDF5's metadata
-    for (size_t k = 0; k < tensors_.size(); ++k) {
-      Tensor& t = tensors_[k];
-      t.offset = offsets[k];
-      t.hash.reset(XXH3_createState());
-      if (!t.hash) throw std::bad_alloc();
-      XXH3_64bits_reset(t.hash.get());
-      if (!resume) continue;
-      auto it = resume->find(in_place_name(t));
-      if (it == resume->end())
-        throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: no state for " + in_place_name(t));
-      const uint64_t row = t.ds.row_bytes(), rows = row ? it->second.bytes / row : 0;
-      if (k == 0) rows_ = rows;
-      if ((row && it->second.bytes % row) || rows != rows_ || rows > ctx_.rows)
-        throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: " + in_place_name(t) + " records " +
-                          std::to_string(it->second.bytes) + " bytes, not whole rows of every dataset");
-      // The rows so far, hashed again (for the first dataset, into the file's hash too, in
-      // the same pass): they must be what the checkpoint recorded.
-      hash_range(fd_, t.offset, it->second.bytes, t.hash.get(), partial_, ctx_.threads,
-                 &t == streamed_ ? file_hash_.get() : nullptr);
-      t.bytes = it->second.bytes;
-      if (XXH3_64bits_digest(t.hash.get()) != it->second.xxh3)
-        throw OutputError(partial_ + ": dataset " + t.ds.name +
-                          " differs from the checkpoint; the run cannot be resumed");
+    order_ = std::make_unique<FileOrderHash>(fd_, partial_, extents, place_.file_size);
+    if (!resume) {
+      order_->start();
+      return;
+    }
+    const auto state = [&](const char* name) {
+      auto it = resume->find(name);
+      if (it == resume->end()) throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: no state for " + name);
+      return it->second;
+    };
+    const FileState written = state(kWrittenState), held = state(kHeldState);
+    std::string names;
+    for (const Tensor& t : tensors_) names += (names.empty() ? "" : ", ") + t.ds.name;
+    // The file in order up to where the checkpoint's hash reached; the rows written so far
+    // end there, inside the first dataset's chunk (or at the end of the file).
+    order_->skip_to(written.bytes, ctx_.threads);
+    if (order_->digest() != written.xxh3)
+      throw OutputError(partial_ + ": its bytes up to " + std::to_string(written.bytes) +
+                        " (the rows written so far of datasets " + names +
+                        ") differ from the checkpoint; the run cannot be resumed");
+    if (written.bytes == place_.file_size) {
+      rows_ = ctx_.rows;
+    } else {
+      const auto e = std::upper_bound(extents.begin(), extents.end(), written.bytes,
+                                      [](uint64_t a, const FileExtent& x) { return a < x.address; }) -
+                     extents.begin() - 1;
+      const uint64_t at = written.bytes - extents[static_cast<size_t>(e)].address, row = tensors_[0].ds.row_bytes();
+      if (static_cast<size_t>(e) % tensors_.size() != 0 || at % row != 0)
+        throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: " + kWrittenState +
+                          " does not end after a whole row of " + tensors_[0].ds.name);
+      rows_ = static_cast<uint64_t>(e) / tensors_.size() * chunk_rows + at / row;
+    }
+    // The rest of the rows so far (the other datasets' part of the chunk being written),
+    // read back and fed ahead of the hash, as the run that wrote them did.
+    if (rows_ % chunk_rows != 0) {
+      const uint64_t c = rows_ / chunk_rows;
+      std::string buf;
+      for (size_t k = 1; k < tensors_.size(); ++k) {
+        const uint64_t row = tensors_[k].ds.row_bytes();
+        buf.resize((rows_ - c * chunk_rows) * row);
+        read_at(buf, place_.address[k][c]);
+        order_->feed(c * tensors_.size() + k, 0, buf);
+      }
+    }
+    const FileState now = order_->held(kHeldState);
+    if (now.bytes != held.bytes || now.xxh3 != held.xxh3)
+      throw OutputError(partial_ + ": the rows " + std::to_string(rows_ / chunk_rows * chunk_rows) + ".." +
+                        std::to_string(rows_) + " of datasets " + names +
+                        " differ from the checkpoint; the run cannot be resumed");
+  }
+
+  void read_at(std::string& buf, uint64_t offset) const {
+    for (size_t done = 0; done < buf.size();) {
+      const ssize_t r = ::pread(fd_, buf.data() + done, buf.size() - done, static_cast<off_t>(offset + done));
+      if (r < 0 && errno == EINTR) continue;
+      if (r <= 0) throw OutputError(partial_ + ": cannot read back for resume: " + std::strerror(r < 0 ? errno : EIO));
+      done += static_cast<size_t>(r);
     }
   }
 
