@@ -8,6 +8,7 @@
 #include <atomic>
 #include <csignal>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -31,7 +32,9 @@ class Serve : public ::testing::Test {
     tmp_ = tmpl;
     fs::create_directories(tmp_ / "root");
     fs::create_directories(tmp_ / "cap");
-    server_ = portalsim::test::start(tmp_ / "cap", {"serve", "--port", "0", "--root", (tmp_ / "root").string()});
+    std::vector<std::string> args{"serve", "--port", "0", "--root", (tmp_ / "root").string()};
+    for (const std::string& a : extra_args()) args.push_back(a);
+    server_ = portalsim::test::start(tmp_ / "cap", args);
     // The URL line says the server is listening.
     for (int i = 0; i < 6000 && port_ == 0; ++i) {
       const std::string out = slurp(server_.out_path);
@@ -52,6 +55,8 @@ class Serve : public ::testing::Test {
     std::error_code ec;
     fs::remove_all(tmp_, ec);
   }
+  // More of serve's arguments (a fixture's own catalogue); tmp_ exists when this is called.
+  virtual std::vector<std::string> extra_args() { return {}; }
   httplib::Client client() const {
     httplib::Client c("127.0.0.1", port_);
     c.set_read_timeout(60, 0);
@@ -78,6 +83,38 @@ TEST_F(Serve, PageAndCatalogueAreServed) {
   const json j = json::parse(cat->body);
   EXPECT_EQ(j["regions"].size(), 13u);
   EXPECT_NE(std::find(j["objects"].begin(), j["objects"].end(), "gun:v"), j["objects"].end());
+}
+
+// The default catalogue with its first subject at 0.85 of the height: the page's hit boxes
+// (/api/catalogue's per-subject places) move down with that subject's body.
+class ServeShortSubject : public Serve {
+ protected:
+  std::vector<std::string> extra_args() override {
+    std::string t = slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "catalogue.toml");
+    const size_t first = t.find("[[subjects]]");
+    const size_t line = t.find('\n', t.find("\nbuild = ", first) + 1) + 1;
+    t.insert(line, "height = 0.85\n");
+    const fs::path file = tmp_ / "short.toml";
+    std::ofstream(file) << t;
+    return {"--catalogue", file.string(), "--assets", (fs::path(PORTALSIM_SOURCE_DIR) / "scenarios").string()};
+  }
+};
+
+TEST_F(ServeShortSubject, HitBoxesFollowTheSubjectsHeight) {
+  auto cat = client().Get("/api/catalogue");
+  ASSERT_TRUE(cat);
+  ASSERT_EQ(cat->status, 200) << cat->body;
+  const json j = json::parse(cat->body);
+  ASSERT_EQ(j["regions"].size(), 13u);
+  for (const json& r : j["regions"]) {
+    ASSERT_EQ(r["places"].size(), j["subjects"].size()) << r.dump();
+    const auto rect = r["rect"].get<std::vector<int>>(), shorter = r["places"][0].get<std::vector<int>>();
+    EXPECT_EQ(r["places"][1].get<std::vector<int>>(), rect) << "subject 2 is of height 1: " << r.dump();
+    EXPECT_GT(shorter[1], rect[1]) << "a shorter body holds its objects lower: " << r.dump();
+    EXPECT_EQ(shorter[0], rect[0]);
+    EXPECT_EQ(shorter[2], rect[2]);
+    EXPECT_EQ(shorter[3], rect[3]);
+  }
 }
 
 TEST_F(Serve, RenderGivesTheThesisGunExample) {

@@ -435,11 +435,24 @@ struct Server::Impl {
     j["subjects"] = json::array();
     for (const Subject& sub : c.subjects) j["subjects"].push_back(sub.name);
     j["regions"] = json::array();
-    for (const Region& r : c.regions)
+    for (size_t k = 0; k < c.regions.size(); ++k) {
+      const Region& r = c.regions[k];
+      const char* view = r.view == View::upper ? "upper" : "lower";
+      // Where the region holds an object on each subject: the rectangle moved with the
+      // subject's stature (Sensor::place), which the page's hit boxes follow.
+      json places = json::array();
+      const int s = c.sensor_index(view);
+      for (size_t sub = 0; sub < c.subjects.size(); ++sub) {
+        const Rect p =
+            s < 0 ? r.mmw : c.sensors[static_cast<size_t>(s)].place(static_cast<int>(sub), static_cast<int>(k));
+        places.push_back({p.x, p.y, p.w, p.h});
+      }
       j["regions"].push_back({{"id", r.id},
                               {"name", r.name},
-                              {"view", r.view == View::upper ? "upper" : "lower"},
-                              {"rect", {r.mmw.x, r.mmw.y, r.mmw.w, r.mmw.h}}});
+                              {"view", view},
+                              {"rect", {r.mmw.x, r.mmw.y, r.mmw.w, r.mmw.h}},
+                              {"places", places}});
+    }
     j["objects"] = json::array();
     for (size_t v = 0; v < c.variant_list.size(); ++v) j["objects"].push_back(c.variant_name(static_cast<int>(v)));
     j["tiers"] = {"fast", "standard", "exact"};

@@ -73,7 +73,6 @@ async function init() {
   $("tier").value = "standard";
   cat.objects.forEach((o) => option($("tool"), o));
   $("tool").value = cat.objects.find((o) => o.startsWith("gun")) ?? cat.objects[0];
-  const [w, h] = cat.mmw;
   for (const reg of cat.regions) {
     const r = reg.id;
     const row = document.createElement("div");
@@ -90,9 +89,6 @@ async function init() {
     // The clickable region on the body: a button, so it is focusable and has a name.
     const b = document.createElement("button");
     b.id = "hit" + r; b.className = "region"; b.type = "button";
-    const [x, y, rw, rh] = reg.rect;
-    Object.assign(b.style, { left: x / w * 100 + "%", top: y / h * 100 + "%", width: rw / w * 100 + "%",
-      height: rh / h * 100 + "%" });
     b.addEventListener("click", () => {
       sel.value = sel.value === $("tool").value ? "none" : $("tool").value;
       regionChanged(r);
@@ -101,6 +97,7 @@ async function init() {
     b.textContent = r;
     b.setAttribute("aria-label", "region " + r + " " + reg.name + ": none");
   }
+  placeHits();
   for (let z = 1; z <= 19; ++z) {
     const row = document.createElement("div");
     row.className = "zone"; row.id = "zone" + z; row.setAttribute("role", "img");
@@ -109,10 +106,23 @@ async function init() {
   }
   for (const id of ["subject", "seed", "tier", "placement", "palette", "pattern-noise", "pixel-noise", "rule", "threat"])
     $(id).addEventListener("change", render);
+  $("subject").addEventListener("change", placeHits);
   $("save").addEventListener("click", save);
   $("generate").addEventListener("click", generate);
   await render();
   document.body.dataset.ready = "1";
+}
+
+// Each region's hit box where the chosen subject holds its object (it moves with the
+// subject's stature; the catalogue's rectangle for subjects of height 1).
+function placeHits() {
+  const [w, h] = cat.mmw;
+  const subject = Number($("subject").value) - 1;
+  for (const reg of cat.regions) {
+    const [x, y, rw, rh] = reg.places[subject] ?? reg.rect;
+    Object.assign($("hit" + reg.id).style, { left: x / w * 100 + "%", top: y / h * 100 + "%",
+      width: rw / w * 100 + "%", height: rh / h * 100 + "%" });
+  }
 }
 
 async function save() {
