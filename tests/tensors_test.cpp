@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 #include <sys/wait.h>
+#include <xxhash.h>
 
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -412,6 +414,48 @@ TEST(TensorsH5, CompressedResumeAfterKill9IsExact) {
   expect_same_run(t.w() / "ref", t.w() / "killed");
   EXPECT_EQ(read_h5(t.w() / "killed" / "data.h5", "region_flip", H5T_NATIVE_UINT8).dims,
             (std::vector<hsize_t>{1500, 13}));
+}
+
+// A crash while a finished run renames its files (after the last checkpoint, before the
+// manifest), built from a complete run as GenerateResume.CrashWhileFinishingIsResumable
+// builds it: the last checkpoint (every row written, the file hashed in order to its end,
+// nothing held), data.h5 renamed or not, no manifest. --resume must finish the job. 100 rows
+// end inside a chunk.
+TEST(TensorsH5, CrashWhileFinishingIsResumable) {
+  portalsim::test::TempDir t;
+  const Args spec{"--count", "100", "--seed", "4", "--rule", "gun", "--what", "images", "--format", "h5"};
+  const fs::path ref = t.w() / "ref";
+  ExpectOk(run(t, spec, ref));
+  const nlohmann::json m = nlohmann::json::parse(slurp(ref / "manifest.json"));
+  nlohmann::json checkpoint;
+  checkpoint["identity"] = {
+      {"portalsim", m["portalsim"]}, {"catalogue", m["catalogue"]}, {"spec", m["spec"]}, {"shard", m["shard"]}};
+  checkpoint["next"] = m["shard"]["end"];
+  checkpoint["positive"] = m["classes"]["positive"];
+  checkpoint["negative"] = m["classes"]["negative"];
+  checkpoint["files"] = nlohmann::json::array();
+  for (const nlohmann::json& o : m["outputs"]) {
+    const uint64_t hash = std::stoull(o["xxh3_64"].get<std::string>(), nullptr, 16);
+    if (o["name"] == "data.h5") {
+      checkpoint["files"].push_back({{"name", "data.h5#written"}, {"bytes", o["bytes"]}, {"xxh3", hash}});
+      checkpoint["files"].push_back({{"name", "data.h5#held"}, {"bytes", 0}, {"xxh3", XXH3_64bits(nullptr, 0)}});
+    } else {
+      checkpoint["files"].push_back({{"name", o["name"]}, {"bytes", o["bytes"]}, {"xxh3", hash}});
+    }
+  }
+  for (const bool renamed : {false, true}) {
+    SCOPED_TRACE(renamed ? "data.h5 renamed" : "data.h5 not yet renamed");
+    const fs::path dir = t.w() / (renamed ? "renamed" : "partial");
+    fs::copy(ref, dir, fs::copy_options::recursive);
+    fs::create_directory(dir / ".portalsim");
+    std::ofstream(dir / ".portalsim" / "checkpoint.json") << checkpoint.dump(1) << "\n";
+    fs::remove(dir / "manifest.json");
+    if (!renamed) fs::rename(dir / "data.h5", dir / "data.h5.partial");
+    ExpectOk(run(t, plus(spec, {"--resume"}), dir));
+    EXPECT_TRUE(slurp(dir / "data.h5") == slurp(ref / "data.h5"));
+    EXPECT_EQ(slurp(dir / "manifest.json"), slurp(ref / "manifest.json"));
+    EXPECT_FALSE(fs::exists(dir / ".portalsim"));
+  }
 }
 
 TEST(TensorsH5, ResumeRefusesRowsChangedSinceTheCheckpoint) {

@@ -466,7 +466,7 @@ class TensorSink final : public Sink {
     }
     // The rest of the rows so far (the other datasets' part of the chunk being written),
     // read back and fed ahead of the hash, as the run that wrote them did.
-    if (rows_ % chunk_rows != 0) {
+    if (rows_ % chunk_rows != 0 && rows_ < ctx_.rows) {
       const uint64_t c = rows_ / chunk_rows;
       std::string buf;
       for (size_t k = 1; k < tensors_.size(); ++k) {
