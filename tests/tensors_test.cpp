@@ -506,6 +506,32 @@ TEST(TensorsH5, DefaultBatchEndsWhereAChunkDoes) {
     }
 }
 
+// A checkpoint whose `next` disagrees with how far data.h5 is written (edited by hand, or
+// damaged) is refused naming checkpoint.json and the field, as is one of the wrong type.
+TEST(TensorsH5, ResumeRefusesACheckpointWhoseNextDisagrees) {
+  const Args spec{"--count", "4000", "--seed", "12", "--rule", "gun", "--what", "images", "--format", "h5"};
+  const std::vector<std::pair<std::string, std::function<void(nlohmann::json&)>>> edits{
+      {"next says", [](nlohmann::json& c) { c["next"] = c["next"].get<uint64_t>() - 64; }},
+      {"next: expected a whole number", [](nlohmann::json& c) { c["next"] = "300"; }},
+      {"is not in this run's", [](nlohmann::json& c) { c["next"] = 5000; }},
+      {"files[0].bytes: expected a whole number", [](nlohmann::json& c) { c["files"][0]["bytes"] = -1; }},
+  };
+  for (const auto& [message, edit] : edits) {
+    SCOPED_TRACE(message);
+    portalsim::test::TempDir t;
+    const portalsim::test::Result r = kill_then_resume(t, spec, [&](const fs::path& dir) {
+      const fs::path file = dir / ".portalsim" / "checkpoint.json";
+      nlohmann::json c = nlohmann::json::parse(slurp(file));
+      edit(c);
+      std::ofstream(file) << c.dump(1) << "\n";
+    });
+    EXPECT_TRUE(r.exited && r.status != 0) << portalsim::test::describe(r);
+    EXPECT_NE(r.err.find("checkpoint.json"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("FileOrderHash"), std::string::npos) << r.err;
+  }
+}
+
 TEST(TensorsH5, CompressWithoutH5IsRefusedNamingTheFlag) {
   portalsim::test::TempDir t;
   const portalsim::test::Result r = run(t, {"--count", "5", "--compress"}, t.w() / "x");

@@ -184,6 +184,25 @@ bool finished_run_here(const std::string& dir, const json& identity, bool resume
   return true;
 }
 
+// A checkpoint's fields have the types the resume reads (a hand-edited or damaged one gets
+// a message naming the field, not a JSON library's).
+void check_checkpoint(const json& c, const std::string& path) {
+  const auto whole = [&](const json& j, const std::string& field) {
+    if (!j.is_number_unsigned()) throw OutputError(path + ": " + field + ": expected a whole number");
+  };
+  if (!c.is_object()) throw OutputError(path + ": expected a JSON object");
+  for (const char* k : {"next", "positive", "negative"}) whole(c.contains(k) ? c[k] : json(), k);
+  if (!c.contains("files") || !c["files"].is_array()) throw OutputError(path + ": files: expected an array");
+  for (size_t i = 0; i < c["files"].size(); ++i) {
+    const json& f = c["files"][i];
+    const std::string at = "files[" + std::to_string(i) + "]";
+    if (!f.is_object() || !f.contains("name") || !f["name"].is_string())
+      throw OutputError(path + ": " + at + ".name: expected a string");
+    whole(f.contains("bytes") ? f["bytes"] : json(), at + ".bytes");
+    whole(f.contains("xxh3") ? f["xxh3"] : json(), at + ".xxh3");
+  }
+}
+
 // What the output folder holds, read with its lock held: new (or a run stopped before its
 // first checkpoint, whose files go), an interrupted run to resume, or a finished one.
 // Throws when the folder holds anything else, or a run with another identity.
@@ -205,6 +224,7 @@ FolderStart examine_folder(const std::string& dir, const json& identity, bool re
     } catch (const json::exception& e) {
       throw OutputError(checkpoint_path.string() + ": unreadable checkpoint: " + e.what());
     }
+    check_checkpoint(start.checkpoint, checkpoint_path.string());
     if (const std::string diff = differing_keys(start.checkpoint.value("identity", json::object()), identity);
         !diff.empty())
       throw InputError("--resume: " + dir + " was made by a different run: " + diff +
@@ -436,6 +456,9 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   if (::access(state_dir.c_str(), W_OK) != 0) throw OutputError(dir + ": the output folder is not writable");
 
   const uint64_t first = start.resuming ? start.checkpoint["next"].get<uint64_t>() : res.begin;
+  if (first < res.begin || first > res.end)
+    throw OutputError(checkpoint_path.string() + ": next: " + std::to_string(first) + " is not in this run's [" +
+                      std::to_string(res.begin) + ", " + std::to_string(res.end) + "]; the run cannot be resumed");
   if (start.resuming) {
     res.positive = start.checkpoint["positive"].get<uint64_t>();
     res.negative = start.checkpoint["negative"].get<uint64_t>();
@@ -446,6 +469,7 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   ctx.assets = &assets;
   ctx.layout = FeatureLayout::of(cat, plan.model.block);
   ctx.rows = res.end - res.begin;
+  ctx.done = first - res.begin;
   ctx.threads = threads;
   ctx.model = plan.model;
   ctx.image_format = spec.image_format;

@@ -31,6 +31,7 @@ struct SinkContext {
   const AssetSet* assets = nullptr;
   FeatureLayout layout;
   uint64_t rows = 0;  // rows the finished table will hold (the npy header needs it)
+  uint64_t done = 0;  // resuming: rows written before, by the checkpoint's `next`
   unsigned threads = 1;
   ModelSettings model;  // the model's knobs (scenarios.csv records each object's randomised transform)
   std::string image_format = "png";

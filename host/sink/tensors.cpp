@@ -206,6 +206,7 @@ class TensorSink final : public Sink {
   // each batch from memory again for every step.
   void write(const SceneBatch& scenes, const BatchOutput& out) override {
     const size_t n = scenes.size();
+    if (rows_ + n > ctx_.rows) throw std::logic_error("TensorSink: more rows than the run holds");
     struct Piece {
       Tensor* t;
       size_t lo, hi;          // the batch's rows
@@ -464,6 +465,10 @@ class TensorSink final : public Sink {
                           " does not end after a whole row of " + tensors_[0].ds.name);
       rows_ = static_cast<uint64_t>(e) / tensors_.size() * chunk_rows + at / row;
     }
+    if (rows_ != ctx_.done)
+      throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: next says " + std::to_string(ctx_.done) +
+                        " rows are written, " + kWrittenState + " " + std::to_string(rows_) +
+                        "; the run cannot be resumed");
     // The rest of the rows so far (the other datasets' part of the chunk being written),
     // read back and fed ahead of the hash, as the run that wrote them did.
     if (rows_ % chunk_rows != 0 && rows_ < ctx_.rows) {
