@@ -532,6 +532,19 @@ TEST(TensorsH5, ResumeRefusesACheckpointWhoseNextDisagrees) {
   }
 }
 
+// data.h5 is allocated whole before the first row: a run whose file could never fit the
+// filesystem is refused at once, naming the file, and leaves no folder behind.
+TEST(TensorsH5, AFileLargerThanTheFilesystemIsRefusedAtOnce) {
+  portalsim::test::TempDir t;
+  const fs::path dir = t.w() / "huge";
+  const portalsim::test::Result r =
+      run(t, {"--count", "1099511627776", "--seed", "1", "--what", "images", "--format", "h5"}, dir);
+  EXPECT_TRUE(r.exited && r.status != 0) << portalsim::test::describe(r);
+  EXPECT_NE(r.err.find("data.h5.partial: 1099511627776 rows would take"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("more than the whole filesystem holds"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir));
+}
+
 TEST(TensorsH5, CompressWithoutH5IsRefusedNamingTheFlag) {
   portalsim::test::TempDir t;
   const portalsim::test::Result r = run(t, {"--count", "5", "--compress"}, t.w() / "x");

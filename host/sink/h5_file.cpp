@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <hdf5.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -117,7 +118,7 @@ H5Attribute read_strings(hid_t obj, const char* name, const std::string& path) {
 // once the file is closed. Compressed, chunks are shuffled and gzipped, and `each(k,
 // dataset)` writes dataset k while it is open.
 void create_file(const std::string& path, const H5Layout& layout, const std::function<void(size_t, hid_t)>& each,
-                 H5InPlace* place) {
+                 H5InPlace* place, std::vector<std::pair<size_t, uint64_t>>* guessed = nullptr) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors become OutputError below
   std::vector<H5Attribute> attributes = layout.attributes;
   H5Attribute names{"datasets", {}, false};
@@ -180,8 +181,10 @@ void create_file(const std::string& path, const H5Layout& layout, const std::fun
   }
   if (place) {
     // Chunk c of each dataset in turn, each allocated (at the end of the file) as its
-    // dataset grows over it. Its address is where the file ended before, when the file
-    // grew by just the chunk; else (HDF5 also placed metadata) HDF5 is asked.
+    // dataset grows over it. Its address is where the file ended before: when the file grew
+    // by more (HDF5 also placed an index node, after the chunk), that is checked once the
+    // file is closed (create_h5_in_place); when by less, HDF5 is asked (a pass over the
+    // chunk index, so not for every guess).
     const uint64_t chunks = (layout.rows + chunk_rows - 1) / chunk_rows;
     place->chunk_rows = chunk_rows;
     place->address.assign(layout.datasets.size(), std::vector<uint64_t>(chunks, 0));
@@ -208,16 +211,9 @@ void create_file(const std::string& path, const H5Layout& layout, const std::fun
         haddr_t before = 0, after = 0;
         if (H5Fget_eoa(file, &before) < 0 || H5Dset_extent(open[k], dims.data()) < 0 || H5Fget_eoa(file, &after) < 0)
           throw OutputError(path + ": HDF5 could not allocate dataset " + t.name + " (disk full?)");
-        place->address[k][c] = after - before == chunk_rows * t.row_bytes() ? before : ask(k, c);
-      }
-    // The order the writer and its file-order hash rely on, checked.
-    uint64_t end = 0;
-    for (uint64_t c = 0; c < chunks; ++c)
-      for (size_t k = 0; k < layout.datasets.size(); ++k) {
-        if (place->address[k][c] < end)
-          throw OutputError(path + ": HDF5 placed chunk " + std::to_string(c) + " of dataset " +
-                            layout.datasets[k].name + " out of order");
-        end = place->address[k][c] + chunk_rows * layout.datasets[k].row_bytes();
+        const uint64_t grew = after - before, bytes = chunk_rows * t.row_bytes();
+        place->address[k][c] = grew < bytes ? ask(k, c) : before;
+        if (grew > bytes) guessed->emplace_back(k, c);
       }
   }
   if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) throw OutputError(path + ": HDF5 could not flush the file");
@@ -251,15 +247,77 @@ static uint64_t size_of_file(const std::string& path) {
   return static_cast<uint64_t>(st.st_size);
 }
 
+// The chunk of dataset k that holds row c * chunk_rows, as HDF5's index says.
+uint64_t ask_chunk_address(const std::string& path, const H5Layout& layout, size_t k, uint64_t row) {
+  Ids ids;
+  const hid_t file = ids.keep(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  const hid_t ds = file < 0 ? -1 : ids.keep(H5Dopen2(file, layout.datasets[k].name.c_str(), H5P_DEFAULT), H5Dclose);
+  std::vector<hsize_t> origin(layout.datasets[k].dims.size() + 1, 0);
+  origin[0] = row;
+  unsigned filter_mask = 0;
+  haddr_t addr = HADDR_UNDEF;
+  hsize_t size = 0;
+  if (ds < 0 || H5Dget_chunk_info_by_coord(ds, origin.data(), &filter_mask, &addr, &size) < 0 || addr == HADDR_UNDEF)
+    throw OutputError(path + ": HDF5 cannot say where the chunk of row " + std::to_string(row) + " of dataset " +
+                      layout.datasets[k].name + " is");
+  return static_cast<uint64_t>(addr);
+}
+
 H5InPlace create_h5_in_place(const std::string& path, const H5Layout& layout) {
   if (layout.compress) throw std::logic_error("create_h5_in_place: compressed datasets are written through HDF5");
+  // The whole file is allocated up front (and filled as the run goes): refuse one larger
+  // than the filesystem it is on, before laying out millions of chunks for it.
+  const uint64_t chunk_rows = std::min<uint64_t>(kH5ChunkRows, std::max<uint64_t>(1, layout.rows));
+  const uint64_t chunks = (layout.rows + chunk_rows - 1) / chunk_rows;
+  uint64_t total = 0;
+  bool overflow = false;
+  for (const H5Dataset& t : layout.datasets) {
+    uint64_t b = 0;
+    overflow |= __builtin_mul_overflow(chunks * chunk_rows, static_cast<uint64_t>(t.row_bytes()), &b);
+    overflow |= __builtin_add_overflow(total, b, &total);
+  }
+  struct statvfs fs_info {};
+  const std::string dir = fs::path(path).parent_path().string();
+  if (::statvfs(dir.empty() ? "." : dir.c_str(), &fs_info) == 0) {
+    const unsigned __int128 capacity = static_cast<unsigned __int128>(fs_info.f_blocks) * fs_info.f_frsize;
+    if (overflow || total > capacity)
+      throw OutputError(path + ": " + std::to_string(layout.rows) + " rows would take " +
+                        (overflow ? std::string("more than 2^64") : std::to_string(total)) +
+                        " bytes, more than the whole filesystem holds (" +
+                        std::to_string(static_cast<uint64_t>(std::min<unsigned __int128>(capacity, UINT64_MAX))) +
+                        " bytes); make fewer scenarios per run (--shard), or write elsewhere");
+  }
   H5InPlace place;
-  create_file(path, layout, nullptr, &place);
+  std::vector<std::pair<size_t, uint64_t>> guessed;
+  create_file(path, layout, nullptr, &place, &guessed);
   place.file_size = size_of_file(path);
-  for (size_t k = 0; k < layout.datasets.size(); ++k)
-    if (!place.address[k].empty() &&
-        place.address[k].back() + place.chunk_rows * layout.datasets[k].row_bytes() > place.file_size)
-      throw OutputError(path + ": shorter than the chunks HDF5 allocated in it");
+  // A chunk placed with metadata after it: its first bytes were never written (zeros) and
+  // the metadata right after it begins with a signature (never zero). Else HDF5 is asked.
+  if (!guessed.empty()) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw OutputError(path + ": cannot open: " + std::strerror(errno));
+    for (const auto& [k, c] : guessed) {
+      const uint64_t at = place.address[k][c], bytes = place.chunk_rows * layout.datasets[k].row_bytes();
+      unsigned char head[8] = {}, next[4] = {};
+      const bool chunk_here =
+          ::pread(fd, head, sizeof head, static_cast<off_t>(at)) == static_cast<ssize_t>(sizeof head) &&
+          ::pread(fd, next, sizeof next, static_cast<off_t>(at + bytes)) == static_cast<ssize_t>(sizeof next) &&
+          std::all_of(head, head + sizeof head, [](unsigned char b) { return b == 0; }) &&
+          std::any_of(next, next + sizeof next, [](unsigned char b) { return b != 0; });
+      if (!chunk_here) place.address[k][c] = ask_chunk_address(path, layout, k, c * place.chunk_rows);
+    }
+    ::close(fd);
+  }
+  // The order the writer and its file-order hash rely on, checked.
+  uint64_t end = 0;
+  for (uint64_t c = 0; c < chunks; ++c)
+    for (size_t k = 0; k < layout.datasets.size(); ++k) {
+      if (place.address[k][c] < end)
+        throw OutputError(path + ": HDF5 placed chunk " + std::to_string(c) + " of dataset " + layout.datasets[k].name +
+                          " out of order");
+      end = place.address[k][c] + place.chunk_rows * layout.datasets[k].row_bytes();
+    }
+  if (end > place.file_size) throw OutputError(path + ": shorter than the chunks HDF5 allocated in it");
   return place;
 }
 
