@@ -13,7 +13,6 @@
 #include <deque>
 #include <exception>
 #include <filesystem>
-#include <initializer_list>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -50,19 +49,11 @@ Window map_window(int fd, uint64_t at, uint64_t end) {
   return w;
 }
 
-// The hash states one pass over a file feeds; null entries are left out.
-using States = std::initializer_list<XXH3_state_t*>;
-
-void update(States hs, const void* data, size_t n) {
-  for (XXH3_state_t* h : hs)
-    if (h) XXH3_64bits_update(h, data, n);
-}
-
-// Feeds window `w` to every state of `hs` and unmaps it; read() where it could not be mapped.
-void hash_window(int fd, const Window& w, States hs, std::vector<char>& buf, const std::string& path,
+// Feeds window `w` to `h` and unmaps it; read() where it could not be mapped.
+void hash_window(int fd, const Window& w, XXH3_state_t* h, std::vector<char>& buf, const std::string& path,
                  const char* what) {
   if (w.map) {
-    update(hs, static_cast<const char*>(w.map) + (w.at - w.base), static_cast<size_t>(w.end - w.at));
+    XXH3_64bits_update(h, static_cast<const char*>(w.map) + (w.at - w.base), static_cast<size_t>(w.end - w.at));
     ::munmap(w.map, static_cast<size_t>(w.end - w.base));
     return;
   }
@@ -72,17 +63,17 @@ void hash_window(int fd, const Window& w, States hs, std::vector<char>& buf, con
                               static_cast<off_t>(at));
     if (r < 0 && errno == EINTR) continue;
     if (r <= 0) throw OutputError(path + ": cannot read back " + what + ": " + std::strerror(r < 0 ? errno : EIO));
-    update(hs, buf.data(), static_cast<size_t>(r));
+    XXH3_64bits_update(h, buf.data(), static_cast<size_t>(r));
     at += static_cast<uint64_t>(r);
   }
 }
 
-// Feeds bytes [offset, offset + n) of `fd` to every state of `hs`, mapped a window at a time: the hash reads
+// Feeds bytes [offset, offset + n) of `fd` to `h`, mapped a window at a time: the hash reads
 // the page cache in place, without read()'s copy (read() where the file cannot be mapped).
 // Mapping a window (the kernel filling its page table) costs about twice what hashing it
 // does, so with `threads` >= 2 a second thread maps the windows ahead while this one hashes
 // and unmaps them. Throws OutputError naming `path` (`what` says why it was read).
-void hash_mapped(int fd, uint64_t offset, uint64_t n, States hs, const std::string& path, const char* what,
+void hash_mapped(int fd, uint64_t offset, uint64_t n, XXH3_state_t* h, const std::string& path, const char* what,
                  unsigned threads) {
   struct stat st {};
   if (::fstat(fd, &st) != 0 || static_cast<uint64_t>(st.st_size) < offset + n)
@@ -94,7 +85,7 @@ void hash_mapped(int fd, uint64_t offset, uint64_t n, States hs, const std::stri
   const auto window_end = [&](uint64_t at) { return std::min(end, (at / kWindow + 1) * kWindow); };
   if (threads < 2 || n <= 2 * kWindow) {
     for (uint64_t at = offset; at < end; at = window_end(at))
-      hash_window(fd, map_window(fd, at, window_end(at)), hs, buf, path, what);
+      hash_window(fd, map_window(fd, at, window_end(at)), h, buf, path, what);
     return;
   }
   std::mutex m;
@@ -127,7 +118,7 @@ void hash_mapped(int fd, uint64_t offset, uint64_t n, States hs, const std::stri
         ready.pop_front();
       }
       cv.notify_all();
-      hash_window(fd, w, hs, buf, path, what);
+      hash_window(fd, w, h, buf, path, what);
     }
   } catch (...) {
     error = std::current_exception();
@@ -145,9 +136,8 @@ void hash_mapped(int fd, uint64_t offset, uint64_t n, States hs, const std::stri
 
 }  // namespace
 
-void hash_range(int fd, uint64_t offset, uint64_t n, void* xxh3_state, const std::string& path, unsigned threads,
-                void* xxh3_state2) {
-  hash_mapped(fd, offset, n, {state_of(xxh3_state), state_of(xxh3_state2)}, path, "for resume", threads);
+void hash_range(int fd, uint64_t offset, uint64_t n, void* xxh3_state, const std::string& path, unsigned threads) {
+  hash_mapped(fd, offset, n, state_of(xxh3_state), path, "for resume", threads);
 }
 
 FileState hash_file(const std::string& dir, const std::string& name, unsigned threads) {
@@ -168,7 +158,7 @@ FileState hash_file(const std::string& dir, const std::string& name, unsigned th
   XXH3_64bits_reset(h);
   FileState s{name, static_cast<uint64_t>(st.st_size), 0};
   try {
-    hash_mapped(fd, 0, s.bytes, {h}, path, "to hash it", threads);
+    hash_mapped(fd, 0, s.bytes, h, path, "to hash it", threads);
   } catch (...) {
     ::close(fd);
     XXH3_freeState(h);

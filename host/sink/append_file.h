@@ -17,11 +17,9 @@ struct FileState {
 std::string xxh3_hex(uint64_t hash);
 
 // Feeds bytes [offset, offset + n) of the open file `fd` to an XXH3-64 state
-// (XXH3_state_t*), and in the same pass to `xxh3_state2` where given: a resumed run
-// re-hashing what it keeps. With `threads` >= 2, a second thread maps the file ahead of
-// the hash. Throws OutputError naming `path`.
-void hash_range(int fd, uint64_t offset, uint64_t n, void* xxh3_state, const std::string& path, unsigned threads = 1,
-                void* xxh3_state2 = nullptr);
+// (XXH3_state_t*): a resumed run re-hashing what it keeps. With `threads` >= 2, a second
+// thread maps the file ahead of the hash. Throws OutputError naming `path`.
+void hash_range(int fd, uint64_t offset, uint64_t n, void* xxh3_state, const std::string& path, unsigned threads = 1);
 
 // The state of a finished file dir/name (its size and XXH3-64), read as hash_range reads.
 // Throws OutputError.

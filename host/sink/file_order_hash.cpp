@@ -1,14 +1,12 @@
 #include "sink/file_order_hash.h"
 
-#include <unistd.h>
 #include <xxhash.h>
 
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
 #include <stdexcept>
 
 #include "base/error.h"
+#include "sink/h5_file.h"
 
 namespace portalsim {
 
@@ -35,13 +33,11 @@ FileOrderHash::~FileOrderHash() = default;
 
 void FileOrderHash::hash_file_bytes(uint64_t from, uint64_t to) {
   char buf[64 << 10];
-  while (from < to) {
-    const ssize_t r =
-        ::pread(fd_, buf, static_cast<size_t>(std::min<uint64_t>(to - from, sizeof buf)), static_cast<off_t>(from));
-    if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) throw OutputError(path_ + ": cannot read back to hash it: " + std::strerror(r < 0 ? errno : EIO));
-    XXH3_64bits_update(as_state(state_.get()), buf, static_cast<size_t>(r));
-    from += static_cast<uint64_t>(r);
+  for (; from < to;) {
+    const size_t n = static_cast<size_t>(std::min<uint64_t>(to - from, sizeof buf));
+    read_at(fd_, buf, n, from, path_, "to hash it");
+    XXH3_64bits_update(as_state(state_.get()), buf, n);
+    from += n;
   }
 }
 

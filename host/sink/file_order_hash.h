@@ -42,7 +42,10 @@ class FileOrderHash {
   void feed(size_t e, uint64_t at, std::string_view data);
 
   uint64_t position() const { return pos_; }  // bytes hashed: the file's [0, position())
-  uint64_t digest() const;                    // XXH3-64 of those
+  // Where that is: the extent the hash is in (extents.size() past the last) and how far into it.
+  size_t extent() const { return cur_; }
+  uint64_t into_extent() const { return at_; }
+  uint64_t digest() const;  // XXH3-64 of those
   // The bytes fed and held (ahead of the hash), in file order: their count and XXH3-64.
   FileState held(const std::string& name) const;
   // Hashes what is left; every extent must be filled by now. The whole file's XXH3-64.

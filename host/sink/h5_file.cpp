@@ -111,6 +111,20 @@ H5Attribute read_strings(hid_t obj, const char* name, const std::string& path) {
   return a;
 }
 
+// Where the chunk holding row `row` of dataset `d` (open as `ds`) is, as HDF5's chunk index
+// says (a pass over the index). Throws OutputError naming `path`.
+uint64_t chunk_address(hid_t ds, const H5Dataset& d, uint64_t row, const std::string& path) {
+  std::vector<hsize_t> origin(d.dims.size() + 1, 0);
+  origin[0] = row;
+  unsigned filter_mask = 0;
+  haddr_t addr = HADDR_UNDEF;
+  hsize_t size = 0;
+  if (ds < 0 || H5Dget_chunk_info_by_coord(ds, origin.data(), &filter_mask, &addr, &size) < 0 || addr == HADDR_UNDEF)
+    throw OutputError(path + ": HDF5 cannot say where the chunk of row " + std::to_string(row) + " of dataset " +
+                      d.name + " is");
+  return static_cast<uint64_t>(addr);
+}
+
 // Creates `path` with the layout's attributes and datasets (no modification times
 // anywhere: the file's bytes depend on the data alone), chunked kH5ChunkRows along N. With
 // `place` (uncompressed) every chunk is allocated here and never filled, chunk c of every
@@ -189,15 +203,7 @@ void create_file(const std::string& path, const H5Layout& layout, const std::fun
     place->chunk_rows = chunk_rows;
     place->address.assign(layout.datasets.size(), std::vector<uint64_t>(chunks, 0));
     const auto ask = [&](size_t k, uint64_t c) {
-      std::vector<hsize_t> origin(layout.datasets[k].dims.size() + 1, 0);
-      origin[0] = c * chunk_rows;
-      unsigned filter_mask = 0;
-      haddr_t addr = HADDR_UNDEF;
-      hsize_t size = 0;
-      if (H5Dget_chunk_info_by_coord(open[k], origin.data(), &filter_mask, &addr, &size) < 0 || addr == HADDR_UNDEF)
-        throw OutputError(path + ": HDF5 did not allocate chunk " + std::to_string(c) + " of dataset " +
-                          layout.datasets[k].name);
-      return static_cast<uint64_t>(addr);
+      return chunk_address(open[k], layout.datasets[k], c * chunk_rows, path);
     };
     for (uint64_t c = 0; c < chunks; ++c)
       for (size_t k = 0; k < layout.datasets.size(); ++k) {
@@ -241,27 +247,34 @@ void write_at(int fd, const char* data, size_t n, uint64_t offset, const std::st
   }
 }
 
-static uint64_t size_of_file(const std::string& path) {
+void read_at(int fd, char* data, size_t n, uint64_t offset, const std::string& path, const char* what) {
+  while (n > 0) {
+    const ssize_t r = ::pread(fd, data, n, static_cast<off_t>(offset));
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) throw OutputError(path + ": cannot read back " + what + ": " + std::strerror(r < 0 ? errno : EIO));
+    data += r;
+    n -= static_cast<size_t>(r);
+    offset += static_cast<uint64_t>(r);
+  }
+}
+
+namespace {
+
+uint64_t size_of_file(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) throw OutputError(path + ": cannot stat: " + std::strerror(errno));
   return static_cast<uint64_t>(st.st_size);
 }
 
-// The chunk of dataset k that holds row c * chunk_rows, as HDF5's index says.
+// chunk_address, with the closed file `path` opened again.
 uint64_t ask_chunk_address(const std::string& path, const H5Layout& layout, size_t k, uint64_t row) {
   Ids ids;
   const hid_t file = ids.keep(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
   const hid_t ds = file < 0 ? -1 : ids.keep(H5Dopen2(file, layout.datasets[k].name.c_str(), H5P_DEFAULT), H5Dclose);
-  std::vector<hsize_t> origin(layout.datasets[k].dims.size() + 1, 0);
-  origin[0] = row;
-  unsigned filter_mask = 0;
-  haddr_t addr = HADDR_UNDEF;
-  hsize_t size = 0;
-  if (ds < 0 || H5Dget_chunk_info_by_coord(ds, origin.data(), &filter_mask, &addr, &size) < 0 || addr == HADDR_UNDEF)
-    throw OutputError(path + ": HDF5 cannot say where the chunk of row " + std::to_string(row) + " of dataset " +
-                      layout.datasets[k].name + " is");
-  return static_cast<uint64_t>(addr);
+  return chunk_address(ds, layout.datasets[k], row, path);
 }
+
+}  // namespace
 
 H5InPlace create_h5_in_place(const std::string& path, const H5Layout& layout) {
   if (layout.compress) throw std::logic_error("create_h5_in_place: compressed datasets are written through HDF5");

@@ -71,6 +71,9 @@ H5InPlace create_h5_in_place(const std::string& path, const H5Layout& layout);
 H5InPlace h5_in_place_layout(const std::string& path, const H5Layout& layout, const std::string& scratch);
 // pwrite all of [data, data + n) at `offset`. Throws OutputError naming `path`.
 void write_at(int fd, const char* data, size_t n, uint64_t offset, const std::string& path);
+// pread all of [data, data + n) from `offset`. Throws OutputError naming `path` and `what`
+// the bytes were read for ("for resume").
+void read_at(int fd, char* data, size_t n, uint64_t offset, const std::string& path, const char* what);
 
 // The layout of a data.h5 this program wrote. Throws InputError naming the file.
 H5Layout read_h5_layout(const std::string& path);

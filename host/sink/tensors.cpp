@@ -453,17 +453,15 @@ class TensorSink final : public Sink {
       throw OutputError(partial_ + ": its bytes up to " + std::to_string(written.bytes) +
                         " (the rows written so far of datasets " + names +
                         ") differ from the checkpoint; the run cannot be resumed");
-    if (written.bytes == place_.file_size) {
+    if (order_->extent() == extents.size()) {
       rows_ = ctx_.rows;
     } else {
-      const auto e = std::upper_bound(extents.begin(), extents.end(), written.bytes,
-                                      [](uint64_t a, const FileExtent& x) { return a < x.address; }) -
-                     extents.begin() - 1;
-      const uint64_t at = written.bytes - extents[static_cast<size_t>(e)].address, row = tensors_[0].ds.row_bytes();
-      if (static_cast<size_t>(e) % tensors_.size() != 0 || at % row != 0)
+      const size_t e = order_->extent();
+      const uint64_t at = order_->into_extent(), row = tensors_[0].ds.row_bytes();
+      if (e % tensors_.size() != 0 || at % row != 0)
         throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: " + kWrittenState +
                           " does not end after a whole row of " + tensors_[0].ds.name);
-      rows_ = static_cast<uint64_t>(e) / tensors_.size() * chunk_rows + at / row;
+      rows_ = e / tensors_.size() * chunk_rows + at / row;
     }
     if (rows_ != ctx_.done)
       throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: next says " + std::to_string(ctx_.done) +
@@ -477,7 +475,7 @@ class TensorSink final : public Sink {
       for (size_t k = 1; k < tensors_.size(); ++k) {
         const uint64_t row = tensors_[k].ds.row_bytes();
         buf.resize((rows_ - c * chunk_rows) * row);
-        read_at(buf, place_.address[k][c]);
+        read_at(fd_, buf.data(), buf.size(), place_.address[k][c], partial_, "for resume");
         order_->feed(c * tensors_.size() + k, 0, buf);
       }
     }
@@ -486,15 +484,6 @@ class TensorSink final : public Sink {
       throw OutputError(partial_ + ": the rows " + std::to_string(rows_ / chunk_rows * chunk_rows) + ".." +
                         std::to_string(rows_) + " of datasets " + names +
                         " differ from the checkpoint; the run cannot be resumed");
-  }
-
-  void read_at(std::string& buf, uint64_t offset) const {
-    for (size_t done = 0; done < buf.size();) {
-      const ssize_t r = ::pread(fd_, buf.data() + done, buf.size() - done, static_cast<off_t>(offset + done));
-      if (r < 0 && errno == EINTR) continue;
-      if (r <= 0) throw OutputError(partial_ + ": cannot read back for resume: " + std::strerror(r < 0 ? errno : EIO));
-      done += static_cast<size_t>(r);
-    }
   }
 
   std::string file_name(const std::string& tensor) const {
