@@ -215,21 +215,7 @@ World& default_world() {
   return *w;
 }
 
-// Every variant in every region (one object per scenario, rotating subjects), then random
-// crowds of up to `max_objects`.
-std::vector<Scenario> coverage(const Catalogue& c, size_t n, int max_objects, bool singles = true) {
-  std::vector<Scenario> v;
-  if (singles)
-    for (size_t var = 0; var < c.variant_list.size(); ++var)
-      for (int r = 0; r < kRegions; ++r) {
-        Scenario s;
-        s.subject = static_cast<int>((var + r) % c.subjects.size());
-        s.objects[r] = static_cast<int16_t>(var);
-        v.push_back(s);
-      }
-  for (uint64_t k = 0; v.size() < n; ++k) v.push_back(test::random_scenario(c, k, max_objects));
-  return v;
-}
+using test::coverage;
 
 // Every region holding an object: variants rotate from `first`.
 Scenario crowded(const Catalogue& c, int subject, size_t first = 0) {

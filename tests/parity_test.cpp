@@ -36,21 +36,8 @@ Diff compare(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
   return d;
 }
 
-std::vector<Scenario> coverage_set(size_t n, int max_objects) {
-  const Catalogue& c = catalogue();
-  std::vector<Scenario> v;
-  // Every variant in every region, on rotating subjects...
-  for (size_t var = 0; var < c.variant_list.size(); ++var)
-    for (int r = 0; r < kRegions; ++r) {
-      Scenario s;
-      s.subject = static_cast<int>((var + r) % c.subjects.size());
-      s.objects[r] = static_cast<int16_t>(var);
-      v.push_back(s);
-    }
-  // ...then random crowds.
-  for (size_t k = 0; v.size() < n; ++k) v.push_back(test::random_scenario(c, k, max_objects));
-  return v;
-}
+// The default catalogue's coverage set (support.h).
+std::vector<Scenario> coverage_set(size_t n, int max_objects) { return test::coverage(catalogue(), n, max_objects); }
 
 struct Outputs {
   BatchOutput ref, cl;

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "run_binary.h"
+#include "support.h"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
@@ -90,12 +91,9 @@ TEST_F(Serve, PageAndCatalogueAreServed) {
 class ServeShortSubject : public Serve {
  protected:
   std::vector<std::string> extra_args() override {
-    std::string t = slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "catalogue.toml");
-    const size_t first = t.find("[[subjects]]");
-    const size_t line = t.find('\n', t.find("\nbuild = ", first) + 1) + 1;
-    t.insert(line, "height = 0.85\n");
     const fs::path file = tmp_ / "short.toml";
-    std::ofstream(file) << t;
+    std::ofstream(file) << portalsim::test::with_subject_line(
+        slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "catalogue.toml"), 0, "height = 0.85");
     return {"--catalogue", file.string(), "--assets", (fs::path(PORTALSIM_SOURCE_DIR) / "scenarios").string()};
   }
 };

@@ -25,29 +25,18 @@ std::string default_text() {
   return s.str();
 }
 
-// The default catalogue with `line` added to subject k's table (0-based), right after its
-// build line; *at gets the added line's number.
+// The default catalogue with `line` added to subject k's table (support.h).
 std::string with_subject_line(int k, const std::string& line, int* at = nullptr) {
-  std::string t = default_text();
-  size_t p = 0;
-  for (int j = 0; j <= k; ++j) p = t.find("[[subjects]]", p + 1);
-  p = t.find("\nbuild = ", p);
-  p = t.find('\n', p + 1) + 1;
-  t.insert(p, line + "\n");
-  if (at) *at = 1 + static_cast<int>(std::count(t.begin(), t.begin() + static_cast<std::ptrdiff_t>(p), '\n'));
-  return t;
+  return test::with_subject_line(default_text(), k, line, at);
 }
 
 // The default catalogue with each subject's height given (1.0 for subjects not listed).
 Catalogue heights_catalogue(const std::vector<double>& heights) {
   std::string t = default_text();
-  size_t p = 0;
   for (size_t j = 0; j < heights.size(); ++j) {
-    p = t.find("[[subjects]]", p + 1);
-    p = t.find('\n', t.find("\nbuild = ", p) + 1) + 1;
     std::ostringstream line;
-    line << "height = " << heights[j] << "\n";
-    t.insert(p, line.str());
+    line << "height = " << heights[j];
+    t = test::with_subject_line(t, static_cast<int>(j), line.str());
   }
   return parse_catalogue(t, "heights.toml", std::string(PORTALSIM_SOURCE_DIR) + "/scenarios");
 }
@@ -217,16 +206,7 @@ TEST(SubjectHeight, ObjectsStayOnTheirBodyPart) {
 TEST(SubjectHeight, BothBackendsAgreeAndMetalFollows) {
   const Catalogue cat = heights_catalogue({0.86, 0.93, 1.0, 1.08, 1.15});
   const AssetSet a = build_assets(cat);
-  std::vector<Scenario> scenes;
-  for (size_t v = 0; v < cat.variant_list.size(); ++v)
-    for (int r = 0; r < kRegions; ++r) {
-      Scenario s;
-      s.subject = static_cast<int>((v + r) % cat.subjects.size());
-      s.objects[r] = static_cast<int16_t>(v);
-      scenes.push_back(s);
-    }
-  for (uint64_t k = 0; k < 120; ++k) scenes.push_back(test::random_scenario(cat, k, 8));
-  const SceneBatch batch = test::batch_of(scenes);
+  const SceneBatch batch = test::batch_of(test::coverage(cat, cat.variant_list.size() * kRegions + 120, 8));
   auto ref = make_reference_backend(cat, a);
   auto cl = make_opencl_backend(cat, a, test::runtime());
   for (Model model : {Model::thesis, Model::physics}) {
@@ -257,17 +237,22 @@ TEST(SubjectHeight, BothBackendsAgreeAndMetalFollows) {
   }
   // Thesis features-only from the footprint tables (sparse) against the dense path, to
   // the bit: each subject's footprints sit at its places.
+  // Features of plan `p` (sparse) and of the same plan pooled densely.
+  const auto sparse_and_dense = [&](const Plan& p) {
+    Plan dense = p;
+    dense.fidelity.pooling = Pooling::dense;
+    std::pair<BatchOutput, BatchOutput> o;
+    cl->run(batch, p, o.first);
+    cl->run(batch, dense, o.second);
+    return o;
+  };
   for (bool noise : {true, false}) {
     Plan p;
     p.images = 0;
     p.model.pattern_noise = noise;
     p.model.seed = 4242;
     ASSERT_TRUE(p.sparse_features());
-    Plan dense = p;
-    dense.fidelity.pooling = Pooling::dense;
-    BatchOutput s, dn;
-    cl->run(batch, p, s);
-    cl->run(batch, dense, dn);
+    const auto [s, dn] = sparse_and_dense(p);
     EXPECT_EQ(s.features, dn.features) << "pattern noise " << noise;
   }
   // Physics features-only from the object tables (sparse) against the dense path: the
@@ -278,11 +263,7 @@ TEST(SubjectHeight, BothBackendsAgreeAndMetalFollows) {
   p.model.netd = 0;
   p.fidelity = tier_fidelity(Tier::fast);
   ASSERT_TRUE(p.physics_sparse_features());
-  Plan dense = p;
-  dense.fidelity.pooling = Pooling::dense;
-  BatchOutput s, dn;
-  cl->run(batch, p, s);
-  cl->run(batch, dense, dn);
+  const auto [s, dn] = sparse_and_dense(p);
   ASSERT_EQ(s.features.size(), dn.features.size());
   EXPECT_LE(compare_outputs(s, dn).feature_max_abs, 0.5);
 }

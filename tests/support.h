@@ -3,8 +3,10 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "assets/assets.h"
 #include "backend/backend.h"
@@ -42,6 +44,33 @@ inline Scenario random_scenario(const Catalogue& cat, uint64_t k, int max_object
   }
   s.label = static_cast<int>(r[2] & 1);
   return s;
+}
+
+// Catalogue text `text` with `line` added to subject k's table (0-based), right after its
+// build line; *at gets the added line's number.
+inline std::string with_subject_line(std::string text, int k, const std::string& line, int* at = nullptr) {
+  size_t p = 0;
+  for (int j = 0; j <= k; ++j) p = text.find("[[subjects]]", p + 1);
+  p = text.find('\n', text.find("\nbuild = ", p) + 1) + 1;
+  text.insert(p, line + "\n");
+  if (at) *at = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(p), '\n'));
+  return text;
+}
+
+// Every variant in every region (one object per scenario, rotating subjects), then random
+// crowds of up to `max_objects` (random_scenario from k = 0) until there are `n`.
+inline std::vector<Scenario> coverage(const Catalogue& c, size_t n, int max_objects, bool singles = true) {
+  std::vector<Scenario> v;
+  if (singles)
+    for (size_t var = 0; var < c.variant_list.size(); ++var)
+      for (int r = 0; r < kRegions; ++r) {
+        Scenario s;
+        s.subject = static_cast<int>((var + r) % c.subjects.size());
+        s.objects[r] = static_cast<int16_t>(var);
+        v.push_back(s);
+      }
+  for (uint64_t k = 0; v.size() < n; ++k) v.push_back(random_scenario(c, k, max_objects));
+  return v;
 }
 
 // The physics model's plan at its defaults, with a run seed.
