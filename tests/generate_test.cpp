@@ -385,8 +385,8 @@ TEST(GenerateArff, HeaderRowsAndWekaLearnsTheGunRule) {
   const RunResult r = run_ps(
       t, gen({"--count", "400", "--seed", "1", "--rule", "gun", "--balance", "--format", "arff,csv", "--quiet"}, out));
   ExpectOk(r);
-  EXPECT_EQ(entries_of(out),
-            (std::vector<std::string>{"features.arff", "features.csv", "manifest.json", "scenarios.csv"}));
+  EXPECT_EQ(entries_of(out), (std::vector<std::string>{"README.md", "croissant.json", "features.arff", "features.csv",
+                                                       "manifest.json", "scenarios.csv"}));
   const std::string arff = read_all(out / "features.arff");
   const std::vector<std::string> lines = lines_of(arff);
   ASSERT_FALSE(lines.empty());
@@ -465,8 +465,9 @@ TEST(GenerateTables, NpyParsesAndEqualsTheCsv) {
   ExpectOk(run_ps(t, gen({"--count", "300", "--seed", "5", "--rule", "gun|iron-rod", "--metal-noise", "3", "--format",
                           "csv,npy", "--quiet"},
                          out)));
-  EXPECT_EQ(entries_of(out), (std::vector<std::string>{"features.columns.txt", "features.csv", "features.npy",
-                                                       "manifest.json", "scenarios.csv"}));
+  EXPECT_EQ(entries_of(out),
+            (std::vector<std::string>{"README.md", "croissant.json", "features.columns.txt", "features.csv",
+                                      "features.npy", "manifest.json", "scenarios.csv"}));
   const std::vector<std::string> csv = lines_of(read_all(out / "features.csv"));
   ASSERT_EQ(csv.size(), 301u);
   const std::vector<std::string> header = split_on(csv[0], ',');
@@ -540,8 +541,9 @@ TEST(GenerateDeterminism, FeaturesDoNotDependOnBatchOrThreads) {
   commands.push_back(gen(other, t.w() / "seed8"));
   const std::vector<RunResult> r = run_ps_all(t, commands);
   for (const RunResult& x : r) ExpectOk(x);
-  ASSERT_EQ(entries_of(t.w() / "v0"), (std::vector<std::string>{"features.arff", "features.columns.txt", "features.csv",
-                                                                "features.npy", "manifest.json", "scenarios.csv"}));
+  ASSERT_EQ(entries_of(t.w() / "v0"),
+            (std::vector<std::string>{"README.md", "croissant.json", "features.arff", "features.columns.txt",
+                                      "features.csv", "features.npy", "manifest.json", "scenarios.csv"}));
   const std::string manifest = read_all(t.w() / "v0" / "manifest.json");
   EXPECT_FALSE(has(manifest, "second")) << "the manifest must not hold timings:\n" << manifest;
   for (size_t i = 1; i < variants.size(); ++i) {

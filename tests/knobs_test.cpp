@@ -1,6 +1,6 @@
 // The knobs of plan/knobs.h are declared once: each one must reach the flags of simulate
-// and generate, the spec file, the checks, the manifest and the README table from that
-// declaration alone.
+// and generate, the spec file, the checks, the manifest and the table of
+// docs/reference/knobs.md from that declaration alone.
 #include "plan/knobs.h"
 
 #include <gtest/gtest.h>
@@ -107,11 +107,11 @@ TEST(Knobs, EachIsAFlagOfSimulateAndGenerate) {
   }
 }
 
-TEST(Knobs, TheReadmeTableIsTheDeclaredOne) {
-  const std::string readme = slurp(std::filesystem::path(PORTALSIM_SOURCE_DIR) / "README.md");
+TEST(Knobs, TheReferenceTableIsTheDeclaredOne) {
+  const std::string page = slurp(std::filesystem::path(PORTALSIM_SOURCE_DIR) / "docs/reference/knobs.md");
   const std::string table = knob_table_markdown();
-  EXPECT_NE(readme.find(table), std::string::npos)
-      << "README.md must hold the knob table exactly as `portalsim knobs` prints it:\n"
+  EXPECT_NE(page.find(table), std::string::npos)
+      << "docs/reference/knobs.md must hold the knob table exactly as `portalsim knobs` prints it:\n"
       << table;
 }
 

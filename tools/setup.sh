@@ -12,6 +12,7 @@ packages=(build-essential cmake ninja-build pkg-config
   libxxhash-dev libgtest-dev libbenchmark-dev libcpp-httplib-dev libhdf5-dev libboost-dev
   openmpi-bin libopenmpi-dev slurm-wlm munge
   weka default-jdk-headless python3 python3-matplotlib python3-scipy python3-h5py python3-numpy python3-torch
+  python3-pyld python3-yaml
   clang-format ccache
   clang libclang-rt-14-dev chromium)
 

@@ -1,6 +1,6 @@
 // Every knob of the sensor model and of the fidelity tiers, declared once: its key, the
 // values it takes, its default and its help. The command-line flags, the spec-file keys,
-// the checks, the manifest entries and the README's knob table all come from this list.
+// the checks, the manifest entries and the knob table of docs/reference/knobs.md all come from this list.
 #pragma once
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -50,7 +50,7 @@ void check_knobs(const Plan& plan);
 // The value as set_knob reads it back: "10", "2.5", "on", "bilinear".
 std::string knob_text(const nlohmann::json& value);
 
-// The README's knob table (Markdown), from the declarations.
+// The knob table of docs/reference/knobs.md (Markdown), from the declarations.
 std::string knob_table_markdown();
 
 }  // namespace portalsim

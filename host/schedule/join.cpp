@@ -15,6 +15,7 @@
 
 #include "base/error.h"
 #include "io/input_file.h"
+#include "schedule/dataset_card.h"
 #include "schedule/identity.h"
 #include "sink/append_file.h"
 #include "sink/h5_file.h"
@@ -485,7 +486,9 @@ JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir
     // Small files beside the outputs (an npy table's column names) are the same in every part.
     for (const auto& e : fs::directory_iterator(parts[0].dir)) {
       const std::string n = e.path().filename().string();
-      if (!e.is_regular_file() || n == "manifest.json" || n.starts_with(kStateDir)) continue;
+      if (!e.is_regular_file() || n == "manifest.json" || n == "README.md" || n == "croissant.json" ||
+          n.starts_with(kStateDir))
+        continue;  // each part's own; the whole gets its own card
       bool listed = false;
       for (const json& o : first["outputs"]) listed = listed || o["name"] == n;
       if (listed) continue;
@@ -579,6 +582,7 @@ JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir
       if (ec) throw OutputError((out / n).string() + ": cannot move into place: " + ec.message());
     }
     const json manifest = run_manifest(identity, total, res.positive, res.negative, states, first.contains("images"));
+    write_dataset_card(out_dir, manifest);
     write_text_atomic((out / "manifest.json").string(), manifest.dump(2) + "\n");
   });
   return res;

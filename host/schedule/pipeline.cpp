@@ -14,6 +14,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "schedule/dataset_card.h"
 #include "schedule/identity.h"
 #include "sink/coco.h"
 #include "sink/h5_file.h"
@@ -366,7 +367,7 @@ void run_batches(const ScenarioSource& source, const Plan& plan, Backend& backen
   if (writer_error) std::rethrow_exception(writer_error);
 }
 
-// A finished run: every file gets its final name, then the manifest is written.
+// A finished run: every file gets its final name, then the dataset card, then the manifest.
 void write_manifest(const std::string& dir, std::vector<std::unique_ptr<Sink>>& sinks, const json& identity,
                     const PipelineResult& res, bool image_folders) {
   std::vector<FileState> outputs;
@@ -375,6 +376,7 @@ void write_manifest(const std::string& dir, std::vector<std::unique_ptr<Sink>>& 
     for (const FileState& f : s->files()) outputs.push_back(f);
   }
   const json manifest = run_manifest(identity, res.end - res.begin, res.positive, res.negative, outputs, image_folders);
+  write_dataset_card(dir, manifest);  // before the manifest, which marks the folder finished
   write_text_atomic((fs::path(dir) / "manifest.json").string(), manifest.dump(2) + "\n");
 }
 
