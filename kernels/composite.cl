@@ -10,7 +10,7 @@
 //   places:  int2 (x0, y0) per (view, variant, region), the sprite centred in its region;
 //            then int2 (0, dy) per (subject, view, region), its place's move with the
 //            subject's height (Sensor::subject_dy)
-//   records: the view's placement record per scenario (kernels/shared.h, PS_REC_*)
+//   records: the view's placement record per scenario (kernels/contract.h, PS_REC_*)
 //   field:   the view's values before display, n * height * width, at the build's precision
 //   phys:    the physics model's parameters (kernels/shared.h, PS_PHYS_*)
 //   raw:     physics: the MMW raw grid, n * raw_height * raw_width
@@ -77,7 +77,7 @@ typedef struct {
   greal cx[PS_MAX_LAYERS], rx[PS_MAX_LAYERS], ry[PS_MAX_LAYERS], ax[PS_MAX_LAYERS], ay[PS_MAX_LAYERS];
 } Layers;
 
-// A value of the affine record (kernels/shared.h, PS_LAYER_CX..A11) at greal precision,
+// A value of the affine record (kernels/contract.h, PS_LAYER_CX..A11) at greal precision,
 // two ints wide.
 inline void put_greal(global int* p, greal v) {
 #if defined(PRECISION_FP64)

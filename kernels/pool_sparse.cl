@@ -7,7 +7,7 @@
 // arithmetic, integer sums, and the same final division.
 //
 // The footprint record per (variant, region, subject: the place moves with its height)
-// is laid out in kernels/shared.h (PS_FP_*).
+// is laid out in kernels/contract.h (PS_FP_*).
 // Pooled views: `pooled[k]` is the camera view of the k-th pooled view (its blocks are
 // the k-th run of the row); `region_slot[r]` is the pooled view region r lies in, and
 // rects[r] its rectangle there.

@@ -1,50 +1,15 @@
-/* Constants shared by the host (C++) and the kernels (OpenCL C): counts, random
- * stream ids, flags and record layouts. The host includes this file; the kernel
- * program is this file followed by the kernels/ sources. Plain #defines only, so it is valid
- * in both languages. */
+/* The kernel side's macros: computations over kernels/contract.h's layouts, shared by the
+ * kernels (OpenCL C) and the OpenCL host code, never by the CPU reference, which
+ * implements each itself (tests/layering_check.py). The kernel program is
+ * kernels/contract.h, this file, then the kernels/ sources. */
 #ifndef PORTALSIM_SHARED_H
 #define PORTALSIM_SHARED_H
 
-/* The body's regions (thesis 4.1) and the metal detector's zones. */
-#define PS_REGIONS 13
-#define PS_ZONES 19
-/* Most sprites one camera view draws: one per region. */
-#define PS_MAX_LAYERS PS_REGIONS
+#ifndef __OPENCL_VERSION__
+#include "contract.h" /* in the kernel program it comes first, by concatenation */
+#endif
 
-/* The metal detector under --model physics (README, "Metal detector physics"). */
-#define PS_METAL_PANEL_A_ZONES 9            /* zones 1..9 transmit from panel A (x < 0), the rest from B */
-#define PS_METAL_MAX_DEDUCTION 199          /* most one zone's response takes off its base value */
-#define PS_METAL_FOUR_PI 12.566370614359172 /* 4 pi, the dipole field's denominator */
-/* Record of one zone's coils, doubles: transmit and receive coil position (x, z, metres;
- * y = 0) and moment (along x, A m^2), then the zone's gain. */
-#define PS_MZ_TX_X 0
-#define PS_MZ_TX_Z 1
-#define PS_MZ_TX_M 2
-#define PS_MZ_RX_X 3
-#define PS_MZ_RX_Z 4
-#define PS_MZ_RX_M 5
-#define PS_MZ_GAIN 6
-#define PS_MZ_LEN 8
-/* Record of one region, doubles: its rectangle's centre in its MMW view (column, and row
- * counted from the top of the upper view: the two views stacked). */
-#define PS_MR_COL 0
-#define PS_MR_ROW 1
-#define PS_MR_LEN 2
-
-/* Random streams of the counter generator: each kind of draw has its own, so adding one
- * never shifts another. element = the index within the stream named beside it. */
-#define PS_STREAM_NOISE_PATTERN 1u /* which MMW noise pattern a scenario gets; element 0 */
-#define PS_STREAM_METAL_NOISE 2u   /* metal detector noise; element = zone */
-#define PS_STREAM_PIXEL_NOISE 3u   /* per-pixel sensor noise; element = view << 28 | pixel / 2 */
-#define PS_STREAM_BLOCK_NOISE 4u   /* block-mean noise model; element = feature */
-#define PS_STREAM_JITTER 5u        /* sprite placement jitter; element = region */
-#define PS_STREAM_RAW_NOISE 6u     /* physics: MMW noise per raw pixel; element: PS_GAUSS_ELEMENT */
-#define PS_STREAM_IR_NOISE 7u      /* physics: IR noise per pixel; element: PS_GAUSS_ELEMENT */
-#define PS_STREAM_TRANSFORM 8u     /* randomised objects: rotation, scale, flip; element = region */
-#define PS_STREAM_FEATURE_NOISE 9u /* physics features-only: NETD noise in feature space; PS_GAUSS_ELEMENT */
-#define PS_STREAM_GENERATE 16u     /* scenario generators (host only) */
-#define PS_PIXEL_NOISE_VIEW_SHIFT 28
-/* The physics model's table Gaussians: cell p of a view's field (raw grid or pixels, row by
+/* The physics model's table Gaussians (kernels/contract.h): cell p of a view's field (raw grid or pixels, row by
  * row) reads element view << 28 | (16 (p / 128) + p % 16) of its stream, the 16-bit half
  * (p / 16) % 2 (low first) of word (p % 128) / 32, whose top PS_GAUSS_BITS bits are k
  * (PS_GAUSS_INDEX), and takes k to Phi^-1((k + 1/2) / PS_GAUSS_TABLE). So one draw of the
@@ -54,8 +19,6 @@
 #define PS_GAUSS_ELEMENT(view, p) (((PS_U32)(view) << PS_PIXEL_NOISE_VIEW_SHIFT) | (PS_U32)(16 * ((p) >> 7) + ((p)&15)))
 #define PS_GAUSS_WORD(p) (((p)&127) >> 5)
 #define PS_GAUSS_SHIFT(p) ((((p) >> 4) & 1) * 16)
-#define PS_GAUSS_BITS 12
-#define PS_GAUSS_TABLE (1 << PS_GAUSS_BITS)
 #define PS_GAUSS_INDEX(word, p) (((word) >> (PS_GAUSS_SHIFT(p) + 16 - PS_GAUSS_BITS)) & (PS_GAUSS_TABLE - 1))
 /* physics_features' work space per scenario, in values: the features, band_x zeros, the
  * draws, band_y rows of zeros, Z Lx^T. Up to PS_FEATURE_NOISE_PRIVATE it lives in private
@@ -64,126 +27,11 @@
 #define PS_FEATURE_SPACE(bx, by, band_x, band_y, regions) (3 * (bx) * (by) + 2 * (regions) + (band_x) + (band_y) * (bx))
 #define PS_FEATURE_NOISE_PRIVATE 2048
 
-/* Per-launch flags of the render kernels. */
-#define PS_FLAG_PATTERN_NOISE 1
-#define PS_FLAG_PIXEL_NOISE 2
-#define PS_FLAG_BILINEAR 4
-#define PS_FLAG_AFFINE 8     /* randomised objects: sprites sampled through their inverse affine map */
-#define PS_FLAG_FLIP 16      /* with PS_FLAG_AFFINE: mirror each object with probability 1/2 */
-#define PS_FLAG_TABULATED 32 /* physics features-only: scenarios the object tables cover skip physics_raw */
-
-/* Footprint record of the sparse features path, per (variant, region, subject), ints. */
-#define PS_FP_SPRITE_X0 0
-#define PS_FP_SPRITE_Y0 1
-#define PS_FP_SPRITE_W 2
-#define PS_FP_SPRITE_H 3
-#define PS_FP_SPRITE_OFFSET 4 /* atlas offset of the sprite */
-#define PS_FP_TILE_X0 5
-#define PS_FP_TILE_Y0 6
-#define PS_FP_X0 7 /* footprint, clipped to the view, exclusive ends */
-#define PS_FP_Y0 8
-#define PS_FP_X1 9
-#define PS_FP_Y1 10
-#define PS_FP_BLOCK_X0 11
-#define PS_FP_BLOCK_Y0 12
-#define PS_FP_BLOCKS_W 13
-#define PS_FP_BLOCKS_H 14
-#define PS_FP_DELTAS 15        /* offset of its block delta table */
-#define PS_FP_SPRITE_PADDED 16 /* atlas offset of the sprite's padded copy (PS_PAD) */
-#define PS_FP_LEN 17
-
-/* One camera view's launch of a render stage, passed by value to every stage kernel.
- * 4-byte fields only, so host and device lay it out alike. */
-#ifdef __OPENCL_VERSION__
-#define PS_U32 uint
-#define PS_I32 int
-#define PS_F32 float
-#else
-#include <stdint.h>
-#define PS_U32 uint32_t
-#define PS_I32 int32_t
-#define PS_F32 float
-#endif
-typedef struct {
-  PS_U32 n;           /* scenarios in the batch */
-  PS_I32 view;        /* camera view: base image slot, pixel noise element */
-  PS_I32 views;       /* camera views per subject (stride of the base table) */
-  PS_I32 sprite_set;  /* 0 MMW, 1 IR: row of the sprite table */
-  PS_I32 variants;    /* stride of the sprite and place tables */
-  PS_U32 region_mask; /* bit r: region r is drawn in this view */
-  PS_I32 width, height;
-  PS_U32 seed_lo, seed_hi, first_lo, first_hi;
-  PS_I32 patterns;           /* noise patterns in the catalogue */
-  PS_I32 tile_size;          /* noise tile side */
-  PS_I32 flags;              /* PS_FLAG_* */
-  PS_F32 jitter_x, jitter_y; /* in this view's pixels */
-  /* The physics model: the raw grid, and where its parameters lie in `phys`. */
-  PS_I32 raw_width, raw_height;
-  PS_I32 psf_radius; /* taps either side of the centre */
-  PS_I32 subjects;   /* subjects in the catalogue (the layout of phys) */
-  /* The physics fast path's tables in phys: the raw grid's weights of each view column
-   * (raw_width x width) and row (raw_height x height), optics and sampling folded in; the
-   * first and last raw column of each view column and raw row of each view row (2 per);
-   * and each subject's bare raw grid (subjects x raw_height x raw_width). */
-  PS_I32 phys_wx, phys_wy, phys_cband, phys_rband, phys_base;
-  PS_I32 phys_gauss; /* the PS_GAUSS_TABLE values of Phi^-1((k + 1/2) / PS_GAUSS_TABLE) in phys */
-  /* Randomised objects (PS_FLAG_AFFINE): the ranges of the angle (degrees) and the scale,
-   * as floats, and the same four as doubles (low word, high word) for fp64 builds. */
-  PS_F32 rotate_lo, rotate_hi, scale_lo, scale_hi;
-  PS_U32 ranges_fp64[8];
-} PsViewLaunch;
-
-/* The physics model's parameters for one launch (kernels' `phys`, at the build's parameter
- * precision): these scalars, then a (gain, offset) pair per subject turning its base
- * image's gray into kelvin, then each variant's apparent temperature under clothing, then
- * the PSF's 2 psf_radius + 1 normalised taps. */
-#define PS_PHYS_BACKGROUND 0 /* K */
-#define PS_PHYS_WINDOW_MIN 1 /* K shown as gray 0 */
-#define PS_PHYS_WINDOW_MAX 2 /* K shown as gray 255 */
-#define PS_PHYS_NETD 3       /* K rms per raw pixel */
-#define PS_PHYS_SUBJECTS 4
+/* The metal detector under --model physics. */
+#define PS_METAL_MAX_DEDUCTION 199          /* most one zone's response takes off its base value */
+#define PS_METAL_FOUR_PI 12.566370614359172 /* 4 pi, the dipole field's denominator */
+/* Offsets in the physics parameters (kernels/contract.h, PS_PHYS_*). */
 #define PS_PHYS_VARIANTS(S) (PS_PHYS_SUBJECTS + 2 * (S))
 #define PS_PHYS_TAPS(S, V) (PS_PHYS_VARIANTS(S) + (V))
-
-/* A camera view's placement record per scenario, written by place_view and read by
- * every render stage: the objects it draws, in region order, and the noise pattern. */
-#define PS_REC_COUNT 0   /* layers */
-#define PS_REC_PATTERN 1 /* the scenario's noise pattern, -1 for none */
-#define PS_REC_LAYERS 2
-#define PS_LAYER_X0 0 /* whole-pixel top-left corner, jitter rounded */
-#define PS_LAYER_Y0 1
-#define PS_LAYER_FX 2 /* sub-pixel top-left corner (float bits) */
-#define PS_LAYER_FY 3
-#define PS_LAYER_W 4
-#define PS_LAYER_H 5
-#define PS_LAYER_OFFSET 6  /* atlas offset of the sprite */
-#define PS_LAYER_PADDED 7  /* atlas offset of its padded copy */
-#define PS_LAYER_TILE_X0 8 /* the noise tile, centred on the unmoved sprite */
-#define PS_LAYER_TILE_Y0 9
-#define PS_LAYER_VARIANT 10 /* the object drawing */
-/* Affine placement (PS_FLAG_AFFINE): the image box the transformed sprite can touch
- * (inclusive), then the inverse map, a sprite point (sx, sy) per image pixel (x, y):
- * sx = SCX + A00 (x - CX) + A01 (y - CY), sy = SCY + A10 (x - CX) + A11 (y - CY), each
- * value at the kernels' sample precision (a double, or a float and a spare int). */
-#define PS_LAYER_BX0 11
-#define PS_LAYER_BY0 12
-#define PS_LAYER_BX1 13
-#define PS_LAYER_BY1 14
-#define PS_LAYER_CX 15 /* the sprite's centre in the image */
-#define PS_LAYER_CY 17
-#define PS_LAYER_A00 19
-#define PS_LAYER_A01 21
-#define PS_LAYER_A10 23
-#define PS_LAYER_A11 25
-#define PS_LAYER_LEN 27
-#define PS_REC_LEN (PS_REC_LAYERS + PS_MAX_LAYERS * PS_LAYER_LEN)
-
-/* The vector render path reads 16 pixels of a sprite or noise tile row at a time, so
- * each also lives padded: every row with PS_PAD neutral pixels on both sides (sprites:
- * coverage 0, as value row then coverage row; tiles: 128). */
-#define PS_PAD 16
-
-/* Work-group size of every launch: fixed, so PoCL compiles each kernel once. */
-#define PS_LOCAL_SIZE 64
 
 #endif

@@ -1,6 +1,7 @@
 // Philox4x32-10 (Salmon et al., "Parallel random numbers: as easy as 1, 2, 3", SC11),
-// the counter-based generator behind every random draw. kernels/philox.cl is the same
-// algorithm in OpenCL C; tests/philox_test.cpp holds both to the published vectors.
+// the counter-based generator behind every random draw, written for the host and the
+// reference from docs/model/determinism.md. kernels/philox.cl is the kernels' own
+// implementation; tests/philox_test.cpp holds both to the published vectors.
 //
 // A draw is a pure function of (seed, scenario index, stream, element):
 //   key = (seed low 32, seed high 32), counter = (element, stream, index low, index high).
@@ -8,7 +9,7 @@
 #include <array>
 #include <cstdint>
 
-#include "shared.h"
+#include "contract.h"
 
 namespace portalsim {
 
@@ -28,7 +29,7 @@ inline Philox4 philox4x32_10(Philox4 ctr, std::array<uint32_t, 2> key) {
   return ctr;
 }
 
-// Streams (kernels/shared.h): each kind of draw has its own, so adding one never shifts another.
+// Streams (kernels/contract.h): each kind of draw has its own, so adding one never shifts another.
 enum Stream : uint32_t {
   kStreamNoisePattern = PS_STREAM_NOISE_PATTERN,
   kStreamMetalNoise = PS_STREAM_METAL_NOISE,

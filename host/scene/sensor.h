@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "shared.h"
+#include "contract.h"
 
 namespace portalsim {
 

@@ -4,6 +4,7 @@
 // and the objects' signals add. Plain double precision, one zone and object at a time.
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "backend/reference/stages.h"
 #include "scene/philox.h"
@@ -22,7 +23,7 @@ Vec dipole(Vec m, Vec c, Vec p) {
   const double d2 = r.x * r.x + r.y * r.y + r.z * r.z;
   const double d = std::sqrt(d2);
   const double k = 3.0 * (m.x * r.x + m.y * r.y + m.z * r.z) / d2;
-  const double den = PS_METAL_FOUR_PI * d2 * d;
+  const double den = 4 * std::numbers::pi * d2 * d;
   return {(k * r.x - m.x) / den, (k * r.y - m.y) / den, (k * r.z - m.z) / den};
 }
 
@@ -77,7 +78,8 @@ void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSett
     for (const MetalObject& o : objects) signal += zone_signal(mp, z, o);
     // Rounded half up; anything at or past the cap (or not finite, an object on a coil) is the cap.
     const double t = mp.gain[z < PS_METAL_PANEL_A_ZONES ? 0 : 1] * std::fabs(signal);
-    const int deduction = t < PS_METAL_MAX_DEDUCTION ? static_cast<int>(std::floor(t + 0.5)) : PS_METAL_MAX_DEDUCTION;
+    constexpr int kMaxDeduction = 199;  // a zone reads at least 1 from its base of 200
+    const int deduction = t < kMaxDeduction ? static_cast<int>(std::floor(t + 0.5)) : kMaxDeduction;
     int value = cat.subjects[s.subject].base_zones[z] - deduction;
     if (m.metal_noise > 0 && deduction > 0) {
       const Philox4 r = draw(m.seed, index, kStreamMetalNoise, static_cast<uint32_t>(z));

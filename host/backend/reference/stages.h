@@ -1,7 +1,9 @@
 // The reference's stages: the sensor model written as plainly as possible, in double
 // precision, one pixel at a time. Each is a free function under the stage's name, the
-// same name as its kernel in kernels/ and its entry in backend/stages.h. They share
-// nothing with kernels/ except the random generator (scene/philox.h) and the catalogue.
+// same name as its kernel in kernels/ and its entry in backend/stages.h. They share with
+// kernels/ only the contract header's constants and layouts (kernels/contract.h, through
+// scene/), never a computation (tests/layering_check.py); the random draws follow
+// docs/model/determinism.md (draws.h).
 #pragma once
 #include <array>
 #include <cstdint>

@@ -1,0 +1,21 @@
+// The reference's mappings from a Philox draw to a value, written from the random-stream
+// contract (docs/model/determinism.md) and shared with the kernels only through its
+// constants (kernels/contract.h): the kernels implement each mapping on their own.
+#pragma once
+#include <cstdint>
+
+namespace portalsim::reference {
+
+// The standard normal quantile Phi^-1(q), q in (0, 1), to double precision.
+double normal_quantile(double q);
+
+// The physics model's table Gaussian of cell p (row by row) of view `view`'s field in
+// `stream`: the top 12 bits k of one 16-bit half of one word of one draw, taken to
+// Phi^-1((k + 1/2) / 4096).
+double table_gaussian(uint64_t seed, uint64_t index, uint32_t stream, int view, int p);
+
+// The thesis model's per-pixel sensor noise of pixel p of view `view`: Box-Muller over the
+// first two words of the draw of pixel pair p / 2, cosine for even p, sine for odd.
+double pixel_gaussian(uint64_t seed, uint64_t index, int view, int p);
+
+}  // namespace portalsim::reference
