@@ -39,7 +39,7 @@ Plan images_plan() {
 
 void time_backend(benchmark::State& state, Backend& backend, const Plan& plan, size_t n) {
   bench::time_runs(state, backend, plan, n);
-  state.SetLabel(fused_chain()[state.range(0) - 1]);
+  state.SetLabel(fx().cat.sensors[0].chain[state.range(0) - 1]);
 }
 
 // Arg: the stages kept before display (1 = composite only ... 3 = the whole chain).

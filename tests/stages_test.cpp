@@ -99,7 +99,8 @@ TEST(Stages, EachStageKernelMatchesItsReference) {
   for (const ViewStage& stage : view_stages()) {
     if (stage.name == "composite" || stage.name == "display") continue;  // in every chain below
     // The thesis chain's stages; the physics model's are tested in physics_test.cpp.
-    if (std::find(fused_chain().begin(), fused_chain().end(), stage.name) == fused_chain().end()) continue;
+    const std::vector<std::string>& thesis = catalogue().sensors[0].chain;
+    if (std::find(thesis.begin(), thesis.end(), stage.name) == thesis.end()) continue;
     SCOPED_TRACE(std::string(stage.name));
     Catalogue cat = catalogue();
     for (Sensor& s : cat.sensors) s.chain = {"composite", std::string(stage.name), "display"};

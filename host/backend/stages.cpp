@@ -31,21 +31,6 @@ const std::vector<ViewStage>& view_stages() {
   return stages;
 }
 
-const std::vector<std::string>& fused_chain() {
-  static const std::vector<std::string> chain = {"composite", "pattern_noise", "sensor_noise", "display"};
-  return chain;
-}
-
-const std::vector<std::string>& physics_fused_chain() {
-  static const std::vector<std::string> chain = {"radiometry", "optics", "sample", "netd", "mmw_display"};
-  return chain;
-}
-
-const std::vector<std::string>& ir_fused_chain() {
-  static const std::vector<std::string> chain = {"contact_shadow", "heat_spread", "ir_surface"};
-  return chain;
-}
-
 void check_chain(const Sensor& view) {
   for (Model m : {Model::thesis, Model::physics}) {
     const std::vector<std::string>& chain = view.chain_for(m);

@@ -2,7 +2,8 @@
 // double-precision reference function (backend/reference/), its kernel (kernels/, named
 // stage_<name>), its test and its benchmark. A sensor's chain (scene/sensor.h) lists
 // stage names; both backends run the chain through this table. A new stage is its
-// reference file, its kernel and one line in stages.cpp.
+// reference file, its kernel and one line in stages.cpp. The OpenCL backend's fast paths
+// declare which chains they implement (backend/opencl/paths/).
 #pragma once
 #include <string>
 #include <string_view>
@@ -30,16 +31,6 @@ struct ViewStage {
 };
 
 const std::vector<ViewStage>& view_stages();
-// The chain the fused render_view kernel implements (a declared fast path); views whose
-// chain differs run stage by stage.
-const std::vector<std::string>& fused_chain();
-// The physics MMW chain the physics_raw fast path (then mmw_display) implements.
-const std::vector<std::string>& physics_fused_chain();
-// The first stages of the physics IR chain that the ir_surface_fused fast path
-// implements; the chain's later stages run as their kernels, or, where only ir_display
-// is left (ir_netd at 0 K is nothing), ir_surface_display_fused does it all, and where
-// ir_netd then ir_display are left, ir_surface_noise_display_fused.
-const std::vector<std::string>& ir_fused_chain();
 // Throws std::logic_error unless every stage of each of the view's chains is registered
 // and each chain ends with a stage that makes pixels, and no other stage does.
 void check_chain(const Sensor& view);

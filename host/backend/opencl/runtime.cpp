@@ -28,6 +28,18 @@ std::string pocl_cache() {
   const char* home = std::getenv("HOME");
   return std::string(home && *home ? home : "~") + "/.cache/pocl";
 }
+
+// What keeps PoCL from writing its kernel cache, or "" where nothing does: the cache, or
+// the nearest of its parents that exists, must be a writable folder.
+std::string cache_problem() {
+  std::error_code ec;
+  fs::path dir = pocl_cache();
+  while (!dir.empty() && !fs::exists(dir, ec) && dir != dir.parent_path()) dir = dir.parent_path();
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    return "must be a writable folder, and " + (dir == pocl_cache() ? std::string("it") : dir.string()) + " is a file";
+  if (::access(dir.c_str(), W_OK) != 0) return "must be writable";
+  return "";
+}
 }  // namespace
 
 OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
@@ -96,17 +108,14 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
   base_options_ = options.build_options;
 }
 
-// PoCL compiles into its kernel cache: an unwritable cache is the machine's problem (exit
-// 5), anything else a bug in the kernels (internal).
+// PoCL compiles into its kernel cache: a cache it cannot write is the machine's problem
+// (exit 5), anything else a bug in the kernels (internal).
 void OpenCLRuntime::build_failed(const cl::Program& p, const std::string& options) const {
   const std::string log = p.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
   const std::string what = "OpenCL program build failed" + (options.empty() ? "" : " (" + options + ")");
-  std::error_code ec;
-  fs::path dir = pocl_cache();
-  while (!dir.empty() && !fs::exists(dir, ec) && dir != dir.parent_path()) dir = dir.parent_path();
-  if (::access(dir.c_str(), W_OK) != 0)
-    throw EnvironmentError(what + ": PoCL's kernel cache, " + pocl_cache() +
-                           ", must be writable (or set POCL_CACHE_DIR)\n" + log);
+  if (const std::string problem = cache_problem(); !problem.empty())
+    throw EnvironmentError(what + ": PoCL's kernel cache, " + pocl_cache() + ", " + problem +
+                           " (or set POCL_CACHE_DIR)\n" + log);
   throw std::runtime_error(what + ":\n" + log);
 }
 

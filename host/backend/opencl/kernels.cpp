@@ -1,0 +1,31 @@
+#include "backend/opencl/kernels.h"
+
+namespace portalsim::opencl {
+
+std::string build_options(const Fidelity& f) {
+  std::string o = f.precision == Precision::fp64      ? "-DPRECISION_FP64"
+                  : f.precision == Precision::fixed16 ? "-DPRECISION_FIXED"
+                                                      : "";
+  if (f.fast_math) o += " -cl-fast-relaxed-math";
+  return o;
+}
+
+Kernels::Kernels(OpenCLRuntime& rt, const Fidelity& f)
+    : program_(rt.program(build_options(f))), fp64_(f.precision == Precision::fp64) {}
+
+cl::Kernel& Kernels::operator[](std::string_view name) {
+  auto it = kernels_.find(name);
+  if (it == kernels_.end()) {
+    const std::string kernel(name);
+    it = kernels_.emplace(kernel, cl::Kernel(program_, kernel.c_str())).first;
+  }
+  return it->second;
+}
+
+Kernels& KernelVariants::operator()(const Fidelity& f) {
+  std::unique_ptr<Kernels>& k = variants_[build_options(f)];
+  if (!k) k = std::make_unique<Kernels>(rt_, f);
+  return *k;
+}
+
+}  // namespace portalsim::opencl

@@ -1,0 +1,98 @@
+// The metal detector's zones: the thesis model's influence tables (kernels/metal.cl), or
+// the physics model's coil fields and polarizability tensors (kernels/metal_physics.cl, in
+// fp64).
+#include "backend/opencl/launch.h"
+#include "backend/opencl/paths/paths.h"
+#include "base/error.h"
+
+namespace portalsim::opencl {
+
+// The coil model's tables (kernels/shared.h, PS_MZ_* and PS_MR_*) and each variant's
+// polarizability tensor, as the reference computes them.
+MetalPath::MetalPath(Device& d) : d_(d) {
+  const Catalogue& cat = d.cat;
+  if (!cat.metal_physics.present) return;
+  const MetalPhysics& mp = cat.metal_physics;
+  const size_t S = cat.subjects.size();
+  std::vector<cl_double> zones(kZones * PS_MZ_LEN, 0.0), regions(S * kRegions * PS_MR_LEN, 0.0), tensors;
+  for (int z = 0; z < kZones; ++z) {
+    const double side = z < PS_METAL_PANEL_A_ZONES ? -1.0 : 1.0;
+    cl_double* rec = &zones[z * PS_MZ_LEN];
+    rec[PS_MZ_TX_X] = side * mp.panel_separation / 2.0;
+    rec[PS_MZ_TX_Z] = mp.tx_height[z];
+    rec[PS_MZ_TX_M] = -side * mp.tx_moment;
+    rec[PS_MZ_RX_X] = -side * mp.panel_separation / 2.0;
+    rec[PS_MZ_RX_Z] = mp.rx_height[z];
+    rec[PS_MZ_RX_M] = side * mp.rx_moment;
+    rec[PS_MZ_GAIN] = mp.gain[z < PS_METAL_PANEL_A_ZONES ? 0 : 1];
+  }
+  double row_offset = 0;  // the MMW views stacked, the first on top
+  for (const Sensor& s : cat.sensors) {
+    if (s.camera != Camera::mmw) continue;
+    if (!view_) view_ = &s;
+    // Each subject's region centres: the places, moved with its height.
+    for (size_t j = 0; j < S; ++j)
+      for (int r = 0; r < kRegions; ++r)
+        if (s.sees(r)) {
+          const Rect rc = s.place(static_cast<int>(j), r);
+          cl_double* rec = &regions[(j * kRegions + r) * PS_MR_LEN];
+          rec[PS_MR_COL] = rc.x + rc.w / 2.0;
+          rec[PS_MR_ROW] = row_offset + rc.y + rc.h / 2.0;
+        }
+    row_offset += s.height;
+  }
+  for (size_t v = 0; v < cat.variant_list.size(); ++v)
+    for (double e : cat.polarizability(static_cast<int>(v))) tensors.push_back(e);
+  zone_rec_ = constant(d.ctx(), zones);
+  region_rec_ = constant(d.ctx(), regions);
+  tensors_ = constant(d.ctx(), tensors);
+}
+
+void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOutput& out) {
+  const Catalogue& cat = d_.cat;
+  cl::Buffer& metal = out_.at_least(d_.ctx(), b.n * kZones);
+  const cl_uint n = static_cast<cl_uint>(b.n);
+  if (plan.model.model == Model::physics) {
+    if (!d_.rt.has_fp64())
+      throw EnvironmentError("--model physics computes metal zones in fp64, and " + d_.rt.device_name() +
+                             " has no cl_khr_fp64; --backend reference works without it");
+    if (!cat.metal_physics.present || !view_)
+      throw InputError("--model physics: the catalogue has no [metal.physics] section");
+    const MetalPhysics& mp = cat.metal_physics;
+    // The reference's jitter, (jitter * scale) * (2u - 1), in the MMW views' pixels.
+    enqueue(d_.queue(), K["metal_physics"], K.fp64(),
+            MetalPhysicsArgs{.zone_rec = zone_rec_,
+                             .region_rec = region_rec_,
+                             .tensors = tensors_,
+                             .base_zones = d_.data.base_zones,
+                             .subject = b.subject,
+                             .objects = b.objects,
+                             .n = n,
+                             .seed = b.seed,
+                             .first = b.first,
+                             .noise = plan.model.metal_noise,
+                             .jitter_x = plan.model.jitter * view_->jitter_scale_x,
+                             .jitter_y = plan.model.jitter * view_->jitter_scale_y,
+                             .half_width = view_->width / 2.0,
+                             .scale = mp.body_height / (2.0 * cat.images.mmw_height),
+                             .body_height = mp.body_height,
+                             .out = metal},
+            b.n);
+  } else {
+    enqueue(d_.queue(), K["metal_zones"], K.fp64(),
+            MetalZonesArgs{.influence = d_.data.influence,
+                           .variant_category = d_.data.categories,
+                           .base_zones = d_.data.base_zones,
+                           .subject = b.subject,
+                           .objects = b.objects,
+                           .n = n,
+                           .seed = b.seed,
+                           .first = b.first,
+                           .noise = plan.model.metal_noise,
+                           .out = metal},
+            b.n);
+  }
+  d_.queue().enqueueReadBuffer(metal, CL_FALSE, 0, b.n * kZones, out.metal.data());
+}
+
+}  // namespace portalsim::opencl

@@ -1,0 +1,82 @@
+// The OpenCL backend's declared paths (docs/dev/architecture.md). A view path renders one
+// camera view; a features path makes the feature rows of features-only runs without
+// rendering. Each fast path declares the chain of stages it implements and one gate,
+// applies(plan, sensor): the one place that decides whether it runs. Where no fast path's
+// gate applies, the stage chain renders the view and pooling makes the features.
+#pragma once
+#include <CL/opencl.hpp>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "backend/backend.h"
+#include "backend/opencl/device.h"
+#include "backend/opencl/kernels.h"
+#include "backend/opencl/view_launch.h"
+
+namespace portalsim::opencl {
+
+class ViewPath {
+ public:
+  virtual ~ViewPath() = default;
+  virtual const char* name() const = 0;
+  // The stages it implements, in order (the IR path: the chain's first stages).
+  virtual const std::vector<std::string>& chain() const = 0;
+  virtual bool applies(const Plan& plan, const Sensor& sensor) const = 0;
+  // Whether its kernels pass a field of reals between them (else they write the pixels).
+  virtual bool uses_field() const = 0;
+  // Renders the view, after place_view has written its records.
+  virtual void render(ViewLaunch& v) const = 0;
+};
+
+// The view paths in the order they are tried; the last, the stage chain, applies to all.
+const std::vector<const ViewPath*>& view_paths();
+// The first view path whose gate applies.
+const ViewPath& view_path(const Plan& plan, const Sensor& sensor);
+
+// The fast view paths (paths/*.cpp) and the general one.
+const ViewPath& thesis_images_path();
+const ViewPath& physics_raw_path();
+const ViewPath& ir_fused_path();
+const ViewPath& stage_chain_path();
+
+// The stage chain from its stage `from` on, each stage's kernels in order.
+void run_stages(ViewLaunch& v, size_t from);
+// The physics MMW raw grid alone (physics_raw's first kernel), into Device::raw.
+void run_raw_grid(ViewLaunch& v);
+
+class FeaturePath {
+ public:
+  virtual ~FeaturePath() = default;
+  virtual const char* name() const = 0;
+  // Whether it makes `plan`'s features of the pooled view `sensor`; the path runs where
+  // its gate applies to every pooled view.
+  virtual bool applies(const Plan& plan, const Sensor& sensor) const = 0;
+  // Writes the batch's image features (blocks and regions) into `features`.
+  virtual void features(Kernels& K, const Plan& plan, const DeviceBatch& b, cl::Buffer& features) = 0;
+};
+
+std::unique_ptr<FeaturePath> thesis_sparse_features_path(Device& d);
+std::unique_ptr<FeaturePath> physics_raw_features_path(Device& d);
+
+// Block and region means of one rendered pooled view (slot of `lay`) into its columns of
+// the feature rows: the features of every plan no features path takes.
+void pool_view(Device& d, Kernels& K, const FeatureLayout& lay, const DeviceBatch& b, int slot, const cl::Buffer& img,
+               const cl::Buffer& features);
+// The block-mean noise model: each mean gets N(0, sigma^2 / pixels) from the generator.
+void block_mean_noise(Device& d, Kernels& K, const Plan& plan, const DeviceBatch& b, const cl::Buffer& features);
+
+// The metal detector's zones, thesis or physics model, into out.metal.
+class MetalPath {
+ public:
+  explicit MetalPath(Device& d);
+  void run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOutput& out);
+
+ private:
+  Device& d_;
+  cl::Buffer zone_rec_, region_rec_, tensors_;  // the coil model's tables
+  const Sensor* view_ = nullptr;                // the first MMW view: the coil model's pixel scale
+  Grown out_;
+};
+
+}  // namespace portalsim::opencl

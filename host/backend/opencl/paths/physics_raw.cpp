@@ -1,0 +1,36 @@
+// The physics model's MMW view path: physics_raw (kernels/physics_raw.cl) makes each
+// scenario's raw grid straight from the placement records, radiometry, optics, sampling
+// and NETD together; stage_mmw_display then shows it.
+#include "backend/opencl/paths/paths.h"
+
+namespace portalsim::opencl {
+
+namespace {
+
+class PhysicsRaw final : public ViewPath {
+ public:
+  const char* name() const override { return "physics_raw"; }
+  const std::vector<std::string>& chain() const override {
+    static const std::vector<std::string> stages = {"radiometry", "optics", "sample", "netd", "mmw_display"};
+    return stages;
+  }
+  bool applies(const Plan& plan, const Sensor& sensor) const override {
+    return plan.fidelity.fused && sensor.chain_for(plan.model.model) == chain();
+  }
+  bool uses_field() const override { return false; }
+  void render(ViewLaunch& v) const override {
+    run_raw_grid(v);
+    v.run("stage_mmw_display", v.batch.n);
+  }
+};
+
+}  // namespace
+
+void run_raw_grid(ViewLaunch& v) { v.run("physics_raw", v.batch.n); }
+
+const ViewPath& physics_raw_path() {
+  static const PhysicsRaw path;
+  return path;
+}
+
+}  // namespace portalsim::opencl

@@ -1,0 +1,255 @@
+// The physics model's features-only path (raw_grid_pooling.h, kernels/physics_features.cl):
+// per pooled view, the raw grid of the scenarios the tables do not cover (physics_raw,
+// noise-free), then physics_features pools it and draws the NETD per feature with the
+// covariance per-raw-pixel noise gives. It implements physics_raw's chain, under the
+// block-mean noise model (like it, it leaves single pixels' rounding and clipping out).
+#include <algorithm>
+#include <array>
+#include <map>
+
+#include "backend/opencl/launch.h"
+#include "backend/opencl/paths/paths.h"
+#include "backend/opencl/raw_grid_pooling.h"
+#include "backend/opencl/table_key.h"
+
+namespace portalsim::opencl {
+
+namespace {
+
+// Whether two boxes, widened by the bilinear fringe, meet (kernels/physics_raw.cl, layers_meet).
+bool boxes_meet(const Rect& a, const Rect& b) {
+  return a.x - 2 < b.x + b.w + 2 && b.x - 2 < a.x + a.w + 2 && a.y - 2 < b.y + b.h + 2 && b.y - 2 < a.y + a.h + 2;
+}
+
+// The plan of the raw grid: without sensor noise, which is drawn per feature.
+Plan quiet(const Plan& plan) {
+  Plan q = plan;
+  q.model.netd = 0;
+  return q;
+}
+
+class PhysicsRawFeatures final : public FeaturePath {
+ public:
+  explicit PhysicsRawFeatures(Device& d) : d_(d) {}
+  const char* name() const override { return "physics_raw_features"; }
+  bool applies(const Plan& plan, const Sensor& sensor) const override {
+    return plan.physics_sparse_features() && physics_raw_path().applies(quiet(plan), sensor);
+  }
+  void features(Kernels& K, const Plan& plan, const DeviceBatch& b, cl::Buffer& feats) override;
+
+ private:
+  struct Tables {
+    int count = 0;
+    cl::Buffer first, cells, weights, columns;
+    cl_int8 dims{};  // blocks_x, blocks_y, band_x, band_y, regions (RawGridNoise), the first block's column
+    cl::Buffer noise, base_features, object_range, object_feature, object_value;
+  };
+  Tables& tables(Kernels& K, const Plan& quiet, const FeatureLayout& lay, int slot, bool tabulated);
+  // The raw grid of view `view` for batch b (place_view, then physics_raw) into Device::raw.
+  void raw_grid(ViewLaunch& v) {
+    v.run("place_view", v.batch.n);
+    run_raw_grid(v);
+  }
+
+  Device& d_;
+  std::map<std::string, Tables> tables_;  // per (knobs, view, tabulated, program variant)
+  Grown scratch_;
+};
+
+void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const DeviceBatch& b, cl::Buffer& feats) {
+  const Catalogue& cat = d_.cat;
+  const FeatureLayout lay = FeatureLayout::of(cat, plan.model.block);
+  const Plan q = quiet(plan);
+  // Tables where objects stand at their places, and while the pairs' index (subjects x
+  // (variants x regions)^2) stays small.
+  const size_t combos = cat.variant_list.size() * kRegions;
+  const bool tabulated =
+      plan.model.jitter <= 0 && !plan.model.transforms() && cat.subjects.size() * combos * combos <= (size_t(1) << 26);
+  cl::Context& ctx = d_.ctx();
+  for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
+    const int view = lay.pooled[slot];
+    Tables& t = tables(K, q, lay, static_cast<int>(slot), tabulated);
+    ViewLaunch v(d_, K, q, view, b, d_.pooled_only[view].at_least(ctx, 1), false, tabulated);
+    raw_grid(v);
+    const auto& d = t.dims.s;
+    const size_t per = PS_FEATURE_SPACE(size_t(d[0]), size_t(d[1]), size_t(d[2]), size_t(d[3]), size_t(d[4]));
+    // Work spaces too large for private memory take global scratch, 64 MiB at most: a
+    // launch per that many scenarios (the kernel indexes it from its launch's offset).
+    const size_t rb = K.real_bytes();
+    const size_t chunk = per > PS_FEATURE_NOISE_PRIVATE
+                             ? std::max<size_t>(kLocalSize, (size_t(64) << 20) / (per * rb) / kLocalSize * kLocalSize)
+                             : padded(b.n);
+    cl::Buffer& scratch =
+        scratch_.at_least(ctx, per > PS_FEATURE_NOISE_PRIVATE ? std::min(chunk, padded(b.n)) * per * rb : 1);
+    const PhysicsFeaturesArgs args{.raw = d_.raw.buf,
+                                   .first = t.first,
+                                   .cells = t.cells,
+                                   .weights = t.weights,
+                                   .columns = t.columns,
+                                   .count = t.count,
+                                   .raw_cells = plan.model.raw_width * plan.model.raw_height,
+                                   .phys = v.args().phys,
+                                   .row_len = lay.image_features(),
+                                   .features = feats,
+                                   .L = v.args().L,
+                                   .records = d_.records.buf,
+                                   .subject = b.subject,
+                                   .objects = b.objects,
+                                   .base_features = t.base_features,
+                                   .object_range = t.object_range,
+                                   .object_feature = t.object_feature,
+                                   .object_value = t.object_value,
+                                   .sd = {plan.model.netd},
+                                   .dims = t.dims,
+                                   .noise = t.noise,
+                                   .scratch = scratch};
+    for (size_t at = 0; at < b.n; at += chunk)
+      enqueue(d_.queue(), K["physics_features"], K.fp64(), args, std::min(chunk, padded(b.n) - at), at);
+  }
+}
+
+// A pooled view's tables for physics_features, made once per (knobs, view, precision):
+// the pooling taps, the noise factors and, when `tabulated`, each subject's bare features
+// and each (subject, variant, region)'s change to them, made by physics_raw itself on one
+// scenario per object (so a tabulated scenario differs from its raw grid only in the order
+// of float sums).
+PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& quiet, const FeatureLayout& lay,
+                                                       int slot, bool tabulated) {
+  const Catalogue& cat = d_.cat;
+  const int view = lay.pooled[slot];
+  const Sensor& sv = cat.sensors[view];
+  const ModelSettings& m = quiet.model;
+  const int RW = m.raw_width, RH = m.raw_height, cells = RW * RH;
+  // Per program variant too (&K): tables made by another variant's arithmetic (fast math)
+  // would make a run's features depend on what ran before it.
+  char variant[32];
+  std::snprintf(variant, sizeof variant, "%p", static_cast<const void*>(&K));
+  Tables& t = tables_[table_key(
+      quiet, "view=" + std::to_string(view) + ";tabulated=" + std::to_string(tabulated) + ";variant=" + variant)];
+  if (t.first()) return t;
+  cl::Context& ctx = d_.ctx();
+  const bool fp64 = K.fp64();
+  const RawGridPooling p = raw_grid_pooling(sv, lay, slot, RW, RH);
+  t.count = static_cast<int>(p.columns.size());
+  t.cells = constant(ctx, p.cells);
+  t.columns = constant(ctx, p.columns);
+  t.weights = params(ctx, fp64, p.weights);
+  const RawGridNoise z = raw_grid_noise(sv, lay, RW, RH);
+  t.dims = {{z.blocks_x, z.blocks_y, z.band_x, z.band_y, z.regions, p.columns.empty() ? 0 : p.columns[0], 0, 0}};
+  std::vector<double> noise = z.dx;
+  for (const std::vector<double>* v : {&z.dy, &z.region_blocks, &z.region_own})
+    noise.insert(noise.end(), v->begin(), v->end());
+  t.noise = params(ctx, fp64, noise);
+  const int S = static_cast<int>(cat.subjects.size()), V = static_cast<int>(cat.variant_list.size());
+  std::vector<double> bare(static_cast<size_t>(S) * t.count, 0.0), values;
+  const size_t combos = static_cast<size_t>(V) * kRegions;
+  std::vector<cl_int2> object_range(S * combos + S * combos * combos, cl_int2{{0, 0}});  // [begin, end)
+  std::vector<cl_int> features;
+  if (tabulated) {
+    // One scenario per subject bare, per (subject, variant, region seen) alone, and per
+    // pair of those whose boxes meet.
+    // A pair counts where its boxes meet on any subject (places move with the height).
+    const auto meet = [&](int va, int ra, int vb, int rb) {
+      const Image &a = d_.assets.sprite(sv.camera, va), &b = d_.assets.sprite(sv.camera, vb);
+      for (int s = 0; s < S; ++s)
+        if (boxes_meet(sprite_box(sv.place(s, ra), a), sprite_box(sv.place(s, rb), b))) return true;
+      return false;
+    };
+    SceneBatch b;
+    std::vector<std::array<int, 4>> pairs;  // va, ra, vb, rb with ra < rb
+    for (int ra = 0; ra < kRegions; ++ra)
+      for (int rb = ra + 1; rb < kRegions; ++rb)
+        if (sv.sees(ra) && sv.sees(rb))
+          for (int va = 0; va < V; ++va)
+            for (int vb = 0; vb < V; ++vb)
+              if (meet(va, ra, vb, rb)) pairs.push_back({va, ra, vb, rb});
+    for (int s = 0; s < S; ++s) {
+      Scenario sc;
+      sc.subject = s;
+      b.push(sc);
+      for (int v = 0; v < V; ++v)
+        for (int r = 0; r < kRegions; ++r)
+          if (sv.sees(r)) {
+            sc.objects.fill(kNoObject);
+            sc.objects[r] = static_cast<int16_t>(v);
+            b.push(sc);
+          }
+      for (const auto& [va, ra, vb, rb] : pairs) {
+        sc.objects.fill(kNoObject);
+        sc.objects[ra] = static_cast<int16_t>(va);
+        sc.objects[rb] = static_cast<int16_t>(vb);
+        b.push(sc);
+      }
+    }
+    const size_t N = b.size();
+    const DeviceBatch table_batch{.n = N,
+                                  .subject = constant(ctx, b.subject),
+                                  .objects = constant(ctx, b.objects),
+                                  .seed = {{0, 0}},
+                                  .first = {{0, 0}}};
+    ViewLaunch v(d_, K, quiet, view, table_batch, d_.pooled_only[view].at_least(ctx, 1), false);
+    raw_grid(v);
+    std::vector<double> raw(N * cells);
+    if (fp64) {
+      d_.queue().enqueueReadBuffer(d_.raw.buf, CL_TRUE, 0, N * cells * sizeof(cl_double), raw.data());
+    } else {
+      std::vector<cl_float> f(N * cells);
+      d_.queue().enqueueReadBuffer(d_.raw.buf, CL_TRUE, 0, N * cells * sizeof(cl_float), f.data());
+      raw.assign(f.begin(), f.end());
+    }
+    // Feature f of a raw grid: its taps' weighted sum.
+    const auto pooled = [&](const double* g, int f) {
+      double d = 0;
+      for (int k = p.first[f]; k < p.first[f + 1]; ++k) d += p.weights[k] * g[p.cells[k]];
+      return d;
+    };
+    // The features of sum_k sign_k raw[scenario_k], kept where not zero.
+    std::vector<double> grid(cells);
+    const auto entries = [&](size_t u, std::initializer_list<std::pair<size_t, double>> terms) {
+      std::fill(grid.begin(), grid.end(), 0.0);
+      for (const auto& [scenario, sign] : terms)
+        for (int c = 0; c < cells; ++c) grid[c] += sign * raw[scenario * cells + c];
+      object_range[u].s[0] = static_cast<cl_int>(features.size());
+      for (int f = 0; f < t.count; ++f) {
+        const double d = pooled(grid.data(), f);
+        if (d == 0) continue;
+        features.push_back(f);
+        values.push_back(d);
+      }
+      object_range[u].s[1] = static_cast<cl_int>(features.size());
+      if (features.size() > INT32_MAX) throw std::runtime_error("physics feature tables exceed 2^31 entries");
+    };
+    size_t at = 0;
+    std::vector<size_t> alone(combos);
+    for (int s = 0; s < S; ++s) {
+      const size_t bare_at = at++;
+      for (int f = 0; f < t.count; ++f) bare[static_cast<size_t>(s) * t.count + f] = pooled(&raw[bare_at * cells], f);
+      for (int v = 0; v < V; ++v)
+        for (int r = 0; r < kRegions; ++r) {
+          const size_t c = static_cast<size_t>(v) * kRegions + r;
+          if (sv.sees(r)) {
+            alone[c] = at++;
+            entries(s * combos + c, {{alone[c], 1.0}, {bare_at, -1.0}});
+          }
+        }
+      // Pairs: both together less each alone, plus the bare grid counted twice over.
+      for (const auto& [va, ra, vb, rb] : pairs) {
+        const size_t a = static_cast<size_t>(va) * kRegions + ra, c = static_cast<size_t>(vb) * kRegions + rb;
+        entries(S * combos + (s * combos + a) * combos + c,
+                {{at++, 1.0}, {alone[a], -1.0}, {alone[c], -1.0}, {bare_at, 1.0}});
+      }
+    }
+  }
+  t.base_features = params(ctx, fp64, bare);
+  t.object_range = constant(ctx, object_range);
+  t.object_feature = constant(ctx, features);
+  t.object_value = params(ctx, fp64, values);
+  t.first = constant(ctx, p.first);  // last: a table without it is made again
+  return t;
+}
+
+}  // namespace
+
+std::unique_ptr<FeaturePath> physics_raw_features_path(Device& d) { return std::make_unique<PhysicsRawFeatures>(d); }
+
+}  // namespace portalsim::opencl

@@ -1,0 +1,60 @@
+// The features of plans that no features path takes: each pooled view rendered by its view
+// path, then its block and region means (kernels/pool.cl); and the block-mean noise model,
+// which every features path's means get where it is chosen (kernels/pool_sparse.cl).
+#include "backend/opencl/launch.h"
+#include "backend/opencl/paths/paths.h"
+
+namespace portalsim::opencl {
+
+void pool_view(Device& d, Kernels& K, const FeatureLayout& lay, const DeviceBatch& b, int slot, const cl::Buffer& img,
+               const cl::Buffer& features) {
+  const int view = lay.pooled[slot];
+  const Sensor& s = d.cat.sensors[view];
+  const cl_uint n = static_cast<cl_uint>(b.n);
+  const int row_len = lay.image_features();
+  enqueue(d.queue(), K["pool_blocks"], K.fp64(),
+          PoolBlocksArgs{.img = img,
+                         .n = n,
+                         .width = s.width,
+                         .height = s.height,
+                         .block = lay.block,
+                         .blocks_x = lay.blocks_x,
+                         .blocks_y = lay.blocks_y,
+                         .offset = slot * lay.blocks_per_view(),
+                         .row_len = row_len,
+                         .features = features},
+          b.n * lay.blocks_per_view());
+  enqueue(d.queue(), K["pool_regions"], K.fp64(),
+          PoolRegionsArgs{.img = img,
+                          .n = n,
+                          .width = s.width,
+                          .height = s.height,
+                          .rects = d.data.view_rects[view],
+                          .region_mask = s.region_mask,
+                          .offset = lay.block_features(),
+                          .row_len = row_len,
+                          .features = features},
+          b.n * kRegions);
+}
+
+void block_mean_noise(Device& d, Kernels& K, const Plan& plan, const DeviceBatch& b, const cl::Buffer& features) {
+  const FeatureLayout lay = FeatureLayout::of(d.cat, plan.model.block);
+  const Sensor& s = d.cat.sensors[lay.pooled.at(0)];  // every pooled view has its size
+  enqueue(d.queue(), K["analytic_noise"], K.fp64(),
+          AnalyticNoiseArgs{.features = features,
+                            .rects = d.data.region_rects,
+                            .n = static_cast<cl_uint>(b.n),
+                            .width = s.width,
+                            .height = s.height,
+                            .block = lay.block,
+                            .blocks_x = lay.blocks_x,
+                            .blocks_y = lay.blocks_y,
+                            .npooled = static_cast<cl_int>(lay.pooled.size()),
+                            .row_len = lay.image_features(),
+                            .sigma = static_cast<cl_float>(plan.model.pixel_sigma),
+                            .seed = b.seed,
+                            .first = b.first},
+          b.n);
+}
+
+}  // namespace portalsim::opencl

@@ -1,0 +1,46 @@
+// The general view path: each stage of the view's chain as its own kernels, in order, over
+// a field of reals (backend/stages.h). It renders every chain, and is what the fast paths
+// are checked against bit for bit.
+#include "backend/opencl/paths/paths.h"
+
+namespace portalsim::opencl {
+
+namespace {
+
+class StageChain final : public ViewPath {
+ public:
+  const char* name() const override { return "stage_chain"; }
+  const std::vector<std::string>& chain() const override {
+    static const std::vector<std::string> any;  // whatever the view's chain is
+    return any;
+  }
+  bool applies(const Plan&, const Sensor&) const override { return true; }
+  bool uses_field() const override { return true; }
+  void render(ViewLaunch& v) const override { run_stages(v, 0); }
+};
+
+}  // namespace
+
+void run_stages(ViewLaunch& v, size_t from) {
+  for (size_t k = from; k < v.chain.size(); ++k)
+    for (const StageKernel& sk : view_stage(v.chain[k]).kernels) v.run(sk);
+}
+
+const ViewPath& stage_chain_path() {
+  static const StageChain path;
+  return path;
+}
+
+const std::vector<const ViewPath*>& view_paths() {
+  static const std::vector<const ViewPath*> paths = {&thesis_images_path(), &physics_raw_path(), &ir_fused_path(),
+                                                     &stage_chain_path()};
+  return paths;
+}
+
+const ViewPath& view_path(const Plan& plan, const Sensor& sensor) {
+  for (const ViewPath* p : view_paths())
+    if (p->applies(plan, sensor)) return *p;
+  return stage_chain_path();
+}
+
+}  // namespace portalsim::opencl

@@ -1,0 +1,31 @@
+// The thesis model's fused view path: render_view (kernels/render.cl) makes a whole view
+// per work-item, its composite, pattern noise, sensor noise and display in one pass, with
+// the stage kernels' bits.
+#include "backend/opencl/paths/paths.h"
+
+namespace portalsim::opencl {
+
+namespace {
+
+class ThesisImages final : public ViewPath {
+ public:
+  const char* name() const override { return "thesis_images"; }
+  const std::vector<std::string>& chain() const override {
+    static const std::vector<std::string> stages = {"composite", "pattern_noise", "sensor_noise", "display"};
+    return stages;
+  }
+  bool applies(const Plan& plan, const Sensor& sensor) const override {
+    return plan.fidelity.fused && sensor.chain_for(plan.model.model) == chain();
+  }
+  bool uses_field() const override { return false; }
+  void render(ViewLaunch& v) const override { v.run("render_view", v.batch.n); }
+};
+
+}  // namespace
+
+const ViewPath& thesis_images_path() {
+  static const ThesisImages path;
+  return path;
+}
+
+}  // namespace portalsim::opencl

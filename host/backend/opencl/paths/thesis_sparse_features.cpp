@@ -1,0 +1,209 @@
+// The thesis model's features-only path (kernels/pool_sparse.cl): each subject's base
+// features and each object footprint's change to them, tabulated once per knobs; a batch
+// then sums a scenario's changes and counts only the pixels where footprints overlap. No
+// image is rendered. It implements the thesis chain on MMW views whose sprites stay at
+// their places, with no per-pixel noise (the block-mean model adds its noise after).
+#include <algorithm>
+#include <map>
+
+#include "backend/opencl/launch.h"
+#include "backend/opencl/paths/paths.h"
+#include "backend/opencl/table_key.h"
+
+namespace portalsim::opencl {
+
+namespace {
+
+class ThesisSparseFeatures final : public FeaturePath {
+ public:
+  explicit ThesisSparseFeatures(Device& d) : d_(d) {}
+  const char* name() const override { return "thesis_sparse_features"; }
+  // The chain the tables implement: thesis_images's.
+  bool applies(const Plan& plan, const Sensor& sensor) const override {
+    return plan.sparse_features() && sensor.camera == Camera::mmw &&
+           sensor.chain_for(plan.model.model) == thesis_images_path().chain();
+  }
+  void features(Kernels& K, const Plan& plan, const DeviceBatch& b, cl::Buffer& feats) override;
+
+ private:
+  struct Tables {
+    std::string key;
+    int patterns = 1;
+    bool noise = false;
+    cl::Buffer fps, deltas, region_deltas, base_sums, base_means;
+  };
+  Tables& tables(Kernels& K, const Plan& plan);
+  // The tables assume every pooled view has the first one's size.
+  const Sensor& pooled_view(const FeatureLayout& lay) const { return d_.cat.sensors[lay.pooled.at(0)]; }
+
+  Device& d_;
+  std::map<const Kernels*, Tables> tables_;  // per program variant: the last knobs' tables
+  Grown patterns_;
+};
+
+ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Plan& plan) {
+  Tables& t = tables_[&K];
+  const std::string key = table_key(plan, "");
+  if (t.key == key) return t;
+  t.key.clear();  // until the tables below are whole
+  const Catalogue& cat = d_.cat;
+  const DeviceCatalogue& c = d_.data;
+  const ImagesConfig& ic = cat.images;
+  const FeatureLayout lay = FeatureLayout::of(cat, plan.model.block);
+  const Sensor& view = pooled_view(lay);
+  const int block = plan.model.block, W = view.width, H = view.height, N = ic.noise_size;
+  const bool noise = plan.model.pattern_noise;
+  const int S = static_cast<int>(cat.subjects.size()), V = static_cast<int>(cat.variant_list.size());
+  const int P = noise ? static_cast<int>(cat.noise.size()) : 1;
+  // A footprint per (variant, region, subject): the place moves with the subject's height.
+  std::vector<cl_int> fps(static_cast<size_t>(V) * kRegions * S * PS_FP_LEN, 0);
+  cl_int offset = 0;
+  for (int v = 0; v < V; ++v)
+    for (int r = 0; r < kRegions; ++r)
+      for (int s = 0; s < S; ++s) {
+        const Image& sp = d_.assets.sprite(Camera::mmw, v);
+        const Rect box = sprite_box(cat.sensors[lay.pooled[region_slot(cat, lay, r)]].place(s, r), sp);
+        cl_int* f = &fps[((static_cast<size_t>(v) * kRegions + r) * S + s) * PS_FP_LEN];
+        f[PS_FP_SPRITE_X0] = box.x;
+        f[PS_FP_SPRITE_Y0] = box.y;
+        f[PS_FP_SPRITE_W] = box.w;
+        f[PS_FP_SPRITE_H] = box.h;
+        f[PS_FP_SPRITE_OFFSET] = c.mmw_sprites[v].s[0];
+        f[PS_FP_SPRITE_PADDED] = c.mmw_sprites[v].s[3];
+        f[PS_FP_TILE_X0] = f[PS_FP_SPRITE_X0] + (sp.width >> 1) - (N >> 1);
+        f[PS_FP_TILE_Y0] = f[PS_FP_SPRITE_Y0] + (sp.height >> 1) - (N >> 1);
+        int x0 = f[PS_FP_SPRITE_X0], y0 = f[PS_FP_SPRITE_Y0], x1 = f[PS_FP_SPRITE_X0] + f[PS_FP_SPRITE_W],
+            y1 = f[PS_FP_SPRITE_Y0] + f[PS_FP_SPRITE_H];
+        if (noise) {
+          x0 = std::min(x0, f[PS_FP_TILE_X0]);
+          y0 = std::min(y0, f[PS_FP_TILE_Y0]);
+          x1 = std::max(x1, f[PS_FP_TILE_X0] + N);
+          y1 = std::max(y1, f[PS_FP_TILE_Y0] + N);
+        }
+        x0 = std::max(x0, 0);
+        y0 = std::max(y0, 0);
+        x1 = std::min(x1, W);
+        y1 = std::min(y1, H);
+        if (x0 >= x1 || y0 >= y1) x0 = y0 = x1 = y1 = 0;  // wholly outside: touches nothing
+        f[PS_FP_X0] = x0;
+        f[PS_FP_Y0] = y0;
+        f[PS_FP_X1] = x1;
+        f[PS_FP_Y1] = y1;
+        f[PS_FP_BLOCK_X0] = x0 / block;
+        f[PS_FP_BLOCK_Y0] = y0 / block;
+        f[PS_FP_BLOCKS_W] = x1 > x0 ? (x1 - 1) / block - f[PS_FP_BLOCK_X0] + 1 : 0;
+        f[PS_FP_BLOCKS_H] = y1 > y0 ? (y1 - 1) / block - f[PS_FP_BLOCK_Y0] + 1 : 0;
+        f[PS_FP_DELTAS] = offset;
+        const int64_t next = offset + static_cast<int64_t>(P) * f[PS_FP_BLOCKS_W] * f[PS_FP_BLOCKS_H];
+        if (next > INT32_MAX) throw std::runtime_error("sparse feature tables exceed 2^31 entries; use --block larger");
+        offset = static_cast<cl_int>(next);
+      }
+  cl::Context& ctx = d_.ctx();
+  cl::CommandQueue& q = d_.queue();
+  const int row_len = lay.image_features(), combos = V * kRegions * S * P;
+  t.fps = constant(ctx, fps);
+  t.deltas = cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<size_t>(1, offset) * sizeof(cl_int));
+  t.region_deltas = cl::Buffer(ctx, CL_MEM_READ_WRITE, static_cast<size_t>(combos) * kRegions * sizeof(cl_int));
+  t.base_sums = cl::Buffer(ctx, CL_MEM_READ_WRITE, static_cast<size_t>(S) * row_len * sizeof(cl_int));
+  t.base_means = cl::Buffer(ctx, CL_MEM_READ_WRITE, static_cast<size_t>(S) * row_len * sizeof(cl_float));
+  const cl_int npooled = static_cast<cl_int>(lay.pooled.size()), views = static_cast<cl_int>(cat.sensors.size());
+  enqueue(q, K["base_features"], K.fp64(),
+          BaseFeaturesArgs{.atlas = c.atlas,
+                           .bases = c.bases,
+                           .rects = c.region_rects,
+                           .pooled = c.pooled,
+                           .npooled = npooled,
+                           .views = views,
+                           .region_slot = c.region_slot,
+                           .subjects = S,
+                           .width = W,
+                           .height = H,
+                           .block = block,
+                           .blocks_x = lay.blocks_x,
+                           .blocks_y = lay.blocks_y,
+                           .row_len = row_len,
+                           .sums = t.base_sums,
+                           .means = t.base_means},
+          static_cast<size_t>(S) * row_len);
+  enqueue(q, K["footprint_deltas"], K.fp64(),
+          FootprintDeltasArgs{.atlas = c.atlas,
+                              .bases = c.bases,
+                              .fps = t.fps,
+                              .noise_offsets = c.noise_offsets,
+                              .noise_gains = c.noise_gains,
+                              .rects = c.region_rects,
+                              .pooled = c.pooled,
+                              .views = views,
+                              .region_slot = c.region_slot,
+                              .combos = combos,
+                              .subjects = S,
+                              .patterns = P,
+                              .width = W,
+                              .block = block,
+                              .alpha = {ic.alpha},
+                              .tile = N,
+                              .use_noise = noise ? 1 : 0,
+                              .deltas = t.deltas,
+                              .region_deltas = t.region_deltas},
+          static_cast<size_t>(combos));
+  q.finish();
+  t.noise = noise;
+  t.patterns = P;
+  t.key = key;
+  return t;
+}
+
+void ThesisSparseFeatures::features(Kernels& K, const Plan& plan, const DeviceBatch& b, cl::Buffer& feats) {
+  const Tables& t = tables(K, plan);
+  const Catalogue& cat = d_.cat;
+  const DeviceCatalogue& c = d_.data;
+  const ImagesConfig& ic = cat.images;
+  const FeatureLayout lay = FeatureLayout::of(cat, plan.model.block);
+  const Sensor& view = pooled_view(lay);
+  cl::CommandQueue& q = d_.queue();
+  cl::Buffer& patterns = patterns_.at_least(d_.ctx(), b.n * sizeof(cl_int));
+  const cl_uint n = static_cast<cl_uint>(b.n);
+  if (t.noise)
+    enqueue(q, K["sparse_patterns"], K.fp64(),
+            SparsePatternsArgs{.n = n, .patterns = t.patterns, .seed = b.seed, .first = b.first, .out = patterns}, b.n);
+  enqueue(q, K["features_sparse"], K.fp64(),
+          FeaturesSparseArgs{.atlas = c.atlas,
+                             .bases = c.bases,
+                             .fps = t.fps,
+                             .deltas = t.deltas,
+                             .region_deltas = t.region_deltas,
+                             .base_sums = t.base_sums,
+                             .base_means = t.base_means,
+                             .noise_offsets = c.noise_offsets,
+                             .noise_gains = c.noise_gains,
+                             .rects = c.region_rects,
+                             .pooled = c.pooled,
+                             .npooled = static_cast<cl_int>(lay.pooled.size()),
+                             .views = static_cast<cl_int>(cat.sensors.size()),
+                             .region_slot = c.region_slot,
+                             .subject = b.subject,
+                             .objects = b.objects,
+                             .patterns = patterns,
+                             .n = n,
+                             .subjects = static_cast<cl_int>(cat.subjects.size()),
+                             .pattern_count = t.patterns,
+                             .width = view.width,
+                             .height = view.height,
+                             .block = lay.block,
+                             .blocks_x = lay.blocks_x,
+                             .blocks_y = lay.blocks_y,
+                             .alpha = {ic.alpha},
+                             .tile = ic.noise_size,
+                             .use_noise = t.noise ? 1 : 0,
+                             .row_len = lay.image_features(),
+                             .features = feats},
+          b.n);
+}
+
+}  // namespace
+
+std::unique_ptr<FeaturePath> thesis_sparse_features_path(Device& d) {
+  return std::make_unique<ThesisSparseFeatures>(d);
+}
+
+}  // namespace portalsim::opencl

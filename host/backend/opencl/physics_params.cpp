@@ -1,0 +1,154 @@
+#include "backend/opencl/physics_params.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "backend/opencl/gauss_table.h"
+#include "backend/opencl/table_key.h"
+
+namespace portalsim::opencl {
+
+namespace {
+
+// An object's physical temperature after `worn` minutes on the body: from the room towards
+// the skin with its material's time constant.
+double worn_temperature(const PhysicsConfig& pc, const Material& mat, double worn) {
+  return pc.skin_temperature - (pc.skin_temperature - pc.room_temperature) * std::exp(-worn / mat.warm_minutes);
+}
+
+// A Gaussian of `sigma` taps over +-4 sigma, normalised; sigma 0 is the single tap 1.
+void append_gaussian_taps(std::vector<double>& p, double sigma, int32_t& radius) {
+  radius = sigma > 0 ? static_cast<int32_t>(std::ceil(4.0 * sigma)) : 0;
+  double total = 0;
+  const size_t first = p.size();
+  for (int d = -radius; d <= radius; ++d) {
+    p.push_back(sigma > 0 ? std::exp(-0.5 * d * d / (sigma * sigma)) : 1.0);
+    total += p.back();
+  }
+  for (size_t k = first; k < p.size(); ++k) p[k] /= total;
+}
+
+// The raw grid's weight of each view pixel along one axis (size pixels, raw cells): the
+// PSF's taps (edges held) folded into each cell's box over size / raw pixels; then the
+// first and last cell each pixel reaches.
+void axis_weights(int size, int raw, const double* taps, int radius, std::vector<double>& w,
+                  std::vector<double>& band) {
+  w.assign(static_cast<size_t>(raw) * size, 0.0);
+  const double step = double(size) / raw;
+  for (int c = 0; c < raw; ++c)
+    for (int x = static_cast<int>(std::floor(c * step)); x < std::min(size, int(std::ceil((c + 1) * step))); ++x) {
+      const double share = (std::min(x + 1.0, (c + 1) * step) - std::max(double(x), c * step)) / step;
+      for (int d = -radius; d <= radius; ++d)
+        w[size_t(c) * size + std::clamp(x + d, 0, size - 1)] += share * taps[d + radius];
+    }
+  band.assign(2 * static_cast<size_t>(size), 0.0);
+  for (int x = 0; x < size; ++x) {
+    int lo = raw, hi = -1;
+    for (int c = 0; c < raw; ++c)
+      if (w[size_t(c) * size + x] != 0) lo = std::min(lo, c), hi = std::max(hi, c);
+    band[2 * x] = lo;
+    band[2 * x + 1] = hi;
+  }
+}
+
+}  // namespace
+
+size_t mmw_display_scratch(const Sensor& s, int raw_width, int raw_height) {
+  return size_t(s.height) * raw_width + 16 * size_t(raw_height);
+}
+
+cl::Buffer PhysicsParams::operator()(bool fp64, const Plan& plan, int view, PsViewLaunch& L) {
+  L.psf_radius = L.phys_wx = L.phys_wy = L.phys_cband = L.phys_rband = L.phys_base = L.phys_gauss = 0;
+  if (plan.model.model != Model::physics) return none_.at_least(ctx_, 16);
+  Tables& t = tables_[table_key(plan, "view=" + std::to_string(view) + ";fp64=" + std::to_string(fp64))];
+  if (t.values.empty()) t = make(plan, cat_.sensors[view], view);
+  L.psf_radius = t.radius;
+  L.phys_wx = t.wx;
+  L.phys_wy = t.wy;
+  L.phys_cband = t.cband;
+  L.phys_rband = t.rband;
+  L.phys_base = t.base;
+  L.phys_gauss = t.gauss;
+  if (!t.buffer()) t.buffer = params(ctx_, fp64, t.values);
+  return t.buffer;
+}
+
+PhysicsParams::Tables PhysicsParams::make(const Plan& plan, const Sensor& s, int view) const {
+  const PhysicsConfig& pc = cat_.physics;
+  const ModelSettings& m = plan.model;
+  const bool ir = s.camera == Camera::ir;
+  const auto seen = [&](double e, double t) {
+    return pc.clothing_transmission * (e * t + (1 - e) * m.illumination) +
+           (1 - pc.clothing_transmission) * pc.clothing_temperature;
+  };
+  Tables t;
+  std::vector<double>& p = t.values;
+  p.assign(PS_PHYS_SUBJECTS, 0.0);
+  p[PS_PHYS_BACKGROUND] = pc.background_temperature;
+  p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : pc.display_min;
+  p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : pc.display_max;
+  p[PS_PHYS_NETD] = ir ? m.ir_netd : m.netd;
+  // Per subject, its base image's value to kelvin: the IR index map, or the MMW's gray
+  // between the room behind and the bare body.
+  const double body = seen(pc.skin_emissivity, pc.skin_temperature);
+  for (const Subject& subj : cat_.subjects) {
+    const double gain = ir ? (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0
+                           : (body - pc.background_temperature) / (subj.mmw_level - pc.base_background_gray);
+    p.push_back(gain);
+    p.push_back(ir ? pc.ir_index_min_k : pc.background_temperature - gain * pc.base_background_gray);
+  }
+  // Per variant: the IR surface's contact shadow, or the MMW apparent temperature.
+  for (size_t v = 0; v < cat_.variant_list.size(); ++v) {
+    const Material& mat = cat_.materials.at(cat_.object_of(static_cast<int>(v)).material_id);
+    const double worn = worn_temperature(pc, mat, m.worn_minutes);
+    p.push_back(ir ? -pc.ir_coupling * (pc.skin_temperature - worn) : seen(mat.emissivity, worn));
+  }
+  // MMW: the Airy core's FWHM, 1.02 lambda / D at the range, in this view's pixels, as a
+  // Gaussian of that FWHM. IR: ir_spread_mm over the view's pixel (as wide as an MMW view).
+  const double span_m = 2.0 * pc.range_m * std::tan(pc.fov_rad / 2.0);
+  const double lambda = 299792458.0 / (pc.frequency_ghz * 1e9);
+  const double sigma = ir ? pc.ir_spread_mm / (1000.0 * span_m / s.width)
+                          : 1.02 * lambda / pc.aperture_m * pc.range_m / (span_m / s.width) / 2.3548200450309493;
+  const size_t taps = p.size();
+  append_gaussian_taps(p, sigma, t.radius);
+  const std::vector<double> psf(p.begin() + static_cast<std::ptrdiff_t>(taps), p.end());
+  const auto append = [&](const std::vector<double>& v) {
+    if (p.size() + v.size() > 0x7fffffffu) throw std::runtime_error("physics tables exceed 2^31 values");
+    const int32_t at = static_cast<int32_t>(p.size());
+    p.insert(p.end(), v.begin(), v.end());
+    return at;
+  };
+  t.gauss = append(gauss_table());  // the sensor noise's table Gaussians
+  if (ir) return t;
+  // The MMW raw-grid path's tables (kernels/physics_raw.cl).
+  const int W = s.width, H = s.height, RW = m.raw_width, RH = m.raw_height;
+  std::vector<double> wx, wy, cband, rband;
+  axis_weights(W, RW, psf.data(), t.radius, wx, cband);
+  axis_weights(H, RH, psf.data(), t.radius, wy, rband);
+  t.wx = append(wx);
+  t.wy = append(wy);
+  t.cband = append(cband);
+  t.rband = append(rband);
+  // Each subject's bare raw grid: wy . T . wx^T over its base image in kelvin.
+  std::vector<double> bare(cat_.subjects.size() * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
+  for (size_t subj = 0; subj < cat_.subjects.size(); ++subj) {
+    const Image& base = assets_.bases[subj][view];
+    const double gain = p[PS_PHYS_SUBJECTS + 2 * subj], offset = p[PS_PHYS_SUBJECTS + 2 * subj + 1];
+    std::fill(rows.begin(), rows.end(), 0.0);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const double kelvin = gain * base.at(x, y) + offset;
+        for (int c = int(cband[2 * x]); c <= int(cband[2 * x + 1]); ++c)
+          rows[size_t(y) * RW + c] += wx[size_t(c) * W + x] * kelvin;
+      }
+    double* out = &bare[subj * size_t(RW) * RH];
+    for (int y = 0; y < H; ++y)
+      for (int r = int(rband[2 * y]); r <= int(rband[2 * y + 1]); ++r)
+        for (int c = 0; c < RW; ++c) out[size_t(r) * RW + c] += wy[size_t(r) * H + y] * rows[size_t(y) * RW + c];
+  }
+  t.base = append(bare);
+  return t;
+}
+
+}  // namespace portalsim::opencl

@@ -1,0 +1,176 @@
+// The OpenCL backend's declared paths (backend/opencl/paths/paths.h): a fast path runs only
+// where its gate applies, and where it does not the stage chain and pooling give the
+// reference's outputs; table caches are keyed by every knob; launch structs are checked
+// against the kernels' own argument counts.
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+
+#include "backend/compare.h"
+#include "backend/opencl/launch.h"
+#include "backend/opencl/paths/paths.h"
+#include "backend/opencl/table_key.h"
+#include "plan/knobs.h"
+#include "run_binary.h"
+#include "support.h"
+
+namespace portalsim {
+namespace {
+
+using test::assets;
+using test::catalogue;
+
+// The default catalogue with its MMW views' physics chain less the optics stage: a chain
+// the physics_raw path (which blurs in the same pass) does not implement.
+Catalogue without_mmw_optics() {
+  Catalogue cat = catalogue();
+  for (Sensor& s : cat.sensors)
+    if (s.camera == Camera::mmw) s.physics_chain = {"radiometry", "sample", "netd", "mmw_display"};
+  return cat;
+}
+
+TEST(OpenCLPaths, EachViewTakesTheFirstPathWhoseGateApplies) {
+  const Catalogue& cat = catalogue();
+  Plan plan;
+  EXPECT_STREQ(opencl::view_path(plan, cat.sensors[0]).name(), "thesis_images");
+  plan.model.model = Model::physics;
+  EXPECT_STREQ(opencl::view_path(plan, cat.sensors[0]).name(), "physics_raw");
+  EXPECT_STREQ(opencl::view_path(plan, cat.sensors[2]).name(), "ir_fused");
+  plan.fidelity.fused = false;
+  for (const Sensor& s : cat.sensors) EXPECT_STREQ(opencl::view_path(plan, s).name(), "stage_chain");
+  plan.fidelity.fused = true;
+  const Catalogue other = without_mmw_optics();
+  EXPECT_STREQ(opencl::view_path(plan, other.sensors[0]).name(), "stage_chain");
+}
+
+// A features-only physics run under the block-mean model (the fast tier's), on views whose
+// chain physics_raw does not implement: its gate fails, so the views are rendered stage by
+// stage and pooled, and the features are the reference's within the physics model's dense
+// bounds. This used to stop on a logic_error ("the raw grid alone needs the physics fast path").
+TEST(OpenCLPaths, AFailedGateFallsBackToTheStageChainAndMatchesTheReference) {
+  const Catalogue cat = without_mmw_optics();
+  const SceneBatch batch = test::batch_of(test::coverage(cat, 200, 4));
+  auto cl = make_opencl_backend(cat, assets(), test::runtime());
+  auto ref = make_reference_backend(cat, assets());
+  for (Tier tier : {Tier::fast, Tier::standard}) {
+    SCOPED_TRACE(tier_name(tier));
+    Plan plan = test::physics_plan();
+    plan.images = 0;
+    plan.fidelity = tier_fidelity(tier);
+    plan.fidelity.noise = NoiseModel::block_mean;
+    ASSERT_TRUE(plan.physics_sparse_features()) << "the plan alone would ask for the raw-grid features path";
+    BatchOutput a, b;
+    ASSERT_NO_THROW(cl->run(batch, plan, a));
+    ref->run(batch, plan, b);
+    const OutputDiff d = compare_outputs(a, b);
+    const Tolerance t = model_tolerance(Model::physics, Tier::standard);  // the dense path's bounds
+    EXPECT_LE(d.feature_max_abs, t.feature_max_abs);
+    EXPECT_LE(d.feature_mean_abs, t.feature_mean_abs);
+    EXPECT_EQ(d.metal_exact, 1.0);
+  }
+}
+
+// A value of `k` other than the one in `p`, set through the registry.
+void change(Plan& p, const Knob& k) {
+  switch (k.kind) {
+    case KnobKind::on_off:
+      return k.set(p, k.get(p).get<bool>() ? 0 : 1);
+    case KnobKind::choice: {
+      const std::string now = k.get(p).get<std::string>();
+      return k.set(p, now == k.choices[0] ? 1 : 0);
+    }
+    case KnobKind::grid:
+      return k.set(p, 3 * 65536 + 5);
+    case KnobKind::range:
+      return k.set_range(p, k.min, k.max);
+    case KnobKind::integer:
+    case KnobKind::number:
+      return k.set(p, k.get(p).get<double>() == k.max ? k.min : k.max);
+  }
+}
+
+// Every knob of the registry is in a table's key: changing any one gives another key, so a
+// knob added later cannot leave a stale table in use.
+TEST(OpenCLPaths, TableKeysChangeWithEveryKnob) {
+  const Plan base;
+  const std::string key = opencl::table_key(base, "view=0");
+  EXPECT_EQ(key, opencl::table_key(base, "view=0"));
+  EXPECT_NE(key, opencl::table_key(base, "view=1"));
+  for (const Knob& k : knobs()) {
+    SCOPED_TRACE(k.key);
+    Plan p = base;
+    change(p, k);
+    ASSERT_NE(k.get(p), k.get(base)) << "the test did not change the knob";
+    EXPECT_NE(opencl::table_key(p, "view=0"), key);
+  }
+}
+
+// The tables in use follow the knobs: one backend run under a knob's new value gives what a
+// fresh backend gives (physics images use the per-view parameter tables, features-only
+// runs the raw-grid and sparse tables).
+TEST(OpenCLPaths, ChangedKnobsGiveFreshTables) {
+  const SceneBatch batch = test::batch_of(test::coverage(catalogue(), 64, 3, false));
+  auto kept = make_opencl_backend(catalogue(), assets(), test::runtime());
+  struct Case {
+    Model model;
+    bool images;
+    const char* knob;
+    const char* first;
+    const char* second;
+  };
+  for (const Case& c :
+       {Case{Model::physics, true, "worn_minutes", "5", "60"}, Case{Model::physics, true, "illumination", "293", "50"},
+        Case{Model::physics, false, "mmw_raw", "28x28", "20x20"},
+        Case{Model::thesis, false, "pattern_noise", "on", "off"}, Case{Model::thesis, false, "block", "10", "20"}}) {
+    SCOPED_TRACE(std::string(c.knob) + " " + c.second);
+    Plan plan;
+    plan.model.model = c.model;
+    plan.fidelity = tier_fidelity(Tier::fast);
+    if (!c.images) plan.images = 0;
+    const Knob& k = *find_knob(c.knob);
+    set_knob(plan, k, c.first, c.knob);
+    BatchOutput first, again, fresh;
+    kept->run(batch, plan, first);
+    set_knob(plan, k, c.second, c.knob);
+    kept->run(batch, plan, again);
+    make_opencl_backend(catalogue(), assets(), test::runtime())->run(batch, plan, fresh);
+    EXPECT_EQ(again.features, fresh.features);
+    for (size_t v = 0; v < fresh.views.size(); ++v) EXPECT_EQ(again.views[v].pixels, fresh.views[v].pixels);
+    EXPECT_TRUE(again.features != first.features || again.views[0].pixels != first.views[0].pixels)
+        << "the knob changed nothing: the case cannot tell";
+  }
+}
+
+// A launch struct set on a kernel of another signature is refused, naming both counts.
+TEST(OpenCLPaths, LaunchStructsMatchTheirKernels) {
+  opencl::Kernels K(*test::runtime(), Fidelity{});
+  EXPECT_NO_THROW(opencl::PoolRegionsArgs{}.set(K["pool_regions"], false));
+  try {
+    opencl::PoolBlocksArgs{}.set(K["pool_regions"], false);
+    FAIL() << "pool_blocks' arguments were taken by pool_regions";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("pool_regions takes 9 arguments"), std::string::npos) << e.what();
+  }
+}
+
+// A POCL_CACHE_DIR that is a file: PoCL fails the build with no word of its cache ("failed
+// to build the program"); the message must name the cache and what is wrong with it, as
+// the machine's problem (exit 5), and write nothing.
+TEST(OpenCLRuntime, APoclCacheThatIsAFileIsNamed) {
+  namespace fs = std::filesystem;
+  test::TempDir t;
+  const fs::path cache = t.w() / "cache";
+  test::spit(cache, "not a folder\n");
+  const test::Result r = test::finish(test::start_program(
+      t.cap(), "/usr/bin/env",
+      {"POCL_CACHE_DIR=" + cache.string(), PORTALSIM_BINARY, "simulate", "gun", "--out", (t.w() / "o").string()}));
+  SCOPED_TRACE(test::describe(r));
+  EXPECT_TRUE(r.exited && r.status == 5) << "5: the OpenCL environment";
+  EXPECT_NE(r.err.find("PoCL's kernel cache, " + cache.string()), std::string::npos);
+  EXPECT_NE(r.err.find("is a file"), std::string::npos);
+  EXPECT_FALSE(fs::exists(t.w() / "o"));
+}
+
+}  // namespace
+}  // namespace portalsim
