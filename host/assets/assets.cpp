@@ -10,6 +10,9 @@ namespace portalsim {
 
 namespace {
 
+// Whether a view shows the body's upper half: its floor lies below it (Sensor::floor_row).
+bool upper_half(const Sensor& view) { return view.floor_row > view.height; }
+
 bool has_alpha(const Image& img) { return img.channels == 2 || img.channels == 4; }
 
 int luminance(const Image& img, int x, int y) {
@@ -83,7 +86,7 @@ AssetSet build_assets(const Catalogue& cat) {
                               view.height));
       else
         views.push_back(ir ? procedural::ir_body(body, view.width, view.height)
-                           : procedural::mmw_body(body, view.name == "upper", view.width, view.height));
+                           : procedural::mmw_body(body, upper_half(view), view.width, view.height));
     }
     a.bases.push_back(std::move(views));
   }

@@ -37,7 +37,7 @@ struct BatchOutput {
   // asks for annotations.
   std::vector<ViewAnnotations> annotations;
 
-  // The view called `name` ("upper", "lower", "ir"); throws std::out_of_range if none is.
+  // The view called `name` (a Catalogue::sensors name); throws std::out_of_range if none is.
   const ViewImages& view(std::string_view name) const;
   const uint8_t* metal_of(size_t i) const { return metal.data() + i * kZones; }
   const float* features_of(size_t i) const { return features.data() + i * layout.image_features(); }

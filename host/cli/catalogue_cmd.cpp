@@ -28,8 +28,12 @@ int list(CatalogueOptions& o) {
     std::printf("  %zu  %s  build %g  height %g\n", i + 1, c.subjects[i].name.c_str(), c.subjects[i].build,
                 c.subjects[i].height);
   std::printf("\nregions:\n");
-  for (const Region& r : c.regions)
-    std::printf("  %2d  %-15s %s\n", r.id, r.name.c_str(), r.view == View::upper ? "upper" : "lower");
+  for (const Region& r : c.regions) {
+    std::string view;  // the MMW view whose rectangles hold it, named in the sensor table
+    for (const Sensor& s : c.sensors)
+      if (view.empty() && s.camera == Camera::mmw && s.sees(r.id - 1)) view = s.name;
+    std::printf("  %2d  %-15s %s\n", r.id, r.name.c_str(), view.c_str());
+  }
   std::printf("\nobjects (name [variants] metal category: aliases):\n");
   for (const Object& ob : c.objects) {
     std::string vars, aliases;

@@ -49,7 +49,7 @@ FeaturesCount write_features(const std::vector<std::string>& folder_args, const 
     throw InputError("--out: \"" + out_name + "\": name it .arff, .csv or .npy, or give --format");
   const fs::path out(out_name);
   if (fs::exists(out)) throw OutputError(out_name + ": already exists; choose a new file name");
-  const std::vector<std::string> folders = find_scenario_folders(folder_args);
+  const std::vector<std::string> folders = find_scenario_folders(folder_args, s.catalogue);
 
   BatchOutput rows;
   rows.layout = FeatureLayout::of(s.catalogue, block);

@@ -67,8 +67,8 @@ struct Fidelity {
   Pooling pooling = Pooling::sparse;
   bool fast_math = false;  // -cl-fast-relaxed-math
   NoiseModel noise = NoiseModel::per_pixel;
-  // Camera views rendered by the fused render_view kernel (a declared fast path), or by
-  // the chain of stage kernels, one launch per stage; both give the same bits.
+  // Camera views rendered by the fast view paths where their gates apply (backend/opencl/
+  // paths/), or all by the chain of stage kernels, one launch per stage; the same bits.
   bool fused = true;
 };
 
@@ -100,15 +100,15 @@ struct Plan {
   bool pixel_noise_per_pixel() const {
     return model.pixel_sigma > 0 && (images != 0 || fidelity.noise == NoiseModel::per_pixel);
   }
-  // Features straight from precomputed tables, never materialising an image. Block sums
-  // must stay exact in fp32 (255 * 256^2 < 2^24).
+  // The plan's half of thesis_sparse_features's gate (backend/opencl/paths/), which also checks
+  // the views' chains and alone decides. Block sums stay exact in fp32 (255 * 256^2 < 2^24).
   bool sparse_features() const {
     return features && images == 0 && model.model == Model::thesis && fidelity.pooling == Pooling::sparse &&
            !pixel_noise_per_pixel() && model.block <= 256 && !model.moves_sprites();
   }
-  // Physics features-only runs from the MMW raw grid (backend/opencl/raw_grid_pooling.h),
-  // when the block-mean noise model is chosen: like it, this leaves single pixels' rounding
-  // and clipping out. It needs the raw-grid fast path (fused).
+  // The plan's half of physics_raw_features's gate (backend/opencl/paths/), which also needs
+  // physics_raw's chain on every pooled view and alone decides: features only, block-mean
+  // noise model (the raw grid leaves single pixels' rounding and clipping out), fused.
   bool physics_sparse_features() const {
     return features && images == 0 && model.model == Model::physics && fidelity.pooling == Pooling::sparse &&
            fidelity.noise == NoiseModel::block_mean && fidelity.fused;

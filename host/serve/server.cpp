@@ -192,8 +192,8 @@ struct Server::Impl {
     try {
       res["metal"] = run(r, scene, dir.string());
       res["threat"] = scene.label == 1;
-      for (const char* f : {"upper", "lower", "ir"})
-        res[f] = "data:image/png;base64," + base64(read_file(dir / (std::string(f) + ".png")));
+      for (const Sensor& s : cat.sensors)
+        res[s.name] = "data:image/png;base64," + base64(read_file(dir / (s.name + ".png")));
     } catch (...) {
       std::error_code ec;
       fs::remove_all(dir, ec);
@@ -437,11 +437,14 @@ struct Server::Impl {
     j["regions"] = json::array();
     for (size_t k = 0; k < c.regions.size(); ++k) {
       const Region& r = c.regions[k];
-      const char* view = r.view == View::upper ? "upper" : "lower";
+      // The MMW view whose rectangles hold the region, named in the sensor table.
+      int s = -1;
+      for (size_t v = 0; s < 0 && v < c.sensors.size(); ++v)
+        if (c.sensors[v].camera == Camera::mmw && c.sensors[v].sees(static_cast<int>(k))) s = static_cast<int>(v);
+      const std::string view = s < 0 ? "" : c.sensors[static_cast<size_t>(s)].name;
       // Where the region holds an object on each subject: the rectangle moved with the
       // subject's stature (Sensor::place), which the page's hit boxes follow.
       json places = json::array();
-      const int s = c.sensor_index(view);
       for (size_t sub = 0; sub < c.subjects.size(); ++sub) {
         const Rect p =
             s < 0 ? r.mmw : c.sensors[static_cast<size_t>(s)].place(static_cast<int>(sub), static_cast<int>(k));

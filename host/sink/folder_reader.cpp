@@ -8,6 +8,7 @@
 #include "assets/image_io.h"
 #include "base/error.h"
 #include "io/input_file.h"
+#include "sink/pooling.h"
 
 namespace portalsim {
 
@@ -33,18 +34,14 @@ std::string one_line(std::string_view raw, const std::string& source) {
   return line;
 }
 
-// The kernels' mean_of (kernels/pool.cl), so rows from folders equal generate's rows.
-float mean_of(uint32_t sum, int count) {
-  const uint32_t q = sum / static_cast<uint32_t>(count), r = sum % static_cast<uint32_t>(count);
-  return std::clamp(static_cast<float>(q) + static_cast<float>(r) / static_cast<float>(count), 0.0f, 255.0f);
-}
-
 }  // namespace
 
-std::vector<std::string> find_scenario_folders(const std::vector<std::string>& paths) {
+std::vector<std::string> find_scenario_folders(const std::vector<std::string>& paths, const Catalogue& cat) {
+  // A scenario folder holds the first pooled view's image.
+  const std::string& stem = cat.sensors[FeatureLayout::of(cat, 1).pooled.at(0)].name;
   std::vector<std::string> out;
   std::function<void(const fs::path&)> walk = [&](const fs::path& p) {
-    if (!find_image(p, "upper").empty()) {
+    if (!find_image(p, stem).empty()) {
       out.push_back(p.string());
       return;
     }
@@ -60,46 +57,27 @@ std::vector<std::string> find_scenario_folders(const std::vector<std::string>& p
     if (!fs::is_directory(p, ec)) throw InputError(p + ": not a folder");
     const size_t before = out.size();
     walk(p);
-    if (out.size() == before) throw InputError(p + ": no scenario folders (none holds upper.png or upper.jpg)");
+    if (out.size() == before)
+      throw InputError(p + ": no scenario folders (none holds " + stem + ".png or " + stem + ".jpg)");
   }
   return out;
 }
 
 bool read_scenario_folder(const std::string& dir, const Catalogue& cat, BatchOutput& out, size_t i) {
   const fs::path d(dir);
-  const int W = cat.images.mmw_width, H = cat.images.mmw_height;
-  std::array<Image, 2> views;
-  const char* stems[2] = {"upper", "lower"};
-  for (int v = 0; v < 2; ++v) {
-    const std::string path = find_image(d, stems[v]);
-    if (path.empty()) throw InputError((d / stems[v]).string() + ".png: missing");
-    views[v] = to_gray(read_image(path, stems[v]), false);
-    if (views[v].width != W || views[v].height != H)
-      throw InputError(path + ": is " + std::to_string(views[v].width) + "x" + std::to_string(views[v].height) +
-                       ", the catalogue's MMW views are " + std::to_string(W) + "x" + std::to_string(H));
-  }
-  // Block and region means, as integer sums divided in float: the same numbers the
-  // kernels give for the same pixels.
   const FeatureLayout& f = out.layout;
-  float* row = out.features.data() + i * f.image_features();
-  int k = 0;
-  for (const Image& img : views)
-    for (int by = 0; by < f.blocks_y; ++by)
-      for (int bx = 0; bx < f.blocks_x; ++bx) {
-        const int x0 = bx * f.block, y0 = by * f.block;
-        const int x1 = std::min(x0 + f.block, W), y1 = std::min(y0 + f.block, H);
-        uint32_t sum = 0;
-        for (int y = y0; y < y1; ++y)
-          for (int x = x0; x < x1; ++x) sum += img.at(x, y);
-        row[k++] = mean_of(sum, (x1 - x0) * (y1 - y0));
-      }
-  for (const Region& r : cat.regions) {
-    const Image& img = views[r.view == View::upper ? 0 : 1];
-    uint32_t sum = 0;
-    for (int y = r.mmw.y; y < r.mmw.y + r.mmw.h; ++y)
-      for (int x = r.mmw.x; x < r.mmw.x + r.mmw.w; ++x) sum += img.at(x, y);
-    row[k++] = mean_of(sum, r.mmw.w * r.mmw.h);
+  std::vector<Image> views;  // the pooled views, by their sensors' names
+  for (int view : f.pooled) {
+    const Sensor& s = cat.sensors[view];
+    const std::string path = find_image(d, s.name);
+    if (path.empty()) throw InputError((d / s.name).string() + ".png: missing");
+    views.push_back(to_gray(read_image(path, s.name), false));
+    if (views.back().width != s.width || views.back().height != s.height)
+      throw InputError(path + ": is " + std::to_string(views.back().width) + "x" + std::to_string(views.back().height) +
+                       ", the catalogue's " + s.name + " view is " + std::to_string(s.width) + "x" +
+                       std::to_string(s.height));
   }
+  pool_images(cat, f, views, out.features.data() + i * f.image_features());
   const fs::path metal = d / "metal.txt";
   const std::array<uint8_t, kZones> zones =
       parse_metal_text(io::read_file(metal.string(), "metal file", io::kMaxTextBytes), metal.string());

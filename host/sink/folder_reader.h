@@ -10,11 +10,13 @@
 
 namespace portalsim {
 
-// The scenario folders under each path, in order: a path that holds upper.* itself is
-// one folder; otherwise its sub-folders are searched (sorted by name), recursively.
-std::vector<std::string> find_scenario_folders(const std::vector<std::string>& paths);
+// The scenario folders under each path, in order: a path that holds the first pooled
+// view's image (upper.*) itself is one folder; otherwise its sub-folders are searched
+// (sorted by name), recursively.
+std::vector<std::string> find_scenario_folders(const std::vector<std::string>& paths, const Catalogue& cat);
 
-// Reads folder `dir` into row i of `out` (features and metal) and returns its label.
+// Reads folder `dir` into row i of `out` (features and metal) and returns its label: the
+// pooled views' images, named as their sensors (upper, lower), pooled by pool_images.
 // Images of another size are rejected. Throws InputError naming the file and line.
 bool read_scenario_folder(const std::string& dir, const Catalogue& cat, BatchOutput& out, size_t i);
 
