@@ -44,8 +44,11 @@ TEST(ServeKnobs, ListHasEveryKnobOfTheRegistryWithItsDeclaration) {
   ASSERT_NE(model, nullptr);
   EXPECT_EQ((*model)["choices"], json({"thesis", "physics"}));
   EXPECT_EQ((*model)["default"], "thesis");
-  for (const json& e : list)
-    if (e["key"] == "netd") EXPECT_EQ(e["group"], "physics");
+  for (const json& e : list) {
+    if (e["key"] == "netd") {
+      EXPECT_EQ(e["group"], "physics");
+    }
+  }
 }
 
 // A request's fields set each knob as its flag: the same plan as set_knob on the text.
