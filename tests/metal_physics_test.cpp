@@ -1,5 +1,5 @@
 // The metal detector under --model physics: dipole fall-off, additivity, orientation,
-// jitter, the worked examples within the fit's residual, exact parity of the kernel with
+// jitter, the worked examples pinned and within the fit's residual, exact parity of the kernel with
 // the reference, and the catalogue's checks of [metal.physics].
 #include <gtest/gtest.h>
 
@@ -82,6 +82,27 @@ TEST(MetalPhysics, FieldAlongThePanelIsMinusHalfTheAxialField) {
   }
 }
 
+// Each zone has its own gain (its channel's sensitivity): doubling zone 14's doubles its
+// deduction (within rounding) and leaves every other zone as it was.
+TEST(MetalPhysics, EachZoneHasItsOwnGain) {
+  Catalogue cat = catalogue();
+  const Scenario s = parse_object_list(cat, {"none", "none", "none", "none", "none", "none", "compact-disk"});
+  std::array<uint8_t, kZones> before{}, after{};
+  reference::metal_physics(cat, assets(), physics(), s, 0, before.data());
+  const int zone = 13;
+  cat.metal_physics.gain[zone] *= 2;
+  reference::metal_physics(cat, assets(), physics(), s, 0, after.data());
+  for (int z = 0; z < kZones; ++z) {
+    const int d0 = 200 - before[z], d1 = 200 - after[z];
+    if (z == zone) {
+      ASSERT_GT(d0, 0);
+      EXPECT_NEAR(d1, 2 * d0, 1);
+    } else {
+      EXPECT_EQ(d1, d0) << "zone " << z + 1;
+    }
+  }
+}
+
 class MetalPhysicsBothBackends : public ::testing::TestWithParam<std::string> {
  protected:
   std::unique_ptr<Backend> backend() {
@@ -144,23 +165,38 @@ TEST_P(MetalPhysicsBothBackends, EveryRegionRespondsAndNonMetalDoesNot) {
   }
 }
 
-// The three worked examples come out within the fit's largest residual
-// (tools/fit_metal_coils.py reports it; README, "Metal detector physics").
-TEST_P(MetalPhysicsBothBackends, WorkedExamplesWithinTheFitResidual) {
+// The three worked examples under the physics model, pinned value by value (both backends
+// compute them exactly), and their rms residual against the thesis within the fit's
+// (docs/model/metal.md; tools/fit_metal_coils.py reports it). A refit of
+// [metal.physics] changes the pinned values: copy them from the fit's report.
+TEST_P(MetalPhysicsBothBackends, WorkedExamplesArePinnedAndNearTheThesis) {
   auto b = backend();
-  const int worst = 93;  // the gun's zone 14: physics 1, thesis 94
-  const std::vector<std::pair<std::vector<std::string>, std::vector<int>>> examples{
+  struct Example {
+    std::vector<std::string> objects;
+    std::vector<int> thesis, physics;
+    double rms_bound;  // the fit's rms residual, rounded up to 0.1
+  };
+  const std::vector<Example> examples{
       {{"none", "none", "none", "Gun"},
-       {193, 112, 75, 2, 1, 1, 96, 200, 200, 190, 196, 53, 53, 94, 64, 82, 53, 200, 200}},
+       {193, 112, 75, 2, 1, 1, 96, 200, 200, 190, 196, 53, 53, 94, 64, 82, 53, 200, 200},
+       {194, 112, 76, 2, 1, 2, 98, 199, 200, 191, 196, 54, 54, 89, 58, 85, 56, 197, 200},
+       2.3},
       {{"none", "none", "metal-barrel"},
-       {197, 131, 108, 88, 95, 106, 192, 200, 200, 197, 199, 54, 54, 75, 44, 84, 137, 200, 200}},
+       {197, 131, 108, 88, 95, 106, 192, 200, 200, 197, 199, 54, 54, 75, 44, 84, 137, 200, 200},
+       {197, 131, 104, 80, 87, 99, 189, 200, 200, 198, 199, 58, 58, 87, 55, 84, 136, 199, 200},
+       5.2},
       {{"none", "none", "Mobile", "none", "none", "none", "compact-disk"},
-       {200, 183, 165, 136, 137, 142, 193, 200, 200, 198, 199, 185, 185, 195, 176, 175, 190, 200, 200}}};
-  for (const auto& [objs, thesis] : examples) {
-    const auto got = zones(*b, objs);
-    for (int z = 0; z < kZones; ++z) EXPECT_NEAR(got[z], thesis[z], worst) << "zone " << z + 1;
+       {200, 183, 165, 136, 137, 142, 193, 200, 200, 198, 199, 185, 185, 195, 176, 175, 190, 200, 200},
+       {199, 183, 177, 170, 173, 176, 197, 199, 200, 200, 200, 166, 166, 172, 164, 178, 190, 200, 200},
+       16.6}};
+  for (const Example& e : examples) {
+    const auto got = zones(*b, e.objects);
+    EXPECT_EQ(got, e.physics) << e.objects.back();
+    double sum = 0;
+    for (int z = 0; z < kZones; ++z) sum += double(got[z] - e.thesis[z]) * (got[z] - e.thesis[z]);
+    EXPECT_LE(std::sqrt(sum / kZones), e.rms_bound) << e.objects.back();
     // The thesis model still gives the thesis's numbers exactly.
-    EXPECT_EQ(zones(*b, objs, ModelSettings{}), thesis);
+    EXPECT_EQ(zones(*b, e.objects, ModelSettings{}), e.thesis);
   }
 }
 

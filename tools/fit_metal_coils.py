@@ -12,21 +12,29 @@ The model (README, "Metal detector physics"; host/backend/reference/metal_physic
   moments tx_moment and rx_moment along x, pointing into the portal.
 - An object at p with polarizability tensor M gives H_R(p)^T M H_T(p), with the dipole
   field H(p) = (3 (m.r) r / |r|^2 - m) / (4 pi |r|^3), r = p - coil. Objects add.
-- A zone deducts D = round(gain[panel] * |sum|) (half up, at most 199) from the subject's
+- A zone deducts D = round(gain[z] * |sum|) (half up, at most 199) from the subject's
   base value; the value is clamp(base - D, 1, 200) (thesis: base 200 for subject 1).
+  gain[z] is the zone's own sensitivity: the PD 6500i sets a sensitivity per zone, and
+  each zone's receive channel has its own amplifier. Bounded to GAIN_SPREAD either side
+  of its panel's geometric mean.
 - M = m_c * 3 / (a + 2) * (I + (a - 1) u u^T): mean polarizability m_c of the object's
   metal category, anisotropy a along the drawing's long axis u (x for "h" or a single
   drawing, z for "v"). The anisotropy is the object's metal_anisotropy (1: isotropic).
 - Object position: its region's rectangle centre in its MMW view; the two MMW views
   stacked span body_height (upper view on top), x centred on the view.
 
-Fitted, by least squares: the 19 transmit and 19 receive heights, the two panel gains and
+Fitted, by least squares: the 19 transmit and 19 receive heights, the 19 zone gains and
 the polarizabilities of trace, small, medium and large metal, to the thesis's three worked
 examples (section 4.3.3 and the gun of 4.4.1), with the existing thesis table's cells as
 soft constraints (weight SOFT). Only gain * polarizability is identified, so heavy is
-held at HEAVY_CM3 as the scale. Residuals are reported on the integer zones the C++ gives.
+held at HEAVY_CM3 as the scale. A zone the thesis saturates (value 1) counts only where
+the model falls short of 199; elsewhere the residual is on the unclamped deduction, so a
+zone the model saturates still has a gradient. Residuals are reported on the integer
+zones the C++ gives, in the fit and with each example left out of it (its table cells
+too): the left-out example is then a prediction.
 
-Usage: tools/fit_metal_coils.py [scenarios/catalogue.toml]   (uses Debian's numpy/scipy)
+Usage: /usr/bin/python3 tools/fit_metal_coils.py [--loo] [scenarios/catalogue.toml]
+  (Debian's numpy/scipy); --loo adds the leave-one-example-out residuals to the report.
 """
 import math
 import os
@@ -41,9 +49,9 @@ SEPARATION = 0.76  # m, Garrett PD 6500i passage width (30 in)
 TX_MOMENT = 1.0  # A m^2; only gain * tx_moment * rx_moment is identified
 RX_MOMENT = 1.0
 HEAVY_CM3 = 100.0  # the scale anchor (see above)
+GAIN_SPREAD = 10.0  # a zone's gain within this factor of its panel's geometric mean
 SOFT = 0.05  # weight of a thesis-table cell against a worked example's zone
 PANEL_A_ZONES = 9
-STARTS = 1  # fresh least-squares starts (a thesis-like guess, then perturbed ones), besides the catalogue's
 MAX_NFEV = 400
 FIT_CATEGORIES = ["trace", "small", "medium", "large"]
 
@@ -109,65 +117,86 @@ def zone_signals(tx_h, rx_h, objects):
     return out
 
 
-def gains_of(g):
-    return np.array([g[0]] * PANEL_A_ZONES + [g[1]] * (19 - PANEL_A_ZONES))
-
-
 def deduction(gains, s):
     return np.minimum(gains * np.abs(s), 199.0)
 
 
+# The thesis table's cells that are the worked examples themselves (tools/metal_table.py
+# pins them): left out with their example.
+EXAMPLE_CELLS = [[("heavy", 4)], [("large", 3)], [("small", 3), ("trace", 7)]]
+NAMES = ["gun in region 4", "iron pipe in region 3", "mobile in region 3 + disk in region 7"]
+# Parameter vector: 19 transmit heights, 19 receive heights, 2 panel log-gains, 19 zone
+# log-gain offsets from their panel's, 4 log-polarizabilities.
+TX, RX, PANEL, OFFSET, POL = slice(0, 19), slice(19, 38), slice(38, 40), slice(40, 59), slice(59, 63)
+PANELS = [slice(0, PANEL_A_ZONES), slice(PANEL_A_ZONES, 19)]
+
+
 class Problem:
-    def __init__(self, cat):
+    def __init__(self, cat, leave_out=None):
         self.cat = cat
         self.pos = region_positions(cat)
         gun_a = anisotropy(cat, "gun")
         # (list of (category, anisotropy, axis, region), thesis zones)
-        self.examples = [
+        examples = [
             ([("heavy", gun_a, 0, 4)], GUN),
             ([("large", anisotropy(cat, "iron-pipe"), 0, 3)], PIPE),
             ([("small", anisotropy(cat, "mobile-phone"), 0, 3), ("trace", anisotropy(cat, "compact-disk"), 0, 7)],
              PHONE_DISK),
         ]
+        self.examples = examples
+        self.fitted = [i for i in range(3) if i != leave_out]
+        skip = EXAMPLE_CELLS[leave_out] if leave_out is not None else []
         cats = cat["metal"]["categories"]
         self.table = []  # (category, region, 19 deductions)
         for c in FIT_CATEGORIES + ["heavy"]:
             rows = cat["metal"]["influence"][c]
             for r in range(13):
-                self.table.append((c, r + 1, np.array(rows[r], dtype=float)))
+                if (c, r + 1) not in skip:
+                    self.table.append((c, r + 1, np.array(rows[r], dtype=float)))
         assert cats[0] == "none"
 
-    def unpack(self, th):
-        tx_h, rx_h = th[0:19], th[19:38]
-        gains = np.exp(th[38:40])
+    @staticmethod
+    def unpack(th):
+        gains = np.exp(np.concatenate([th[OFFSET][p] + th[PANEL][i] for i, p in enumerate(PANELS)]))
         pol = {"none": 0.0, "heavy": HEAVY_CM3}
         for i, c in enumerate(FIT_CATEGORIES):
-            pol[c] = math.exp(th[40 + i])
-        return tx_h, rx_h, gains, pol
+            pol[c] = math.exp(th[POL][i])
+        return th[TX], th[RX], gains, pol
 
-    def example_zones(self, th, ex, rounded=False):
+    def example_deductions(self, th, ex):
         tx_h, rx_h, gains, pol = self.unpack(th)
         objs = [(tensor(pol[c], a, axis), self.pos[r]) for c, a, axis, r in ex]
-        d = deduction(gains_of(gains), zone_signals(tx_h, rx_h, objs))
-        if rounded:
-            d = np.floor(d + 0.5)
-        return np.clip(200.0 - d, 1.0, 200.0)
+        return gains * np.abs(zone_signals(tx_h, rx_h, objs))
+
+    def example_zones(self, th, ex):
+        """The integer zones as the C++ computes them."""
+        d = np.floor(np.minimum(self.example_deductions(th, ex), 199.0) + 0.5)
+        return np.clip(200.0 - d, 1.0, 200.0).astype(int)
 
     def residuals(self, th):
         res = []
-        for ex, target in self.examples:
-            res.extend(self.example_zones(th, ex) - np.array(target, dtype=float))
+        for i in self.fitted:
+            ex, target = self.examples[i]
+            want = 200.0 - np.array(target, dtype=float)
+            r = self.example_deductions(th, ex) - want
+            sat = want >= 199.0  # the thesis's 1: anything at or past the cap
+            r[sat] = np.minimum(r[sat], 0.0)
+            res.extend(r)
         tx_h, rx_h, gains, pol = self.unpack(th)
-        g = gains_of(gains)
+        # An isotropic 1 cm^3 object in each region; the table's cells scale it.
+        unit = {r: zone_signals(tx_h, rx_h, [(np.eye(3), self.pos[r])]) for r in range(1, 14)}
         for c, r, row in self.table:
-            d = deduction(g, zone_signals(tx_h, rx_h, [(tensor(pol[c], 1.0, 0), self.pos[r])]))
-            res.extend(SOFT * (d - row))
+            res.extend(SOFT * (deduction(gains, pol[c] * unit[r]) - row))
+        # Each panel's offsets average to zero, so the panel gain is their geometric mean.
+        res.extend([np.mean(th[OFFSET][p]) for p in PANELS])
         return np.array(res)
 
 
-# Bounds: heights within the portal (0 to 2.1 m), gains and polarizabilities positive.
-LO = np.concatenate([np.full(38, 0.0), np.full(2, -20.0), np.full(4, math.log(0.01))])
-HI = np.concatenate([np.full(38, 2.1), np.full(2, 20.0), np.full(4, math.log(1000.0))])
+# Bounds: heights within the portal (0 to 2.1 m), gains and polarizabilities positive,
+# each zone's gain within GAIN_SPREAD of its panel's.
+SPREAD = math.log(GAIN_SPREAD)
+LO = np.concatenate([np.full(38, 0.0), np.full(2, -20.0), np.full(19, -SPREAD), np.full(4, math.log(0.01))])
+HI = np.concatenate([np.full(38, 2.1), np.full(2, 20.0), np.full(19, SPREAD), np.full(4, math.log(1000.0))])
 
 
 def current(problem):
@@ -176,27 +205,35 @@ def current(problem):
     if not mp:
         return None
     pol = mp["polarizability"]
-    return np.concatenate([mp["tx_height"], mp["rx_height"], np.log(mp["gain"]),
+    g = np.log(np.array(mp["gain"], dtype=float))
+    if len(g) == 2:  # the panel gains of the model before per-zone gains
+        g = np.repeat(g, [PANEL_A_ZONES, 19 - PANEL_A_ZONES])
+    panel = [np.mean(g[p]) for p in PANELS]
+    offset = np.concatenate([g[p] - panel[i] for i, p in enumerate(PANELS)])
+    return np.concatenate([mp["tx_height"], mp["rx_height"], panel, offset,
                            [math.log(max(pol[c], 1e-3)) for c in FIT_CATEGORIES]])
 
 
-def fit(problem):
+def solve(problem, th0):
+    return least_squares(problem.residuals, np.clip(th0, LO + 1e-9, HI - 1e-9), bounds=(LO, HI), x_scale="jac",
+                         max_nfev=MAX_NFEV)
+
+
+def fit(problem, start=None):
+    """From `start` alone, or else from the catalogue's values and a thesis-like guess: the better."""
+    if start is not None:
+        return solve(problem, start).x
     best = None
-    rng = np.random.default_rng(8)
     start = current(problem)
     if start is not None:
-        best = least_squares(problem.residuals, np.clip(start, LO + 1e-9, HI - 1e-9), bounds=(LO, HI),
-                             x_scale="jac", max_nfev=MAX_NFEV)
+        best = solve(problem, start)
     base_h = np.array([1.55, 1.40, 1.30, 1.15, 1.05, 0.95, 0.75, 0.45, 0.15,
                        1.65, 1.55, 1.40, 1.30, 1.15, 1.05, 0.95, 0.75, 0.45, 0.15])
-    for start in range(STARTS):
-        h0 = np.clip(base_h + rng.normal(0, 0.08 if start else 0.0, 19), 0.05, 2.0)
-        h1 = np.clip(base_h + rng.normal(0, 0.08 if start else 0.0, 19), 0.05, 2.0)
-        th0 = np.concatenate([h0, h1, [math.log(2.0), math.log(2.0)],
-                              [math.log(v) for v in (8.0, 20.0, 40.0, 70.0)]])
-        r = least_squares(problem.residuals, th0, bounds=(LO, HI), x_scale="jac", max_nfev=MAX_NFEV)
-        if best is None or r.cost < best.cost:
-            best = r
+    th0 = np.concatenate([base_h, base_h, [math.log(2.0), math.log(2.0)], np.zeros(19),
+                          [math.log(v) for v in (8.0, 20.0, 40.0, 70.0)]])
+    r = solve(problem, th0)
+    if best is None or r.cost < best.cost:
+        best = r
     return best.x
 
 
@@ -204,8 +241,11 @@ def rounded(th):
     """The parameters as written to the catalogue (so residuals are the catalogue's)."""
     out = th.copy()
     out[0:38] = np.round(th[0:38], 4)
-    out[38:40] = np.log(np.array([float("%.6g" % v) for v in np.exp(th[38:40])]))
-    out[40:44] = np.log(np.array([float("%.5g" % v) for v in np.exp(th[40:44])]))
+    g = np.array([float("%.6g" % v) for v in Problem.unpack(th)[2]])
+    lg = np.log(g)
+    out[PANEL] = [np.mean(lg[p]) for p in PANELS]
+    out[OFFSET] = np.concatenate([lg[p] - out[PANEL][i] for i, p in enumerate(PANELS)])
+    out[POL] = np.log(np.array([float("%.5g" % v) for v in np.exp(th[POL])]))
     return out
 
 
@@ -225,8 +265,9 @@ def section(problem, th):
         "# right; 10-19: on panel B; receive on the other panel). Fitted.",
         "tx_height = [%s]" % fmt(tx_h),
         "rx_height = [%s]" % fmt(rx_h),
-        "# Counts per unit of |H_R^T M H_T| (H in A/m, M in cm^3), panels A and B. Fitted.",
-        "gain = [%.6g, %.6g]" % tuple(gains),
+        "# Counts per unit of |H_R^T M H_T| (H in A/m, M in cm^3), zones 1-19: each zone's own",
+        "# sensitivity, within a factor %g of its panel's geometric mean. Fitted." % GAIN_SPREAD,
+        "gain = [%s]" % ", ".join("%.6g" % g for g in gains),
         "# Mean magnetic polarizability per metal category, cm^3 (the tensor's trace / 3, Ledger &",
         "# Lionheart). Fitted; heavy is the scale anchor (only gain * polarizability is identified).",
         "[metal.physics.polarizability]",
@@ -237,27 +278,44 @@ def section(problem, th):
     return "\n".join(lines) + "\n"
 
 
-def report(problem, th):
-    names = ["gun in region 4", "iron pipe in region 3", "mobile in region 3 + disk in region 7"]
-    worst = 0
+def rms(res):
+    return math.sqrt(np.mean(np.asarray(res, dtype=float) ** 2))
+
+
+def report(problem, th, loo=None):
+    """Per example: the zones, the residuals, their rms and max; with `loo`, the rms of
+    each example predicted by the fit without it."""
     print("zone residuals (physics - thesis), integer zones as the C++ computes them:")
-    for name, (ex, target) in zip(names, problem.examples):
-        got = problem.example_zones(th, ex, rounded=True).astype(int)
+    for i, (name, (ex, target)) in enumerate(zip(NAMES, problem.examples)):
+        got = problem.example_zones(th, ex)
         res = got - np.array(target)
-        worst = max(worst, int(np.max(np.abs(res))))
         print("  %s" % name)
         print("    physics: " + " ".join("%3d" % v for v in got))
         print("    thesis:  " + " ".join("%3d" % v for v in target))
         print("    resid:   " + " ".join("%3d" % v for v in res))
-        print("    rms %.1f, max |%d|" % (math.sqrt(np.mean(res ** 2)), int(np.max(np.abs(res)))))
-    return worst
+        line = "    rms %.1f, max |%d|" % (rms(res), int(np.max(np.abs(res))))
+        if loo is not None:
+            line += "; left out of the fit: rms %.1f, max |%d|" % loo[i]
+        print(line)
+    g = problem.unpack(th)[2]
+    print("zone gains / panel geometric mean: " + " ".join("%.2f" % v for v in
+          np.concatenate([g[p] / math.exp(np.mean(np.log(g[p]))) for p in PANELS])))
 
 
-def main():
-    path = sys.argv[1] if len(sys.argv) > 1 else "scenarios/catalogue.toml"
-    problem = Problem(load(path))
-    th = rounded(fit(problem))
-    report(problem, th)
+def leave_one_out(cat, th):
+    """Each example predicted by a fit to the other two (and the table without its cells)."""
+    out = []
+    for k in range(3):
+        p = Problem(cat, leave_out=k)
+        thk = rounded(fit(p, start=th))
+        ex, target = p.examples[k]
+        res = p.example_zones(thk, ex) - np.array(target)
+        out.append((rms(res), int(np.max(np.abs(res)))))
+    return out
+
+
+def write(path, problem, th):
+    """Replaces [metal.physics] (between its markers) in the catalogue, all or nothing."""
     text = open(path).read()
     new = section(problem, th)
     if "# BEGIN metal physics" in text:
@@ -270,6 +328,16 @@ def main():
     with open(path + ".tmp", "w") as f:
         f.write(text)
     os.replace(path + ".tmp", path)
+
+
+def main():
+    args = [a for a in sys.argv[1:] if a != "--loo"]
+    path = args[0] if args else "scenarios/catalogue.toml"
+    cat = load(path)
+    problem = Problem(cat)
+    th = rounded(fit(problem))
+    write(path, problem, th)
+    report(problem, th, leave_one_out(cat, th) if "--loo" in sys.argv[1:] else None)
 
 
 if __name__ == "__main__":

@@ -187,7 +187,7 @@ void read_metal_physics(const Reader& rd, const toml::node* node, Catalogue& cat
   mp.rx_moment = rd.number(*t, "rx_moment", f, 1e-6, 1e6);
   mp.tx_height = rd.numbers<kZones>(*t, "tx_height", f, 0.0, 5.0);
   mp.rx_height = rd.numbers<kZones>(*t, "rx_height", f, 0.0, 5.0);
-  mp.gain = rd.numbers<2>(*t, "gain", f, 0.0, 1e12);
+  mp.gain = rd.numbers<kZones>(*t, "gain", f, 0.0, 1e12);
   const toml::node* pn = rd.need(*t, "polarizability", f + ".polarizability");
   const toml::table* pol = pn->as_table();
   if (!pol) rd.fail(pn, f + ".polarizability", "expected a table of category = cm^3");

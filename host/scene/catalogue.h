@@ -110,7 +110,7 @@ struct MetalPhysics {
   double body_height = 1.75, panel_separation = 0.76;   // m
   double tx_moment = 1.0, rx_moment = 1.0;              // A m^2
   std::array<double, kZones> tx_height{}, rx_height{};  // m above the floor
-  std::array<double, 2> gain{};                         // counts per unit signal, panels A and B
+  std::array<double, kZones> gain{};                    // counts per unit signal, per zone
   std::vector<double> polarizability;                   // cm^3 per metal category
 };
 

@@ -21,6 +21,7 @@
 #include "base/error.h"
 #include "io/input_file.h"
 #include "plan/knobs.h"
+#include "serve/knob_fields.h"
 #include "serve/one_scenario.h"
 #include "sink/staging.h"
 
@@ -156,15 +157,6 @@ struct Server::Impl {
     r.in.threat = field<std::string>(j, "threat", "");
     r.seed = field<std::string>(j, "seed", "0");
     r.tier = field<std::string>(j, "tier", "standard");
-    // The page's knobs, checked as their flags are.
-    const auto knob = [&](const char* key, const std::string& text) {
-      const Knob& k = *find_knob(key);
-      set_knob(r.plan, k, text, k.flag());
-    };
-    knob("pattern_noise", field<bool>(j, "pattern_noise", true) ? "on" : "off");
-    knob("pixel_noise", knob_text(field<double>(j, "pixel_noise", 0.0)));
-    knob("placement", field<std::string>(j, "placement", "integer"));
-    knob("palette", field<std::string>(j, "palette", "ironbow"));
     if (r.in.objects.size() > static_cast<size_t>(kRegions))
       throw InputError("objects: " + std::to_string(r.in.objects.size()) + " given, at most 13 regions");
     r.plan.model.seed = io::parse_u64(r.seed, "--seed");
@@ -172,6 +164,7 @@ struct Server::Impl {
     if (r.tier != "fast" && r.tier != "standard" && r.tier != "exact")
       throw InputError("--tier: " + r.tier + " not in {fast,standard,exact}");
     r.plan.fidelity = tier_fidelity(parse_tier(r.tier, "--tier"));
+    apply_knobs(j, r.plan);  // every knob of the registry, checked as its flag is; after the tier
     validate(r.plan, cat);
     return r;
   }
@@ -286,8 +279,11 @@ struct Server::Impl {
                                   "both",
                                   "--batch",
                                   "64"};
-    for (const Knob& k : knobs())  // the page's model, knob by knob; the tier sets the rest
-      if (!k.fidelity) args.insert(args.end(), {k.flag(), knob_text(k.get(r.plan))});
+    // The page's model, knob by knob; a fidelity knob only where it overrides the tier.
+    Plan tier;
+    tier.fidelity = tier_fidelity(parse_tier(r.tier, "--tier"));
+    for (const Knob& k : knobs())
+      if (!k.fidelity || k.get(r.plan) != k.get(tier)) args.insert(args.end(), {k.flag(), knob_text(k.get(r.plan))});
     if (!r.in.rule.empty()) args.insert(args.end(), {"--rule", r.in.rule});
     args.insert(args.end(), opt.session.begin(), opt.session.end());
     if (job_waiter.joinable()) job_waiter.join();
@@ -399,6 +395,9 @@ struct Server::Impl {
     http.Get("/style.css", page(embedded::serve_style_css, "text/css"));
     http.Get("/api/catalogue", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(catalogue().dump(), "application/json");
+    });
+    http.Get("/api/knobs", [](const httplib::Request&, httplib::Response& res) {
+      res.set_content(knob_list().dump(), "application/json");
     });
     http.Post("/api/render", [this](const httplib::Request& q, httplib::Response& r) { api(q, r, &Impl::render); });
     http.Post("/api/save", [this](const httplib::Request& q, httplib::Response& r) { api(q, r, &Impl::save); });

@@ -77,7 +77,7 @@ void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSett
     double signal = 0;
     for (const MetalObject& o : objects) signal += zone_signal(mp, z, o);
     // Rounded half up; anything at or past the cap (or not finite, an object on a coil) is the cap.
-    const double t = mp.gain[z < PS_METAL_PANEL_A_ZONES ? 0 : 1] * std::fabs(signal);
+    const double t = mp.gain[z] * std::fabs(signal);
     constexpr int kMaxDeduction = 199;  // a zone reads at least 1 from its base of 200
     const int deduction = t < kMaxDeduction ? static_cast<int>(std::floor(t + 0.5)) : kMaxDeduction;
     int value = cat.subjects[s.subject].base_zones[z] - deduction;

@@ -3,17 +3,57 @@
 "use strict";
 const $ = (id) => document.getElementById(id);
 let cat = null;
+let knobs = [];
 let pending = 0;
 
 function settings() {
   const objects = [];
   for (let r = 1; r <= cat.regions.length; ++r) objects.push($("region" + r).value);
-  return {
-    subject: Number($("subject").value), seed: $("seed").value, tier: $("tier").value, placement: $("placement").value,
-    palette: $("palette").value,
-    pattern_noise: $("pattern-noise").checked, pixel_noise: Number($("pixel-noise").value),
+  const s = {
+    subject: Number($("subject").value), seed: $("seed").value, tier: $("tier").value,
     rule: $("rule").value.trim(), threat: $("threat").value, objects,
   };
+  // Every knob as its flag takes it; an empty fidelity knob leaves the tier's value.
+  for (const k of knobs) {
+    const c = $("knob-" + k.key);
+    const v = c.type === "checkbox" ? (c.checked ? "on" : "off") : c.value.trim();
+    if (v !== "") s[k.key] = v;
+  }
+  return s;
+}
+
+// One control per knob of the registry (/api/knobs), by its kind: a checkbox for on/off,
+// a list for a choice, a number field within the knob's range, text for WxH and A..B.
+function knobControl(k) {
+  let c;
+  if ((k.fidelity && k.choices.length) || k.kind === "choice") {
+    c = document.createElement("select");
+    if (k.fidelity) option(c, "", "from the tier (" + k.default + ")");
+    k.choices.forEach((v) => option(c, v));
+    c.value = k.fidelity ? "" : k.default;
+  } else if (k.kind === "on_off") {
+    c = document.createElement("input");
+    c.type = "checkbox";
+    c.checked = k.default === "on";
+  } else {
+    c = document.createElement("input");
+    if (k.kind === "integer" || k.kind === "number") {
+      c.type = "number";
+      c.min = k.min; c.max = k.max; c.step = k.kind === "integer" ? "1" : "any";
+    }
+    c.value = k.fidelity ? "" : k.default;
+    if (k.fidelity) c.placeholder = "from the tier (" + k.default + ")";
+  }
+  c.id = "knob-" + k.key;
+  c.title = k.help + " (" + k.flag + ": " + k.values + ")";
+  c.addEventListener("change", render);
+  const row = document.createElement("div");
+  row.className = "row knob";
+  const label = document.createElement("label");
+  label.htmlFor = c.id;
+  label.textContent = k.key.replaceAll("_", " ") + (k.unit ? " (" + k.unit + ")" : "");
+  row.append(label, c);
+  $(k.fidelity ? "knobs-fidelity" : "knobs-" + k.group).appendChild(row);
 }
 
 async function post(path, body) {
@@ -45,9 +85,20 @@ async function render() {
     drawZones(out.metal);
     $("label").textContent = "Threat: " + (out.threat ? "yes" : "no");
     $("error").textContent = "";
+    if ($("side-by-side").checked) await compare(ticket);
     document.body.dataset.rendered = String(ticket);
   } catch (e) {
     if (ticket === pending) $("error").textContent = e.message;
+  }
+}
+
+// The same scenario and knobs under each model, in two columns.
+async function compare(ticket) {
+  for (const model of ["thesis", "physics"]) {
+    const out = await post("/api/render", { ...settings(), model });
+    if (ticket !== pending) return;
+    for (const v of ["upper", "lower", "ir"]) $(model + "-" + v).src = out[v];
+    $(model + "-zones").value = out.metal.join(",");
   }
 }
 
@@ -68,6 +119,8 @@ function regionChanged(r) {
 
 async function init() {
   cat = await (await fetch("/api/catalogue")).json();
+  knobs = await (await fetch("/api/knobs")).json();
+  knobs.forEach(knobControl);
   cat.subjects.forEach((s, i) => option($("subject"), i + 1, (i + 1) + " " + s));
   cat.tiers.forEach((t) => option($("tier"), t));
   $("tier").value = "standard";
@@ -104,8 +157,12 @@ async function init() {
     row.innerHTML = '<span class="name">' + z + '</span><div class="bar"><div></div></div><span class="value"></span>';
     $(z <= 9 ? "panel-a" : "panel-b").appendChild(row);
   }
-  for (const id of ["subject", "seed", "tier", "placement", "palette", "pattern-noise", "pixel-noise", "rule", "threat"])
+  for (const id of ["subject", "seed", "tier", "rule", "threat"])
     $(id).addEventListener("change", render);
+  $("side-by-side").addEventListener("change", () => {
+    $("compare-views").hidden = !$("side-by-side").checked;
+    render();
+  });
   $("subject").addEventListener("change", placeHits);
   $("save").addEventListener("click", save);
   $("generate").addEventListener("click", generate);

@@ -24,7 +24,7 @@ MetalPath::MetalPath(Device& d) : d_(d) {
     rec[PS_MZ_RX_X] = -side * mp.panel_separation / 2.0;
     rec[PS_MZ_RX_Z] = mp.rx_height[z];
     rec[PS_MZ_RX_M] = side * mp.rx_moment;
-    rec[PS_MZ_GAIN] = mp.gain[z < PS_METAL_PANEL_A_ZONES ? 0 : 1];
+    rec[PS_MZ_GAIN] = mp.gain[z];
   }
   double row_offset = 0;  // the MMW views stacked, the first on top
   for (const Sensor& s : cat.sensors) {
