@@ -16,6 +16,7 @@
 #include "base/parallel.h"
 #include "schedule/dataset_card.h"
 #include "schedule/identity.h"
+#include "schedule/run_state.h"
 #include "sink/coco.h"
 #include "sink/h5_file.h"
 #include "sink/output_folder.h"
@@ -107,7 +108,7 @@ void draw_progress(uint64_t done, uint64_t total, double seconds) {
 class ScenarioSource {
  public:
   ScenarioSource(const RunSpec& spec, const Catalogue& cat) {
-    if (!spec.rule.empty()) rule_.emplace(cat, spec.rule, "--rule");
+    if (!spec.rule.empty()) rule_.emplace(cat, spec.rule, spec.where("rule"));
     if (!spec.scenarios.empty()) {
       std::vector<ListedTransforms> recorded;
       listed_ = read_scenario_file(cat, spec.scenarios, &recorded);
@@ -173,9 +174,9 @@ bool finished_run_here(const std::string& dir, const json& identity, bool resume
                       "only checks that it is complete)");
   json manifest;
   try {
-    manifest = json::parse(read_state_file(manifest_path.string()));
-  } catch (const json::exception& e) {
-    throw OutputError(dir + "/manifest.json: unreadable: " + e.what());
+    manifest = parse_manifest(read_state_file(manifest_path.string()), manifest_path.string());
+  } catch (const InputError& e) {  // the folder is the run's output
+    throw OutputError(e.what());
   }
   json was = json::object();
   for (const auto& [k, v] : identity.items()) was[k] = manifest.value(k, json());
@@ -183,25 +184,6 @@ bool finished_run_here(const std::string& dir, const json& identity, bool resume
     throw InputError("--resume: " + dir + " holds a finished run with other parameters: " + diff +
                      "; give the same parameters, or another folder");
   return true;
-}
-
-// A checkpoint's fields have the types the resume reads (a hand-edited or damaged one gets
-// a message naming the field, not a JSON library's).
-void check_checkpoint(const json& c, const std::string& path) {
-  const auto whole = [&](const json& j, const std::string& field) {
-    if (!j.is_number_unsigned()) throw OutputError(path + ": " + field + ": expected a whole number");
-  };
-  if (!c.is_object()) throw OutputError(path + ": expected a JSON object");
-  for (const char* k : {"next", "positive", "negative"}) whole(c.contains(k) ? c[k] : json(), k);
-  if (!c.contains("files") || !c["files"].is_array()) throw OutputError(path + ": files: expected an array");
-  for (size_t i = 0; i < c["files"].size(); ++i) {
-    const json& f = c["files"][i];
-    const std::string at = "files[" + std::to_string(i) + "]";
-    if (!f.is_object() || !f.contains("name") || !f["name"].is_string())
-      throw OutputError(path + ": " + at + ".name: expected a string");
-    whole(f.contains("bytes") ? f["bytes"] : json(), at + ".bytes");
-    whole(f.contains("xxh3") ? f["xxh3"] : json(), at + ".xxh3");
-  }
 }
 
 // What the output folder holds, read with its lock held: new (or a run stopped before its
@@ -220,12 +202,7 @@ FolderStart examine_folder(const std::string& dir, const json& identity, bool re
     return start;
   }
   if (resume && fs::exists(checkpoint_path, ec)) {
-    try {
-      start.checkpoint = json::parse(read_state_file(checkpoint_path.string()));
-    } catch (const json::exception& e) {
-      throw OutputError(checkpoint_path.string() + ": unreadable checkpoint: " + e.what());
-    }
-    check_checkpoint(start.checkpoint, checkpoint_path.string());
+    start.checkpoint = parse_checkpoint(read_state_file(checkpoint_path.string()), checkpoint_path.string());
     if (const std::string diff = differing_keys(start.checkpoint.value("identity", json::object()), identity);
         !diff.empty())
       throw InputError("--resume: " + dir + " was made by a different run: " + diff +
