@@ -12,6 +12,7 @@
 #include "assets/image_io.h"
 #include "calibrate/captures.h"
 #include "calibrate/fit.h"
+#include "plan/knobs.h"
 #include "run_binary.h"
 #include "scene/catalogue.h"
 
@@ -75,6 +76,15 @@ fs::path make_captures(const TempDir& t, const Camera& cam, int count, uint64_t 
                                 "--out",
                                 dir.string(),
                                 "--quiet"};
+  // The camera calibrate fits: one frame, a fixed window, bilinear display, no smoothing,
+  // said outright where this build has those knobs (their defaults may differ).
+  const std::pair<const char*, std::string> camera[] = {
+      {"frames", "1"},
+      {"window", std::to_string(cam.display_min) + ".." + std::to_string(cam.display_max)},
+      {"display_filter", "bilinear"},
+      {"smooth", "0"}};
+  for (const auto& [key, value] : camera)
+    if (const portalsim::Knob* k = portalsim::find_knob(key)) args.insert(args.end(), {k->flag(), value});
   args.insert(args.end(), extra.begin(), extra.end());
   const auto r = run(t, args);
   EXPECT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
