@@ -10,7 +10,9 @@ StreamDataset: scenarios straight from the kernels, no file written.
 
 Sample i is generate's row i (the same for any number of DataLoader workers or
 torch.distributed ranks): the index range start..start+count is dealt out in blocks of
-`batch` scenarios, block j to shard j mod (ranks x workers). Each worker makes its own
+`batch` scenarios, block j to shard j mod (ranks x workers). Make the dataset after
+torch.distributed.init_process_group, or launch with torchrun (RANK, WORLD_SIZE): DataLoader
+workers do not see the process group. Each worker makes its own
 OpenCL context when it starts iterating (after the fork: a context made before a fork hangs
 PoCL), with POCL_MAX_PTHREAD_COUNT set so that workers x threads fit the cores.
 
@@ -133,13 +135,22 @@ def _channels(arrays, views):
     return planes[0] if len(planes) == 1 else np.concatenate(planes, axis=1)
 
 
-def _shard():
-    """(this process's shard, shards): torch.distributed's rank x DataLoader's worker."""
+def _ranks(made_at=(0, 1)):
+    """(rank, ranks) of torch.distributed: its process group where this process sees one
+    initialised; in a DataLoader worker (which does not) the RANK and WORLD_SIZE that torchrun
+    and other launchers set, or else `made_at`, the group the dataset was made in."""
+    if torch.distributed.is_available() and torch.distributed.is_initialized():
+        return torch.distributed.get_rank(), torch.distributed.get_world_size()
+    if os.environ.get("RANK", "").isdigit() and os.environ.get("WORLD_SIZE", "").isdigit():
+        return int(os.environ["RANK"]), int(os.environ["WORLD_SIZE"])
+    return made_at
+
+
+def _shard(made_at):
+    """(this process's shard, shards, workers): torch.distributed's rank x DataLoader's worker."""
     info = get_worker_info()
     worker, workers = (info.id, info.num_workers) if info is not None else (0, 1)
-    rank, ranks = 0, 1
-    if torch.distributed.is_available() and torch.distributed.is_initialized():
-        rank, ranks = torch.distributed.get_rank(), torch.distributed.get_world_size()
+    rank, ranks = _ranks(made_at)
     return rank * workers + worker, ranks * workers, workers
 
 
@@ -176,6 +187,7 @@ class StreamDataset(IterableDataset):
         self.views, self.target = tuple(views), target
         self.start, self.count, self.batch, self.batched, self.scale = int(start), count, int(batch), batched, scale
         self.indices = indices
+        self.ranks = _ranks()  # a worker, forked later, no longer sees the process group
         keywords.setdefault("what", "images" if self.views else "features")
         if target == "mask":
             keywords["annotations"] = True
@@ -218,7 +230,7 @@ class StreamDataset(IterableDataset):
         return x, y
 
     def __iter__(self):
-        shard, shards, workers = _shard()
+        shard, shards, workers = _shard(self.ranks)
         keywords = dict(self.keywords)
         if get_worker_info() is not None:
             keywords.setdefault("threads", _threads_per_worker(workers))
