@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "backend/opencl/display_tables.h"
 #include "backend/opencl/gauss_table.h"
 #include "backend/opencl/raw_grid_pooling.h"
 #include "backend/stages.h"
@@ -380,6 +381,8 @@ class OpenCLBackend final : public Backend {
     std::memcpy(L.ranges_fp64, ranges, sizeof ranges);  // little-endian host and device: low word first
     L.raw_width = plan.model.raw_width;
     L.raw_height = plan.model.raw_height;
+    L.frames = kernel_frames(plan);
+    L.window_auto = plan.model.window_auto;
     L.subjects = static_cast<int32_t>(cat_.subjects.size());
     const std::vector<std::string>& chain = s.chain_for(plan.model.model);
     const bool fused = plan.fidelity.fused && chain == fused_chain();
@@ -429,7 +432,9 @@ class OpenCLBackend final : public Backend {
     if (raw_only && !physics_fast) throw std::logic_error("the raw grid alone needs the physics fast path");
     if (physics_fast) {
       launch(stage_kernel(K, "physics_raw"), n);
-      if (!raw_only) launch(stage_kernel(K, "stage_mmw_display"), n);
+      if (raw_only) return;
+      if (plan.model.window_auto) launch(stage_kernel(K, "stage_window"), n);
+      launch(stage_kernel(K, "stage_mmw_display"), n);
       return;
     }
     const auto per_scenario = [&](StageItems items) -> size_t {
@@ -487,9 +492,10 @@ class OpenCLBackend final : public Backend {
     L.psf_radius = L.phys_wx = L.phys_wy = L.phys_cband = L.phys_rband = L.phys_base = L.phys_gauss = 0;
     if (plan.model.model != Model::physics) return physics_none_.at_least(rt_->context(), 16);
     const ModelSettings& m = plan.model;
-    char key[200];
-    std::snprintf(key, sizeof key, "%d %d %a %a %a %a %d %d", view, int(K.fp64), m.illumination, m.netd, m.ir_netd,
-                  m.worn_minutes, m.raw_width, m.raw_height);
+    char key[300];
+    std::snprintf(key, sizeof key, "%d %d %a %a %a %a %d %d %a %a %a %d %a", view, int(K.fp64), m.illumination,
+                  kernel_netd(plan), m.ir_netd, m.worn_minutes, m.raw_width, m.raw_height, m.window_lo, m.window_hi,
+                  m.smooth, int(m.display_filter), double(m.frames));
     PhysicsTables& t = physics_tables_[key];
     if (t.values.empty()) t = physics_tables(plan, cat_.sensors[view], view);
     L.psf_radius = t.radius;
@@ -499,6 +505,11 @@ class OpenCLBackend final : public Backend {
     L.phys_rband = t.rband;
     L.phys_base = t.base;
     L.phys_gauss = t.gauss;
+    L.display_stride = t.display.stride;
+    L.phys_dx = t.display.dx;
+    L.phys_dxband = t.display.dxband;
+    L.phys_dy = t.display.dy;
+    L.phys_dyband = t.display.dyband;
     if (!t.buffer()) {
       t.buffer = K.fp64 ? constant(rt_->context(), t.values)
                         : constant(rt_->context(), std::vector<cl_float>(t.values.begin(), t.values.end()));
@@ -509,6 +520,7 @@ class OpenCLBackend final : public Backend {
   struct PhysicsTables {
     std::vector<double> values;
     int32_t radius = 0, wx = 0, wy = 0, cband = 0, rband = 0, base = 0, gauss = 0;
+    DisplayTables display;
     cl::Buffer buffer;
   };
 
@@ -565,9 +577,9 @@ class OpenCLBackend final : public Backend {
     std::vector<double>& p = t.values;
     p.assign(PS_PHYS_SUBJECTS, 0.0);
     p[PS_PHYS_BACKGROUND] = pc.background_temperature;
-    p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : pc.display_min;
-    p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : pc.display_max;
-    p[PS_PHYS_NETD] = ir ? m.ir_netd : m.netd;
+    p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : m.window_lo;
+    p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : m.window_hi;
+    p[PS_PHYS_NETD] = ir ? m.ir_netd : kernel_netd(plan);
     // Per subject, its base image's value to kelvin: the IR index map, or the MMW's gray
     // between the room behind and the bare body.
     const double body = seen(pc.skin_emissivity, pc.skin_temperature);
@@ -609,6 +621,7 @@ class OpenCLBackend final : public Backend {
     t.wy = append(wy);
     t.cband = append(cband);
     t.rband = append(rband);
+    t.display = append_display_tables(p, m, W, H, RW, RH);
     // Each subject's bare raw grid: wy . T . wx^T over its base image in kelvin.
     std::vector<double> bare(cat_.subjects.size() * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
     for (size_t subj = 0; subj < cat_.subjects.size(); ++subj) {
@@ -761,7 +774,7 @@ class OpenCLBackend final : public Backend {
       k.setArg(a++, t.object_range);
       k.setArg(a++, t.object_feature);
       k.setArg(a++, t.object_value);
-      set_param(K, k, a++, plan.model.netd);
+      set_param(K, k, a++, kernel_netd(plan));
       k.setArg(a++, t.dims);
       k.setArg(a++, t.noise);
       // Work spaces too large for private memory take global scratch, 64 MiB at most: a

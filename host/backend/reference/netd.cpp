@@ -37,7 +37,7 @@ double normal_quantile(double q) {
 
 // Gaussian noise of `sd` kelvin rms on each value of f: cell p's table Gaussian of the
 // counter generator's `stream` (kernels/shared.h, PS_GAUSS_ELEMENT): the top PS_GAUSS_BITS
-// of a 16-bit half of a draw's word as k, then Phi^-1((k + 1/2) / PS_GAUSS_TABLE).
+// of a 16-bit half of a draw's word as k, then Phi^-1((k + 1/2) / PS_GAUSS_TABLE), times sd.
 void add_noise(const ViewScene& vs, Field& f, double sd, uint32_t stream) {
   if (sd <= 0) return;
   for (int p = 0; p < f.width * f.height; ++p) {
@@ -49,8 +49,14 @@ void add_noise(const ViewScene& vs, Field& f, double sd, uint32_t stream) {
 
 }  // namespace
 
-// The MMW camera's NETD, per raw pixel.
-void netd(const ViewScene& vs, Field& f) { add_noise(vs, f, vs.model.netd, kStreamRawNoise); }
+// The MMW camera's NETD, per raw pixel, integrated over `frames` raw frames: the scene holds
+// still while the camera averages them, so each frame adds its own draw of NETD / frames
+// (frame 0 from the raw-noise stream, frame k from PS_STREAM_FRAME_NOISE + k).
+void netd(const ViewScene& vs, Field& f) {
+  const int n = vs.model.frames;
+  for (int k = 0; k < n; ++k)
+    add_noise(vs, f, vs.model.netd / n, k == 0 ? kStreamRawNoise : PS_STREAM_FRAME_NOISE + uint32_t(k));
+}
 
 // The IR camera's NETD, per view pixel.
 void ir_netd(const ViewScene& vs, Field& f) { add_noise(vs, f, vs.model.ir_netd, kStreamIrNoise); }
