@@ -49,9 +49,9 @@ struct ModelSettings {
   // (room 293 K and body 298.6 K well inside it, 3 sigma of noise unclipped) or set per
   // image from the raw grid's 1st and 99th percentiles (window_auto); the interpolation
   // from the raw grid to the view, and a Gaussian of `smooth` view pixels.
-  int frames = 1;
+  int frames = 10;
   bool window_auto = false;
-  double window_lo = 285.0, window_hi = 305.0;
+  double window_lo = 290.0, window_hi = 302.0;
   DisplayFilter display_filter = DisplayFilter::bilinear;
   double smooth = 0.0;
   bool transforms() const { return rotate_lo != 0 || rotate_hi != 0 || scale_lo != 1 || scale_hi != 1 || flip; }
