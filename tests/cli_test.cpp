@@ -680,6 +680,27 @@ TEST(CliOutput, NoFoldersLeftWhenTheDiskFillsAfterCreatingThem) {
   EXPECT_TRUE(x.left.empty()) << "left behind: " << testing::PrintToString(x.left);
 }
 
+// A disk already full (a file fills the 64 KiB tmpfs first): the first write that fails is
+// the lock's PID in OUT/.portalsim/lock. Nothing of the run's may stay: not .portalsim/,
+// not OUT/ when the run made it, and an OUT/ that was there stays as it was.
+TEST(CliOutput, NothingLeftWhenTheDiskIsFullFromTheStart) {
+  for (const bool out_exists : {false, true}) {
+    SCOPED_TRACE(out_exists ? "out/ exists" : "out/ is made by the run");
+    TempDir t;
+    const fs::path mnt = t.w() / "mnt", out = mnt / "out";
+    const std::string fill = "(dd if=/dev/zero of=" + quoted((mnt / "fill").string()) + " bs=4k 2>/dev/null; true)";
+    const TmpfsRun x = run_on_tmpfs(
+        t, "64k", false, out_exists ? "mkdir " + quoted(out.string()) + " && " + fill : fill, simulate({"gun"}, out));
+    ExpectCleanFailure(x.r, out, false, {});
+    EXPECT_EQ(x.r.status, 4) << "a full disk is an output problem\n" << describe(x.r);
+    std::vector<std::string> left = x.left;
+    std::sort(left.begin(), left.end());
+    const std::vector<std::string> want =
+        out_exists ? std::vector<std::string>{"./fill", "./out"} : std::vector<std::string>{"./fill"};
+    EXPECT_EQ(left, want);
+  }
+}
+
 TEST(CliOutput, FeaturesOnAFullDiskLeavesNoPartialFile) {
   TempDir t;
   const fs::path scans = t.w() / "scans";

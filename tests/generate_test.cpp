@@ -86,12 +86,7 @@ void send_signal(const Started& r, int sig) {
   if (r.pid > 0) ::kill(r.pid, sig);
 }
 
-// True once the process has ended (without reaping it).
-bool has_ended(const Started& r) {
-  siginfo_t info{};
-  if (::waitid(P_PID, static_cast<id_t>(r.pid), &info, WEXITED | WNOHANG | WNOWAIT) != 0) return true;
-  return info.si_pid != 0;
-}
+using portalsim::test::has_ended;
 
 RunResult wait_for(const Started& r, int limit_s = 120) { return portalsim::test::finish(r, limit_s); }
 
@@ -352,18 +347,19 @@ Npy parse_npy(const std::string& bytes) {
 using portalsim::test::checkpoint_next;
 
 // Polls the run's checkpoint until "next" reaches `at_least` (-1: the checkpoint just exists).
-// False when the run ended first or 60 s passed.
+// False when the run ended first or the (scaled) limit passed.
 bool wait_for_checkpoint(const Started& r, const fs::path& dir, long long at_least) {
   // Generous: under the sanitizers on a loaded 2-core machine the kernel build alone can
   // take a minute.
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(300);
-  while (std::chrono::steady_clock::now() < deadline) {
-    const long long next = checkpoint_next(dir);
-    if (next >= 0 && next >= at_least) return true;
-    if (has_ended(r)) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return false;
+  bool reached = false;
+  portalsim::test::wait_until(
+      [&] {
+        const long long next = checkpoint_next(dir);
+        reached = next >= 0 && next >= at_least;
+        return reached || has_ended(r);
+      },
+      300, 5);
+  return reached;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -714,16 +710,13 @@ TEST(GenerateResume, KillNineThenResumeMatchesAnUninterruptedRun) {
   const fs::path dir = t.w() / "killed", ref = t.w() / "ref";
   const Started reference = start_ps(t, gen(with(kLongSpec, "--batch", "1000"), ref));
   const Started victim = start_ps(t, gen(kLongSpec, dir));
-  const bool progressed = wait_for_checkpoint(victim, dir, 1);
-  send_signal(victim, SIGKILL);
-  const RunResult k = wait_for(victim);
+  const portalsim::test::Killed killed = portalsim::test::kill_mid_run(victim, dir, 1, 300);
+  const RunResult& k = killed.result;
   ExpectOk(wait_for(reference));
-  ASSERT_TRUE(progressed) << "the run never checkpointed progress\n" << describe_run(k);
   ASSERT_TRUE(k.signaled && k.signal == SIGKILL) << "the run ended before it could be killed; make kLongSpec longer\n"
                                                  << describe_run(k);
-  const long long next = checkpoint_next(dir);
-  EXPECT_GT(next, 0);
-  EXPECT_LT(next, 30000);
+  ASSERT_TRUE(killed.next > 0 && killed.next < 30000) << "the kill must come mid-run: next " << killed.next;
+  EXPECT_EQ(checkpoint_next(dir), killed.next) << "the checkpoint is the one the kill left";
   ExpectInterruptedState(dir, {"features.csv", "features.npy", "scenarios.csv"});
 
   // Resume with other batch and thread counts: they are not part of the spec.
@@ -784,12 +777,11 @@ TEST(GenerateResume, ImagesKillNineThenResumeMatchesAnUninterruptedRun) {
   const fs::path dir = t.w() / "killed", ref = t.w() / "ref";
   const Started reference = start_ps(t, gen(with(spec, "--batch", "50"), ref));
   const Started victim = start_ps(t, gen(spec, dir));
-  const bool progressed = wait_for_checkpoint(victim, dir, 1);
-  send_signal(victim, SIGKILL);
-  const RunResult k = wait_for(victim);
+  const portalsim::test::Killed killed = portalsim::test::kill_mid_run(victim, dir, 1, 300);
+  const RunResult& k = killed.result;
   ExpectOk(wait_for(reference));
-  ASSERT_TRUE(progressed) << describe_run(k);
   ASSERT_TRUE(k.signaled) << "the run ended before it could be killed\n" << describe_run(k);
+  ASSERT_TRUE(killed.next > 0 && killed.next < 160) << "the kill must come mid-run: next " << killed.next;
   ExpectInterruptedState(dir, {"features.csv", "scenarios.csv"});
   const RunResult r = run_ps(t, gen(plus(spec, {"--resume"}), dir));
   ExpectOk(r);
@@ -888,6 +880,32 @@ TEST(GenerateResume, ResumeIntoAFolderWithoutACheckpointSaysSo) {
   EXPECT_FALSE(has(r.err, "use --resume")) << "--resume was given; telling the user to use it does not help";
   EXPECT_EQ(entries_of(dir), std::vector<std::string>{"notes.txt"});
   EXPECT_EQ(read_all(dir / "notes.txt"), "mine\n");
+}
+
+// A finished folder whose manifest.json is damaged (valid JSON of the wrong shape, as the
+// manifest fuzz target first found, or a field of the wrong type): --resume refuses it
+// naming the file and the field, exit 4, and changes nothing.
+TEST(GenerateResume, DamagedManifestIsRefusedNamingIt) {
+  GenTempDir t;
+  const fs::path dir = t.w() / "done";
+  const Args spec{"--count", "5", "--quiet"};
+  ExpectOk(run_ps(t, gen(spec, dir)));
+  const std::string good = read_all(dir / "manifest.json");
+  json wrong_count = json::parse(good);
+  wrong_count["count"] = "5";
+  for (const auto& [text, field] : std::vector<std::pair<std::string, std::string>>{
+           {"[]", "expected a JSON object"}, {"1", "expected a JSON object"}, {wrong_count.dump(), "count"}}) {
+    SCOPED_TRACE(text.substr(0, 40));
+    write_all(dir / "manifest.json", text);
+    const auto before = snapshot(dir);
+    const RunResult r = run_ps(t, gen(plus(spec, {"--resume"}), dir));
+    SCOPED_TRACE(describe_run(r));
+    EXPECT_TRUE(r.exited && r.status == 4) << "a damaged run folder is an output problem";
+    EXPECT_EQ(stderr_messages(r.err).size(), 1u);
+    EXPECT_TRUE(has(r.err, (dir / "manifest.json").string()));
+    EXPECT_TRUE(has(r.err, field));
+    EXPECT_TRUE(snapshot(dir) == before);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

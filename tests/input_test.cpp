@@ -180,10 +180,9 @@ TEST(InputFiles, FifoDeviceFolderAndHugeFilesAreRefusedWithoutBlocking) {
   for (const Case& c : cases) {
     Args a = c.args;
     if (a[0] == "generate") a.insert(a.end(), {"--out", out.string(), "--quiet"});
-    const auto t0 = std::chrono::steady_clock::now();
-    const Result r = run(t, a, 20);
-    ExpectExit(r, 3, {c.path, c.kind});
-    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(15));
+    // A run that blocked on the FIFO would hang: run's limit (a hang detector) ends it,
+    // and ExpectExit fails on its status.
+    ExpectExit(run(t, a, 20), 3, {c.path, c.kind});
     EXPECT_FALSE(fs::exists(out)) << "nothing is made for a refused input";
   }
   // A sparse file over the documented cap is refused by its size, before it is read.
@@ -221,6 +220,15 @@ TEST(InputFiles, HostileTextIsRefusedNamingFileLineAndField) {
   const std::string big = file("big.toml", "count = 99999999999999\n");
   const std::string twice = file("twice.toml", "count = 5\ncount = 6\n");
   const std::string longf = file("long.csv", kHeader + "\n1," + std::string(300, 'g') + empty_row + "\n");
+  // Quoting as RFC 4180 reads it: "gun,none" is one field (no object of that name), not two.
+  std::string nones;
+  for (int r = 0; r < 12; ++r) nones += ",none";
+  const std::string quoted_comma = file("quoted.csv", kHeader + "\n1,\"gun,none\"" + nones + "\n");
+  const std::string short_row = file("short.csv", kHeader + "\n1,\"gun,none\",none" + nones.substr(5 * 2) + "\n");
+  const std::string stray = file("stray.csv", kHeader + "\n1,gu\"n" + nones + "\n");
+  const std::string open = file("open.csv", kHeader + "\n1,none,\"gun" + nones.substr(5) + "\n");
+  const std::string after = file("after.csv", kHeader + "\n1,\"gun\"x" + nones + "\n");
+  const std::string bad_rule = file("rule.toml", "count = 5\n\nrule = \"gun&\"\n");
   std::string cat = slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "catalogue.toml");
   cat.insert(cat.find("\n", cat.find("[[subjects]]")) + 1, "mmw_uper = \"u.png\"\n");
   const std::string typo = file("typo.toml", cat);
@@ -234,6 +242,12 @@ TEST(InputFiles, HostileTextIsRefusedNamingFileLineAndField) {
       {{"generate", "--spec", big}, {big + ":1", "count", "out of range"}},
       {{"generate", "--spec", twice}, {twice + ":2", "count"}},
       {{"generate", "--scenarios", longf}, {longf + ":2", "column 2", "longer than 256"}},
+      {{"generate", "--scenarios", quoted_comma}, {quoted_comma + ":2", "region1", "unknown object \"gun,none\""}},
+      {{"generate", "--scenarios", short_row}, {short_row + ":2", "expected 14 fields, found 13"}},
+      {{"generate", "--scenarios", stray}, {stray + ":2", "column 2", "a quote inside an unquoted field"}},
+      {{"generate", "--scenarios", open}, {open + ":2", "column 3", "not closed on its line"}},
+      {{"generate", "--scenarios", after}, {after + ":2", "column 2", "after the closing quote"}},
+      {{"generate", "--spec", bad_rule}, {bad_rule + ":3: rule", "\"gun&\" at character 5"}},
       {{"catalogue", "--catalogue", typo}, {typo + ":", "subjects[1].mmw_uper", "did you mean mmw_upper?"}},
   };
   for (const Case& c : cases) {
@@ -248,6 +262,21 @@ TEST(InputFiles, HostileTextIsRefusedNamingFileLineAndField) {
       run(t, {"generate", "--scenarios", sheet, "--out", out.string(), "--quiet", "--backend", "reference"});
   ExpectExit(ok, 0, {});
   EXPECT_TRUE(has(slurp(out / "scenarios.csv"), "gun")) << slurp(out / "scenarios.csv");
+  // The same rule on the command line: a usage error naming the flag.
+  const fs::path rule_out = t.w() / "rule-out";
+  ExpectExit(run(t, {"generate", "--rule", "gun&", "--count", "5", "--out", rule_out.string(), "--quiet"}), 2,
+             {"--rule: \"gun&\" at character 5"});
+  EXPECT_FALSE(fs::exists(rule_out));
+  // Quoted fields as a spreadsheet may write them, spaces round the quotes, a quote doubled
+  // inside one: read as their text ("gun" is gun; "gu""n" is gu"n, a name that, as every
+  // object name, is matched without its punctuation: gun).
+  fs::remove_all(out);
+  const std::string quoted_good =
+      file("quoted-good.csv", kHeader + ",label\n\"1\", \"gun\" ,\"gu\"\"n\"" + nones.substr(5) + ",\"yes\"\n");
+  ExpectExit(
+      run(t, {"generate", "--scenarios", quoted_good, "--out", out.string(), "--quiet", "--backend", "reference"}), 0,
+      {});
+  EXPECT_TRUE(has(slurp(out / "scenarios.csv"), "1,gun:h,gun:h,none")) << slurp(out / "scenarios.csv");
 }
 
 TEST(InputFiles, ImageDeclaringTooManyPixelsIsRefusedBeforeDecoding) {
@@ -260,10 +289,10 @@ TEST(InputFiles, ImageDeclaringTooManyPixelsIsRefusedBeforeDecoding) {
   const fs::path dir = t.w() / "scan";
   fs::create_directory(dir);
   spit(dir / "upper.png", png);
-  const auto t0 = std::chrono::steady_clock::now();
+  // Refused by the header's size, before decoding: decoding the few bytes of data would
+  // fail with the decoder's own message instead, which names no size.
   ExpectExit(run(t, {"features", dir.string(), "--out", (t.w() / "f.csv").string()}, 30), 3,
              {(dir / "upper.png").string(), "16384x16384"});
-  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(10)) << "it must not decode";
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,14 +1,16 @@
 // Kernel against reference, stage by stage, over hundreds of random scenarios that
 // cover every object variant, region and subject.
 //
-// Tolerances (the core tier, fp32 kernels against the fp64 reference):
-//   metal zones and labels   exact
-//   image pixels             |kernel - reference| <= 1 gray level (rounding of x.5 ties)
-//   features                 |kernel - reference| <= 1.0 (a mean of pixels each within 1),
-//                            and the mean absolute feature error <= 0.01
+// Tolerances: the table in plan/tolerance.h (docs/dev/testing.md); the stage tests below
+// hold the standard tier's (fp32 kernels against the fp64 reference).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
 
 #include "backend/compare.h"
 #include "plan/tolerance.h"
@@ -283,6 +285,114 @@ TEST(Parity, PlacementJitterIntegerAndBilinear) {
   BatchOutput c;
   cl->run(test::batch_of(scenes), p, c);
   EXPECT_LE(compare_outputs(c, still).mmw.max_abs, 1);
+}
+
+}  // namespace
+}  // namespace portalsim
+
+namespace portalsim::embedded {
+extern const std::string_view default_catalogue;
+}
+
+namespace portalsim {
+namespace {
+
+// Helpers both backends call (docs/dev/testing.md, "Shared helpers"), against values
+// worked out by hand from the catalogue: a shared mistake here would pass every parity test.
+
+// Catalogue::polarizability: the category's mean m spread as m 3 / (a + 2) across and
+// a times that along the drawing's long axis (x, or z for a "v" drawing).
+TEST(SharedHelpers, PolarizabilityHandComputed) {
+  const Catalogue& c = catalogue();
+  struct Case {
+    const char* object;
+    int drawing;           // index among the object's drawings
+    double along, across;  // cm^3
+    int axis;              // 0 x, 2 z
+  };
+  // gun: heavy 100, anisotropy 1.6; iron-rod: large 74.063, 13.9; compact-disk: trace 5.2329, 1.
+  for (const Case& k : {Case{"gun", 0, 300 / 3.6 * 1.6, 300 / 3.6, 0}, Case{"gun", 1, 300 / 3.6 * 1.6, 300 / 3.6, 2},
+                        Case{"iron-rod", 1, 74.063 * 3 / 15.9 * 13.9, 74.063 * 3 / 15.9, 2},
+                        Case{"compact-disk", 0, 5.2329, 5.2329, 0}}) {
+    SCOPED_TRACE(std::string(k.object) + " drawing " + std::to_string(k.drawing));
+    const std::array<double, 9> t = c.polarizability(test::variant_of(c, k.object) + k.drawing);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const double want = i != j ? 0.0 : i == k.axis ? k.along : k.across;
+        EXPECT_NEAR(t[i * 3 + j], want, 1e-12 * std::max(1.0, want)) << i << "," << j;
+      }
+  }
+  EXPECT_EQ(c.polarizability(test::variant_of(c, "ceramic-plate")), (std::array<double, 9>{}));  // metal "none"
+}
+
+// Sensor::place: region r's rectangle moved down round((1 - height) (floor_row - c)) rows,
+// c its centre row; floor_row is 400 for the upper MMW view (one view below), 200 for the
+// lower view and the IR view. Heights 0.875 and 1.125 are exact in binary.
+TEST(SharedHelpers, PlaceHandComputed) {
+  std::string text = test::with_subject_line(std::string(embedded::default_catalogue), 0, "height = 0.875");
+  text = test::with_subject_line(text, 1, "height = 1.125");
+  const Catalogue c = parse_catalogue(text, "test.toml", "", "");
+  struct Case {
+    const char* view;
+    int region, subject;  // 1-based region
+    int y;
+  };
+  // upper r1 [49, 40, 34, 70]: 0.125 (400 - 75) = 40.625 -> 41; lower r7 [48, 5, 34, 65]:
+  // 0.125 (200 - 37.5) = 20.3 -> 20; lower r12 [54, 140, 40, 50]: 0.125 * 35 = 4.4 -> 4;
+  // IR r1 [24, 20, 17, 35]: 0.125 (200 - 37.5) -> 20; IR r13 [53, 170, 20, 25]: 2.2 -> 2;
+  // and the same at 1.125, the other way.
+  for (const Case& k : {Case{"upper", 1, 0, 81}, Case{"lower", 7, 0, 25}, Case{"lower", 12, 0, 144},
+                        Case{"ir", 1, 0, 40}, Case{"ir", 13, 0, 172}, Case{"upper", 1, 1, -1},
+                        Case{"lower", 12, 1, 136}, Case{"ir", 13, 1, 168}, Case{"upper", 1, 2, 40}}) {
+    SCOPED_TRACE(std::string(k.view) + " region " + std::to_string(k.region) + " subject " + std::to_string(k.subject));
+    const Sensor& s = c.sensors[c.sensor_index(k.view)];
+    const Rect r = s.place(k.subject, k.region - 1);
+    EXPECT_EQ(r.y, k.y);
+    EXPECT_EQ(r.x, s.rects[k.region - 1].x);
+    EXPECT_EQ(r.w, s.rects[k.region - 1].w);
+    EXPECT_EQ(r.h, s.rects[k.region - 1].h);
+  }
+}
+
+// FeatureLayout::of: ceil(200 / block) blocks a side in each of the two MMW views, then the
+// 13 regions.
+TEST(SharedHelpers, FeatureLayoutHandComputed) {
+  for (auto [block, side] : {std::pair{10, 20}, std::pair{7, 29}, std::pair{1, 200}, std::pair{300, 1}}) {
+    const FeatureLayout f = FeatureLayout::of(catalogue(), block);
+    EXPECT_EQ(f.blocks_x, side);
+    EXPECT_EQ(f.blocks_y, side);
+    EXPECT_EQ(f.image_features(), 2 * side * side + 13);
+  }
+}
+
+// The tolerance table in docs/dev/testing.md is plan/tolerance.h's. After changing the
+// table, regenerate the page's copy: PORTALSIM_UPDATE_GOLDEN=1 build/portalsim_tests
+// --gtest_filter='Tolerance.*'.
+TEST(Tolerance, TestingPageHoldsTheTable) {
+  const std::string path = std::string(PORTALSIM_SOURCE_DIR) + "/docs/dev/testing.md";
+  const std::string begin = "<!-- tolerance table: generated from host/plan/tolerance.h -->\n", end = "<!-- end -->";
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string page = ss.str();
+  const size_t a = page.find(begin);
+  size_t b = page.find(end, a == std::string::npos ? 0 : a);
+  ASSERT_NE(a, std::string::npos) << path << ": no \"" << begin << "\"";
+  ASSERT_NE(b, std::string::npos) << path << ": no \"" << end << "\" after the table";
+  const std::string table = tolerance_table_markdown();
+  if (const char* u = std::getenv("PORTALSIM_UPDATE_GOLDEN"); u && std::string(u) == "1") {
+    page.replace(a + begin.size(), b - a - begin.size(), table);
+    std::ofstream(path) << page;
+    b = a + begin.size() + table.size();
+  }
+  EXPECT_EQ(page.substr(a + begin.size(), b - a - begin.size()), table)
+      << path << " differs from plan/tolerance.h; regenerate it (see this test)";
+  // No bound is the whole range, and every (model, tier, output) has a row.
+  for (const Bound& bound : kTolerances) EXPECT_LT(bound.max_abs, 255) << output_name(bound.output);
+  for (Model m : {Model::thesis, Model::physics})
+    for (Tier t : {Tier::exact, Tier::standard, Tier::fast})
+      for (Output o : {Output::pixels, Output::features, Output::features_only, Output::metal, Output::masks})
+        EXPECT_STRNE(tolerance_bound(m, t, o).reason, "no row: nothing may differ") << output_name(o);
 }
 
 }  // namespace

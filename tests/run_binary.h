@@ -22,7 +22,28 @@
 
 extern char** environ;
 
+// How many times slower the build under test runs than a Release build: CMakeLists.txt
+// sets it for the sanitizer build (PORTALSIM_SANITIZE).
+#ifndef PORTALSIM_TIME_SCALE
+#define PORTALSIM_TIME_SCALE 1
+#endif
+
 namespace portalsim::test {
+
+// Every limit on how long a child may run is a hang detector, never a speed check; each
+// is multiplied by this factor, so that a slower build cannot miss one.
+inline constexpr int kTimeScale = PORTALSIM_TIME_SCALE;
+
+// Polls `done` every poll_ms until it holds (true) or `limit_s` (scaled) passed (false).
+template <class Done>
+bool wait_until(Done done, int limit_s, int poll_ms = 2) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(limit_s * kTimeScale);
+  for (;;) {
+    if (done()) return true;
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(poll_ms));
+  }
+}
 
 // A fresh folder under /tmp for one test: w/ is the test's workspace, cap/ holds the captured
 // stdout and stderr of every run (kept apart so that w/ shows only what portalsim wrote).
@@ -157,12 +178,13 @@ inline Running start(const std::filesystem::path& cap, const std::vector<std::st
   return start_program(cap, PORTALSIM_BINARY, args);
 }
 
-// Waits for a started run (at most limit_s, then kills that one child) and collects what it printed.
+// Waits for a started run (at most limit_s, scaled, then kills that one child) and collects
+// what it printed.
 inline Result finish(const Running& r, int limit_s = 120) {
   Result res;
   res.command = r.command;
   if (r.pid <= 0) return res;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(limit_s);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(limit_s * kTimeScale);
   int ws = 0;
   for (;;) {
     const pid_t w = ::waitpid(r.pid, &ws, WNOHANG);
@@ -186,6 +208,37 @@ inline Result finish(const Running& r, int limit_s = 120) {
   res.out = slurp(r.out_path);
   res.err = slurp(r.err_path);
   return res;
+}
+
+// True once the started run has ended (without reaping it).
+inline bool has_ended(const Running& r) {
+  siginfo_t info{};
+  if (::waitid(P_PID, static_cast<id_t>(r.pid), &info, WEXITED | WNOHANG | WNOWAIT) != 0) return true;
+  return info.si_pid != 0;
+}
+
+// A run killed with SIGKILL in the middle, and the checkpoint's "next" the kill left (-1
+// without one).
+struct Killed {
+  Result result;
+  long long next = -1;
+};
+
+// Waits (at most limit_s, scaled) until the run's checkpoint in `dir` reaches `at_least`,
+// stops the run there (SIGSTOP, waiting until every thread has stopped, so that the
+// checkpoint read then is the one the kill leaves), and kills it. Callers assert
+// 0 < next < count: a kill before the first checkpoint or after the last is no mid-run kill.
+inline Killed kill_mid_run(const Running& r, const std::filesystem::path& dir, long long at_least, int limit_s = 120) {
+  Killed k;
+  if (r.pid <= 0) return k;
+  wait_until([&] { return checkpoint_next(dir) >= at_least || has_ended(r); }, limit_s);
+  ::kill(r.pid, SIGSTOP);
+  siginfo_t info{};
+  ::waitid(P_PID, static_cast<id_t>(r.pid), &info, WSTOPPED | WEXITED | WNOWAIT);
+  k.next = checkpoint_next(dir);
+  ::kill(r.pid, SIGKILL);
+  k.result = finish(r, 60);
+  return k;
 }
 
 // Runs `script` with sh in a private mount namespace (unshare -m, as root) after mounting

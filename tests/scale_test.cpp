@@ -195,13 +195,18 @@ TEST(Mpi, KilledRankEndsTheJobAndResumeFinishesItOnAnyNumberOfRanks) {
     const Running job = start_mpi(t, 3, gen(spec, dir));
     // Rank 1 holds its part's lock, which names its PID; kill it once it has checkpointed.
     pid_t victim = -1;
-    for (int i = 0; i < 6000 && victim < 0; ++i) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      if (part_next(part) > 0) victim = static_cast<pid_t>(std::atol(slurp(part / ".portalsim" / "lock").c_str()));
-    }
+    wait_until(
+        [&] {
+          if (part_next(part) > 0) victim = static_cast<pid_t>(std::atol(slurp(part / ".portalsim" / "lock").c_str()));
+          return victim > 0 || has_ended(job);
+        },
+        60);
     ASSERT_GT(victim, 0) << "rank 1 never checkpointed\n" << describe(finish(job, 600));
     ASSERT_EQ(::kill(victim, SIGKILL), 0);
     const Result k = finish(job, 600);
+    // Rank 1's part is scenarios [400, 800): the kill must have come in its middle.
+    const long long done = part_next(part);
+    EXPECT_TRUE(done > 0 && done < 400) << "rank 1 was killed with " << done << " of its 400 scenarios written";
     EXPECT_TRUE(k.exited && k.status != 0) << describe(k);
     EXPECT_NE((k.out + k.err).find("rank 1"), std::string::npos) << "the message names the rank\n" << describe(k);
     EXPECT_FALSE(fs::exists(dir / "manifest.json"));

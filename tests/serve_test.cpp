@@ -37,13 +37,15 @@ class Serve : public ::testing::Test {
     for (const std::string& a : extra_args()) args.push_back(a);
     server_ = portalsim::test::start(tmp_ / "cap", args);
     // The URL line says the server is listening.
-    for (int i = 0; i < 6000 && port_ == 0; ++i) {
-      const std::string out = slurp(server_.out_path);
-      const size_t at = out.find("http://127.0.0.1:");
-      if (at != std::string::npos && out.find('/', at + 17) != std::string::npos)
-        port_ = std::stoi(out.substr(at + 17));
-      if (port_ == 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
+    portalsim::test::wait_until(
+        [&] {
+          const std::string out = slurp(server_.out_path);
+          const size_t at = out.find("http://127.0.0.1:");
+          if (at != std::string::npos && out.find('/', at + 17) != std::string::npos)
+            port_ = std::stoi(out.substr(at + 17));
+          return port_ != 0 || portalsim::test::has_ended(server_);
+        },
+        60);
     ASSERT_GT(port_, 0) << "no URL printed: " << slurp(server_.err_path);
   }
   void TearDown() override {
@@ -60,7 +62,7 @@ class Serve : public ::testing::Test {
   virtual std::vector<std::string> extra_args() { return {}; }
   httplib::Client client() const {
     httplib::Client c("127.0.0.1", port_);
-    c.set_read_timeout(60, 0);
+    c.set_read_timeout(60 * portalsim::test::kTimeScale, 0);
     return c;
   }
   httplib::Result post(const std::string& path, const json& body) const {
@@ -264,13 +266,13 @@ TEST_F(Serve, GenerateRunsAndLinksItsResults) {
   ASSERT_TRUE(r);
   ASSERT_EQ(r->status, 200) << r->body;
   json s;
-  for (int i = 0; i < 1200; ++i) {
-    auto g = client().Get("/api/generate");
-    ASSERT_TRUE(g);
-    s = json::parse(g->body);
-    if (s["state"] != "running") break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
+  portalsim::test::wait_until(
+      [&] {
+        auto g = client().Get("/api/generate");
+        s = g ? json::parse(g->body) : json();
+        return s.value("state", "") != "running";
+      },
+      120, 50);
   ASSERT_EQ(s["state"], "done") << s.dump();
   EXPECT_EQ(s["done"], 200);
   auto manifest = client().Get("/files/ds/manifest.json");

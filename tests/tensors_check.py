@@ -4,7 +4,7 @@
     tensors_check.py PORTALSIM WORKDIR
 
 Generates a small balanced gun set with --format h5, checks every dataset's shape and
-dtype and the attributes with h5py, reads items through tools/portalsim_dataset.py, and
+dtype and the attributes with h5py, reads items through portalsim.torch.H5Dataset, and
 runs tools/train_example.py on it: fails if the file cannot be read or if the model's
 held-out accuracy is not clearly above chance. Also checks a randomised set's transforms
 (the loader's transforms() against scenarios.csv) and an annotated set's mask targets.
@@ -20,9 +20,9 @@ import h5py
 import numpy as np
 import torch
 
+from portalsim.torch import H5Dataset
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "tools"))
-from portalsim_dataset import PortalsimDataset  # noqa: E402
 
 N = 1000
 
@@ -73,11 +73,11 @@ def main():
         expect((f["subject"][:] >= 1).all(), "data.h5: subject numbers are 1-based")
         expect((f["ir"][:5] > 0).any() and (f["upper"][:5] > 0).any(), "data.h5: images are all zero")
 
-    ds = PortalsimDataset(out / "data.h5", views=("upper", "lower"))
+    ds = H5Dataset(out / "data.h5", views=("upper", "lower"))
     x, y = ds[3]
     expect(tuple(x.shape) == (2, 200, 200) and float(x.max()) <= 1.0, f"dataset item has shape {tuple(x.shape)}")
     expect(int(y) == int(label[3]), "dataset label differs from the file's")
-    ir = PortalsimDataset(out / "data.h5", views=("ir",), target="region_label")
+    ir = H5Dataset(out / "data.h5", views=("ir",), target="region_label")
     x, y = ir[0]
     expect(tuple(x.shape) == (3, 200, 100) and tuple(y.shape) == (13,), f"ir item {tuple(x.shape)}, {tuple(y.shape)}")
 
@@ -92,7 +92,7 @@ def main():
         for name, dtype in (("region_rotation", np.float64), ("region_scale", np.float64), ("region_flip", np.uint8)):
             expect(f[name].shape == (60, 13) and f[name].dtype == dtype, f"data.h5: {name} is {f[name].dtype} "
                    f"{f[name].shape}, expected {np.dtype(dtype)} (60, 13)")
-    tds = PortalsimDataset(rnd / "data.h5", views=("upper", "lower"))
+    tds = H5Dataset(rnd / "data.h5", views=("upper", "lower"))
     expect(tds.has_transforms, "the loader does not see the transforms")
     with open(rnd / "scenarios.csv") as fh:
         rows = list(csv.DictReader(fh))
@@ -115,7 +115,7 @@ def main():
     ann = work / "annotated"
     subprocess.run([portalsim, "generate", "--count", "40", "--seed", "3", "--objects", "2..5", "--what", "images",
                     "--format", "h5", "--annotations", "--out", str(ann), "--quiet"], check=True)
-    seg = PortalsimDataset(ann / "data.h5", views=("upper", "lower"), target="mask")
+    seg = H5Dataset(ann / "data.h5", views=("upper", "lower"), target="mask")
     coco = json.loads((ann / "annotations.json").read_text())
     by_image = {}
     for a in coco["annotations"]:
@@ -126,7 +126,7 @@ def main():
     for im in views:
         x, m = seg[im["scenario"]]
         expect(tuple(m.shape) == (2, 200, 200) and m.dtype == torch.int64, f"mask target {tuple(m.shape)} {m.dtype}")
-        got = PortalsimDataset.boxes(m[("upper", "lower").index(im["view"])].numpy())
+        got = H5Dataset.boxes(m[("upper", "lower").index(im["view"])].numpy())
         expect(got == by_image.get(im["id"], {}),
                f"scenario {im['scenario']} view {im['view']}: loader boxes {got}, COCO {by_image.get(im['id'], {})}")
         seen += len(got)

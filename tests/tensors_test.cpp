@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <xxhash.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -340,6 +341,12 @@ TEST(TensorsH5, ByteIdenticalForAnyBatchAndThreads) {
 
 using portalsim::test::checkpoint_next;
 
+// The --count of a spec's arguments (-1 when it has none).
+long long count_of(const Args& spec) {
+  const auto it = std::find(spec.begin(), spec.end(), "--count");
+  return it == spec.end() || it + 1 == spec.end() ? -1 : std::stoll(*(it + 1));
+}
+
 // Runs `spec` to completion in ref/, and again in killed/ with kill -9 after its checkpoint
 // passes 300 scenarios; `after_kill` looks at (and may change) what the kill left; then
 // resumes with another batch size. Returns the resumed run's result.
@@ -352,12 +359,10 @@ portalsim::test::Result kill_then_resume(portalsim::test::TempDir& t, const Args
   victim_args.insert(victim_args.end(), {"--batch", "100", "--out", dir.string(), "--quiet"});
   const portalsim::test::Running victim = portalsim::test::start_program(t.cap(), PORTALSIM_BINARY, victim_args);
   EXPECT_GT(victim.pid, 0);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (checkpoint_next(dir) < 300 && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  ::kill(victim.pid, SIGKILL);
-  const portalsim::test::Result k = portalsim::test::finish(victim, 120);
-  EXPECT_TRUE(k.signaled) << "the run ended before it could be killed: " << portalsim::test::describe(k);
+  const portalsim::test::Killed k = portalsim::test::kill_mid_run(victim, dir, 300);
+  EXPECT_TRUE(k.result.signaled) << "the run ended before it could be killed: " << portalsim::test::describe(k.result);
+  EXPECT_TRUE(k.next > 0 && k.next < count_of(spec))
+      << "the kill must come mid-run; the checkpoint says next " << k.next;
   EXPECT_FALSE(fs::exists(dir / "data.h5")) << "killed mid-run, there is no data.h5 yet";
   after_kill(dir);
   return run(t, plus(spec, {"--batch", "333", "--resume"}), dir);

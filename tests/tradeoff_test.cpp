@@ -4,9 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -33,6 +37,35 @@ const json& row(const json& report, const std::string& model, const std::string&
   return none;
 }
 
+// The instances of an ARFF file: its lines after @data.
+size_t data_rows(const fs::path& arff) {
+  std::istringstream in(test::slurp(arff));
+  size_t rows = 0;
+  bool data = false;
+  for (std::string line; std::getline(in, line);) {
+    if (data && !line.empty() && line[0] != '%') ++rows;
+    if (line.rfind("@data", 0) == 0) data = true;
+  }
+  return rows;
+}
+
+// J48's 10-fold cross-validated percentage correct (seed 1) on `arff`, from WEKA's command
+// line; -1 when it cannot be read.
+double weka_j48_percent(const fs::path& arff) {
+  const fs::path log = arff.string() + ".weka";
+  const std::string cmd = "java -cp /usr/share/java/weka.jar weka.classifiers.trees.J48 -o -x 10 -s 1 -t " +
+                          test::quoted(arff.string()) + " > " + test::quoted(log.string()) + " 2>&1";
+  if (std::system(cmd.c_str()) != 0) return -1;
+  const std::string out = test::slurp(log);
+  const size_t cv = out.find("=== Stratified cross-validation ===");
+  const size_t at = cv == std::string::npos ? cv : out.find("Correctly Classified Instances", cv);
+  if (at == std::string::npos) return -1;
+  std::istringstream row(out.substr(at + std::strlen("Correctly Classified Instances")));
+  double count = 0, percent = -1;
+  row >> count >> percent;
+  return percent;
+}
+
 void every_model_has_its_reference_and_every_tier(const json& report, const fs::path& out) {
   EXPECT_EQ(report["models"], json({"thesis", "physics"}));
   ASSERT_EQ(report["rows"].size(), 8u);
@@ -45,14 +78,20 @@ void every_model_has_its_reference_and_every_tier(const json& report, const fs::
     EXPECT_GT(r["images_per_s"].get<double>(), 0);
     EXPECT_EQ(r["metal_exact_rate"], 1.0);
     EXPECT_EQ(r["within_tolerance"], true);
-    for (const char* key : {"j48_accuracy", "j48_case2_accuracy"}) {
+    for (const auto& [key, c] : {std::pair{"j48_accuracy", "case1"}, std::pair{"j48_case2_accuracy", "case2"}}) {
+      const fs::path arff =
+          out / (r["model"].get<std::string>() + "-" + r["name"].get<std::string>() + "-" + c + ".arff");
+      ASSERT_TRUE(fs::is_regular_file(arff)) << arff;
       ASSERT_TRUE(r[key].is_number()) << key;
-      EXPECT_GE(r[key].get<double>(), 0);
-      EXPECT_LE(r[key].get<double>(), 100);
+      // A share of the file's instances, whole ones: correct * 100 / instances.
+      const double instances = static_cast<double>(data_rows(arff));
+      const double correct = r[key].get<double>() * instances / 100;
+      EXPECT_NEAR(correct, std::round(correct), 1e-6) << key << " is no whole share of " << instances;
+      // The reference rows' scores are WEKA's own on their ARFF, run here.
+      if (r["name"] == "reference") {
+        EXPECT_NEAR(r[key].get<double>(), weka_j48_percent(arff), 1e-3) << key;
+      }
     }
-    for (const char* c : {"case1", "case2"})
-      EXPECT_TRUE(fs::is_regular_file(
-          out / (r["model"].get<std::string>() + "-" + r["name"].get<std::string>() + "-" + c + ".arff")));
   }
   EXPECT_TRUE(fs::is_regular_file(out / "tradeoff.png"));
 }

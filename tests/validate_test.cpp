@@ -1,6 +1,8 @@
 // `portalsim validate` as a user meets it: WEKA scores and t-tests on small generated
 // tables, WEKA's own command line as the reference for the folds, the t-tests against
 // scipy, and bad input refused with a message naming the file.
+#include <boost/math/distributions/students_t.hpp>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <tuple>
@@ -380,17 +382,52 @@ TEST(Validate, DemoMakesBothSetsAndTheReport) {
     ASSERT_EQ(c.size(), 1u) << key;  // J48 alone by default
     const auto& j48 = c["J48"];
     for (const char* set : {"real", "sim", "combined"}) {
+      SCOPED_TRACE(std::string(key) + " " + set);
       const double pct = j48[set]["mean_percent_correct"].get<double>();
       const double n = std::string(set) == "combined" ? 200 : 100;
-      EXPECT_GT(pct, 60) << key << " " << set;  // case 2 is learnable, far above chance
-      EXPECT_LE(pct, 100) << key << " " << set;
-      EXPECT_NEAR(j48[set]["mean_misclassified"].get<double>(), n * (100 - pct) / 100, 1e-6) << key << " " << set;
+      EXPECT_GT(pct, 60);  // case 2 is learnable, far above chance
+      EXPECT_NEAR(j48[set]["mean_misclassified"].get<double>(), n * (100 - pct) / 100, 1e-6);
+      // Each run's counts cover the set, its percentage is theirs, and the means are the runs'.
+      const auto& runs = j48[set]["runs"];
+      ASSERT_EQ(runs.size(), 2u);
+      double pct_sum = 0;
+      for (const auto& run : runs) {
+        EXPECT_EQ(run["correct"].get<double>() + run["misclassified"].get<double>(), n);
+        EXPECT_NEAR(run["percent_correct"].get<double>(), 100 * run["correct"].get<double>() / n, 1e-9);
+        EXPECT_EQ(run["folds"].size(), report["folds"].get<size_t>());
+        pct_sum += run["percent_correct"].get<double>();
+      }
+      EXPECT_NEAR(pct, pct_sum / 2, 1e-9);
     }
     EXPECT_GT(j48["sim_to_real"]["percent_correct"].get<double>(), 60) << key;
-    for (const double p :
-         {j48["two_sample_t_test"]["mean_p"].get<double>(), j48["corrected_resampled_t_test"]["p"].get<double>()}) {
-      EXPECT_GE(p, 0) << key;
-      EXPECT_LE(p, 1) << key;
+    // The P values belong to the runs' fold accuracies: each run's two-sample test on its
+    // real and simulated folds, and the corrected test (t, df and P recomputed here) on
+    // their differences, test/train = 1 / (k - 1) for k folds.
+    double p_sum = 0;
+    std::vector<double> d;
+    for (size_t r = 0; r < 2; ++r) {
+      const auto a = j48["real"]["runs"][r]["folds"].get<std::vector<double>>();
+      const auto b = j48["sim"]["runs"][r]["folds"].get<std::vector<double>>();
+      const auto two = portalsim::cli::student_two_sample(a, b);
+      const auto& reported = j48["two_sample_t_test"]["per_run"][r];
+      EXPECT_NEAR(reported["t"].get<double>(), two.t, 1e-9) << key << " run " << r;
+      EXPECT_NEAR(reported["p"].get<double>(), two.p, 1e-9) << key << " run " << r;
+      p_sum += two.p;
+      for (size_t i = 0; i < a.size(); ++i) d.push_back(a[i] - b[i]);
+    }
+    EXPECT_NEAR(j48["two_sample_t_test"]["mean_p"].get<double>(), p_sum / 2, 1e-9) << key;
+    double mean = 0, var = 0;
+    for (double x : d) mean += x / static_cast<double>(d.size());
+    for (double x : d) var += (x - mean) * (x - mean) / static_cast<double>(d.size() - 1);
+    const auto& corrected = j48["corrected_resampled_t_test"];
+    EXPECT_EQ(corrected["df"].get<double>(), static_cast<double>(d.size() - 1)) << key;
+    if (var > 0) {
+      const double ratio = 1.0 / (report["folds"].get<double>() - 1);
+      const double t = mean / std::sqrt((1.0 / static_cast<double>(d.size()) + ratio) * var);
+      EXPECT_NEAR(corrected["t"].get<double>(), t, 1e-9) << key;
+      const double p = 2 * boost::math::cdf(boost::math::complement(
+                               boost::math::students_t(static_cast<double>(d.size() - 1)), std::fabs(t)));
+      EXPECT_NEAR(corrected["p"].get<double>(), p, 1e-9) << key;
     }
   }
   const std::string md = slurp(out / "report.md");

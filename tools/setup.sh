@@ -13,20 +13,11 @@ packages=(build-essential cmake ninja-build pkg-config
   openmpi-bin libopenmpi-dev slurm-wlm munge
   weka default-jdk-headless python3 python3-matplotlib python3-scipy python3-h5py python3-numpy python3-torch
   python3-pyld python3-yaml
+  python3-dev pybind11-dev python3-pybind11 python3-pytest python3-pil
   clang-format ccache
   clang libclang-rt-14-dev chromium)
 
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ "$(id -u)" = 0 ]; then
-  apt-get update -q
-  [ ${#missing[@]} -eq 0 ] || DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
-elif [ ${#missing[@]} -ne 0 ]; then
-  echo "portalsim setup: missing packages (run as root to install): ${missing[*]}" >&2
-  exit 1
-fi
+bash tools/apt-install.sh "${packages[@]}"
 
 build_dir=${PORTALSIM_BUILD_DIR:-build}
 # A new build folder uses Ninja (it runs the test files' compiles beside the library's);

@@ -11,6 +11,7 @@ namespace portalsim {
 
 struct ImageDiff {
   int max_abs = 0;       // gray levels (IR: temperature index)
+  double mean_abs = 0;   // over all pixels
   double rmse_mean = 0;  // mean over images of each image's RMSE
   double rmse_max = 0;   // worst image's RMSE
   double psnr = 0;       // over all pixels, dB (infinite when identical: reported as 999)
@@ -22,13 +23,27 @@ struct ImageDiff {
 struct OutputDiff {
   ImageDiff mmw, ir;
   double feature_max_abs = 0, feature_mean_abs = 0;
-  double metal_exact = 1;  // share of scenarios whose 19 zones all match
+  double metal_exact = 1;      // share of scenarios whose 19 zones all match
+  bool features_only = false;  // the test run rendered no images: its features came from a features-only path
 };
 
-// Compares what both outputs hold (images, features, metal); `test` against `ref`.
+// Compares what both outputs hold (images, features, metal); `test` against `ref`. A test
+// run without images (a features-only run) is compared on its features and metal only.
 OutputDiff compare_outputs(const BatchOutput& test, const BatchOutput& ref);
 
-// Empty when `d` is within `t` (features checked only where present); else what broke.
+// Empty when `d` is within `t` (features checked only where present, against the bounds of
+// a features-only run where `d` compares one); else what broke.
 std::string check_tolerance(const OutputDiff& d, const Tolerance& t);
+
+// Two samples side by side: their moments and the Kolmogorov-Smirnov distance between
+// their empirical distributions (b empty: between a's and the standard normal's).
+struct SampleComparison {
+  double mean_a = 0, mean_b = 0, sd_a = 0, sd_b = 0;
+  double ks = 0;  // sup |F_a - F_b|
+  // Where two independent samples of one distribution give a larger ks with
+  // probability 0.001 (one sample: against the normal).
+  double ks_critical = 0;
+};
+SampleComparison compare_samples(std::vector<double> a, std::vector<double> b = {});
 
 }  // namespace portalsim

@@ -4,6 +4,7 @@
 
 #include "backend/opencl/opencl_backend.h"
 #include "base/error.h"
+#include "io/input_file.h"
 #include "plan/knobs.h"
 
 namespace portalsim::cli {
@@ -67,6 +68,16 @@ Session open_session(const CommonOptions& o) {
   open_catalogue(s, o);
   open_backend(s, o);
   return s;
+}
+
+void parse_args(CLI::App& app, const std::vector<std::string>& args) {
+  try {
+    app.parse(std::vector<std::string>(args.rbegin(), args.rend()));  // CLI11 takes them last first
+  } catch (const CLI::ParseError& e) {
+    throw InputError(e.what());
+  }
+  for (const CLI::Option* o : app.get_options())
+    for (const std::string& v : o->results()) io::check_flag_value(v, o->get_name());
 }
 
 }  // namespace portalsim::cli

@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "assets/assets.h"
 #include "backend/backend.h"
@@ -29,6 +30,10 @@ void add_common_options(CLI::App& app, CommonOptions& o);
 void add_knob_options(CLI::App& app, std::string& tier, std::map<std::string, std::string>& values);
 // The knobs given on the command line, by key, as text.
 std::map<std::string, std::string> given_knobs(const CLI::App& app, const std::map<std::string, std::string>& values);
+
+// Parses `args` into `app` and checks every value as the command line does; a parse error
+// becomes InputError with CLI11's message.
+void parse_args(CLI::App& app, const std::vector<std::string>& args);
 
 // The catalogue, its assets and a backend, with the time each took.
 struct Session {

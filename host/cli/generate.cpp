@@ -7,6 +7,7 @@
 #include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "cli/python_requests.h"
 #include "io/input_file.h"
 #include "schedule/pipeline.h"
 #include "schedule/ranked_run.h"
@@ -29,13 +30,9 @@ struct GenerateOptions {
   CLI::App* app = nullptr;
 };
 
-int generate(GenerateOptions& o) {
+// The run the flags ask for: the --spec file, then the flags given over it.
+RunSpec build_spec(GenerateOptions& o) {
   CLI::App& app = *o.app;
-  // Under an MPI launcher every rank runs this; rank 0 alone speaks.
-  std::unique_ptr<Ranks> alone;
-  Ranks* ranks = mpi_ranks();
-  if (!ranks) ranks = (alone = single_rank()).get();
-  if (ranks->rank() != 0) print_errors(false);
   RunSpec spec;
   if (!o.spec_file.empty()) read_spec_file(o.spec_file, spec);
   // Flags given on the command line override the spec file.
@@ -82,6 +79,17 @@ int generate(GenerateOptions& o) {
     spec.set_knob_text(key, text, spec.where(key));
   }
   spec.validate();
+  return spec;
+}
+
+int generate(GenerateOptions& o) {
+  CLI::App& app = *o.app;
+  // Under an MPI launcher every rank runs this; rank 0 alone speaks.
+  std::unique_ptr<Ranks> alone;
+  Ranks* ranks = mpi_ranks();
+  if (!ranks) ranks = (alone = single_rank()).get();
+  if (ranks->rank() != 0) print_errors(false);
+  const RunSpec spec = build_spec(o);
   if (o.out.empty()) throw InputError("--out: empty folder name");
 
   PipelineOptions popt;
@@ -105,9 +113,7 @@ int generate(GenerateOptions& o) {
   // Together: a rank that cannot start stops them all, rather than leaving them waiting.
   ranks->together([&] {
     open_catalogue(s, o.common);
-    // Check the generator's spec before any output exists.
-    if (spec.scenarios.empty()) Generator check(s.catalogue, generator_spec(spec, s.catalogue), spec.seed);
-    validate(spec.settings(), s.catalogue);
+    check_generate(spec, s.catalogue);
     open_backend(s, o.common);
   });
 
@@ -143,11 +149,7 @@ int generate(GenerateOptions& o) {
   return 0;
 }
 
-}  // namespace
-
-std::function<int()> add_generate(CLI::App& app) {
-  auto o = std::make_shared<GenerateOptions>();
-  CLI::App* sub = app.add_subcommand("generate", "make a labelled data set of many scenarios");
+void add_generate_options(CLI::App* sub, GenerateOptions* o) {
   o->app = sub;
   add_common_options(*sub, o->common);
   sub->add_option("--spec", o->spec_file, "TOML spec file; command-line flags override its keys");
@@ -173,7 +175,32 @@ std::function<int()> add_generate(CLI::App& app) {
   sub->add_option("--shard", o->shard, "i/k: make only part i (0-based) of k of the index range");
   sub->add_flag("--resume", o->resume, "continue an interrupted run in --out");
   sub->add_flag("--quiet", o->quiet, "no progress bar");
+}
+
+}  // namespace
+
+std::function<int()> add_generate(CLI::App& app) {
+  auto o = std::make_shared<GenerateOptions>();
+  add_generate_options(app.add_subcommand("generate", "make a labelled data set of many scenarios"), o.get());
   return [o] { return generate(*o); };
+}
+
+void check_generate(const RunSpec& spec, const Catalogue& cat) {
+  // The generator's spec, before any output exists.
+  if (spec.scenarios.empty()) Generator check(cat, generator_spec(spec, cat), spec.seed);
+  validate(spec.settings(), cat);
+}
+
+GenerateRequest parse_generate(const std::vector<std::string>& args) {
+  CLI::App app{"portalsim generate"};
+  GenerateOptions o;
+  add_generate_options(&app, &o);
+  parse_args(app, args);
+  GenerateRequest r;
+  r.spec = build_spec(o);
+  r.common = o.common;
+  r.threads = o.threads;
+  return r;
 }
 
 }  // namespace portalsim::cli

@@ -46,6 +46,7 @@ int run(int argc, char** argv) {
   commands["validate"] = add_validate(app);
   commands["knobs"] = add_knobs(app);
   commands["merge"] = add_merge(app);
+  commands["calibrate"] = add_calibrate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -5,6 +5,7 @@
 #include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "cli/python_requests.h"
 #include "io/input_file.h"
 #include "plan/knobs.h"
 #include "serve/one_scenario.h"
@@ -23,15 +24,8 @@ struct SimulateOptions {
   CLI::App* app = nullptr;
 };
 
-int simulate(SimulateOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
-  Session s;
-  open_catalogue(s, o.common);
-  const Catalogue& cat = s.catalogue;
-
-  // Everything the user gave is checked before any backend work or any file is written.
-  const Scenario scene = make_scenario(cat, ScenarioInputs{o.subject, o.objects, o.rule, o.threat});
-
+// The model and fidelity the flags ask for, checked against the catalogue.
+Plan simulate_plan(const SimulateOptions& o, const Catalogue& cat) {
   Plan plan;
   plan.fidelity = tier_fidelity(parse_tier(o.tier, "--tier"));
   for (const auto& [key, text] : given_knobs(*o.app, o.knobs)) {
@@ -40,6 +34,18 @@ int simulate(SimulateOptions& o) {
   }
   plan.model.seed = io::parse_u64(o.common.seed, "--seed");
   validate(plan, cat);
+  return plan;
+}
+
+int simulate(SimulateOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Session s;
+  open_catalogue(s, o.common);
+  const Catalogue& cat = s.catalogue;
+
+  // Everything the user gave is checked before any backend work or any file is written.
+  const Scenario scene = make_scenario(cat, ScenarioInputs{o.subject, o.objects, o.rule, o.threat});
+  const Plan plan = simulate_plan(o, cat);
 
   open_backend(s, o.common);
   BatchOutput out;
@@ -61,11 +67,8 @@ int simulate(SimulateOptions& o) {
   }
   return 0;
 }
-}  // namespace
 
-std::function<int()> add_simulate(CLI::App& app) {
-  auto o = std::make_shared<SimulateOptions>();
-  CLI::App* sub = app.add_subcommand("simulate", "simulate the three sensors for one person carrying objects");
+void add_simulate_options(CLI::App* sub, SimulateOptions* o) {
   add_common_options(*sub, o->common);
   sub->add_option("objects", o->objects,
                   "objects for regions 1..13 in order (none = empty region; gun:v = vertical variant)");
@@ -79,7 +82,28 @@ std::function<int()> add_simulate(CLI::App& app) {
                 "<view>.<k>.<stage>.npy (float64)");
   add_knob_options(*sub, o->tier, o->knobs);
   o->app = sub;
+}
+}  // namespace
+
+std::function<int()> add_simulate(CLI::App& app) {
+  auto o = std::make_shared<SimulateOptions>();
+  add_simulate_options(app.add_subcommand("simulate", "simulate the three sensors for one person carrying objects"),
+                       o.get());
   return [o] { return simulate(*o); };
+}
+
+SimulateRequest parse_simulate(const std::vector<std::string>& args, const Catalogue* cat) {
+  CLI::App app{"portalsim simulate"};
+  SimulateOptions o;
+  add_simulate_options(&app, &o);
+  parse_args(app, args);
+  SimulateRequest r;
+  r.common = o.common;
+  if (cat) {
+    r.scene = make_scenario(*cat, ScenarioInputs{o.subject, o.objects, o.rule, o.threat});
+    r.plan = simulate_plan(o, *cat);
+  }
+  return r;
 }
 
 }  // namespace portalsim::cli

@@ -1,5 +1,6 @@
 #include "scene/generator.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -97,27 +98,44 @@ std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view
   std::istringstream in(std::string(io::check_text(raw, path, io::Bom::skip)));
   std::string line;
   size_t lineno = 0;
+  // One line's fields as RFC 4180 reads them: a field may be quoted, with "" for a quote
+  // inside; spaces round an unquoted field are dropped. A quote anywhere else, or a quoted
+  // field still open at the line's end (no field holds a line break), is refused.
   auto split = [&](const std::string& l) {
+    const std::string_view line = std::string_view(l).substr(0, l.size() - (l.ends_with('\r') ? 1 : 0));
     std::vector<std::string> f;
-    std::string cur;
-    for (char c : l) {
-      if (c == ',') {
-        f.push_back(cur);
-        cur.clear();
-      } else if (c != '\r') {
-        cur.push_back(c);
+    const auto fail = [&](const std::string& why) {
+      throw InputError(path + ":" + std::to_string(lineno) + ": column " + std::to_string(f.size() + 1) + ": " + why);
+    };
+    const auto blank = [&](size_t k) {
+      while (k < line.size() && (line[k] == ' ' || line[k] == '\t')) ++k;
+      return k;
+    };
+    for (size_t at = 0;; ++at) {  // `at`: where the field starts, after the previous comma
+      std::string field;
+      size_t k = blank(at);
+      if (k < line.size() && line[k] == '"') {
+        for (++k;; ++k) {
+          if (k >= line.size()) fail("a quoted field is not closed on its line");
+          if (line[k] == '"' && (k + 1 >= line.size() || line[k + 1] != '"')) break;
+          if (line[k] == '"') ++k;  // "" is one quote
+          field.push_back(line[k]);
+        }
+        k = blank(k + 1);
+        if (k < line.size() && line[k] != ',') fail("text after the closing quote of a quoted field");
+      } else {
+        const size_t end = std::min(line.find(',', k), line.size());
+        field = std::string(line.substr(k, end - k));
+        if (field.find('"') != std::string::npos)
+          fail("a quote inside an unquoted field: quote the whole field, and double each quote in it");
+        field.erase(field.find_last_not_of(" \t") + 1);
+        k = end;
       }
+      if (field.size() > kMaxFieldBytes) fail("field longer than " + std::to_string(kMaxFieldBytes) + " bytes");
+      f.push_back(std::move(field));
+      if (k >= line.size()) return f;
+      at = k;
     }
-    f.push_back(cur);
-    for (size_t k = 0; k < f.size(); ++k) {
-      std::string& s = f[k];
-      const size_t a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t");
-      s = a == std::string::npos ? "" : s.substr(a, b - a + 1);
-      if (s.size() > kMaxFieldBytes)
-        throw InputError(path + ":" + std::to_string(lineno) + ": column " + std::to_string(k + 1) +
-                         ": field longer than " + std::to_string(kMaxFieldBytes) + " bytes");
-    }
-    return f;
   };
   std::vector<std::string> header;
   while (header.empty() && std::getline(in, line)) {

@@ -17,6 +17,7 @@
 #include "io/input_file.h"
 #include "schedule/dataset_card.h"
 #include "schedule/identity.h"
+#include "schedule/run_state.h"
 #include "sink/append_file.h"
 #include "sink/h5_file.h"
 #include "sink/output_folder.h"
@@ -224,50 +225,6 @@ void link_folder(const fs::path& src, const fs::path& dst) {
   if (ec) throw OutputError(dst.string() + ": cannot move into place: " + ec.message());
 }
 
-const json& field(const json& j, const char* key, const std::string& where) {
-  if (!j.is_object() || !j.contains(key)) throw InputError(where + key + ": missing");
-  return j[key];
-}
-
-uint64_t count_field(const json& j, const char* key, const std::string& where) {
-  const json& v = field(j, key, where);
-  if (!v.is_number_unsigned()) throw InputError(where + key + ": not a count");
-  return v.get<uint64_t>();
-}
-
-// The scenarios in the whole data set a spec describes.
-uint64_t total_of(const json& spec) {
-  return count_field(spec, spec.contains("scenarios_count") ? "scenarios_count" : "count", "spec.");
-}
-
-// Every field a join reads, checked before it is trusted: counts are counts, output
-// names are plain file names (no folder, nothing hidden), hashes are 16 hex digits.
-void check_manifest(const json& m) {
-  const uint64_t begin = count_field(field(m, "shard", ""), "begin", "shard."),
-                 end = count_field(m["shard"], "end", "shard."), count = count_field(m, "count", "");
-  if (end < begin || count != end - begin) throw InputError("shard: its range and count disagree");
-  const json& spec = field(m, "spec", "");
-  if (end > total_of(spec)) throw InputError("shard.end: past the spec's count");
-  const json& classes = field(m, "classes", "");
-  if (count_field(classes, "positive", "classes.") + count_field(classes, "negative", "classes.") != count)
-    throw InputError("classes: do not add up to count");
-  const json& outputs = field(m, "outputs", "");
-  if (!outputs.is_array() || outputs.size() > 64) throw InputError("outputs: not a list of outputs");
-  for (const json& o : outputs) {
-    const json& name = field(o, "name", "outputs[].");
-    if (!name.is_string()) throw InputError("outputs[].name: not a string");
-    const std::string n = name.get<std::string>();
-    if (n.empty() || n.size() > 255 || n[0] == '.' ||
-        n.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") != std::string::npos)
-      throw InputError("outputs[].name: \"" + n + "\" is not a plain file name");
-    count_field(o, "bytes", "outputs[].");
-    const json& h = field(o, "xxh3_64", "outputs[].");
-    if (!h.is_string() || h.get<std::string>().size() != 16 ||
-        h.get<std::string>().find_first_not_of("0123456789abcdef") != std::string::npos)
-      throw InputError("outputs[].xxh3_64: not 16 hexadecimal digits");
-  }
-}
-
 }  // namespace
 
 std::vector<Part> read_parts(const std::vector<std::string>& dirs) {
@@ -280,16 +237,9 @@ std::vector<Part> read_parts(const std::vector<std::string>& dirs) {
       throw InputError(d + ": no manifest.json: not a finished run (finish it with generate --resume first)");
     Part p;
     p.dir = d;
-    try {
-      p.manifest = json::parse(io::read_text_file(m.string(), "manifest", io::Bom::refuse));
-      check_manifest(p.manifest);
-      p.begin = p.manifest["shard"]["begin"].get<uint64_t>();
-      p.end = p.manifest["shard"]["end"].get<uint64_t>();
-    } catch (const json::exception& e) {
-      throw InputError(m.string() + ": not a manifest portalsim wrote: " + e.what());
-    } catch (const InputError& e) {
-      throw InputError(m.string() + ": " + e.what());
-    }
+    p.manifest = parse_manifest(io::read_text_file(m.string(), "manifest", io::Bom::refuse), m.string());
+    p.begin = p.manifest["shard"]["begin"].get<uint64_t>();
+    p.end = p.manifest["shard"]["end"].get<uint64_t>();
     parts.push_back(std::move(p));
   }
   const json id = shared_identity(parts[0].manifest);
@@ -307,7 +257,7 @@ std::vector<Part> read_parts(const std::vector<std::string>& dirs) {
   }
   std::stable_sort(parts.begin(), parts.end(),
                    [](const Part& a, const Part& b) { return a.begin != b.begin ? a.begin < b.begin : a.end < b.end; });
-  const uint64_t total = total_of(id["spec"]);
+  const uint64_t total = manifest_total(id["spec"]);
   uint64_t next = 0;
   for (size_t k = 0; k < parts.size(); ++k) {
     const Part& p = parts[k];

@@ -16,6 +16,8 @@
 #include "base/parallel.h"
 #include "schedule/dataset_card.h"
 #include "schedule/identity.h"
+#include "schedule/run_state.h"
+#include "schedule/scenario_source.h"
 #include "sink/coco.h"
 #include "sink/h5_file.h"
 #include "sink/output_folder.h"
@@ -102,47 +104,6 @@ void draw_progress(uint64_t done, uint64_t total, double seconds) {
   std::fflush(stderr);
 }
 
-// Where scenarios come from: the generator, or a listed file (a listed scenario without a
-// label takes the rule's). The rule also gives data.h5 its region labels.
-class ScenarioSource {
- public:
-  ScenarioSource(const RunSpec& spec, const Catalogue& cat) {
-    if (!spec.rule.empty()) rule_.emplace(cat, spec.rule, "--rule");
-    if (!spec.scenarios.empty()) {
-      std::vector<ListedTransforms> recorded;
-      listed_ = read_scenario_file(cat, spec.scenarios, &recorded);
-      total_ = listed_.size();
-      // Randomised objects are re-made from (seed, index, knobs), like every draw: a list
-      // that records them must be re-made with the seed and knobs that drew them.
-      const ModelSettings model = spec.settings().model;
-      for (size_t i = 0; i < recorded.size(); ++i)
-        for (int r = 0; r < kRegions; ++r)
-          if (listed_[i].objects[r] != kNoObject && object_transform(model, i, r) != recorded[i].t[r])
-            throw InputError(recorded[i].where + ": region" + std::to_string(r + 1) +
-                             ": its rotation, scale and flip are not what scenario " + std::to_string(i) +
-                             " of this run draws; re-make a list with the --seed, --rotate, --scale and --flip of "
-                             "the run that wrote it, from its first scenario");
-    } else {
-      generator_.emplace(cat, generator_spec(spec, cat), spec.seed);
-      total_ = spec.count;
-    }
-  }
-  uint64_t total() const { return total_; }
-  const ThreatRule* rule() const { return rule_ ? &*rule_ : nullptr; }
-  Scenario operator()(uint64_t i) const {
-    if (generator_) return (*generator_)(i);
-    Scenario s = listed_[i];
-    if (s.label < 0) s.label = rule_ && (*rule_)(s) ? 1 : 0;
-    return s;
-  }
-
- private:
-  std::optional<Generator> generator_;
-  std::vector<Scenario> listed_;
-  std::optional<ThreatRule> rule_;
-  uint64_t total_ = 0;
-};
-
 // What a run is, for its checkpoint, its manifest and a later --resume or merge.
 json run_identity(const RunSpec& spec, const Catalogue& cat, uint64_t total, const PipelineOptions& opt,
                   const PipelineResult& res) {
@@ -173,9 +134,9 @@ bool finished_run_here(const std::string& dir, const json& identity, bool resume
                       "only checks that it is complete)");
   json manifest;
   try {
-    manifest = json::parse(read_state_file(manifest_path.string()));
-  } catch (const json::exception& e) {
-    throw OutputError(dir + "/manifest.json: unreadable: " + e.what());
+    manifest = parse_manifest(read_state_file(manifest_path.string()), manifest_path.string());
+  } catch (const InputError& e) {  // the folder is the run's output
+    throw OutputError(e.what());
   }
   json was = json::object();
   for (const auto& [k, v] : identity.items()) was[k] = manifest.value(k, json());
@@ -183,25 +144,6 @@ bool finished_run_here(const std::string& dir, const json& identity, bool resume
     throw InputError("--resume: " + dir + " holds a finished run with other parameters: " + diff +
                      "; give the same parameters, or another folder");
   return true;
-}
-
-// A checkpoint's fields have the types the resume reads (a hand-edited or damaged one gets
-// a message naming the field, not a JSON library's).
-void check_checkpoint(const json& c, const std::string& path) {
-  const auto whole = [&](const json& j, const std::string& field) {
-    if (!j.is_number_unsigned()) throw OutputError(path + ": " + field + ": expected a whole number");
-  };
-  if (!c.is_object()) throw OutputError(path + ": expected a JSON object");
-  for (const char* k : {"next", "positive", "negative"}) whole(c.contains(k) ? c[k] : json(), k);
-  if (!c.contains("files") || !c["files"].is_array()) throw OutputError(path + ": files: expected an array");
-  for (size_t i = 0; i < c["files"].size(); ++i) {
-    const json& f = c["files"][i];
-    const std::string at = "files[" + std::to_string(i) + "]";
-    if (!f.is_object() || !f.contains("name") || !f["name"].is_string())
-      throw OutputError(path + ": " + at + ".name: expected a string");
-    whole(f.contains("bytes") ? f["bytes"] : json(), at + ".bytes");
-    whole(f.contains("xxh3") ? f["xxh3"] : json(), at + ".xxh3");
-  }
 }
 
 // What the output folder holds, read with its lock held: new (or a run stopped before its
@@ -220,12 +162,7 @@ FolderStart examine_folder(const std::string& dir, const json& identity, bool re
     return start;
   }
   if (resume && fs::exists(checkpoint_path, ec)) {
-    try {
-      start.checkpoint = json::parse(read_state_file(checkpoint_path.string()));
-    } catch (const json::exception& e) {
-      throw OutputError(checkpoint_path.string() + ": unreadable checkpoint: " + e.what());
-    }
-    check_checkpoint(start.checkpoint, checkpoint_path.string());
+    start.checkpoint = parse_checkpoint(read_state_file(checkpoint_path.string()), checkpoint_path.string());
     if (const std::string diff = differing_keys(start.checkpoint.value("identity", json::object()), identity);
         !diff.empty())
       throw InputError("--resume: " + dir + " was made by a different run: " + diff +
@@ -264,15 +201,9 @@ std::vector<std::unique_ptr<Sink>> open_sinks(const RunSpec& spec, const Plan& p
     for (const std::string& f : spec.formats)
       if (f != "h5") sinks.push_back(make_table_sink(f, ctx, resume_state("features." + f)));
   if (plan.images && !spec.image_tensors()) sinks.push_back(make_image_sink(ctx, start.resuming, first));
-  TensorOptions topt;
-  topt.rule = rule;
+  TensorOptions topt = h5_tensor_options(spec, plan, rule);
   topt.identity = identity;
-  topt.annotations = plan.annotations;
   if (spec.has_format("h5")) {
-    topt.h5 = true;
-    topt.compress = spec.compress;
-    topt.images = spec.wants_images();
-    topt.features = spec.wants_features();
     sinks.push_back(make_tensor_sink(ctx, topt, start.resuming ? &saved : nullptr));
   }
   if (spec.npy_image_tensors()) {
@@ -331,18 +262,7 @@ void run_batches(const ScenarioSource& source, const Plan& plan, Backend& backen
       std::unique_ptr<Job> job = hand.recycled();
       const size_t n = static_cast<size_t>(std::min<uint64_t>(res.batch, res.end - at));
       SceneBatch& b = job->scenes;
-      b.first_index = at;
-      b.subject.resize(n);
-      b.objects.resize(n * kRegions);
-      b.label.resize(n);
-      parallel_for(n, n >= 1024 ? threads : 1, [&](size_t lo, size_t hi) {
-        for (size_t i = lo; i < hi; ++i) {
-          const Scenario s = source(at + i);
-          b.subject[i] = static_cast<uint8_t>(s.subject);
-          std::copy(s.objects.begin(), s.objects.end(), b.objects.begin() + i * kRegions);
-          b.label[i] = static_cast<uint8_t>(s.label);
-        }
-      });
+      source.fill(at, n, threads, b);
       const auto tc = Clock::now();
       backend.run(b, plan, job->out);
       res.compute_seconds += since(tc);
@@ -414,12 +334,7 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   res.begin = source.total() * opt.shard / opt.shards;
   res.end = source.total() * (opt.shard + 1) / opt.shards;
 
-  Plan plan = spec.settings();
-  plan.features = spec.wants_features();
-  plan.metal = true;
-  plan.images = spec.wants_images() ? kAllViews : 0;
-  plan.annotations = spec.annotations;
-  validate(plan, cat);
+  const Plan plan = run_plan(spec, cat);
   res.batch = opt.batch ? opt.batch : default_batch(plan, cat);
   const unsigned threads = opt.threads ? opt.threads : default_threads();
   const json identity = run_identity(spec, cat, source.total(), opt, res);
@@ -465,17 +380,10 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
     res.positive = start.checkpoint["positive"].get<uint64_t>();
     res.negative = start.checkpoint["negative"].get<uint64_t>();
   }
-  SinkContext ctx;
+  SinkContext ctx = plan_sink_context(plan, cat, assets, threads, spec.image_format);
   ctx.dir = dir;
-  ctx.cat = &cat;
-  ctx.assets = &assets;
-  ctx.layout = FeatureLayout::of(cat, plan.model.block);
   ctx.rows = res.end - res.begin;
   ctx.done = first - res.begin;
-  ctx.threads = threads;
-  ctx.model = plan.model;
-  ctx.image_format = spec.image_format;
-  ctx.palette = procedural::ir_palette(plan.palette);
   std::vector<std::unique_ptr<Sink>> sinks = open_sinks(spec, plan, ctx, source.rule(), identity, start, first);
 
   const auto checkpoint = [&](uint64_t next) {

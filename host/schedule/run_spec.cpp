@@ -235,6 +235,9 @@ GeneratorSpec generator_spec(const RunSpec& spec, const Catalogue& cat) {
                        std::to_string(cat.subjects.size()) + ")");
     g.subjects.push_back(s - 1);
   }
+  // Compiled here too, so that a rule that does not parse is named where it was given
+  // (the spec file's line, or --rule); the generator knows no file.
+  if (!spec.rule.empty()) (void)ThreatRule(cat, spec.rule, spec.where("rule"));
   g.rule = spec.rule;
   g.balance = spec.balance;
   return g;

@@ -1,6 +1,5 @@
-// One scenario from what a user typed (subject, objects per region, rule or label) to its
-// folder: shared by `simulate` and `serve`, so both check the same way and write the
-// same bytes.
+// One scenario (scene/scenario_inputs.h) to its folder: shared by `simulate` and `serve`,
+// so both write the same bytes.
 #pragma once
 #include <string>
 #include <vector>
@@ -9,20 +8,11 @@
 #include "backend/backend.h"
 #include "plan/plan.h"
 #include "scene/catalogue.h"
+#include "scene/scenario_inputs.h"
 #include "scene/scene.h"
 #include "sink/scenario_folder.h"
 
 namespace portalsim {
-
-struct ScenarioInputs {
-  int subject = 1;                   // 1-based, as typed
-  std::vector<std::string> objects;  // tokens for regions 1..13 ("none", "gun:v")
-  std::string rule;                  // threat rule, or empty
-  std::string threat;                // "yes" / "no" / empty; not together with rule
-};
-
-// Checks the inputs with the command line's messages (InputError) and builds the scenario.
-Scenario make_scenario(const Catalogue& cat, const ScenarioInputs& in);
 
 struct OneScenarioTimes {
   double run_seconds = 0, write_seconds = 0;

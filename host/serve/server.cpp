@@ -23,6 +23,7 @@
 #include "plan/knobs.h"
 #include "serve/knob_fields.h"
 #include "serve/one_scenario.h"
+#include "serve/request.h"
 #include "sink/staging.h"
 
 extern char** environ;
@@ -62,46 +63,6 @@ std::string base64(const std::string& in) {
   }
   return out;
 }
-
-// A field of the request, checked for type; errors name it as the command line would.
-template <class T>
-T field(const json& j, const char* name, const T& fallback) {
-  if (!j.contains(name) || j[name].is_null()) return fallback;
-  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
-    if (!j[name].is_number_integer())
-      throw InputError(std::string("request: field \"") + name + "\" is not a whole number");
-    // Out-of-range values become a range error of their own field, never a wrap.
-    if (j[name].is_number_unsigned() ? j[name].get<uint64_t>() > uint64_t(std::numeric_limits<T>::max())
-                                     : j[name].get<int64_t>() < int64_t(std::numeric_limits<T>::min()))
-      throw InputError(std::string("request: field \"") + name + "\" is out of range");
-  }
-  try {
-    return j[name].get<T>();
-  } catch (const json::exception&) {
-    throw InputError(std::string("request: field \"") + name + "\" has the wrong type");
-  }
-}
-
-// One name for a folder under --root: a single path component of safe characters.
-std::string check_name(const std::string& name, const char* what) {
-  const std::string w = std::string(what) + ": \"" + name + "\" ";
-  if (name.empty()) throw InputError(std::string(what) + ": empty name");
-  if (name.size() > 100) throw InputError(w + "is longer than 100 characters");
-  if (name[0] == '/') throw InputError(w + "is an absolute path; give a name inside --root");
-  if (name.find("..") != std::string::npos) throw InputError(w + "contains \"..\"; give a name inside --root");
-  if (name.find('/') != std::string::npos) throw InputError(w + "contains \"/\"; give one folder name");
-  if (name[0] == '.') throw InputError(w + "starts with \".\"");
-  for (char c : name)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.'))
-      throw InputError(w + "may only use letters, digits, '-', '_' and '.'");
-  return name;
-}
-
-struct Request {
-  ScenarioInputs in;
-  Plan plan;
-  std::string seed = "0", tier = "standard";
-};
 
 struct Job {
   pid_t pid = -1;
@@ -147,28 +108,6 @@ struct Server::Impl {
     fs::remove_all(scratch, ec);
   }
 
-  Request parse(const std::string& body) const {
-    json j = json::parse(body, nullptr, false);
-    if (j.is_discarded() || !j.is_object()) throw InputError("request: the body is not a JSON object");
-    Request r;
-    r.in.subject = field<int>(j, "subject", 1);
-    r.in.objects = field<std::vector<std::string>>(j, "objects", {});
-    r.in.rule = field<std::string>(j, "rule", "");
-    r.in.threat = field<std::string>(j, "threat", "");
-    r.seed = field<std::string>(j, "seed", "0");
-    r.tier = field<std::string>(j, "tier", "standard");
-    if (r.in.objects.size() > static_cast<size_t>(kRegions))
-      throw InputError("objects: " + std::to_string(r.in.objects.size()) + " given, at most 13 regions");
-    r.plan.model.seed = io::parse_u64(r.seed, "--seed");
-    // The command line's own check (CLI11's IsMember) and its words.
-    if (r.tier != "fast" && r.tier != "standard" && r.tier != "exact")
-      throw InputError("--tier: " + r.tier + " not in {fast,standard,exact}");
-    r.plan.fidelity = tier_fidelity(parse_tier(r.tier, "--tier"));
-    apply_knobs(j, r.plan);  // every knob of the registry, checked as its flag is; after the tier
-    validate(r.plan, cat);
-    return r;
-  }
-
   // Runs the scenario into `dir` (all or nothing); returns the metal zones.
   std::vector<int> run(const Request& r, const Scenario& scene, const std::string& dir) {
     BatchOutput out;
@@ -178,8 +117,8 @@ struct Server::Impl {
   }
 
   json render(const std::string& body) {
-    const Request r = parse(body);
-    const Scenario scene = make_scenario(cat, r.in);
+    const Request r = parse_request(cat, body);
+    const Scenario& scene = r.scene;
     const fs::path dir = scratch / ("r" + std::to_string(counter++));
     json res;
     try {
@@ -208,12 +147,11 @@ struct Server::Impl {
   }
 
   json save(const std::string& body) {
-    const Request r = parse(body);
-    json j = json::parse(body);
-    const Scenario scene = make_scenario(cat, r.in);
+    const Request r = parse_request(cat, body);
+    const Scenario& scene = r.scene;
     // One save at a time: the name check, the folder and the list row go together.
     std::lock_guard<std::mutex> lock(csv_mutex);
-    const fs::path dir = new_folder(field<std::string>(j, "name", ""));
+    const fs::path dir = new_folder(r.name);
     const fs::path csv = root / "scenarios.csv";
     {
       std::error_code ec;
@@ -240,10 +178,9 @@ struct Server::Impl {
   }
 
   json generate(const std::string& body) {
-    const Request r = parse(body);
-    json j = json::parse(body);
-    const Scenario scene = make_scenario(cat, r.in);
-    const int64_t count = field<int64_t>(j, "count", 0);
+    const Request r = parse_request(cat, body);
+    const Scenario& scene = r.scene;
+    const int64_t count = r.count;
     if (count < 1 || count > 1000000) throw InputError("--count: " + std::to_string(count) + " is not 1 to 1000000");
     std::string pool;
     int placed = 0;
@@ -257,7 +194,7 @@ struct Server::Impl {
     pool.pop_back();
     std::lock_guard<std::mutex> lock(job_mutex);
     if (job && job->running) throw InputError("generate: a run is already going (" + job->name + ")");
-    const fs::path dir = new_folder(field<std::string>(j, "name", ""));
+    const fs::path dir = new_folder(r.name);
     std::vector<std::string> args{opt.self,
                                   "generate",
                                   "--quiet",

@@ -48,11 +48,17 @@ FolderLock::FolderLock(const std::string& dir) {
   std::error_code ec;
   fs::create_directories(state, ec);
   if (ec) throw OutputError(dir + ": cannot create " + state.string() + ": " + ec.message());
+  // What this constructor made goes again when it throws (a full disk fails the PID's
+  // write): .portalsim/ only if empty, so a folder's other state is never touched.
+  const auto fail = [&](const std::string& message) {
+    fs::remove(state, ec);
+    throw OutputError(message);
+  };
   // The holder removes the file on release: a lock taken on a file already unlinked is
   // no lock, so try again on the new one.
   for (int attempt = 0;; ++attempt) {
     fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
-    if (fd_ < 0) throw OutputError(path.string() + ": cannot open the lock file: " + std::strerror(errno));
+    if (fd_ < 0) fail(path.string() + ": cannot open the lock file: " + std::strerror(errno));
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
       const int err = errno;
       char pid[32] = {};
@@ -76,17 +82,20 @@ FolderLock::FolderLock(const std::string& dir) {
   const std::string me = std::to_string(::getpid()) + "\n";
   if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, me.data(), me.size(), 0) != static_cast<ssize_t>(me.size())) {
     const int err = errno;
-    ::close(fd_);
-    throw OutputError(path.string() + ": cannot write the lock file: " + std::strerror(err));
+    release();
+    fail(path.string() + ": cannot write the lock file: " + std::strerror(err));
   }
 }
 
-FolderLock::~FolderLock() {
+FolderLock::~FolderLock() { release(); }
+
+void FolderLock::release() {
   if (fd_ < 0) return;
   std::error_code ec;
   fs::remove(path_, ec);                          // before the unlock, so that a waiting run finds a fresh file
   fs::remove(fs::path(path_).parent_path(), ec);  // only if empty
   ::close(fd_);                                   // releases the flock
+  fd_ = -1;
 }
 
 }  // namespace portalsim

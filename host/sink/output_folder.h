@@ -32,6 +32,7 @@ class FolderLock {
   ~FolderLock();
 
  private:
+  void release();  // removes the lock file (and .portalsim/ when empty), then unlocks
   int fd_ = -1;
   std::string path_;
 };

@@ -51,15 +51,177 @@ std::string_view rows_of(const std::vector<T>& v, size_t row, size_t lo, size_t 
   return {reinterpret_cast<const char*>(v.data() + lo * row), (hi - lo) * row * sizeof(T)};
 }
 
-// One tensor: its dataset description, how a batch fills it and, unless data.h5 is written
-// in place, its .npy file.
+// One tensor and, unless data.h5 is written in place, its .npy file.
 struct Tensor {
-  H5Dataset ds;
-  // The batch's rows [lo, hi): a view of the batch's own memory, or of `scratch` filled here.
-  std::function<std::string_view(const SceneBatch&, const BatchOutput&, size_t lo, size_t hi, std::string& scratch)>
-      fill;
+  TensorColumn col;
   std::unique_ptr<AppendFile> file;
 };
+
+// Rows of an int16 per-region tensor: `f` of each region's variant.
+template <class F>
+std::string_view per_region(const SceneBatch& b, size_t lo, size_t hi, std::string& buf, F f) {
+  buf.resize((hi - lo) * kRegions * sizeof(int16_t));
+  for (size_t i = lo * kRegions; i < hi * kRegions; ++i) {
+    const int16_t v = f(b.objects[i]);
+    std::memcpy(&buf[(i - lo * kRegions) * sizeof(int16_t)], &v, sizeof v);
+  }
+  return buf;
+}
+
+// Scenario i's region r: `of(object_transform(...))`, or `none` where the region is empty.
+template <class T, class F>
+std::string_view per_transform(const ModelSettings& model, const SceneBatch& b, size_t lo, size_t hi, std::string& buf,
+                               T none, F of) {
+  buf.resize((hi - lo) * kRegions * sizeof(T));
+  for (size_t i = lo; i < hi; ++i)
+    for (int r = 0; r < kRegions; ++r) {
+      const T v = b.objects[i * kRegions + r] == kNoObject ? none : of(object_transform(model, b.first_index + i, r));
+      std::memcpy(&buf[((i - lo) * kRegions + r) * sizeof(T)], &v, sizeof v);
+    }
+  return buf;
+}
+
+}  // namespace
+
+std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOptions& opt) {
+  std::vector<TensorColumn> columns;
+  const auto add = [&](const std::string& name, TensorType type, std::vector<uint64_t> dims, Fill fill,
+                       bool view = false) {
+    TensorColumn c;
+    c.ds.name = name;
+    c.ds.type = type;
+    c.ds.dims = std::move(dims);
+    if (name == "features") {
+      c.ds.columns = ctx.layout.names();
+      c.ds.columns.resize(static_cast<size_t>(ctx.layout.image_features()));
+    }
+    c.fill = std::move(fill);
+    c.view = view;
+    columns.push_back(std::move(c));
+  };
+  const Catalogue* cat = ctx.cat;
+  const ThreatRule* rule = opt.rule;
+  const ModelSettings model = ctx.model;
+  if (opt.images)
+    for (size_t k = 0; k < cat->sensors.size(); ++k) {
+      const Sensor& s = cat->sensors[k];
+      const uint64_t h = static_cast<uint64_t>(s.height), w = static_cast<uint64_t>(s.width);
+      if (s.palette) {
+        // Through the palette as 4-byte words, each store overlapping the next pixel's.
+        std::array<uint32_t, 256> rgb{};
+        for (size_t i = 0; i < rgb.size(); ++i) std::memcpy(&rgb[i], ctx.palette[i].data(), 3);
+        add(s.name, TensorType::u8, {h, w, 3},
+            [k, rgb](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string& buf) {
+              const ViewImages& v = o.views[k];
+              const size_t per = v.pixels_per_image(), n = (hi - lo) * per;
+              const uint8_t* p = v.pixels.data() + lo * per;
+              buf.resize(n * 3 + 1);
+              char* d = buf.data();
+              for (size_t i = 0; i < n; ++i) std::memcpy(d + i * 3, &rgb[p[i]], 4);
+              return std::string_view(buf.data(), n * 3);
+            });
+        add(
+            s.name + "_index", TensorType::u8, {h, w},
+            [k](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+              return rows_of(o.views[k].pixels, o.views[k].pixels_per_image(), lo, hi);
+            },
+            true);
+      } else {
+        add(
+            s.name, TensorType::u8, {h, w},
+            [k](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+              return rows_of(o.views[k].pixels, o.views[k].pixels_per_image(), lo, hi);
+            },
+            true);
+      }
+    }
+  if (opt.annotations)
+    for (size_t k = 0; k < cat->sensors.size(); ++k) {
+      const Sensor& s = cat->sensors[k];
+      add(
+          "mask_" + s.name, TensorType::u8, {static_cast<uint64_t>(s.height), static_cast<uint64_t>(s.width)},
+          [k, per = static_cast<size_t>(s.pixels())](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi,
+                                                     std::string&) {
+            return rows_of(o.annotations[k].masks, per, lo, hi);
+          },
+          true);
+    }
+  if (opt.features)
+    add(
+        "features", TensorType::f32, {static_cast<uint64_t>(ctx.layout.image_features())},
+        [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+          return rows_of(o.features, static_cast<size_t>(o.layout.image_features()), lo, hi);
+        },
+        true);
+  if (opt.scenario) {
+    add(
+        "metal", TensorType::u8, {kZones},
+        [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+          return rows_of(o.metal, kZones, lo, hi);
+        },
+        true);
+    add(
+        "label", TensorType::u8, {},
+        [](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string&) {
+          return rows_of(b.label, 1, lo, hi);
+        },
+        true);
+    add("subject", TensorType::u8, {},
+        [](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+          buf.resize(hi - lo);
+          for (size_t i = lo; i < hi; ++i) buf[i - lo] = static_cast<char>(b.subject[i] + 1);
+          return std::string_view(buf);
+        });
+    add("region_object", TensorType::i16, {kRegions},
+        [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+          return per_region(b, lo, hi, buf, [&](int16_t v) {
+            return v == kNoObject ? int16_t(-1) : int16_t(cat->variant_list[v].object);
+          });
+        });
+    add("region_orientation", TensorType::i16, {kRegions},
+        [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+          return per_region(b, lo, hi, buf, [&](int16_t v) {
+            return v == kNoObject ? int16_t(-1) : int16_t(cat->variant_list[v].variant);
+          });
+        });
+    add("region_label", TensorType::u8, {kRegions},
+        [rule](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+          buf.assign((hi - lo) * kRegions, '\0');
+          if (!rule) return std::string_view(buf);
+          for (size_t i = lo; i < hi; ++i)
+            for (int r = 0; r < kRegions; ++r) {
+              const int16_t v = b.objects[i * kRegions + r];
+              if (v == kNoObject) continue;
+              Scenario alone;
+              alone.subject = b.subject[i];
+              alone.objects[r] = v;
+              buf[(i - lo) * kRegions + r] = (*rule)(alone) ? 1 : 0;
+            }
+          return std::string_view(buf);
+        });
+    if (ctx.model.transforms()) {
+      // Each object's randomised draw (plan.h, object_transform), the numbers scenarios.csv
+      // records: float64 so they are the same doubles; identity where a region is empty.
+      add("region_rotation", TensorType::f64, {kRegions},
+          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+            return per_transform<double>(model, b, lo, hi, buf, 0.0,
+                                         [](const ObjectTransform& x) { return x.rotation; });
+          });
+      add("region_scale", TensorType::f64, {kRegions},
+          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+            return per_transform<double>(model, b, lo, hi, buf, 1.0, [](const ObjectTransform& x) { return x.scale; });
+          });
+      add("region_flip", TensorType::u8, {kRegions},
+          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
+            return per_transform<uint8_t>(model, b, lo, hi, buf, 0,
+                                          [](const ObjectTransform& x) { return uint8_t(x.flip); });
+          });
+    }
+  }
+  return columns;
+}
+
+namespace {
 
 // About the bytes of one piece of a tensor's rows (TensorSink::write), well inside a core's
 // L2 cache, and how many pieces of data.h5 may be made before they are written.
@@ -70,119 +232,17 @@ class TensorSink final : public Sink {
  public:
   TensorSink(const SinkContext& ctx, const TensorOptions& opt, const std::map<std::string, FileState>* resume)
       : ctx_(ctx), opt_(opt) {
-    const Catalogue& cat = *ctx.cat;
     if (opt.h5 && opt.compress) {
       std::error_code ec;
       fs::create_directories(fs::path(ctx.dir) / kStateDir / "tensors", ec);
       if (ec) throw OutputError(ctx.dir + "/" + kStateDir + "/tensors: cannot create: " + ec.message());
     }
-    if (opt.images)
-      for (size_t k = 0; k < cat.sensors.size(); ++k) {
-        const Sensor& s = cat.sensors[k];
-        const uint64_t h = static_cast<uint64_t>(s.height), w = static_cast<uint64_t>(s.width);
-        if (s.palette) {
-          // Through the palette as 4-byte words, each store overlapping the next pixel's.
-          std::array<uint32_t, 256> rgb{};
-          for (size_t i = 0; i < rgb.size(); ++i) std::memcpy(&rgb[i], ctx_.palette[i].data(), 3);
-          add(s.name, TensorType::u8, {h, w, 3},
-              [k, rgb](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string& buf) {
-                const ViewImages& v = o.views[k];
-                const size_t per = v.pixels_per_image(), n = (hi - lo) * per;
-                const uint8_t* p = v.pixels.data() + lo * per;
-                buf.resize(n * 3 + 1);
-                char* d = buf.data();
-                for (size_t i = 0; i < n; ++i) std::memcpy(d + i * 3, &rgb[p[i]], 4);
-                return std::string_view(buf.data(), n * 3);
-              });
-          add(s.name + "_index", TensorType::u8, {h, w},
-              [k](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
-                return rows_of(o.views[k].pixels, o.views[k].pixels_per_image(), lo, hi);
-              });
-        } else {
-          add(s.name, TensorType::u8, {h, w},
-              [k](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
-                return rows_of(o.views[k].pixels, o.views[k].pixels_per_image(), lo, hi);
-              });
-        }
-      }
-    if (opt.annotations)
-      for (size_t k = 0; k < cat.sensors.size(); ++k) {
-        const Sensor& s = cat.sensors[k];
-        add("mask_" + s.name, TensorType::u8, {static_cast<uint64_t>(s.height), static_cast<uint64_t>(s.width)},
-            [k, per = static_cast<size_t>(s.pixels())](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi,
-                                                       std::string&) {
-              return rows_of(o.annotations[k].masks, per, lo, hi);
-            });
-      }
-    if (opt.features)
-      add("features", TensorType::f32, {static_cast<uint64_t>(ctx.layout.image_features())},
-          [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
-            return rows_of(o.features, static_cast<size_t>(o.layout.image_features()), lo, hi);
-          });
-    if (opt.scenario) {
-      add("metal", TensorType::u8, {kZones},
-          [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
-            return rows_of(o.metal, kZones, lo, hi);
-          });
-      add("label", TensorType::u8, {}, [](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string&) {
-        return rows_of(b.label, 1, lo, hi);
-      });
-      add("subject", TensorType::u8, {},
-          [](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-            buf.resize(hi - lo);
-            for (size_t i = lo; i < hi; ++i) buf[i - lo] = static_cast<char>(b.subject[i] + 1);
-            return std::string_view(buf);
-          });
-      add("region_object", TensorType::i16, {kRegions},
-          [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-            return per_region(b, lo, hi, buf, [&](int16_t v) {
-              return v == kNoObject ? int16_t(-1) : int16_t(ctx_.cat->variant_list[v].object);
-            });
-          });
-      add("region_orientation", TensorType::i16, {kRegions},
-          [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-            return per_region(b, lo, hi, buf, [&](int16_t v) {
-              return v == kNoObject ? int16_t(-1) : int16_t(ctx_.cat->variant_list[v].variant);
-            });
-          });
-      add("region_label", TensorType::u8, {kRegions},
-          [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-            buf.assign((hi - lo) * kRegions, '\0');
-            if (!opt_.rule) return std::string_view(buf);
-            for (size_t i = lo; i < hi; ++i)
-              for (int r = 0; r < kRegions; ++r) {
-                const int16_t v = b.objects[i * kRegions + r];
-                if (v == kNoObject) continue;
-                Scenario alone;
-                alone.subject = b.subject[i];
-                alone.objects[r] = v;
-                buf[(i - lo) * kRegions + r] = (*opt_.rule)(alone) ? 1 : 0;
-              }
-            return std::string_view(buf);
-          });
-      if (ctx.model.transforms()) {
-        // Each object's randomised draw (plan.h, object_transform), the numbers scenarios.csv
-        // records: float64 so they are the same doubles; identity where a region is empty.
-        add("region_rotation", TensorType::f64, {kRegions},
-            [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-              return per_transform<double>(b, lo, hi, buf, 0.0, [](const ObjectTransform& x) { return x.rotation; });
-            });
-        add("region_scale", TensorType::f64, {kRegions},
-            [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-              return per_transform<double>(b, lo, hi, buf, 1.0, [](const ObjectTransform& x) { return x.scale; });
-            });
-        add("region_flip", TensorType::u8, {kRegions},
-            [this](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-              return per_transform<uint8_t>(b, lo, hi, buf, 0,
-                                            [](const ObjectTransform& x) { return uint8_t(x.flip); });
-            });
-      }
-    }
+    for (TensorColumn& c : tensor_columns(ctx, opt)) tensors_.push_back(Tensor{std::move(c), nullptr});
     if (in_place())
       open_in_place(resume);
     else
       for (Tensor& t : tensors_) {
-        const std::string file = file_name(t.ds.name);
+        const std::string file = file_name(t.col.ds.name);
         const FileState* state = nullptr;
         if (resume) {
           auto it = resume->find(file);
@@ -190,8 +250,8 @@ class TensorSink final : public Sink {
           state = &it->second;
         }
         std::vector<uint64_t> shape{ctx.rows};
-        shape.insert(shape.end(), t.ds.dims.begin(), t.ds.dims.end());
-        const std::string header = npy_array_header(npy_descr(t.ds.type), shape);
+        shape.insert(shape.end(), t.col.ds.dims.begin(), t.col.ds.dims.end());
+        const std::string header = npy_array_header(npy_descr(t.col.ds.type), shape);
         t.file = std::make_unique<AppendFile>(ctx.dir, file, state);
         if (!state) t.file->append(header);
       }
@@ -218,7 +278,7 @@ class TensorSink final : public Sink {
     std::vector<Piece> pieces;
     if (!in_place()) {
       for (Tensor& t : tensors_) {
-        const size_t step = std::max<size_t>(1, kPieceBytes / std::max<size_t>(1, t.ds.row_bytes()));
+        const size_t step = std::max<size_t>(1, kPieceBytes / std::max<size_t>(1, t.col.ds.row_bytes()));
         for (size_t lo = 0; lo < n; lo += step) pieces.push_back({&t, lo, std::min(n, lo + step), 0, 0, 0, {}});
       }
     } else {
@@ -227,7 +287,7 @@ class TensorSink final : public Sink {
       for (uint64_t c = rows_ / chunk_rows; c * chunk_rows < end; ++c) {
         const uint64_t from = std::max(rows_, c * chunk_rows), to = std::min(end, (c + 1) * chunk_rows);
         for (size_t k = 0; k < tensors_.size(); ++k) {
-          const size_t row = std::max<size_t>(1, tensors_[k].ds.row_bytes());
+          const size_t row = std::max<size_t>(1, tensors_[k].col.ds.row_bytes());
           const size_t step = std::max<size_t>(1, kPieceBytes / row);
           for (uint64_t r = from; r < to; r += step)
             pieces.push_back({&tensors_[k],
@@ -248,7 +308,7 @@ class TensorSink final : public Sink {
       parallel_for(threads, threads, [&](size_t first, size_t) {
         for (size_t k = first; k < tensors_.size(); k += threads)
           for (const Piece& p : pieces)
-            if (p.t == &tensors_[k]) p.t->file->append(p.t->fill(scenes, out, p.lo, p.hi, scratch_[first]));
+            if (p.t == &tensors_[k]) p.t->file->append(p.t->col.fill(scenes, out, p.lo, p.hi, scratch_[first]));
       });
       return;
     }
@@ -261,7 +321,7 @@ class TensorSink final : public Sink {
     // after every piece did about a hundred times a batch.
     const auto make = [&](size_t i) {
       Piece& p = pieces[i];
-      p.rows = p.t->fill(scenes, out, p.lo, p.hi, slots_[i % kSlots]);
+      p.rows = p.t->col.fill(scenes, out, p.lo, p.hi, slots_[i % kSlots]);
       order_->feed(p.extent, p.at, p.rows);
     };
     const auto put = [&](const Piece& p) { write_at(fd_, p.rows.data(), p.rows.size(), p.file_at, partial_); };
@@ -406,7 +466,7 @@ class TensorSink final : public Sink {
     layout.rows = ctx_.rows;
     layout.compress = opt_.compress;
     layout.attributes = attributes();
-    for (const Tensor& t : tensors_) layout.datasets.push_back(t.ds);
+    for (const Tensor& t : tensors_) layout.datasets.push_back(t.col.ds);
     return layout;
   }
 
@@ -429,7 +489,7 @@ class TensorSink final : public Sink {
     std::vector<FileExtent> extents;
     for (uint64_t c = 0; c < chunks; ++c)
       for (size_t k = 0; k < tensors_.size(); ++k) {
-        const uint64_t row = tensors_[k].ds.row_bytes();
+        const uint64_t row = tensors_[k].col.ds.row_bytes();
         extents.push_back({place_.address[k][c], chunk_rows * row,
                            (std::min(ctx_.rows, (c + 1) * chunk_rows) - c * chunk_rows) * row});
       }
@@ -445,7 +505,7 @@ class TensorSink final : public Sink {
     };
     const FileState written = state(kWrittenState), held = state(kHeldState);
     std::string names;
-    for (const Tensor& t : tensors_) names += (names.empty() ? "" : ", ") + t.ds.name;
+    for (const Tensor& t : tensors_) names += (names.empty() ? "" : ", ") + t.col.ds.name;
     // The file in order up to where the checkpoint's hash reached; the rows written so far
     // end there, inside the first dataset's chunk (or at the end of the file).
     order_->skip_to(written.bytes, ctx_.threads);
@@ -457,10 +517,10 @@ class TensorSink final : public Sink {
       rows_ = ctx_.rows;
     } else {
       const size_t e = order_->extent();
-      const uint64_t at = order_->into_extent(), row = tensors_[0].ds.row_bytes();
+      const uint64_t at = order_->into_extent(), row = tensors_[0].col.ds.row_bytes();
       if (e % tensors_.size() != 0 || at % row != 0)
         throw OutputError(ctx_.dir + "/.portalsim/checkpoint.json: " + kWrittenState +
-                          " does not end after a whole row of " + tensors_[0].ds.name);
+                          " does not end after a whole row of " + tensors_[0].col.ds.name);
       rows_ = e / tensors_.size() * chunk_rows + at / row;
     }
     if (rows_ != ctx_.done)
@@ -473,7 +533,7 @@ class TensorSink final : public Sink {
       const uint64_t c = rows_ / chunk_rows;
       std::string buf;
       for (size_t k = 1; k < tensors_.size(); ++k) {
-        const uint64_t row = tensors_[k].ds.row_bytes();
+        const uint64_t row = tensors_[k].col.ds.row_bytes();
         buf.resize((rows_ - c * chunk_rows) * row);
         read_at(fd_, buf.data(), buf.size(), place_.address[k][c], partial_, "for resume");
         order_->feed(c * tensors_.size() + k, 0, buf);
@@ -489,51 +549,12 @@ class TensorSink final : public Sink {
   std::string file_name(const std::string& tensor) const {
     return opt_.h5 ? std::string(kStateDir) + "/tensors/" + tensor + ".npy" : tensor + ".npy";
   }
-  void add(const std::string& name, TensorType type, std::vector<uint64_t> dims,
-           std::function<std::string_view(const SceneBatch&, const BatchOutput&, size_t, size_t, std::string&)> fill) {
-    Tensor t;
-    t.ds.name = name;
-    t.ds.type = type;
-    t.ds.dims = std::move(dims);
-    if (name == "features") t.ds.columns = feature_names();
-    t.fill = std::move(fill);
-    tensors_.push_back(std::move(t));
-  }
-  template <class F>
-  static std::string_view per_region(const SceneBatch& b, size_t lo, size_t hi, std::string& buf, F f) {
-    buf.resize((hi - lo) * kRegions * sizeof(int16_t));
-    for (size_t i = lo * kRegions; i < hi * kRegions; ++i) {
-      const int16_t v = f(b.objects[i]);
-      std::memcpy(&buf[(i - lo * kRegions) * sizeof(int16_t)], &v, sizeof v);
-    }
-    return buf;
-  }
-
-  // Scenario i's region r: `of(object_transform(...))`, or `none` where the region is empty.
-  template <class T, class F>
-  std::string_view per_transform(const SceneBatch& b, size_t lo, size_t hi, std::string& buf, T none, F of) const {
-    buf.resize((hi - lo) * kRegions * sizeof(T));
-    for (size_t i = lo; i < hi; ++i)
-      for (int r = 0; r < kRegions; ++r) {
-        const T v =
-            b.objects[i * kRegions + r] == kNoObject ? none : of(object_transform(ctx_.model, b.first_index + i, r));
-        std::memcpy(&buf[((i - lo) * kRegions + r) * sizeof(T)], &v, sizeof v);
-      }
-    return buf;
-  }
-
   // data.h5 from the finished tensor files (compressed).
   void build_h5() {
     std::vector<std::string> paths;
-    for (const Tensor& t : tensors_) paths.push_back((fs::path(ctx_.dir) / file_name(t.ds.name)).string());
+    for (const Tensor& t : tensors_) paths.push_back((fs::path(ctx_.dir) / file_name(t.col.ds.name)).string());
     write_h5(ctx_.dir, h5_layout(), paths);
     h5_state_ = hash_file(ctx_.dir, "data.h5", ctx_.threads);
-  }
-
-  std::vector<std::string> feature_names() const {
-    std::vector<std::string> n = ctx_.layout.names();
-    n.resize(static_cast<size_t>(ctx_.layout.image_features()));
-    return n;
   }
 
   std::vector<H5Attribute> attributes() const {

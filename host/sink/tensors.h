@@ -15,13 +15,16 @@
 // object's transform, the numbers scenarios.csv records; 0, 1, 0 where a region is empty);
 // with annotations, mask_<view> uint8 NxHxW (instance masks: the region number, 0 none).
 #pragma once
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scene/rules.h"
+#include "sink/h5_file.h"
 #include "sink/sinks.h"
 
 namespace portalsim {
@@ -36,6 +39,22 @@ struct TensorOptions {
   const ThreatRule* rule = nullptr;  // for region_label; null = every region 0
   nlohmann::json identity;           // the run's identity (version, catalogue, spec): HDF5 attributes
 };
+
+// The batch's rows [lo, hi) of one tensor: a view of the batch's own memory, or of
+// `scratch` filled here.
+using Fill =
+    std::function<std::string_view(const SceneBatch&, const BatchOutput&, size_t lo, size_t hi, std::string& scratch)>;
+
+// One tensor: its data.h5 dataset and how a batch makes its rows. The tensor sink writes
+// these rows to files, and Python (python/) hands them over as NumPy arrays.
+struct TensorColumn {
+  H5Dataset ds;
+  Fill fill;
+  bool view = false;  // fill returns the batch's own memory, never `scratch`
+};
+
+// The tensors `opt` asks for, in data.h5's order.
+std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOptions& opt);
 
 // `resume` maps a file name (as FileState::name) to its checkpointed state; null when new.
 std::unique_ptr<Sink> make_tensor_sink(const SinkContext& ctx, const TensorOptions& opt,

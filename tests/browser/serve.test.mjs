@@ -64,7 +64,8 @@ try {
   await page.type("#rule", "gun&");
   await page.keyboard.press("Tab");
   await page.waitForFunction(() => document.getElementById("error").textContent.includes("gun&"), { timeout: 30000 });
-  check(true, "a bad rule's message is shown: " + (await page.$eval("#error", (e) => e.textContent)));
+  const ruleError = await page.$eval("#error", (e) => e.textContent);
+  check(ruleError.includes('"gun&" at character 5'), "a bad rule's message is shown, saying where: " + ruleError);
   await page.$eval("#rule", (e) => { e.value = ""; });
   await page.$eval("#rule", (e) => e.dispatchEvent(new Event("change")));
   await page.waitForFunction(() => document.getElementById("error").textContent === "", { timeout: 30000 });
@@ -89,8 +90,11 @@ try {
   // Keyboard: the regions are buttons with names, reachable by Tab.
   const label = await page.$eval("#hit4", (b) => b.getAttribute("aria-label"));
   check(/region 4 .*gun/.test(label), "region 4 is labelled: " + label);
-  await page.screenshot({ path: shot || path.join(work, "serve.png") });
-  check(true, "screenshot " + (shot || path.join(work, "serve.png")));
+  const png = shot || path.join(work, "serve.png");
+  await page.screenshot({ path: png });
+  const signature = Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]);
+  check(fs.existsSync(png) && fs.statSync(png).size > 1000 && fs.readFileSync(png).subarray(0, 8).equals(signature),
+    "screenshot " + png + " is a PNG");
 } finally {
   if (browser) await browser.close();
   server.kill("SIGTERM");

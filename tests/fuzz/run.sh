@@ -10,8 +10,11 @@ generator=()
 [ -f build-fuzz/CMakeCache.txt ] || ! command -v ninja >/dev/null || generator=(-G Ninja)
 CC=clang CXX=clang++ cmake -S . -B build-fuzz "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPORTALSIM_FUZZ=ON \
   -DPORTALSIM_TESTS=OFF -DPORTALSIM_BENCH=OFF ${PORTALSIM_CMAKE_ARGS:-} >/dev/null
-cmake --build build-fuzz -j "$(nproc)" --target fuzz_catalogue fuzz_spec fuzz_scenarios fuzz_feature_table fuzz_image
-for target in catalogue spec scenarios feature_table image; do
+# fuzz_h5 is built on demand only (tests/fuzz/README.md): libhdf5 itself overflows on a
+# crafted file within seconds, which no change here can fix.
+targets=(catalogue spec scenarios feature_table image arff csv checkpoint manifest request)
+cmake --build build-fuzz -j "$(nproc)" --target "${targets[@]/#/fuzz_}"
+for target in "${targets[@]}"; do
   work=build-fuzz/corpus/$target crashes=build-fuzz/crashes/$target
   rm -rf "$work" && mkdir -p "$work" "$crashes"
   echo "== fuzz_$target, $seconds s"

@@ -1,0 +1,368 @@
+#include "calibrate/fit.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "backend/reference/stages.h"
+#include "base/error.h"
+
+namespace portalsim::calibrate {
+
+namespace {
+
+constexpr double kFwhmPerSigma = 2.3548200450309493;  // 2 sqrt(2 ln 2)
+
+// Optics then sampling along one axis as a raw x size matrix: the PSF's Gaussian as
+// reference::gaussian_blur takes it (truncated at 4 sigma, normalised, edges held), then
+// each raw pixel's mean over its footprint as reference::sample takes it.
+std::vector<double> optics_sampling(int size, int raw, double sigma) {
+  std::vector<double> blur(static_cast<size_t>(size) * size, 0.0);
+  if (sigma <= 0) {
+    for (int x = 0; x < size; ++x) blur[static_cast<size_t>(x) * size + x] = 1.0;
+  } else {
+    const int R = static_cast<int>(std::ceil(4.0 * sigma));
+    std::vector<double> tap(2 * R + 1);
+    double total = 0;
+    for (int d = -R; d <= R; ++d) total += tap[d + R] = std::exp(-0.5 * d * d / (sigma * sigma));
+    for (int x = 0; x < size; ++x)
+      for (int d = -R; d <= R; ++d)
+        blur[static_cast<size_t>(x) * size + std::clamp(x + d, 0, size - 1)] += tap[d + R] / total;
+  }
+  const double s = double(size) / raw;
+  std::vector<double> k(static_cast<size_t>(raw) * size, 0.0);
+  for (int c = 0; c < raw; ++c)
+    for (int x = 0; x < size; ++x) {
+      const double w = std::max(0.0, std::min(x + 1.0, (c + 1) * s) - std::max(double(x), c * s)) / s;
+      if (w == 0) continue;
+      for (int j = 0; j < size; ++j)
+        k[static_cast<size_t>(c) * size + j] += w * blur[static_cast<size_t>(x) * size + j];
+    }
+  return k;
+}
+
+// One capture's view: its recovered raw cells that no clipped pixel reaches.
+struct Cells {
+  std::vector<double> value;
+  std::vector<int> index;
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return v[m];
+}
+
+// Least squares y = a + b x over the pairs, then again without those beyond 2.5 robust
+// sigmas (objects on the subject, which the bare subject does not show).
+struct Line {
+  double a = 0, b = 0, se_b = 0;
+};
+Line robust_line(const std::vector<double>& x, const std::vector<double>& y) {
+  std::vector<char> keep(x.size(), 1);
+  Line l;
+  for (int pass = 0; pass < 2; ++pass) {
+    double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (size_t i = 0; i < x.size(); ++i)
+      if (keep[i]) {
+        n += 1;
+        sx += x[i];
+        sy += y[i];
+        sxx += x[i] * x[i];
+        sxy += x[i] * y[i];
+      }
+    const double vx = sxx - sx * sx / n;
+    l.b = vx > 1e-12 ? (sxy - sx * sy / n) / vx : 0.0;
+    l.a = (sy - l.b * sx) / n;
+    std::vector<double> r(x.size());
+    for (size_t i = 0; i < x.size(); ++i) r[i] = std::abs(y[i] - l.a - l.b * x[i]);
+    const double scale = 1.4826 * median(r);
+    double ss = 0, m = 0;
+    for (size_t i = 0; i < x.size(); ++i)
+      if (keep[i]) {
+        ss += r[i] * r[i];
+        m += 1;
+      }
+    l.se_b = vx > 1e-12 ? std::sqrt(ss / std::max(1.0, m - 2) / vx) : INFINITY;
+    if (pass == 0)
+      for (size_t i = 0; i < x.size(); ++i) keep[i] = r[i] <= 2.5 * scale + 1e-9;
+  }
+  return l;
+}
+
+// The mean of the smallest 90% of the squares: objects leave the rest.
+double trimmed_ms(std::vector<double> sq) {
+  if (sq.empty()) return 0;
+  std::sort(sq.begin(), sq.end());
+  const size_t n = std::max<size_t>(1, sq.size() * 9 / 10);
+  double s = 0;
+  for (size_t i = 0; i < n; ++i) s += sq[i];
+  return s / n;
+}
+
+struct Problem {
+  const Captures& cap;
+  int raw_w, raw_h;
+  std::vector<std::vector<reference::Field>> kelvin;  // [subject][view] bare subject, K
+  std::vector<std::vector<Cells>> cells;              // [capture][view]
+};
+
+struct Evaluation {
+  double cost = INFINITY;
+  Line line;
+  std::vector<int> subject;
+  std::vector<double> x, y;  // every cell: the subject's kelvin and the capture's gray
+  size_t pairs = 0;
+};
+
+// Each subject's bare raw grid, K, under a PSF of `fwhm` view pixels.
+std::vector<std::vector<std::vector<double>>> predictions(const Problem& p, double fwhm) {
+  std::vector<std::vector<std::vector<double>>> out(p.kelvin.size());
+  for (size_t v = 0; v < p.cap.views.size(); ++v) {
+    const int W = p.cap.views[v].width, H = p.cap.views[v].height;
+    const std::vector<double> kx = optics_sampling(W, p.raw_w, fwhm / kFwhmPerSigma);
+    const std::vector<double> ky = optics_sampling(H, p.raw_h, fwhm / kFwhmPerSigma);
+    // Where each raw column's weights are not zero.
+    std::vector<std::pair<int, int>> xs(p.raw_w, {W, 0});
+    for (int c = 0; c < p.raw_w; ++c)
+      for (int x = 0; x < W; ++x)
+        if (kx[static_cast<size_t>(c) * W + x] != 0) xs[c] = {std::min(xs[c].first, x), x + 1};
+    for (size_t j = 0; j < p.kelvin.size(); ++j) {
+      const reference::Field& t = p.kelvin[j][v];
+      std::vector<double> mid(static_cast<size_t>(H) * p.raw_w, 0.0);
+      for (int y = 0; y < H; ++y)
+        for (int c = 0; c < p.raw_w; ++c) {
+          double acc = 0;
+          for (int x = xs[c].first; x < xs[c].second; ++x) acc += kx[static_cast<size_t>(c) * W + x] * t.at(x, y);
+          mid[static_cast<size_t>(y) * p.raw_w + c] = acc;
+        }
+      std::vector<double> raw(static_cast<size_t>(p.raw_w) * p.raw_h, 0.0);
+      for (int r = 0; r < p.raw_h; ++r)
+        for (int y = 0; y < H; ++y) {
+          const double w = ky[static_cast<size_t>(r) * H + y];
+          if (w == 0) continue;
+          for (int c = 0; c < p.raw_w; ++c)
+            raw[static_cast<size_t>(r) * p.raw_w + c] += w * mid[static_cast<size_t>(y) * p.raw_w + c];
+        }
+      out[j].push_back(std::move(raw));
+    }
+  }
+  return out;
+}
+
+Evaluation evaluate(const Problem& p, double fwhm) {
+  const auto pred = predictions(p, fwhm);
+  const size_t n = p.cap.count(), subjects = pred.size();
+  Evaluation e;
+  e.subject.assign(n, 0);
+  // Start: each capture's own best line against each subject picks its subject.
+  for (size_t c = 0; c < n; ++c) {
+    double best = INFINITY;
+    for (size_t j = 0; j < subjects; ++j) {
+      std::vector<double> x, y;
+      for (size_t v = 0; v < p.cells[c].size(); ++v)
+        for (size_t k = 0; k < p.cells[c][v].index.size(); ++k) {
+          x.push_back(pred[j][v][p.cells[c][v].index[k]]);
+          y.push_back(p.cells[c][v].value[k]);
+        }
+      if (x.size() < 3) break;
+      const Line l = robust_line(x, y);
+      std::vector<double> sq;
+      for (size_t i = 0; i < x.size(); ++i) sq.push_back(std::pow(y[i] - l.a - l.b * x[i], 2));
+      const double cost = trimmed_ms(sq);
+      if (cost < best) {
+        best = cost;
+        e.subject[c] = static_cast<int>(j);
+      }
+    }
+  }
+  // Then one window for all: fit it, re-match each capture under it, fit again.
+  for (int round = 0; round < 3; ++round) {
+    std::vector<double> x, y;
+    for (size_t c = 0; c < n; ++c)
+      for (size_t v = 0; v < p.cells[c].size(); ++v)
+        for (size_t k = 0; k < p.cells[c][v].index.size(); ++k) {
+          x.push_back(pred[e.subject[c]][v][p.cells[c][v].index[k]]);
+          y.push_back(p.cells[c][v].value[k]);
+        }
+    e.line = robust_line(x, y);
+    e.pairs = x.size();
+    if (round == 2) {
+      std::vector<double> sq(x.size());
+      for (size_t i = 0; i < x.size(); ++i) sq[i] = std::pow(y[i] - e.line.a - e.line.b * x[i], 2);
+      e.cost = trimmed_ms(std::move(sq));
+      e.x = std::move(x);
+      e.y = std::move(y);
+      break;
+    }
+    for (size_t c = 0; c < n; ++c) {
+      double best = INFINITY;
+      for (size_t j = 0; j < subjects; ++j) {
+        std::vector<double> sq;
+        for (size_t v = 0; v < p.cells[c].size(); ++v)
+          for (size_t k = 0; k < p.cells[c][v].index.size(); ++k)
+            sq.push_back(
+                std::pow(p.cells[c][v].value[k] - e.line.a - e.line.b * pred[j][v][p.cells[c][v].index[k]], 2));
+        const double cost = trimmed_ms(std::move(sq));
+        if (cost < best) {
+          best = cost;
+          e.subject[c] = static_cast<int>(j);
+        }
+      }
+    }
+  }
+  return e;
+}
+
+}  // namespace
+
+double aperture_for_fwhm(const Catalogue& cat, int width, double fwhm_pixels) {
+  // reference::psf_fwhm_pixels is inversely proportional to the aperture.
+  Catalogue one = cat;
+  one.physics.aperture_m = 1.0;
+  Sensor view;
+  view.width = width;
+  return reference::psf_fwhm_pixels(one, view) / fwhm_pixels;
+}
+
+CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const AssetSet& assets,
+                     const ModelSettings& model) {
+  check_captures(captures);
+  CameraFit fit;
+  // The raw grid: one for both views (the camera's), from both views' lines together.
+  std::vector<const std::vector<uint8_t>*> imgs;
+  const ViewCaptures& v0 = captures.views[0];
+  for (const ViewCaptures& v : captures.views) {
+    const int s = cat.sensor_index(v.name);
+    if (s < 0) throw InputError(captures.source + ": the catalogue has no camera view \"" + v.name + "\"");
+    if (cat.sensors[s].width != v.width || cat.sensors[s].height != v.height)
+      throw InputError(v.files.front() + ": is " + std::to_string(v.width) + "x" + std::to_string(v.height) +
+                       " but the catalogue's " + v.name + " view is " + std::to_string(cat.sensors[s].width) + "x" +
+                       std::to_string(cat.sensors[s].height));
+    if (v.width != v0.width || v.height != v0.height)
+      throw InputError(v.files.front() + ": the views differ in size from " + v0.files.front());
+    for (const auto& img : v.images) imgs.push_back(&img);
+  }
+  fit.grid_x = raw_grid_axis(imgs, v0.width, v0.height, true);
+  fit.grid_y = raw_grid_axis(imgs, v0.width, v0.height, false);
+  fit.raw_w = fit.grid_x.raw;
+  fit.raw_h = fit.grid_y.raw;
+
+  Problem p{captures, fit.raw_w, fit.raw_h, {}, {}};
+  ModelSettings m = model;
+  m.model = Model::physics;
+  for (size_t j = 0; j < cat.subjects.size(); ++j) {
+    Scenario s;
+    s.subject = static_cast<int>(j);
+    std::vector<reference::Field> views;
+    for (const ViewCaptures& v : captures.views) {
+      const reference::ViewScene vs = reference::view_scene(cat, assets, m, cat.sensor_index(v.name), s, 0);
+      reference::Field f;
+      reference::radiometry(vs, f);
+      views.push_back(std::move(f));
+    }
+    p.kelvin.push_back(std::move(views));
+  }
+  p.cells.resize(captures.count());
+  for (size_t c = 0; c < captures.count(); ++c)
+    for (const ViewCaptures& v : captures.views) {
+      std::vector<double> raw;
+      std::vector<char> valid;
+      recover_raw(v.images[c], v.width, v.height, fit.raw_w, fit.raw_h, raw, valid);
+      // At most about 1,024 cells a view: plenty for a robust fit, and the search stays quick
+      // on a full-size raw grid.
+      const size_t stride = std::max<size_t>(1, raw.size() / 1024);
+      Cells cells;
+      for (size_t k = 0; k < raw.size(); k += stride)
+        if (valid[k]) {
+          cells.value.push_back(raw[k]);
+          cells.index.push_back(static_cast<int>(k));
+        }
+      p.cells[c].push_back(std::move(cells));
+    }
+
+  // The blur: a scan over the PSF's FWHM from a third of a pixel to 8 views wide, then a
+  // golden-section search around the best.
+  const double lo = std::log(0.3), hi = std::log(8.0 * v0.width);
+  const int scan = 12;
+  int best = 0;
+  std::vector<double> us;
+  for (int i = 0; i < scan; ++i) {
+    const double u = lo + (hi - lo) * i / (scan - 1);
+    const double cost = evaluate(p, std::exp(u)).cost;
+    us.push_back(u);
+    fit.blur_fwhm.push_back(std::exp(u));
+    fit.blur_cost.push_back(cost);
+    if (cost < fit.blur_cost[best]) best = i;
+  }
+  double a = us[std::max(0, best - 1)], b = us[std::min(scan - 1, best + 1)];
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  double c1 = b - g * (b - a), c2 = a + g * (b - a);
+  double f1 = evaluate(p, std::exp(c1)).cost, f2 = evaluate(p, std::exp(c2)).cost;
+  for (int it = 0; it < 10; ++it) {  // the bracket to 1% of its width
+    if (f1 < f2) {
+      b = c2;
+      c2 = c1;
+      f2 = f1;
+      c1 = b - g * (b - a);
+      f1 = evaluate(p, std::exp(c1)).cost;
+    } else {
+      a = c1;
+      c1 = c2;
+      f1 = f2;
+      c2 = a + g * (b - a);
+      f2 = evaluate(p, std::exp(c2)).cost;
+    }
+  }
+  fit.fwhm_pixels = std::exp((a + b) / 2);
+  const Evaluation e = evaluate(p, fit.fwhm_pixels);
+  // Told when the scan's widest PSF (everything spread over the view) fits clearly worse
+  // than the best, and the best is not at the scan's end: otherwise the captures say only
+  // that the blur is at least about this wide.
+  fit.blur_told = fit.blur_cost.back() > 1.05 * e.cost + 1e-9 && best < scan - 1;
+  fit.aperture_m = aperture_for_fwhm(cat, v0.width, fit.fwhm_pixels);
+
+  // The window's gain is told by the body against the room. Where the captures hardly
+  // show that contrast (a blur wider than the view, a 1x1 raw grid), the catalogue's
+  // window width is kept and only its level is fitted.
+  fit.gain = e.line.b;
+  fit.gain_rel_error = e.line.se_b / std::abs(fit.gain);
+  double offset = e.line.a;
+  fit.window_told = fit.gain > 0 && std::isfinite(offset) && fit.gain_rel_error <= 0.1;
+  if (!fit.window_told) {
+    fit.gain = 255.0 / (cat.physics.display_max - cat.physics.display_min);
+    std::vector<double> level(e.x.size());
+    for (size_t i = 0; i < e.x.size(); ++i) level[i] = e.y[i] - fit.gain * e.x[i];
+    offset = median(level);
+  }
+  fit.display_min = -offset / fit.gain;
+  fit.display_max = fit.display_min + 255.0 / fit.gain;
+  std::vector<double> absr(e.x.size());
+  for (size_t i = 0; i < e.x.size(); ++i) absr[i] = std::abs(e.y[i] - offset - fit.gain * e.x[i]);
+  const double s = 1.4826 * median(absr);
+  const double round = rounding_variance(v0.width, v0.height, fit.raw_w, fit.raw_h);
+  fit.noise_gray = std::sqrt(std::max(0.0, s * s - round));
+  fit.netd = fit.noise_gray / fit.gain;
+  fit.subject = e.subject;
+  fit.cells = static_cast<int>(e.pairs);
+  return fit;
+}
+
+Catalogue fitted_catalogue(const Catalogue& cat, const CameraFit& fit) {
+  Catalogue out = cat;
+  out.physics.display_min = fit.display_min;
+  out.physics.display_max = fit.display_max;
+  out.physics.aperture_m = fit.aperture_m;
+  return out;
+}
+
+ModelSettings fitted_model(const ModelSettings& model, const CameraFit& fit) {
+  ModelSettings m = model;
+  m.model = Model::physics;
+  m.netd = fit.netd;
+  m.raw_width = fit.raw_w;
+  m.raw_height = fit.raw_h;
+  return m;
+}
+
+}  // namespace portalsim::calibrate

@@ -1,0 +1,118 @@
+"""portalsim for Python: the simulator's scenarios as NumPy arrays, straight from its kernels.
+
+    import portalsim
+    gen = portalsim.Generator(spec="scenarios/case1-gun.toml", seed=1, what="images",
+                              model="physics", rotate="-30..30", annotations=True)
+    b = gen.batch(start=0, count=1024)   # dict of NumPy arrays, as data.h5's datasets
+    one = portalsim.simulate(["none", "none", "none", "gun"], model="thesis")
+
+Every keyword is a flag of `portalsim generate` (or `simulate`) with "_" for "-": spec, seed,
+count, rule, pool, objects, subjects, balance, what, annotations, tier and every model knob
+(`portalsim knobs`). `gen.batch(start, count)` is byte for byte rows start..start+count of the
+data.h5 that `portalsim generate --format h5` writes with the same keywords. A bad keyword or
+value raises ValueError with the command line's message. portalsim.torch holds the PyTorch
+datasets (H5Dataset over a data.h5, StreamDataset straight from the kernels).
+
+Supported interpreter: Debian's /usr/bin/python3 (tools/install-python.sh installs the package
+for it). docs/guide/python.md is the guide.
+"""
+from . import _core
+
+__version__ = _core.version
+__all__ = ["Generator", "simulate", "__version__"]
+
+# generate's flags that make no sense in memory: the output folder and its files, and how a
+# run is split or shown. batch(start, count) takes the place of --batch and --shard.
+_NOT_IN_PYTHON = {"out", "format", "compress", "image-format", "resume", "quiet", "shard", "batch", "timing",
+                  "stages"}
+# Keywords whose list values are comma-separated names; other lists and tuples are ranges.
+_LISTS = {"pool", "subjects"}
+
+
+def _text(key, value):
+    """A keyword's value as the command line's text."""
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    if isinstance(value, (list, tuple)):
+        if key in _LISTS:
+            return ",".join(str(v) for v in value)
+        if len(value) != 2:
+            raise ValueError(f"{key}: expected a range (low, high), got {value!r}")
+        return f"{value[0]}..{value[1]}"
+    return str(value)
+
+
+def _flags(command, keywords):
+    """generate's (or simulate's) flags for `keywords`, with the command line's names."""
+    known = _core.flags(command)  # flag name (no "--") -> takes no value
+    args = []
+    for key, value in keywords.items():
+        if value is None:
+            continue
+        flag = key.replace("_", "-")
+        if flag not in known or flag in _NOT_IN_PYTHON:
+            usable = sorted(k.replace("-", "_") for k in known if k not in _NOT_IN_PYTHON)
+            raise ValueError(f"{key}: not a keyword of portalsim.{'Generator' if command == 'generate' else command}"
+                             f" (`portalsim {command}` has no --{flag} here); the keywords are {', '.join(usable)}")
+        if known[flag]:  # a switch such as --balance or --annotations
+            if not isinstance(value, bool):
+                raise ValueError(f"--{flag}: expected True or False, got {value!r}")
+            args.append(f"--{flag}={'true' if value else 'false'}")
+        else:
+            args.append(f"--{flag}={_text(key, value)}")
+    return args
+
+
+class Generator:
+    """generate's scenarios of a spec and seed, a batch at a time, as NumPy arrays.
+
+    Keywords are generate's flags (spec, seed, count, what, rule, annotations, any knob...).
+    The OpenCL context is made at the first batch, in the process that renders. With
+    prefetch (the default), the batch after the one returned renders on a C++ thread while
+    Python reads this one.
+    """
+
+    def __init__(self, spec=None, seed=None, *, prefetch=True, **keywords):
+        self._keywords = dict(keywords, spec=None if spec is None else str(spec), seed=seed)
+        self._core = _core.Generator(["--out=(python)"] + _flags("generate", self._keywords), prefetch)
+
+    def batch(self, start=0, count=1024, next_start=...):
+        """Scenarios start .. start+count: a dict of NumPy arrays keyed and shaped as data.h5's
+        datasets (upper, lower, ir, ir_index, mask_*, features, metal, label, subject,
+        region_*), each owning its C++ buffer (no copy). With prefetch, the batch of `count`
+        from `next_start` (default start+count; None: none) renders meanwhile."""
+        start, count = int(start), int(count)
+        if next_start is ...:
+            next_start = start + count
+        return self._core.batch(start, count, None if next_start is None else int(next_start))
+
+    @property
+    def datasets(self):
+        """The keys of batch()'s dict, in data.h5's order."""
+        return list(self._core.datasets)
+
+    @property
+    def count(self):
+        """The spec's scenario count (a listed file's length); batch() may go past it for a
+        generator spec, whose scenario i is a function of (seed, i) alone."""
+        return self._core.count
+
+    @property
+    def seed(self):
+        return self._core.seed
+
+    def times(self):
+        """Where the batches' time went so far, in seconds: {"scenarios", "scenes" (drawing
+        them), "kernels" (the backend), "rows" (making data.h5's rows: the IR palette...)}."""
+        return dict(self._core.times())
+
+
+def simulate(objects, **keywords):
+    """One scenario, as `portalsim simulate OBJECTS...` makes it: objects for regions 1..13
+    ("none" for an empty region, "gun:v" a drawing), and simulate's flags as keywords
+    (subject, rule, threat, seed, tier, model and every knob). Returns a dict of NumPy arrays
+    without the scenario axis: upper, lower (gray), ir (RGB), ir_index, features, metal
+    (19 zones), label, subject and region_*."""
+    if isinstance(objects, str):
+        objects = objects.split()
+    return _core.simulate([str(o) for o in objects] + _flags("simulate", keywords))

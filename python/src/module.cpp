@@ -1,0 +1,398 @@
+// portalsim._core: the simulator for Python. Generator.batch gives generate's data.h5 rows
+// (schedule/scenario_source.h, sink/tensors.h: the same code makes them) as NumPy arrays
+// that own the C++ buffers; simulate gives one scenario's outputs. The kernels run with the
+// GIL released, and a Generator renders the next batch on its own thread meanwhile.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstring>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "base/error.h"
+#include "base/parallel.h"
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "cli/python_requests.h"
+#include "plan/knobs.h"
+#include "schedule/scenario_source.h"
+
+namespace py = pybind11;
+using namespace portalsim;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+// One batch: the backend's outputs and the rows made from them. NumPy arrays hold it
+// through capsules; the last one freed hands it back to its generator's pool.
+struct Rows {
+  SceneBatch scenes;
+  BatchOutput out;
+  std::vector<std::unique_ptr<char[]>> made;  // per column: the rows made here (not views)
+  std::vector<size_t> made_bytes;
+  std::vector<std::string_view> rows;  // per column
+};
+
+// Finished batches whose buffers the next one reuses, so that a long stream touches no new
+// pages: at most kKeep are kept.
+class Pool {
+ public:
+  std::unique_ptr<Rows> take() {
+    std::lock_guard<std::mutex> lock(m_);
+    if (free_.empty()) return std::make_unique<Rows>();
+    std::unique_ptr<Rows> r = std::move(free_.back());
+    free_.pop_back();
+    return r;
+  }
+  void give(Rows* r) {
+    std::lock_guard<std::mutex> lock(m_);
+    if (free_.size() < kKeep)
+      free_.emplace_back(r);
+    else
+      delete r;
+  }
+
+ private:
+  static constexpr size_t kKeep = 4;
+  std::mutex m_;
+  std::vector<std::unique_ptr<Rows>> free_;
+};
+
+py::dtype dtype_of(TensorType t) {
+  switch (t) {
+    case TensorType::u8:
+      return py::dtype::of<uint8_t>();
+    case TensorType::i16:
+      return py::dtype::of<int16_t>();
+    case TensorType::f32:
+      return py::dtype::of<float>();
+    case TensorType::f64:
+      return py::dtype::of<double>();
+  }
+  throw std::logic_error("dtype_of: unknown tensor type");
+}
+
+// The columns' rows of `rows` as NumPy arrays (count, dims...), each owning a share of it.
+py::dict to_arrays(const std::shared_ptr<Rows>& rows, const std::vector<TensorColumn>& columns, size_t n) {
+  py::dict d;
+  for (size_t k = 0; k < columns.size(); ++k) {
+    const H5Dataset& ds = columns[k].ds;
+    std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(n)};
+    for (uint64_t v : ds.dims) shape.push_back(static_cast<py::ssize_t>(v));
+    auto* keep = new std::shared_ptr<Rows>(rows);
+    py::capsule owner(keep, [](void* p) { delete static_cast<std::shared_ptr<Rows>*>(p); });
+    d[py::str(ds.name)] = py::array(dtype_of(ds.type), shape, rows->rows[k].data(), owner);
+  }
+  return d;
+}
+
+// Makes each column's rows of a computed batch: the views point into the batch, the rest
+// (the IR palette, labels by region, ...) are made in pieces on `threads` threads.
+void make_rows(Rows& r, const std::vector<TensorColumn>& columns, unsigned threads) {
+  const size_t n = r.scenes.size();
+  r.made.resize(columns.size());
+  r.made_bytes.resize(columns.size(), 0);
+  r.rows.assign(columns.size(), {});
+  struct Piece {
+    size_t column, lo, hi;
+  };
+  std::vector<Piece> pieces;
+  std::string unused;
+  for (size_t k = 0; k < columns.size(); ++k) {
+    if (columns[k].view) {
+      r.rows[k] = columns[k].fill(r.scenes, r.out, 0, n, unused);
+      continue;
+    }
+    const size_t row = std::max<size_t>(1, columns[k].ds.row_bytes()), bytes = n * row;
+    if (r.made_bytes[k] < bytes || !r.made[k]) {
+      r.made[k].reset(new char[std::max<size_t>(1, bytes)]);
+      r.made_bytes[k] = bytes;
+    }
+    r.rows[k] = std::string_view(r.made[k].get(), bytes);
+    const size_t step = std::max<size_t>(1, (256u << 10) / row);  // pieces of about 256 KiB
+    for (size_t lo = 0; lo < n; lo += step) pieces.push_back({k, lo, std::min(n, lo + step)});
+  }
+  const unsigned t = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(pieces.size())));
+  parallel_for(t, t, [&](size_t first, size_t) {
+    std::string scratch;
+    for (size_t i = first; i < pieces.size(); i += t) {
+      const Piece& p = pieces[i];
+      const size_t row = columns[p.column].ds.row_bytes();
+      const std::string_view v = columns[p.column].fill(r.scenes, r.out, p.lo, p.hi, scratch);
+      std::memcpy(r.made[p.column].get() + p.lo * row, v.data(), v.size());
+    }
+  });
+}
+
+// The process that made an OpenCL context here: PoCL hangs in a process forked from one
+// that had made one, so a forked child that would make its own fails with a message instead.
+pid_t g_opencl_pid = 0;
+
+void open_backend_here(cli::Session& s, const cli::CommonOptions& common) {
+  if (common.backend == "opencl") {
+    if (g_opencl_pid != 0 && g_opencl_pid != ::getpid())
+      throw EnvironmentError("portalsim: this process was forked from one that had made an OpenCL context (process " +
+                             std::to_string(g_opencl_pid) +
+                             "), and PoCL hangs in such a child: render only in the workers, or start them with "
+                             "DataLoader(multiprocessing_context=\"spawn\")");
+    g_opencl_pid = ::getpid();
+  }
+  cli::open_backend(s, common);
+}
+
+// generate's run of a spec, a batch at a time, in memory.
+class Engine {
+ public:
+  explicit Engine(const std::vector<std::string>& args) : req_(cli::parse_generate(args)) {
+    cli::open_catalogue(session_, req_.common);
+    cli::check_generate(req_.spec, session_.catalogue);
+    source_.emplace(req_.spec, session_.catalogue);
+    plan_ = run_plan(req_.spec, session_.catalogue);
+    threads_ = req_.threads ? req_.threads : default_threads();
+    ctx_ = plan_sink_context(plan_, session_.catalogue, session_.assets, threads_, req_.spec.image_format);
+    columns_ = tensor_columns(ctx_, h5_tensor_options(req_.spec, plan_, source_->rule()));
+  }
+  const std::vector<TensorColumn>& columns() const { return columns_; }
+  const ScenarioSource& source() const { return *source_; }
+  const cli::GenerateRequest& request() const { return req_; }
+
+  // Scenarios [start, start + count): their rows. The OpenCL context is made on the first
+  // call, in the process that renders (never before a fork).
+  std::unique_ptr<Rows> compute(uint64_t start, size_t count, Pool& pool) {
+    if (source_->listed() && (start > source_->total() || count > source_->total() - start))
+      throw InputError("batch: scenarios " + std::to_string(start) + ".." + std::to_string(start + count) +
+                       " are past the end of the scenario list (" + std::to_string(source_->total()) + ")");
+    if (!session_.backend) open_backend_here(session_, req_.common);
+    std::unique_ptr<Rows> r = pool.take();
+    const auto t0 = Clock::now();
+    source_->fill(start, count, threads_, r->scenes);
+    const auto t1 = Clock::now();
+    session_.backend->run(r->scenes, plan_, r->out);
+    const auto t2 = Clock::now();
+    make_rows(*r, columns_, threads_);
+    const auto t3 = Clock::now();
+    std::lock_guard<std::mutex> lock(times_m_);
+    times_.scenarios += count;
+    times_.scenes += seconds(t0, t1);
+    times_.kernels += seconds(t1, t2);
+    times_.rows += seconds(t2, t3);
+    return r;
+  }
+
+  // Where the time of all batches so far went (for bench/python_bench.py).
+  struct Times {
+    uint64_t scenarios = 0;
+    double scenes = 0, kernels = 0, rows = 0;  // making the scenarios, the backend, the rows
+  };
+  Times times() {
+    std::lock_guard<std::mutex> lock(times_m_);
+    return times_;
+  }
+
+ private:
+  cli::GenerateRequest req_;
+  cli::Session session_;
+  std::optional<ScenarioSource> source_;
+  Plan plan_;
+  unsigned threads_ = 1;
+  SinkContext ctx_;
+  std::vector<TensorColumn> columns_;
+  std::mutex times_m_;
+  Times times_;
+};
+
+// An Engine and the thread that renders the batch after the one asked for, while Python
+// reads that one.
+class StreamGenerator {
+ public:
+  StreamGenerator(const std::vector<std::string>& args, bool prefetch)
+      : engine_(args), pool_(std::make_shared<Pool>()), prefetch_(prefetch) {
+    if (prefetch_) worker_ = std::thread([this] { work(); });
+  }
+  ~StreamGenerator() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    if (worker_.joinable()) worker_.join();
+  }
+
+  // `next`: the start of the batch to render ahead (of `count` scenarios), or none.
+  py::dict batch(uint64_t start, size_t count, std::optional<uint64_t> next) {
+    if (count < 1 || count > (1u << 24))
+      throw InputError("batch: count: " + std::to_string(count) + " is not between 1 and 2^24");
+    std::unique_ptr<Rows> r;
+    {
+      py::gil_scoped_release nogil;
+      std::lock_guard<std::mutex> one_call(call_m_);  // one batch() at a time uses the backend
+      std::unique_lock<std::mutex> lock(m_);
+      cv_.wait(lock, [&] { return !busy_; });
+      if (ahead_ && ahead_start_ == start && ahead_count_ == count) {
+        std::exception_ptr e = std::exchange(ahead_error_, nullptr);
+        r = std::move(ahead_);
+        ahead_.reset();
+        if (e) std::rethrow_exception(e);
+      } else {
+        ahead_.reset();
+        ahead_error_ = nullptr;
+        lock.unlock();
+        r = engine_.compute(start, count, *pool_);
+        lock.lock();
+      }
+      const ScenarioSource& src = engine_.source();
+      if (prefetch_ && next && (!src.listed() || (*next <= src.total() && count <= src.total() - *next))) {
+        next_start_ = *next;
+        next_count_ = count;
+        busy_ = true;
+        cv_.notify_all();
+      }
+    }
+    std::weak_ptr<Pool> pool = pool_;
+    std::shared_ptr<Rows> shared(r.release(), [pool](Rows* p) {
+      if (auto q = pool.lock())
+        q->give(p);
+      else
+        delete p;
+    });
+    return to_arrays(shared, engine_.columns(), count);
+  }
+
+  py::list datasets() const {
+    py::list l;
+    for (const TensorColumn& c : engine_.columns()) l.append(c.ds.name);
+    return l;
+  }
+  uint64_t count() const { return engine_.source().total(); }
+  uint64_t seed() const { return engine_.request().spec.seed; }
+  py::dict times() {
+    const Engine::Times t = engine_.times();
+    py::dict d;
+    d["scenarios"] = t.scenarios;
+    d["scenes"] = t.scenes;
+    d["kernels"] = t.kernels;
+    d["rows"] = t.rows;
+    return d;
+  }
+
+ private:
+  Engine engine_;
+  std::shared_ptr<Pool> pool_;
+  bool prefetch_;
+  std::thread worker_;
+  std::mutex call_m_, m_;
+  std::condition_variable cv_;
+  bool busy_ = false, stop_ = false;
+  uint64_t next_start_ = 0, ahead_start_ = 0;
+  size_t next_count_ = 0, ahead_count_ = 0;
+  std::unique_ptr<Rows> ahead_;
+  std::exception_ptr ahead_error_;
+
+  void work() {
+    std::unique_lock<std::mutex> lock(m_);
+    for (;;) {
+      cv_.wait(lock, [&] { return busy_ || stop_; });
+      if (stop_) return;
+      const uint64_t start = next_start_;
+      const size_t count = next_count_;
+      lock.unlock();
+      std::unique_ptr<Rows> r;
+      std::exception_ptr e;
+      try {
+        r = engine_.compute(start, count, *pool_);
+      } catch (...) {
+        e = std::current_exception();
+      }
+      lock.lock();
+      ahead_ = std::move(r);
+      ahead_error_ = e;
+      ahead_start_ = start;
+      ahead_count_ = count;
+      if (e) ahead_ = std::make_unique<Rows>();  // a marker: the error is for this batch
+      busy_ = false;
+      cv_.notify_all();
+    }
+  }
+};
+
+// One scenario as simulate makes it: every view (gray, and IR as RGB and index), the
+// features, the metal zones and the labels, each without the scenario axis.
+py::dict simulate(const std::vector<std::string>& args) {
+  std::shared_ptr<Rows> rows;
+  std::vector<TensorColumn> columns;
+  {
+    py::gil_scoped_release nogil;
+    cli::Session s;
+    cli::open_catalogue(s, cli::parse_simulate(args, nullptr).common);
+    const cli::SimulateRequest req = cli::parse_simulate(args, &s.catalogue);
+    open_backend_here(s, req.common);
+    Plan plan = req.plan;
+    plan.images = kAllViews;
+    plan.features = plan.metal = true;
+    auto r = std::make_shared<Rows>();
+    r->scenes.first_index = 0;
+    r->scenes.subject = {static_cast<uint8_t>(req.scene.subject)};
+    r->scenes.objects.assign(req.scene.objects.begin(), req.scene.objects.end());
+    r->scenes.label = {static_cast<uint8_t>(req.scene.label)};
+    s.backend->run(r->scenes, plan, r->out);
+    const SinkContext ctx = plan_sink_context(plan, s.catalogue, s.assets, 1, "png");
+    TensorOptions topt;
+    topt.images = topt.features = true;
+    columns = tensor_columns(ctx, topt);
+    make_rows(*r, columns, 1);
+    rows = r;
+  }
+  py::dict d = to_arrays(rows, columns, 1), one;
+  for (auto item : d) one[item.first] = item.second.cast<py::array>()[py::int_(0)];
+  return one;
+}
+
+// The names of generate's and simulate's flags (without "--") and which take no value.
+py::dict flags(const std::string& command) {
+  CLI::App app;
+  if (command == "generate")
+    cli::add_generate(app);
+  else
+    cli::add_simulate(app);
+  py::dict d;
+  for (const CLI::Option* o : app.get_subcommand(command)->get_options()) {
+    const std::string name = o->get_name();
+    if (name.rfind("--", 0) != 0) continue;
+    d[py::str(name.substr(2))] = o->get_expected_min() == 0;
+  }
+  return d;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "portalsim's C++ core (use the portalsim package)";
+  m.attr("version") = PORTALSIM_VERSION;
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const OutputError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const EnvironmentError& e) {
+      PyErr_SetString(PyExc_RuntimeError, e.what());
+    }
+  });
+  py::class_<StreamGenerator>(m, "Generator")
+      .def(py::init<const std::vector<std::string>&, bool>(), py::arg("args"), py::arg("prefetch") = true)
+      .def("batch", &StreamGenerator::batch, py::arg("start"), py::arg("count"), py::arg("next"))
+      .def_property_readonly("datasets", &StreamGenerator::datasets)
+      .def_property_readonly("count", &StreamGenerator::count)
+      .def_property_readonly("seed", &StreamGenerator::seed)
+      .def("times", &StreamGenerator::times);
+  m.def("simulate", &simulate, py::arg("args"));
+  m.def("flags", &flags, py::arg("command"));
+}

@@ -1,0 +1,302 @@
+// portalsim calibrate: synthetic captures made by `generate` with a camera the test chooses
+// (raw grid, aperture, display window, NETD) and does not tell calibrate, which must find
+// it again; and bad input refused with the file named and nothing written.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "assets/assets.h"
+#include "assets/image_io.h"
+#include "calibrate/captures.h"
+#include "calibrate/fit.h"
+#include "plan/knobs.h"
+#include "run_binary.h"
+#include "scene/catalogue.h"
+
+namespace portalsim::embedded {
+extern const std::string_view default_catalogue;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+using portalsim::test::TempDir;
+
+// The camera a test hides from calibrate.
+struct Camera {
+  const char* name;
+  double netd;
+  int raw_w, raw_h;
+  double aperture_m;
+  double display_min, display_max;
+};
+
+// The built-in catalogue with `key = value` set in [physics].
+std::string with_physics(std::string text, const std::string& key, double value) {
+  const size_t at = text.find("\n" + key + " = ", text.find("[physics]"));
+  EXPECT_NE(at, std::string::npos) << key;
+  const size_t end = text.find('\n', at + 1);
+  return text.replace(at + 1, end - at - 1, key + " = " + std::to_string(value));
+}
+
+portalsim::test::Result run(const TempDir& t, const std::vector<std::string>& args) {
+  return portalsim::test::finish(portalsim::test::start(t.cap(), args), 300);
+}
+
+// `count` captures of `cam` made by generate (objects 0..2 on random subjects) in t/w/NAME.
+fs::path make_captures(const TempDir& t, const Camera& cam, int count, uint64_t seed,
+                       const std::vector<std::string>& extra = {}) {
+  std::string cat(portalsim::embedded::default_catalogue);
+  cat = with_physics(cat, "aperture_m", cam.aperture_m);
+  cat = with_physics(cat, "display_min", cam.display_min);
+  cat = with_physics(cat, "display_max", cam.display_max);
+  const fs::path cat_path = t.w() / (std::string(cam.name) + ".catalogue.toml");
+  portalsim::test::spit(cat_path, cat);
+  const fs::path dir = t.w() / cam.name;
+  std::vector<std::string> args{"generate",
+                                "--count",
+                                std::to_string(count),
+                                "--seed",
+                                std::to_string(seed),
+                                "--objects",
+                                "0..2",
+                                "--what",
+                                "images",
+                                "--model",
+                                "physics",
+                                "--netd",
+                                std::to_string(cam.netd),
+                                "--mmw-raw",
+                                std::to_string(cam.raw_w) + "x" + std::to_string(cam.raw_h),
+                                "--catalogue",
+                                cat_path.string(),
+                                "--out",
+                                dir.string(),
+                                "--quiet"};
+  // The camera calibrate fits: one frame, a fixed window, bilinear display, no smoothing,
+  // said outright where this build has those knobs (their defaults may differ).
+  const std::pair<const char*, std::string> camera[] = {
+      {"frames", "1"},
+      {"window", std::to_string(cam.display_min) + ".." + std::to_string(cam.display_max)},
+      {"display_filter", "bilinear"},
+      {"smooth", "0"}};
+  for (const auto& [key, value] : camera)
+    if (const portalsim::Knob* k = portalsim::find_knob(key)) args.insert(args.end(), {k->flag(), value});
+  args.insert(args.end(), extra.begin(), extra.end());
+  const auto r = run(t, args);
+  EXPECT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  return dir;
+}
+
+portalsim::calibrate::CameraFit fit(const fs::path& dir) {
+  const portalsim::Catalogue cat = portalsim::default_catalogue();
+  const portalsim::AssetSet assets = portalsim::build_assets(cat);
+  return portalsim::calibrate::fit_camera(portalsim::calibrate::read_captures(dir.string()), cat, assets,
+                                          portalsim::ModelSettings{});
+}
+
+double fwhm_of(double aperture_m) {
+  portalsim::Catalogue cat = portalsim::default_catalogue();
+  return portalsim::calibrate::aperture_for_fwhm(cat, 200, 1.0) / aperture_m;
+}
+
+// One row of the recovered-against-hidden table (printed for the report).
+void report(const Camera& cam, const portalsim::calibrate::CameraFit& f) {
+  std::printf(
+      "%-9s hidden: NETD %.2f K, raw %dx%d, FWHM %.2f px, window %.1f..%.1f K | recovered: NETD %.4f K "
+      "(%.2f gray), raw %dx%d, FWHM %.2f px%s, window %.3f..%.3f K%s\n",
+      cam.name, cam.netd, cam.raw_w, cam.raw_h, fwhm_of(cam.aperture_m), cam.display_min, cam.display_max, f.netd,
+      f.noise_gray, f.raw_w, f.raw_h, f.fwhm_pixels, f.blur_told ? "" : " (not told)", f.display_min, f.display_max,
+      f.window_told ? "" : " (width not told)");
+}
+
+double gain_of(const Camera& c) { return 255.0 / (c.display_max - c.display_min); }
+
+// The checks every camera shares: the raw grid within 10% (in fact exact), the noise in
+// gray levels within 10% (absolute 0.5 gray where there is none: rounding to whole levels
+// and the kernels' one-level differences from the reference look like noise of that size).
+void expect_grid_and_gray_noise(const Camera& c, const portalsim::calibrate::CameraFit& f) {
+  EXPECT_NEAR(f.raw_w, c.raw_w, 0.1 * c.raw_w) << c.name;
+  EXPECT_NEAR(f.raw_h, c.raw_h, 0.1 * c.raw_h) << c.name;
+  const double gray = c.netd * gain_of(c);
+  if (c.netd == 0)
+    EXPECT_LT(f.noise_gray, 0.5) << c.name;
+  else
+    EXPECT_NEAR(f.noise_gray, gray, 0.1 * gray) << c.name;
+}
+
+// Where the body stands against the room, the blur within 10%, the window's gain within 10%
+// and its ends within 10% of its width (10% of 285 K would say nothing), and the NETD in
+// kelvin within 10% (absolute 0.05 K where it is 0).
+void expect_told(const Camera& c, const portalsim::calibrate::CameraFit& f) {
+  expect_grid_and_gray_noise(c, f);
+  EXPECT_TRUE(f.blur_told) << c.name;
+  EXPECT_NEAR(f.fwhm_pixels, fwhm_of(c.aperture_m), 0.1 * fwhm_of(c.aperture_m)) << c.name;
+  EXPECT_TRUE(f.window_told) << c.name;
+  EXPECT_NEAR(f.gain, gain_of(c), 0.1 * gain_of(c)) << c.name;
+  const double width = c.display_max - c.display_min;
+  EXPECT_NEAR(f.display_min, c.display_min, 0.1 * width) << c.name;
+  EXPECT_NEAR(f.display_max, c.display_max, 0.1 * width) << c.name;
+  if (c.netd == 0)
+    EXPECT_LT(f.netd, 0.05) << c.name;
+  else
+    EXPECT_NEAR(f.netd, c.netd, 0.1 * c.netd) << c.name;
+}
+
+// Where the window's width cannot be told, neither can its ends; its centre can, within
+// 10% of the width as the ends are where the width is told.
+void expect_window_centre(const Camera& c, const portalsim::calibrate::CameraFit& f) {
+  EXPECT_NEAR((f.display_min + f.display_max) / 2, (c.display_min + c.display_max) / 2,
+              0.1 * (c.display_max - c.display_min))
+      << c.name;
+}
+
+class CalibrateGrid : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { dir_ = new TempDir; }
+  static void TearDownTestSuite() { delete dir_; }
+  static TempDir* dir_;
+};
+TempDir* CalibrateGrid::dir_ = nullptr;
+
+// Cameras whose captures show the body against the room: every parameter within 10%.
+class CalibrateTold : public CalibrateGrid, public ::testing::WithParamInterface<Camera> {};
+
+TEST_P(CalibrateTold, RecoversTheHiddenCamera) {
+  const Camera& c = GetParam();
+  const auto f = fit(make_captures(*dir_, c, 8, 7));
+  report(c, f);
+  expect_told(c, f);
+}
+
+INSTANTIATE_TEST_SUITE_P(Calibrate, CalibrateTold,
+                         ::testing::Values(Camera{"default", 3.0, 28, 28, 0.125, 285, 305},
+                                           Camera{"nonoise", 0.0, 28, 28, 0.25, 288, 302},
+                                           Camera{"fullsize", 1.0, 200, 200, 0.5, 286, 306},
+                                           Camera{"coarse", 1.0, 16, 24, 0.1, 283, 305}),
+                         [](const ::testing::TestParamInfo<Camera>& i) { return std::string(i.param.name); });
+
+// A PSF wider than the view (2 mm aperture: FWHM about 740 pixels) leaves almost no body
+// against the room: the blur is told only as at least the view's width, and the window's
+// gain (so the NETD in kelvin) not at all; the raw grid, the noise in gray levels and the
+// window's centre still are.
+TEST_F(CalibrateGrid, BlurWiderThanTheView) {
+  const Camera c{"wideblur", 2.0, 40, 30, 0.002, 285, 305};
+  const auto f = fit(make_captures(*dir_, c, 8, 7));
+  report(c, f);
+  expect_grid_and_gray_noise(c, f);
+  EXPECT_FALSE(f.blur_told);
+  EXPECT_GE(f.fwhm_pixels, 200.0);
+  EXPECT_FALSE(f.window_told);
+  expect_window_centre(c, f);
+}
+
+// A 1x1 raw grid shows each view as one gray level: no edge, so neither the blur nor the
+// window's gain can be told; the grid and the window's centre can. The noise cannot be
+// told from the scenes' own spread between captures (subjects and objects change each
+// view's mean), so it comes out as an upper bound: at least 90% of the hidden noise, and
+// within the scenes' spread above it (here at most 1.5 times).
+TEST_F(CalibrateGrid, OneByOneRawGrid) {
+  const Camera c{"onebyone", 3.0, 1, 1, 0.125, 280, 310};
+  const auto f = fit(make_captures(*dir_, c, 8, 7));
+  report(c, f);
+  EXPECT_EQ(f.raw_w, 1);
+  EXPECT_EQ(f.raw_h, 1);
+  EXPECT_GE(f.noise_gray, 0.9 * c.netd * gain_of(c));
+  EXPECT_LE(f.noise_gray, 1.5 * c.netd * gain_of(c));
+  EXPECT_FALSE(f.blur_told);
+  EXPECT_FALSE(f.window_told);
+  expect_window_centre(c, f);
+}
+
+// data.h5 of generate --format h5 reads as the folders do.
+TEST_F(CalibrateGrid, ReadsDataH5) {
+  const Camera c{"h5", 3.0, 28, 28, 0.125, 285, 305};
+  const fs::path dir = make_captures(*dir_, c, 8, 7, {"--format", "h5"});
+  ASSERT_TRUE(fs::exists(dir / "data.h5"));
+  const auto f = fit(dir);
+  report(c, f);
+  expect_told(c, f);
+}
+
+// The command end to end: calibrate writes a spec and a catalogue that generate takes, and
+// generate's images with them calibrate back to the same camera (their statistics match).
+TEST(Calibrate, GenerateWithItsOutputMakesTheSameCamera) {
+  TempDir t;
+  const Camera c{"cli", 2.0, 24, 24, 0.15, 286, 304};
+  const fs::path real = make_captures(t, c, 8, 3);
+  const fs::path spec = t.w() / "camera.toml";
+  auto r = run(t, {"calibrate", "--real", real.string(), "--out", spec.string()});
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  for (const char* f : {"camera.toml", "camera.catalogue.toml", "camera-report/report.json", "camera-report/report.md"})
+    EXPECT_TRUE(fs::exists(t.w() / f)) << f;
+  const fs::path again = t.w() / "again";
+  r = run(t, {"generate", "--spec", spec.string(), "--catalogue", (t.w() / "camera.catalogue.toml").string(), "--what",
+              "images", "--count", "8", "--seed", "11", "--objects", "0..2", "--out", again.string(), "--quiet"});
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  const auto f1 = fit(real), f2 = fit(again);
+  report(c, f2);
+  EXPECT_EQ(f2.raw_w, f1.raw_w);
+  EXPECT_EQ(f2.raw_h, f1.raw_h);
+  EXPECT_NEAR(f2.fwhm_pixels, f1.fwhm_pixels, 0.1 * f1.fwhm_pixels);
+  EXPECT_NEAR(f2.netd, f1.netd, 0.1 * f1.netd);
+  EXPECT_NEAR(f2.gain, f1.gain, 0.1 * f1.gain);
+  EXPECT_NEAR(f2.display_min, f1.display_min, 0.1 * (f1.display_max - f1.display_min));
+}
+
+// Bad input: exit 3, the file named, and nothing written.
+class CalibrateBadInput : public ::testing::Test {
+ protected:
+  // Four scenario folders copied from a small generate run.
+  void SetUp() override {
+    const Camera c{"good", 3.0, 28, 28, 0.125, 285, 305};
+    const fs::path made = make_captures(t_, c, 4, 5);
+    real_ = t_.w() / "real";
+    fs::create_directories(real_);
+    for (const auto& e : fs::directory_iterator(made / "images")) fs::copy(e.path(), real_ / e.path().filename());
+  }
+  fs::path first(const char* view) {
+    std::vector<fs::path> dirs;
+    for (const auto& e : fs::directory_iterator(real_)) dirs.push_back(e.path());
+    std::sort(dirs.begin(), dirs.end());
+    return dirs.back() / view;
+  }
+  void expect_refused(const std::string& file, const std::string& words) {
+    const fs::path out = t_.w() / "out" / "camera.toml";
+    fs::create_directories(out.parent_path());
+    const auto r = run(t_, {"calibrate", "--real", real_.string(), "--out", out.string()});
+    EXPECT_TRUE(r.exited && r.status == 3) << portalsim::test::describe(r);
+    EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(words), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::is_empty(out.parent_path())) << "something was written";
+  }
+  TempDir t_;
+  fs::path real_;
+};
+
+TEST_F(CalibrateBadInput, ImagesOfMixedSizes) {
+  portalsim::write_image(first("upper.png").string(), portalsim::Image(100, 100, 1, 90));
+  expect_refused(first("upper.png").string(), "same size");
+}
+
+TEST_F(CalibrateBadInput, ColourWhereGrayIsExpected) {
+  portalsim::Image rgb(200, 200, 3);
+  for (size_t i = 0; i < rgb.pixels.size(); ++i) rgb.pixels[i] = static_cast<uint8_t>(i * 7);
+  portalsim::write_image(first("lower.png").string(), rgb);
+  expect_refused(first("lower.png").string(), "gray");
+}
+
+TEST_F(CalibrateBadInput, TooFewCaptures) {
+  fs::remove_all(first("upper.png").parent_path());
+  expect_refused(real_.string(), "at least 4");
+}
+
+TEST_F(CalibrateBadInput, AFlatImage) {
+  portalsim::write_image(first("upper.png").string(), portalsim::Image(200, 200, 1, 128));
+  expect_refused(first("upper.png").string(), "flat");
+}
+
+}  // namespace

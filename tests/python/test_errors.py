@@ -1,0 +1,74 @@
+"""Bad keywords and values raise ValueError with the command line's message; a bad spec file
+names its file and line; the interpreter goes on."""
+import subprocess
+
+import pytest
+
+import portalsim
+
+
+def cli_error(portalsim_bin, *args):
+    """The message `portalsim` prints for args (after "portalsim: error: ")."""
+    r = subprocess.run([portalsim_bin, *args], capture_output=True, text=True)
+    assert r.returncode != 0
+    line = r.stderr.strip().splitlines()[-1]
+    assert line.startswith("portalsim: error: "), r.stderr
+    return line[len("portalsim: error: "):]
+
+
+@pytest.mark.parametrize("keywords, flags", [
+    (dict(rotate="abc"), ["--rotate", "abc"]),
+    (dict(what="pictures"), ["--what", "pictures"]),
+    (dict(seed=-3), ["--seed", "-3"]),
+    (dict(count=0), ["--count", "0"]),
+    (dict(model="optical"), ["--model", "optical"]),
+    (dict(objects="5..2"), ["--objects", "5..2"]),
+    (dict(rule="gun&&"), ["--rule", "gun&&"]),
+    (dict(pool=["gun", "bazooka"]), ["--pool", "gun,bazooka"]),
+])
+def test_generator_value_errors_are_the_command_lines(keywords, flags, portalsim_bin, tmp_path):
+    want = cli_error(portalsim_bin, "generate", *flags, "--out", str(tmp_path / "x"))
+    with pytest.raises(ValueError) as e:
+        portalsim.Generator(**keywords)
+    assert str(e.value) == want
+    assert next(iter(keywords)) in str(e.value)  # it names the keyword
+
+
+def test_unknown_keyword_is_named():
+    with pytest.raises(ValueError, match=r"^rotation: not a keyword of portalsim.Generator"):
+        portalsim.Generator(rotation=30)
+    with pytest.raises(ValueError, match=r"^out: not a keyword"):
+        portalsim.Generator(out="somewhere")
+    with pytest.raises(ValueError, match=r"^--balance: expected True or False"):
+        portalsim.Generator(balance="yes")
+
+
+def test_bad_spec_file_names_file_and_line(tmp_path, portalsim_bin):
+    spec = tmp_path / "bad.toml"
+    spec.write_text('seed = 1\nrule = "gun"\nrotate = "sideways"\n')
+    want = cli_error(portalsim_bin, "generate", "--spec", str(spec), "--out", str(tmp_path / "x"))
+    with pytest.raises(ValueError) as e:
+        portalsim.Generator(spec=spec)
+    assert str(e.value) == want
+    assert f"{spec}:3" in str(e.value) and "rotate" in str(e.value)
+    with pytest.raises(ValueError, match="nowhere.toml"):
+        portalsim.Generator(spec=tmp_path / "nowhere.toml")
+
+
+def test_simulate_errors_are_the_command_lines(portalsim_bin, tmp_path):
+    want = cli_error(portalsim_bin, "simulate", "none", "bazooka", "--out", str(tmp_path / "x"))
+    with pytest.raises(ValueError) as e:
+        portalsim.simulate(["none", "bazooka"])
+    assert str(e.value) == want
+    with pytest.raises(ValueError, match=r"^--fov: expected|^fov: not a keyword"):
+        portalsim.simulate(["gun"], fov=3)
+
+
+def test_bad_batches_and_the_interpreter_goes_on():
+    gen = portalsim.Generator(seed=1)
+    for start, count in ((0, 0), (0, 1 << 25)):
+        with pytest.raises(ValueError, match="count"):
+            gen.batch(start, count)
+    with pytest.raises(TypeError):
+        gen.batch(-1, 4)
+    assert gen.batch(0, 4)["metal"].shape == (4, 19)  # still works

@@ -1,0 +1,99 @@
+"""Generator.batch is generate --format h5's data.h5, byte for byte, for any batch size."""
+import subprocess
+
+import h5py
+import numpy as np
+import pytest
+
+import portalsim
+
+N = 70  # past one 64-row chunk of data.h5
+
+CASES = {
+    "thesis": dict(what="both"),
+    "physics-rotated": dict(what="both", model="physics", rotate="-30..30", scale="0.8..1.2", flip=True),
+    "thesis-annotations": dict(what="images", annotations=True, objects="1..4", rotate=20, rule="gun"),
+    "physics-annotations": dict(what="images", model="physics", annotations=True, objects="2..3"),
+    "spec-file": dict(spec="scenarios/case1-gun.toml", what="both", seed=5),
+}
+
+
+def flags(keywords):
+    out = []
+    for k, v in keywords.items():
+        flag = "--" + k.replace("_", "-")
+        if k == "spec":
+            v = str(v)
+        if v is True and k in ("annotations", "balance"):
+            out.append(flag)
+        elif isinstance(v, bool):
+            out += [flag, "on" if v else "off"]
+        else:
+            out += [flag, str(v)]
+    return out
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_batch_is_generate_rows(case, tmp_path, portalsim_bin, root, monkeypatch):
+    monkeypatch.chdir(root)  # the spec file's relative path, as a user in the repository gives it
+    kw = {"seed": 1, "count": N, **CASES[case]}
+    out = tmp_path / "set"
+    subprocess.run([portalsim_bin, "generate", *flags(kw), "--format", "h5", "--out", str(out), "--quiet"],
+                   check=True)
+    gen = portalsim.Generator(**kw)
+    with h5py.File(out / "data.h5", "r") as f:
+        assert list(f.attrs["datasets"]) == gen.datasets
+        want = {k: f[k][:] for k in gen.datasets}
+    # Batches of several sizes, and a range that starts inside a chunk.
+    for start, count, step in ((0, N, N), (0, N, 7), (13, 50, 50), (N - 1, 1, 1)):
+        got = {k: [] for k in gen.datasets}
+        for s in range(start, start + count, step):
+            b = gen.batch(s, min(step, start + count - s))
+            assert sorted(b) == sorted(gen.datasets)
+            for k, a in b.items():
+                got[k].append(a)
+        for k in gen.datasets:
+            a = np.concatenate(got[k])
+            w = want[k][start:start + count]
+            assert a.dtype == w.dtype and a.shape == w.shape, f"{case} {k}: {a.dtype} {a.shape}, file {w.dtype} {w.shape}"
+            assert a.tobytes() == w.tobytes(), f"{case} {k}: rows {start}..{start + count} (batches of {step}) differ"
+
+
+def test_arrays_own_the_buffers():
+    """Zero copy: the arrays are views of C++ memory (not NumPy's own), each kept alive by a
+    capsule, and they outlive the generator."""
+    gen = portalsim.Generator(seed=2, what="images")
+    b = gen.batch(0, 8)
+    del gen
+    for k, a in b.items():
+        assert not a.flags.owndata, f"{k} was copied into NumPy's own memory"
+        assert type(a.base).__name__ == "PyCapsule", f"{k}'s base is {type(a.base)}"
+    again = portalsim.Generator(seed=2, what="images", prefetch=False).batch(0, 8)
+    assert all(np.array_equal(b[k], again[k]) for k in b)
+
+
+def test_prefetch_gives_the_same_rows():
+    """The batch rendered ahead, and one asked for out of order, are the rows asked for."""
+    ahead = portalsim.Generator(seed=3, what="images")
+    plain = portalsim.Generator(seed=3, what="images", prefetch=False)
+    for start, count in ((0, 16), (16, 16), (32, 16), (5, 9), (100, 16), (116, 16)):
+        a, p = ahead.batch(start, count), plain.batch(start, count)
+        for k in p:
+            assert a[k].tobytes() == p[k].tobytes(), f"{k} of {start}..{start + count}"
+
+
+def test_simulate_is_the_commands_output(tmp_path, portalsim_bin):
+    """portalsim.simulate's arrays are what `portalsim simulate` writes: its images
+    (upper.png, lower.png, ir.png) and its metal zones."""
+    from PIL import Image
+
+    one = portalsim.simulate(["none", "none", "none", "gun"], model="thesis", seed=4)
+    out = tmp_path / "one"
+    r = subprocess.run([portalsim_bin, "simulate", "none", "none", "none", "gun", "--model", "thesis", "--seed", "4",
+                        "--out", str(out)], check=True, capture_output=True, text=True)
+    zones = [int(z) for z in r.stdout.split("metal ")[1].split()[0].split(",")]
+    assert one["metal"].tolist() == zones
+    for view in ("upper", "lower", "ir"):
+        png = np.asarray(Image.open(out / f"{view}.png"))
+        assert png.shape == one[view].shape and np.array_equal(png, one[view]), f"{view} differs from {view}.png"
+    assert int(one["label"]) == (1 if "threat yes" in r.stdout else 0)
