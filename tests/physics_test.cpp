@@ -145,7 +145,7 @@ TEST(Physics, RawGridFeatureNoiseMatchesTheReference) {
   const FeatureLayout& lay = k.layout;
   const size_t row = lay.image_features();
   ASSERT_EQ(r.features.size(), k.features.size());
-  const double scale = 255.0 / (catalogue().physics.display_max - catalogue().physics.display_min);
+  const double scale = 255.0 / (plan.model.window_hi - plan.model.window_lo);
   const Bound& clean = tolerance_bound(Model::physics, Tier::fast, Output::features_only);
   const Bound& noisy = tolerance_bound(Model::physics, Tier::fast, Output::features_only_noisy);
   std::vector<double> z;
