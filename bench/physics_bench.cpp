@@ -2,6 +2,8 @@
 //   ./build/portalsim_bench --benchmark_filter=Model --benchmark_repetitions=3
 // Args: batch size, model (0 thesis, 1 physics), NETD in kelvin (physics only), tier (0
 // standard, 1 fast: physics features-only from the raw grid).
+// The MMW camera's own processing (frames, window, display filter, smoothing), MMW images:
+//   ./build/portalsim_bench --benchmark_filter=MmwCamera --benchmark_repetitions=3
 // The IR camera alone, and its physics chain cut after each stage:
 //   ./build/portalsim_bench --benchmark_filter='Ir' --benchmark_repetitions=3
 #include <benchmark/benchmark.h>
@@ -58,6 +60,35 @@ BENCHMARK_CAPTURE(BM_ModelOpenCL, features, false)
 BENCHMARK_CAPTURE(BM_ModelReference, images, true)
     ->Args({16, 0, 0, 0})
     ->Args({16, 1, 3, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The two MMW views' images under --model physics at NETD 3 K. Args: frames, automatic
+// window (0 fixed, 1 auto), filter (0 bilinear, 1 bicubic), smoothing sigma in tenths of a
+// view pixel, tier (0 standard, 1 fast: frames as one draw of NETD / sqrt(frames)).
+void BM_MmwCamera(benchmark::State& state) {
+  auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+  Plan p;
+  if (state.range(4) == 1) p.fidelity = tier_fidelity(Tier::fast);
+  p.model.model = Model::physics;
+  p.model.frames = static_cast<int>(state.range(0));
+  p.model.window_auto = state.range(1) == 1;
+  p.model.display_filter = state.range(2) == 1 ? DisplayFilter::bicubic : DisplayFilter::bilinear;
+  p.model.smooth = static_cast<double>(state.range(3)) / 10.0;
+  p.images = (1u << fx().cat.sensor_index("upper")) | (1u << fx().cat.sensor_index("lower"));
+  p.features = false;
+  p.metal = false;
+  state.SetLabel("physics MMW images");
+  bench::time_runs(state, *b, p, 1024);
+}
+BENCHMARK(BM_MmwCamera)
+    ->Args({1, 0, 0, 0, 0})
+    ->Args({10, 0, 0, 0, 0})
+    ->Args({10, 0, 0, 0, 1})
+    ->Args({1, 1, 0, 0, 0})
+    ->Args({1, 0, 1, 0, 0})
+    ->Args({1, 0, 0, 20, 0})
+    ->Args({10, 1, 1, 10, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

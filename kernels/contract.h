@@ -43,6 +43,15 @@
 #define PS_STREAM_TRANSFORM 8u     /* randomised objects: rotation, scale, flip; element = region */
 #define PS_STREAM_FEATURE_NOISE 9u /* physics features-only: NETD noise in feature space; PS_GAUSS_ELEMENT */
 #define PS_STREAM_GENERATE 16u     /* scenario generators (host only) */
+/* physics: frame k >= 1 of the MMW camera's integration draws its NETD from stream
+ * PS_STREAM_FRAME_NOISE + k (frame 0 from PS_STREAM_RAW_NOISE); element: PS_GAUSS_ELEMENT */
+#define PS_STREAM_FRAME_NOISE 32u
+/* physics: the MMW camera's automatic window spans these order statistics of the raw grid,
+ * in thousandths (the 1st and 99th percentiles), rank round(q (cells - 1) / 1000) of the
+ * sorted cells, and at least PS_WINDOW_MIN_SPAN kelvin. */
+#define PS_WINDOW_LOW_PERMILLE 10
+#define PS_WINDOW_HIGH_PERMILLE 990
+#define PS_WINDOW_MIN_SPAN 1.0
 #define PS_PIXEL_NOISE_VIEW_SHIFT 28 /* element bit where a view's index starts */
 /* The physics model's table Gaussians (docs/model/determinism.md): a cell's Gaussian is
  * the top PS_GAUSS_BITS bits of a 16-bit half of a draw's word, k, taken to
@@ -113,6 +122,13 @@ typedef struct {
    * and each subject's bare raw grid (subjects x raw_height x raw_width). */
   PS_I32 phys_wx, phys_wy, phys_cband, phys_rband, phys_base;
   PS_I32 phys_gauss; /* the PS_GAUSS_TABLE values of Phi^-1((k + 1/2) / PS_GAUSS_TABLE) in phys */
+  /* The MMW camera's processing: frames averaged (each its own NETD draw), the automatic
+   * window (1) or the fixed one (0), and stage_mmw_display's weights of each raw column for
+   * each view column (raw_width rows of display_stride, zero past width), the first and last
+   * raw column of each run of 16 view columns (2 per run), the weights of each raw row for
+   * each view row (height rows of raw_height), and each view row's first and last raw row. */
+  PS_I32 frames, window_auto;
+  PS_I32 display_stride, phys_dx, phys_dxband, phys_dy, phys_dyband;
   /* Randomised objects (PS_FLAG_AFFINE): the ranges of the angle (degrees) and the scale,
    * as floats, and the same four as doubles (low word, high word) for fp64 builds. */
   PS_F32 rotate_lo, rotate_hi, scale_lo, scale_hi;

@@ -96,6 +96,9 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     }
   }
 
-  const preal sd = (preal)phys[PS_PHYS_NETD];
-  if (sd > 0) gauss_cells_global(r, cells, sd, true, seed, index, PS_STREAM_RAW_NOISE, L.view, phys + L.phys_gauss);
+  // The netd stage: L.frames frames averaged (kernels/netd.cl).
+  const preal sd = (preal)phys[PS_PHYS_NETD] / (preal)L.frames;
+  if (sd > 0)
+    for (int k = 0; k < L.frames; ++k)
+      gauss_cells_global(r, cells, sd, true, seed, index, frame_stream(k), L.view, phys + L.phys_gauss);
 }

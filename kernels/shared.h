@@ -9,6 +9,10 @@
 #include "contract.h" /* in the kernel program it comes first, by concatenation */
 #endif
 
+/* The automatic window's order statistic of `permille` among `cells` sorted cells
+ * (kernels/contract.h, PS_WINDOW_LOW_PERMILLE): rank round(permille (cells - 1) / 1000). */
+#define PS_WINDOW_RANK(permille, cells) (((permille) * ((cells)-1) + 500) / 1000)
+
 /* The physics model's table Gaussians (kernels/contract.h): cell p of a view's field (raw grid or pixels, row by
  * row) reads element view << 28 | (16 (p / 128) + p % 16) of its stream, the 16-bit half
  * (p / 16) % 2 (low first) of word (p % 128) / 32, whose top PS_GAUSS_BITS bits are k

@@ -12,7 +12,6 @@
 #include "assets/image_io.h"
 #include "calibrate/captures.h"
 #include "calibrate/fit.h"
-#include "plan/knobs.h"
 #include "run_binary.h"
 #include "scene/catalogue.h"
 
@@ -51,8 +50,6 @@ fs::path make_captures(const TempDir& t, const Camera& cam, int count, uint64_t 
                        const std::vector<std::string>& extra = {}) {
   std::string cat(portalsim::embedded::default_catalogue);
   cat = with_physics(cat, "aperture_m", cam.aperture_m);
-  cat = with_physics(cat, "display_min", cam.display_min);
-  cat = with_physics(cat, "display_max", cam.display_max);
   const fs::path cat_path = t.w() / (std::string(cam.name) + ".catalogue.toml");
   portalsim::test::spit(cat_path, cat);
   const fs::path dir = t.w() / cam.name;
@@ -76,15 +73,10 @@ fs::path make_captures(const TempDir& t, const Camera& cam, int count, uint64_t 
                                 "--out",
                                 dir.string(),
                                 "--quiet"};
-  // The camera calibrate fits: one frame, a fixed window, bilinear display, no smoothing,
-  // said outright where this build has those knobs (their defaults may differ).
-  const std::pair<const char*, std::string> camera[] = {
-      {"frames", "1"},
-      {"window", std::to_string(cam.display_min) + ".." + std::to_string(cam.display_max)},
-      {"display_filter", "bilinear"},
-      {"smooth", "0"}};
-  for (const auto& [key, value] : camera)
-    if (const portalsim::Knob* k = portalsim::find_knob(key)) args.insert(args.end(), {k->flag(), value});
+  // The camera calibrate fits: its window, one frame, bilinear display, no smoothing, said
+  // outright (the defaults differ).
+  args.insert(args.end(), {"--window", std::to_string(cam.display_min) + ".." + std::to_string(cam.display_max),
+                           "--frames", "1", "--display-filter", "bilinear", "--smooth", "0"});
   args.insert(args.end(), extra.begin(), extra.end());
   const auto r = run(t, args);
   EXPECT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);

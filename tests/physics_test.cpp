@@ -145,7 +145,7 @@ TEST(Physics, RawGridFeatureNoiseMatchesTheReference) {
   const FeatureLayout& lay = k.layout;
   const size_t row = lay.image_features();
   ASSERT_EQ(r.features.size(), k.features.size());
-  const double scale = 255.0 / (catalogue().physics.display_max - catalogue().physics.display_min);
+  const double scale = 255.0 / (plan.model.window_hi - plan.model.window_lo);
   const Bound& clean = tolerance_bound(Model::physics, Tier::fast, Output::features_only);
   const Bound& noisy = tolerance_bound(Model::physics, Tier::fast, Output::features_only_noisy);
   std::vector<double> z;
@@ -242,7 +242,7 @@ TEST(Physics, RawGridNoiseHasThePerPixelCovariance) {
     const FeatureLayout lay = noisy.layout;
     const Sensor& upper = catalogue().sensors[lay.pooled[0]];
     const RawGridPooling pool = raw_grid_pooling(upper, lay, 0, c.raw, c.raw);
-    const double scale = 255.0 / (catalogue().physics.display_max - catalogue().physics.display_min);
+    const double scale = 255.0 / (plan.model.window_hi - plan.model.window_lo);
     const double sd2 = plan.model.netd * plan.model.netd * scale * scale;
     const size_t row = lay.image_features();
     const auto column = [&](int f) { return static_cast<size_t>(pool.columns[f]); };
@@ -384,7 +384,8 @@ TEST(Physics, NoiseMatchesTheNetdThroughTheDisplay) {
   const Catalogue& cat = catalogue();
   auto cl = make_opencl_backend(cat, assets(), test::runtime());
   const std::vector<Scenario> scene(1, test::random_scenario(cat, 3, 2));
-  const double scale = 255.0 / (cat.physics.display_max - cat.physics.display_min);
+  const Plan plan = physics_plan();
+  const double scale = 255.0 / (plan.model.window_hi - plan.model.window_lo);
   for (int raw : {28, 200}) {
     SCOPED_TRACE(raw);
     double measured = 0, expected = 0;
@@ -467,8 +468,7 @@ TEST(Physics, NoDetailFinerThanTheRawGrid) {
   reference::sample(vs, f);
   reference::netd(vs, f);
   // The display's bilinear interpolation alone, in gray levels but unrounded.
-  const PhysicsConfig& pc = cat.physics;
-  const double scale = 255.0 / (pc.display_max - pc.display_min);
+  const double scale = 255.0 / (plan.model.window_hi - plan.model.window_lo);
   std::vector<double> interpolated(200 * 200);
   const auto coord = [](int x, int size, int raw) { return std::clamp((x + 0.5) * raw / size - 0.5, 0.0, raw - 1.0); };
   for (int y = 0; y < 200; ++y)
@@ -478,7 +478,7 @@ TEST(Physics, NoDetailFinerThanTheRawGrid) {
       const double tx = u - c0, ty = v - r0;
       const double t =
           (1 - ty) * ((1 - tx) * f.at(c0, r0) + tx * f.at(c1, r0)) + ty * ((1 - tx) * f.at(c0, r1) + tx * f.at(c1, r1));
-      interpolated[y * 200 + x] = (t - pc.display_min) * scale;
+      interpolated[y * 200 + x] = (t - plan.model.window_lo) * scale;
     }
   reference::Field shown = f;
   reference::mmw_display(vs, shown);
@@ -494,7 +494,7 @@ TEST(Physics, NoDetailFinerThanTheRawGrid) {
 }
 
 // A catalogue whose subject-1 has a flat upper body image (gray = its mmw_level: bare body
-// everywhere), a 120 x 120 metal plate, and a wide display window.
+// everywhere) and a 120 x 120 metal plate; flat_plan() has a wide display window.
 struct FlatWorld {
   test::TempDir dir;
   Catalogue cat;
@@ -509,13 +509,18 @@ struct FlatWorld {
     };
     replace("name = \"subject-1\"\n", "name = \"subject-1\"\nmmw_upper = \"flat.png\"\n");
     replace("shape = \"plate\"\nsize = [32, 40]", "shape = \"plate\"\nsize = [120, 120]");
-    replace("display_min = 285.0", "display_min = 270.0");
-    replace("display_max = 305.0", "display_max = 350.0");
     if (!edit_from.empty()) replace(edit_from, edit_to);
     cat = parse_catalogue(text, "flat.toml", dir.w().string(), "");
     assets = build_assets(cat);
   }
 };
+
+Plan flat_plan() {
+  Plan plan = physics_plan();
+  plan.model.window_lo = 270.0;
+  plan.model.window_hi = 350.0;
+  return plan;
+}
 
 // The raw grid of the upper view, before display (reference stages).
 reference::Field raw_grid(const FlatWorld& w, const ModelSettings& m, const Scenario& s) {
@@ -533,13 +538,13 @@ TEST(Physics, MetalContrastFollowsTheRadiometricFormula) {
     SCOPED_TRACE(emissivity);
     const FlatWorld w("emissivity = 0.0055", std::string("emissivity = ") + emissivity);
     const PhysicsConfig& pc = w.cat.physics;
-    const double scale = 255.0 / (pc.display_max - pc.display_min);
+    const double scale = 255.0 / (flat_plan().model.window_hi - flat_plan().model.window_lo);
     Scenario bare, plate;
     plate.objects[1] = static_cast<int16_t>(variant_of(w.cat, "metal-plate"));  // region 2, centre (100, 75)
     auto cl = make_opencl_backend(w.cat, w.assets, test::runtime());
     for (double illumination : {293.0, 330.0}) {
       SCOPED_TRACE(illumination);
-      Plan plan = physics_plan();
+      Plan plan = flat_plan();
       plan.model.illumination = illumination;
       plan.model.netd = 0;
       const double e = std::stod(emissivity), tc = pc.clothing_transmission;
@@ -571,7 +576,7 @@ TEST(Physics, NoContrastWhenEverythingIsAtBodyTemperature) {
   const FlatWorld w;
   Scenario bare, plate;
   plate.objects[1] = static_cast<int16_t>(variant_of(w.cat, "metal-plate"));
-  Plan plan = physics_plan();
+  Plan plan = flat_plan();
   plan.model.illumination = w.cat.physics.skin_temperature;
   plan.model.worn_minutes = 1440;
   plan.model.netd = 0;
@@ -608,7 +613,7 @@ TEST(Physics, Extremes) {
   // A PSF wider than the view (a 2 mm aperture): nearly uniform, and the backends agree.
   const FlatWorld w("aperture_m = 0.125", "aperture_m = 0.002");
   EXPECT_GT(reference::psf_fwhm_pixels(w.cat, w.cat.sensors[0]), 200.0);
-  Plan wide = physics_plan();
+  Plan wide = flat_plan();
   wide.model.netd = 0;
   BatchOutput r, k;
   Scenario plate;
@@ -633,7 +638,7 @@ TEST(Physics, SimulateWritesEveryStageField) {
     const std::string v(view);
     EXPECT_NE(test::slurp(out / "stages" / (v + ".1.radiometry.npy")).find("'shape': (200, 200,)"), std::string::npos);
     EXPECT_NE(test::slurp(out / "stages" / (v + ".3.sample.npy")).find("'shape': (20, 28,)"), std::string::npos);
-    const std::string shown = test::slurp(out / "stages" / (v + ".5.mmw_display.npy"));
+    const std::string shown = test::slurp(out / "stages" / (v + ".6.mmw_display.npy"));
     ASSERT_EQ(shown.size(), 128u + 200 * 200 * 8);
   }
   EXPECT_TRUE(fs::exists(out / "stages" / "ir.1.contact_shadow.npy"));

@@ -73,11 +73,17 @@ inline std::vector<Scenario> coverage(const Catalogue& c, size_t n, int max_obje
   return v;
 }
 
-// The physics model's plan at its defaults, with a run seed.
+// The physics model's plan at its defaults but for the camera's frames and window, with a
+// run seed.
 inline Plan physics_plan(uint64_t seed = 7) {
   Plan p;
   p.model.model = Model::physics;
   p.model.seed = seed;
+  // One NETD draw per raw pixel and a window wide enough that noise is seldom clipped, as
+  // the noise tests' formulas have it.
+  p.model.frames = 1;
+  p.model.window_lo = 285;
+  p.model.window_hi = 305;
   return p;
 }
 

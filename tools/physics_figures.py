@@ -71,7 +71,7 @@ def profile(physics, path):
     blurred = np.load(stages / "upper.2.optics.npy")
     raw = np.load(stages / "upper.3.sample.npy")
     noisy = np.load(stages / "upper.4.netd.npy")
-    shown = np.load(stages / "upper.5.mmw_display.npy")
+    shown = np.load(stages / "upper.6.mmw_display.npy")
     rw = raw.shape[1]
     r = int(y * raw.shape[0] / t.shape[0])
     edges = np.arange(rw + 1) * t.shape[1] / rw

@@ -17,6 +17,7 @@ const std::vector<ViewStage>& view_stages() {
       {"optics", reference::optics, {{"stage_optics_rows", K::view_rows}, {"stage_optics_columns", K::view_rows}}},
       {"sample", reference::sample, {{"stage_sample", K::raw_rows}}},
       {"netd", reference::netd, {{"stage_netd", K::raw_rows}}},
+      {"window", reference::window, {{"stage_window", K::scenarios}}},
       {"mmw_display", reference::mmw_display, {{"stage_mmw_display", K::scenarios}}, true},
       // The physics model's IR camera. Heat spreading is the PSF's separable Gaussian
       // kernels over the taps its launch passes.

@@ -1,9 +1,8 @@
 #include "calibrate/camera_files.h"
 
 #include <charconv>
+#include <iterator>
 #include <sstream>
-
-#include "plan/knobs.h"
 
 namespace portalsim::calibrate {
 
@@ -37,35 +36,33 @@ std::string camera_spec(const CameraFit& fit, const ModelSettings& model, const 
   t << "# The camera fitted by portalsim calibrate. Use it as\n"
     << "#   portalsim generate --spec " << spec_name << " --catalogue " << catalogue_name
     << " --what images --out DIR\n"
-    << "# (the catalogue holds the fitted display window and aperture).\n"
+    << "# (the catalogue holds the fitted aperture).\n"
     << "model = \"physics\"\n"
     << "netd = " << rounded(fit.netd, 4) << "            # K rms per raw pixel: " << rounded(fit.noise_gray, 3)
     << " gray levels through the window\n"
     << "mmw_raw = \"" << fit.raw_w << "x" << fit.raw_h << "\"\n"
     << "illumination = " << number(model.illumination) << "    # K, assumed by the fit (the catalogue's room)\n";
-  // The camera's processing knobs, where this build has them: the fit assumes one frame,
-  // a fixed window, bilinear display and no smoothing.
-  if (find_knob("frames")) t << "frames = 1\n";
-  if (find_knob("window"))
-    t << "window = \"" << rounded(fit.display_min, 3) << ".." << rounded(fit.display_max, 3) << "\"\n";
-  if (find_knob("display_filter")) t << "display_filter = \"bilinear\"\n";
-  if (find_knob("smooth")) t << "smooth = 0\n";
+  // The fitted window, and the camera's processing the fit assumes, written out whatever
+  // the defaults: one frame, a fixed window, bilinear display and no smoothing.
+  t << "window = \"" << rounded(fit.display_min, 3) << ".." << rounded(fit.display_max, 3)
+    << "\"  # K shown as gray 0 and 255\n"
+    << "frames = 1\n"
+    << "display_filter = \"bilinear\"\n"
+    << "smooth = 0\n";
   return t.str();
 }
 
 std::string camera_catalogue(const std::string& catalogue_text, const CameraFit& fit) {
   const std::pair<std::string, std::string> keys[] = {
-      {"display_min", rounded(fit.display_min, 4) + "  # K shown as gray 0 (fitted by calibrate)"},
-      {"display_max", rounded(fit.display_max, 4) + "  # K shown as gray 255 (fitted by calibrate)"},
       {"aperture_m",
        number(fit.aperture_m) + "  # PSF FWHM " + rounded(fit.fwhm_pixels, 2) + " view pixels (fitted by calibrate)"}};
   std::istringstream in(catalogue_text);
   std::ostringstream out;
   std::string line;
   bool in_physics = false;
-  bool done[3] = {false, false, false};
+  bool done[1] = {false};
   auto flush_missing = [&]() {
-    for (int k = 0; k < 3; ++k)
+    for (size_t k = 0; k < std::size(keys); ++k)
       if (!done[k]) {
         out << keys[k].first << " = " << keys[k].second << "\n";
         done[k] = true;
@@ -81,7 +78,7 @@ std::string camera_catalogue(const std::string& catalogue_text, const CameraFit&
     }
     bool replaced = false;
     if (in_physics)
-      for (int k = 0; k < 3; ++k) {
+      for (size_t k = 0; k < std::size(keys); ++k) {
         const std::string& key = keys[k].first;
         if (t.rfind(key, 0) == 0 && trim(t.substr(key.size())).rfind('=', 0) == 0) {
           out << key << " = " << keys[k].second << "\n";

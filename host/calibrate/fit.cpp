@@ -323,14 +323,14 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
   fit.aperture_m = aperture_for_fwhm(cat, v0.width, fit.fwhm_pixels);
 
   // The window's gain is told by the body against the room. Where the captures hardly
-  // show that contrast (a blur wider than the view, a 1x1 raw grid), the catalogue's
-  // window width is kept and only its level is fitted.
+  // show that contrast (a blur wider than the view, a 1x1 raw grid), the model's window
+  // width (its `window` knob) is kept and only its level is fitted.
   fit.gain = e.line.b;
   fit.gain_rel_error = e.line.se_b / std::abs(fit.gain);
   double offset = e.line.a;
   fit.window_told = fit.gain > 0 && std::isfinite(offset) && fit.gain_rel_error <= 0.1;
   if (!fit.window_told) {
-    fit.gain = 255.0 / (cat.physics.display_max - cat.physics.display_min);
+    fit.gain = 255.0 / (model.window_hi - model.window_lo);
     std::vector<double> level(e.x.size());
     for (size_t i = 0; i < e.x.size(); ++i) level[i] = e.y[i] - fit.gain * e.x[i];
     offset = median(level);
@@ -350,8 +350,6 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
 
 Catalogue fitted_catalogue(const Catalogue& cat, const CameraFit& fit) {
   Catalogue out = cat;
-  out.physics.display_min = fit.display_min;
-  out.physics.display_max = fit.display_max;
   out.physics.aperture_m = fit.aperture_m;
   return out;
 }
@@ -362,6 +360,13 @@ ModelSettings fitted_model(const ModelSettings& model, const CameraFit& fit) {
   m.netd = fit.netd;
   m.raw_width = fit.raw_w;
   m.raw_height = fit.raw_h;
+  // The camera the fit assumes: one frame, the fitted fixed window, bilinear, unsmoothed.
+  m.frames = 1;
+  m.window_auto = false;
+  m.window_lo = fit.display_min;
+  m.window_hi = fit.display_max;
+  m.display_filter = DisplayFilter::bilinear;
+  m.smooth = 0;
   return m;
 }
 

@@ -25,7 +25,7 @@ struct CameraFit {
   // Display window: gray = gain (T - display_min), gain = 255 / (max - min).
   double display_min = 0, display_max = 0, gain = 0;
   double gain_rel_error = 0;  // the gain's standard error over the gain
-  bool window_told = true;    // false: the catalogue's window width kept, its level fitted
+  bool window_told = true;    // false: the model's window width kept, its level fitted
   // Noise: per raw pixel, in gray levels and in kelvin (the NETD).
   double noise_gray = 0, netd = 0;
   // Per capture, the catalogue subject (0-based) it was matched to.
@@ -41,9 +41,10 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
 // The aperture (m) whose Airy core is `fwhm_pixels` wide in a view `width` pixels across.
 double aperture_for_fwhm(const Catalogue& cat, int width, double fwhm_pixels);
 
-// A copy of `cat` with the fitted window and aperture.
+// A copy of `cat` with the fitted aperture.
 Catalogue fitted_catalogue(const Catalogue& cat, const CameraFit& fit);
-// `model` with the fitted NETD and raw grid, under the physics model.
+// `model` with the fitted NETD, raw grid and window, under the physics model, with the
+// camera the fit assumes (one frame, bilinear display, no smoothing).
 ModelSettings fitted_model(const ModelSettings& model, const CameraFit& fit);
 
 }  // namespace portalsim::calibrate

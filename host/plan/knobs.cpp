@@ -19,39 +19,63 @@ std::string format_number(double v) {
 Knob integer(std::string key, int lo, int hi, std::string unit, std::string help,
              std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
   return Knob{
-      std::move(key), KnobKind::integer, double(lo),     double(hi), {}, std::move(unit), std::move(help), false,
-      true,           std::move(set),    std::move(get), false,      {}};
+      std::move(key), KnobKind::integer, double(lo), double(hi), {}, std::move(unit), std::move(help), false, true,
+      std::move(set), std::move(get),    false,      {},         {}};
 }
 
 Knob number(std::string key, double lo, double hi, std::string unit, std::string help,
             std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
   return Knob{std::move(key), KnobKind::number, lo,    hi, {}, std::move(unit), std::move(help), false, true,
-              std::move(set), std::move(get),   false, {}};
+              std::move(set), std::move(get),   false, {}, {}};
 }
 
 Knob on_off(std::string key, std::string help, bool fidelity, std::function<void(Plan&, double)> set,
             std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key), KnobKind::on_off, 0,     1, {"on", "off"}, "", std::move(help), fidelity, true,
-              std::move(set), std::move(get),   false, {}};
+  return Knob{std::move(key),
+              KnobKind::on_off,
+              0,
+              1,
+              {"on", "off"},
+              "",
+              std::move(help),
+              fidelity,
+              true,
+              std::move(set),
+              std::move(get),
+              false,
+              {},
+              {}};
 }
 
 Knob grid(std::string key, int lo, int hi, std::string unit, std::string help, std::function<void(Plan&, double)> set,
           std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key), KnobKind::grid, double(lo),     double(hi), {}, std::move(unit), std::move(help), false,
-              true,           std::move(set), std::move(get), false,      {}};
+  return Knob{std::move(key), KnobKind::grid, double(lo), double(hi), {}, std::move(unit), std::move(help), false, true,
+              std::move(set), std::move(get), false,      {},         {}};
 }
 
 Knob choice(std::string key, std::vector<std::string> choices, std::string help, bool fidelity, bool identity,
             std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key), KnobKind::choice, 0,     0, std::move(choices), "", std::move(help), fidelity, identity,
-              std::move(set), std::move(get),   false, {}};
+  return Knob{std::move(key),
+              KnobKind::choice,
+              0,
+              0,
+              std::move(choices),
+              "",
+              std::move(help),
+              fidelity,
+              identity,
+              std::move(set),
+              std::move(get),
+              false,
+              {},
+              {}};
 }
 
 // A range A..B of numbers within [lo, hi]; `symmetric`: one number X means -X..X.
 Knob range(std::string key, double lo, double hi, bool symmetric, std::string unit, std::string help,
            std::function<void(Plan&, double, double)> set, std::function<std::pair<double, double>(const Plan&)> get) {
   Knob k{std::move(key), KnobKind::range, lo, hi, {}, std::move(unit), std::move(help), false, true, {}, {},
-         symmetric,      std::move(set)};
+         symmetric,      std::move(set),  {}};
   k.get = [get = std::move(get), symmetric](const Plan& p) -> nlohmann::json {
     const auto [a, b] = get(p);
     if (symmetric ? a == -b : a == b) return format_number(b);
@@ -87,6 +111,36 @@ std::vector<Knob> declare() {
       "worn_minutes", 0, 1440, "minutes",
       "physics: how long the objects have been carried; they warm from the room towards the skin",
       [](Plan& p, double v) { p.model.worn_minutes = v; }, [](const Plan& p) { return p.model.worn_minutes; }));
+  // The MMW camera's own processing (docs/model/physics-mmw.md).
+  k.push_back(integer(
+      "frames", 1, 1000, "frames",
+      "physics: raw MMW frames at the camera's 10 Hz averaged into each image, each with its own NETD draw "
+      "(the fast tier: one draw of NETD/sqrt(frames))",
+      [](Plan& p, double v) { p.model.frames = static_cast<int>(v); }, [](const Plan& p) { return p.model.frames; }));
+  {
+    Knob w = range(
+        "window", 0, 1000, false, "K",
+        "physics: the MMW display window, kelvin shown as gray 0 and 255: fixed, or auto, per image from the raw "
+        "grid's 1st and 99th percentiles as a camera's automatic gain does",
+        [](Plan& p, double a, double b) {
+          p.model.window_auto = std::isnan(a);
+          if (!p.model.window_auto) p.model.window_lo = a, p.model.window_hi = b;
+        },
+        [](const Plan& p) { return std::pair(p.model.window_lo, p.model.window_hi); });
+    w.word = "auto";
+    w.get = [get = w.get](const Plan& p) -> nlohmann::json { return p.model.window_auto ? "auto" : get(p); };
+    k.push_back(std::move(w));
+  }
+  k.push_back(choice(
+      "display_filter", {"bilinear", "bicubic"},
+      "physics: how the MMW raw grid is interpolated to the view's pixels (bicubic: Keys' cubic convolution, "
+      "a = -1/2)",
+      false, true, [](Plan& p, double v) { p.model.display_filter = static_cast<DisplayFilter>(v); },
+      [](const Plan& p) { return p.model.display_filter == DisplayFilter::bicubic ? "bicubic" : "bilinear"; }));
+  k.push_back(number(
+      "smooth", 0, 50, "view pixels",
+      "physics: sigma of a Gaussian smoothing of the MMW view after interpolation (0: none)",
+      [](Plan& p, double v) { p.model.smooth = v; }, [](const Plan& p) { return p.model.smooth; }));
   k.push_back(number(
       "ir_netd", 0, 10, "K", "physics: IR sensor noise, rms per pixel (thermal cameras: about 0.05 K)",
       [](Plan& p, double v) { p.model.ir_netd = v; }, [](const Plan& p) { return p.model.ir_netd; }));
@@ -183,8 +237,8 @@ std::string Knob::values() const {
   if (kind == KnobKind::grid)
     return "WxH, each " + format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit);
   if (kind == KnobKind::range)
-    return std::string("X or A..B, each ") + format_number(min) + " .. " + format_number(max) +
-           (unit.empty() ? "" : " " + unit);
+    return (word.empty() ? std::string("X or A..B") : word + " or A..B") + ", each " + format_number(min) + " .. " +
+           format_number(max) + (unit.empty() ? "" : " " + unit);
   if (kind == KnobKind::integer || kind == KnobKind::number)
     return format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit);
   std::string s;
@@ -232,6 +286,10 @@ void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::
       break;
     }
     case KnobKind::range: {
+      if (!knob.word.empty() && text == knob.word) {
+        knob.set_range(plan, std::nan(""), std::nan(""));
+        return;
+      }
       const size_t dots = text.find("..");
       double a = 0, b = 0;
       const bool one = dots == std::string::npos;
@@ -240,9 +298,11 @@ void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::
         throw InputError(where + ": \"" + text + "\" is not " +
                          (knob.symmetric ? "a number X (for -X..X) or a range A..B" : "a range A..B (or one number)"));
       if (one) a = knob.symmetric ? -b : b;
-      if (!std::isfinite(a) || !std::isfinite(b) || a < knob.min || b > knob.max || a > b)
-        throw InputError(where + ": \"" + text + "\" must be A..B with " + format_number(knob.min) +
-                         " <= A <= B <= " + format_number(knob.max));
+      if (!std::isfinite(a) || !std::isfinite(b) || a < knob.min || b > knob.max || a > b ||
+          (!knob.word.empty() && a == b))
+        throw InputError(where + ": \"" + text + "\" must be " + (knob.word.empty() ? "" : knob.word + " or ") +
+                         "A..B with " + format_number(knob.min) +
+                         (knob.word.empty() ? " <= A <= B <= " : " <= A < B <= ") + format_number(knob.max));
       knob.set_range(plan, a, b);
       return;
     }

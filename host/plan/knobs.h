@@ -32,9 +32,12 @@ struct Knob {
   // or -X..X for a symmetric range (get then gives the short form back where it applies).
   bool symmetric = false;
   std::function<void(Plan&, double, double)> set_range;
+  // A range that also takes this one word ("auto"), set as set_range(NaN, NaN); its A..B
+  // must then have A < B.
+  std::string word;
 
   std::string flag() const;
-  // "0 .. 1000 gray levels", "on, off", "fp32, fp64, fixed16", "A..B, each 0.1 .. 10".
+  // "0 .. 1000 gray levels", "on, off", "fp32, fp64, fixed16", "X or A..B, each 0.1 .. 10".
   std::string values() const;
 };
 

@@ -11,6 +11,10 @@
 
 namespace portalsim {
 
+// How the MMW camera interpolates its raw grid to the view: bilinear, or Keys' cubic
+// convolution (a = -1/2), edges held.
+enum class DisplayFilter { bilinear, bicubic };
+
 // The knobs of the sensor model (README, "The model"). Defaults are the thesis's.
 struct ModelSettings {
   uint64_t seed = 0;
@@ -39,6 +43,17 @@ struct ModelSettings {
   int raw_width = 28, raw_height = 28;  // the MMW camera's raw grid over each view
   double worn_minutes = 5.0;            // how long the objects have been carried (their temperature)
   double ir_netd = 0.05;                // K rms: IR sensor noise per pixel
+  // The MMW camera's own processing (docs/model/physics-mmw.md, "The camera's defaults"):
+  // raw frames at 10 Hz averaged, each with its own NETD draw (10: one second, the body 5+
+  // times the noise in both views); the display window, fixed [window_lo, window_hi] kelvin
+  // (room 293 K and body 298.6 K well inside it, 3 sigma of noise unclipped) or set per
+  // image from the raw grid's 1st and 99th percentiles (window_auto); the interpolation
+  // from the raw grid to the view, and a Gaussian of `smooth` view pixels.
+  int frames = 10;
+  bool window_auto = false;
+  double window_lo = 290.0, window_hi = 302.0;
+  DisplayFilter display_filter = DisplayFilter::bilinear;
+  double smooth = 0.0;
   bool transforms() const { return rotate_lo != 0 || rotate_hi != 0 || scale_lo != 1 || scale_hi != 1 || flip; }
   bool moves_sprites() const { return bilinear || jitter > 0 || transforms(); }
 };
@@ -109,10 +124,16 @@ struct Plan {
   // The plan's half of physics_raw_features's gate (backend/opencl/paths/), which also needs
   // physics_raw's chain on every pooled view and alone decides: features only, block-mean
   // noise model (the raw grid leaves single pixels' rounding and clipping out), fused.
+  // The camera's knobs: its tables fold the bilinear interpolation and a fixed window into
+  // each feature, so the automatic window, the bicubic filter and smoothing take the dense path.
   bool physics_sparse_features() const {
     return features && images == 0 && model.model == Model::physics && fidelity.pooling == Pooling::sparse &&
-           fidelity.noise == NoiseModel::block_mean && fidelity.fused;
+           fidelity.noise == NoiseModel::block_mean && fidelity.fused && !model.window_auto &&
+           model.display_filter == DisplayFilter::bilinear && model.smooth == 0;
   }
+  // The MMW camera's frames as the kernels draw them: one each, or (block-mean noise model,
+  // the fast tier) one draw of NETD / sqrt(frames).
+  bool frames_approximated() const { return fidelity.noise == NoiseModel::block_mean && model.frames > 1; }
 };
 
 // The layout of a feature row: the blocks of each pooled view in turn (row-major,

@@ -371,8 +371,8 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     io::reject_unknown_keys(*pt,
                             {"frequency_ghz", "aperture_m", "fov_rad", "range_m", "skin_emissivity", "skin_temperature",
                              "clothing_transmission", "clothing_temperature", "background_temperature",
-                             "room_temperature", "base_background_gray", "display_min", "display_max", "ir_index_min_k",
-                             "ir_index_max_k", "ir_coupling", "ir_spread_mm", "ir_display_min", "ir_display_max"},
+                             "room_temperature", "base_background_gray", "ir_index_min_k", "ir_index_max_k",
+                             "ir_coupling", "ir_spread_mm", "ir_display_min", "ir_display_max"},
                             source_name, "physics");
     PhysicsConfig& pc = cat.physics;
     pc.frequency_ghz = rd.number(*pt, "frequency_ghz", "physics", 1.0, 10000.0, pc.frequency_ghz);
@@ -387,9 +387,6 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
         rd.number(*pt, "background_temperature", "physics", 1.0, 1000.0, pc.background_temperature);
     pc.room_temperature = rd.number(*pt, "room_temperature", "physics", 1.0, 1000.0, pc.room_temperature);
     pc.base_background_gray = rd.integer(*pt, "base_background_gray", "physics", 0, 254, pc.base_background_gray);
-    pc.display_min = rd.number(*pt, "display_min", "physics", 0.0, 1000.0, pc.display_min);
-    pc.display_max = rd.number(*pt, "display_max", "physics", 0.0, 1000.0, pc.display_max);
-    if (pc.display_max <= pc.display_min) rd.fail(pt, "physics.display_max", "must be above physics.display_min");
     pc.ir_index_min_k = rd.number(*pt, "ir_index_min_k", "physics", 1.0, 1000.0, pc.ir_index_min_k);
     pc.ir_index_max_k = rd.number(*pt, "ir_index_max_k", "physics", 1.0, 1000.0, pc.ir_index_max_k);
     if (pc.ir_index_max_k <= pc.ir_index_min_k)

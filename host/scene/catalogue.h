@@ -64,8 +64,6 @@ struct PhysicsConfig {
   // The subject's base image as kelvin: its background gray is background_temperature,
   // the subject's mmw_level is bare body (through clothing); linear in between and beyond.
   int base_background_gray = 25;
-  // Display window: these temperatures map to gray 0 and 255.
-  double display_min = 283.0, display_max = 313.0;
   // The IR camera: the base image's temperature index 0 and 255 in kelvin (linear); how much
   // of an object's coolness reaches the clothing surface; the Gaussian heat spreading in the
   // fabric (sigma, mm); the display window in kelvin shown as index 0 and 255.

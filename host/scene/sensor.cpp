@@ -26,7 +26,7 @@ std::vector<Sensor> camera_sensors(const Catalogue& cat) {
       }
     s.pattern_noise = true;
     s.pooled = true;
-    s.physics_chain = {"radiometry", "optics", "sample", "netd", "mmw_display"};
+    s.physics_chain = {"radiometry", "optics", "sample", "netd", "window", "mmw_display"};
     out.push_back(s);
   }
   // The IR camera sees the whole body at its own scale: the two MMW views stacked.

@@ -60,6 +60,7 @@ size_t mmw_display_scratch(const Sensor& s, int raw_width, int raw_height) {
 
 cl::Buffer PhysicsParams::operator()(bool fp64, const Plan& plan, int view, PsViewLaunch& L) {
   L.psf_radius = L.phys_wx = L.phys_wy = L.phys_cband = L.phys_rband = L.phys_base = L.phys_gauss = 0;
+  L.display_stride = L.phys_dx = L.phys_dxband = L.phys_dy = L.phys_dyband = 0;
   if (plan.model.model != Model::physics) return none_.at_least(ctx_, 16);
   Tables& t = tables_[table_key(plan, "view=" + std::to_string(view) + ";fp64=" + std::to_string(fp64))];
   if (t.values.empty()) t = make(plan, cat_.sensors[view], view);
@@ -70,6 +71,11 @@ cl::Buffer PhysicsParams::operator()(bool fp64, const Plan& plan, int view, PsVi
   L.phys_rband = t.rband;
   L.phys_base = t.base;
   L.phys_gauss = t.gauss;
+  L.display_stride = t.display.stride;
+  L.phys_dx = t.display.dx;
+  L.phys_dxband = t.display.dxband;
+  L.phys_dy = t.display.dy;
+  L.phys_dyband = t.display.dyband;
   if (!t.buffer()) t.buffer = params(ctx_, fp64, t.values);
   return t.buffer;
 }
@@ -86,9 +92,9 @@ PhysicsParams::Tables PhysicsParams::make(const Plan& plan, const Sensor& s, int
   std::vector<double>& p = t.values;
   p.assign(PS_PHYS_SUBJECTS, 0.0);
   p[PS_PHYS_BACKGROUND] = pc.background_temperature;
-  p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : pc.display_min;
-  p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : pc.display_max;
-  p[PS_PHYS_NETD] = ir ? m.ir_netd : m.netd;
+  p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : m.window_lo;
+  p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : m.window_hi;
+  p[PS_PHYS_NETD] = ir ? m.ir_netd : kernel_netd(plan);
   // Per subject, its base image's value to kelvin: the IR index map, or the MMW's gray
   // between the room behind and the bare body.
   const double body = seen(pc.skin_emissivity, pc.skin_temperature);
@@ -130,6 +136,7 @@ PhysicsParams::Tables PhysicsParams::make(const Plan& plan, const Sensor& s, int
   t.wy = append(wy);
   t.cband = append(cband);
   t.rband = append(rband);
+  t.display = append_display_tables(p, m, W, H, RW, RH);
   // Each subject's bare raw grid: wy . T . wx^T over its base image in kelvin.
   std::vector<double> bare(cat_.subjects.size() * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
   for (size_t subj = 0; subj < cat_.subjects.size(); ++subj) {

@@ -10,6 +10,7 @@
 
 #include "assets/assets.h"
 #include "backend/opencl/buffers.h"
+#include "backend/opencl/display_tables.h"
 #include "plan/plan.h"
 #include "scene/catalogue.h"
 
@@ -26,6 +27,7 @@ class PhysicsParams {
   struct Tables {
     std::vector<double> values;
     int32_t radius = 0, wx = 0, wy = 0, cband = 0, rband = 0, base = 0, gauss = 0;
+    DisplayTables display;  // stage_mmw_display's (MMW views)
     cl::Buffer buffer;
   };
 

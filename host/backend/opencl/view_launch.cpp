@@ -4,6 +4,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "backend/opencl/display_tables.h"
+
 namespace portalsim::opencl {
 
 namespace {
@@ -39,6 +41,8 @@ PsViewLaunch settings(const Catalogue& cat, const Plan& plan, int view, const De
   std::memcpy(L.ranges_fp64, ranges, sizeof ranges);  // little-endian host and device: low word first
   L.raw_width = plan.model.raw_width;
   L.raw_height = plan.model.raw_height;
+  L.frames = kernel_frames(plan);
+  L.window_auto = plan.model.window_auto;
   L.subjects = static_cast<int32_t>(cat.subjects.size());
   return L;
 }

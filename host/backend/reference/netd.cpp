@@ -16,8 +16,14 @@ void add_noise(const ViewScene& vs, Field& f, double sd, uint32_t stream) {
 
 }  // namespace
 
-// The MMW camera's NETD, per raw pixel.
-void netd(const ViewScene& vs, Field& f) { add_noise(vs, f, vs.model.netd, kStreamRawNoise); }
+// The MMW camera's NETD, per raw pixel, integrated over `frames` raw frames: the scene holds
+// still while the camera averages them, so each frame adds its own draw of NETD / frames
+// (frame 0 from the raw-noise stream, frame k from PS_STREAM_FRAME_NOISE + k).
+void netd(const ViewScene& vs, Field& f) {
+  const int n = vs.model.frames;
+  for (int k = 0; k < n; ++k)
+    add_noise(vs, f, vs.model.netd / n, k == 0 ? kStreamRawNoise : PS_STREAM_FRAME_NOISE + uint32_t(k));
+}
 
 // The IR camera's NETD, per view pixel.
 void ir_netd(const ViewScene& vs, Field& f) { add_noise(vs, f, vs.model.ir_netd, kStreamIrNoise); }

@@ -76,8 +76,9 @@ void display(const ViewScene& vs, Field& f);        // round half up, clamp to 0
 void radiometry(const ViewScene& vs, Field& f);   // apparent temperature, K, objects under clothing
 void optics(const ViewScene& vs, Field& f);       // Gaussian PSF of the Airy core's FWHM, edges held
 void sample(const ViewScene& vs, Field& f);       // integrate onto the raw grid (the field shrinks)
-void netd(const ViewScene& vs, Field& f);         // Gaussian noise per raw pixel, NETD kelvin rms
-void mmw_display(const ViewScene& vs, Field& f);  // bilinear to the view, window to gray, round
+void netd(const ViewScene& vs, Field& f);         // frames averaged, each NETD kelvin rms per raw pixel
+void window(const ViewScene& vs, Field& f);       // automatic window: raw grid onto the fixed window's scale
+void mmw_display(const ViewScene& vs, Field& f);  // interpolate to the view, smooth, window to gray, round
 
 // The physics model's IR chain (README, "The physics model: IR camera"), in order.
 void contact_shadow(const ViewScene& vs, Field& f);  // dT of objects under clothing, K, alone

@@ -1,6 +1,7 @@
 // The physics model's MMW view path: physics_raw (kernels/physics_raw.cl) makes each
 // scenario's raw grid straight from the placement records, radiometry, optics, sampling
-// and NETD together; stage_mmw_display then shows it.
+// and NETD together; stage_window sets the automatic window where the plan has it, and
+// stage_mmw_display then shows it.
 #include "backend/opencl/paths/paths.h"
 
 namespace portalsim::opencl {
@@ -11,7 +12,7 @@ class PhysicsRaw final : public ViewPath {
  public:
   const char* name() const override { return "physics_raw"; }
   const std::vector<std::string>& chain() const override {
-    static const std::vector<std::string> stages = {"radiometry", "optics", "sample", "netd", "mmw_display"};
+    static const std::vector<std::string> stages = {"radiometry", "optics", "sample", "netd", "window", "mmw_display"};
     return stages;
   }
   bool applies(const Plan& plan, const Sensor& sensor) const override {
@@ -20,6 +21,7 @@ class PhysicsRaw final : public ViewPath {
   bool uses_field() const override { return false; }
   void render(ViewLaunch& v) const override {
     run_raw_grid(v);
+    if (v.plan.model.window_auto) v.run("stage_window", v.batch.n);
     v.run("stage_mmw_display", v.batch.n);
   }
 };

@@ -7,6 +7,7 @@
 #include <array>
 #include <map>
 
+#include "backend/opencl/display_tables.h"
 #include "backend/opencl/launch.h"
 #include "backend/opencl/paths/paths.h"
 #include "backend/opencl/raw_grid_pooling.h"
@@ -99,7 +100,7 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const DeviceBatc
                                    .object_range = t.object_range,
                                    .object_feature = t.object_feature,
                                    .object_value = t.object_value,
-                                   .sd = {plan.model.netd},
+                                   .sd = {kernel_netd(plan)},
                                    .dims = t.dims,
                                    .noise = t.noise,
                                    .scratch = scratch};
