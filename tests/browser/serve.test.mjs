@@ -3,47 +3,21 @@
 // Loads the page, puts a gun in region 4 by clicking the body, checks the images changed
 // and the zones equal the thesis's example, saves, compares the folder with simulate's
 // byte for byte, and takes a screenshot. Missing node, puppeteer-core or Chromium fails.
-import { spawn, spawnSync } from "node:child_process";
+import { spawnSync } from "node:child_process";
 import fs from "node:fs";
 import path from "node:path";
-import puppeteer from "puppeteer-core";
+import { check, withPage } from "./harness.mjs";
 
 const [binary, work, shot] = process.argv.slice(2);
 if (!binary || !work) throw new Error("usage: serve.test.mjs PORTALSIM_BINARY WORK_DIR [SCREENSHOT.png]");
 const THESIS = "193,112,75,2,1,1,96,200,200,190,196,53,53,94,64,82,53,200,200";
-const CHROMIUM = "/usr/bin/chromium";
 
-function check(ok, what) {
-  if (!ok) throw new Error("FAILED: " + what);
-  console.log("ok: " + what);
-}
 
 fs.rmSync(work, { recursive: true, force: true });
 const root = path.join(work, "root");
 fs.mkdirSync(root, { recursive: true });
-check(fs.existsSync(CHROMIUM), CHROMIUM + " is installed");
 
-const server = spawn(binary, ["serve", "--port", "0", "--root", root], { stdio: ["ignore", "pipe", "inherit"] });
-let browser;
-try {
-  const url = await new Promise((resolve, reject) => {
-    let out = "";
-    server.stdout.on("data", (d) => {
-      out += d;
-      const m = out.match(/http:\/\/127\.0\.0\.1:\d+\//);
-      if (m) resolve(m[0]);
-    });
-    server.on("exit", (code) => reject(new Error("server exited with " + code)));
-    setTimeout(() => reject(new Error("no URL from the server in 60 s")), 60000).unref();
-  });
-  browser = await puppeteer.launch({
-    executablePath: CHROMIUM, headless: true,
-    args: ["--no-sandbox", "--no-proxy-server", "--disable-gpu"],
-  });
-  const page = await browser.newPage();
-  await page.setViewport({ width: 1280, height: 1000 });
-  await page.goto(url);
-  await page.waitForSelector("body[data-ready='1']", { timeout: 60000 });
+await withPage(binary, root, { width: 1280, height: 1000 }, async ({ page, url }) => {
   const before = await page.$eval("#upper", (i) => i.src);
   const beforeIr = await page.$eval("#ir", (i) => i.src);
   const zonesBefore = await page.$eval("#zones", (o) => o.value);
@@ -95,7 +69,4 @@ try {
   const signature = Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]);
   check(fs.existsSync(png) && fs.statSync(png).size > 1000 && fs.readFileSync(png).subarray(0, 8).equals(signature),
     "screenshot " + png + " is a PNG");
-} finally {
-  if (browser) await browser.close();
-  server.kill("SIGTERM");
-}
+});

@@ -4,20 +4,15 @@
 // physics knob reach the server (the saved folder equals simulate's with the same flags,
 // byte for byte); a knob out of range shows its flag's message; the side-by-side view
 // shows one scenario under both models with simulate's zones. Missing Chromium fails.
-import { spawn, spawnSync } from "node:child_process";
+import { spawnSync } from "node:child_process";
 import fs from "node:fs";
 import path from "node:path";
-import puppeteer from "puppeteer-core";
+import { check, withPage } from "./harness.mjs";
 
 const [binary, work, shot] = process.argv.slice(2);
 if (!binary || !work) throw new Error("usage: serve_models.test.mjs PORTALSIM_BINARY WORK_DIR [SCREENSHOT.png]");
-const CHROMIUM = "/usr/bin/chromium";
 const GUN = ["none", "none", "none", "gun"];
 
-function check(ok, what) {
-  if (!ok) throw new Error("FAILED: " + what);
-  console.log("ok: " + what);
-}
 
 // simulate's folder for the gun in region 4 with these flags; returns its path.
 function simulate(name, flags) {
@@ -31,34 +26,13 @@ const zonesOf = (dir) => fs.readFileSync(path.join(dir, "metal.txt"), "utf8").tr
 fs.rmSync(work, { recursive: true, force: true });
 const root = path.join(work, "root");
 fs.mkdirSync(root, { recursive: true });
-check(fs.existsSync(CHROMIUM), CHROMIUM + " is installed");
 const thesisDir = simulate("sim-thesis", []);
 const physicsDir = simulate("sim-physics", ["--model", "physics"]);
 const netdDir = simulate("sim-netd", ["--model", "physics", "--netd", "0.5"]);
 const THESIS = zonesOf(thesisDir), PHYSICS = zonesOf(physicsDir);
 check(THESIS !== PHYSICS, "the two models' zones differ: " + THESIS + " | " + PHYSICS);
 
-const server = spawn(binary, ["serve", "--port", "0", "--root", root], { stdio: ["ignore", "pipe", "inherit"] });
-let browser;
-try {
-  const url = await new Promise((resolve, reject) => {
-    let out = "";
-    server.stdout.on("data", (d) => {
-      out += d;
-      const m = out.match(/http:\/\/127\.0\.0\.1:\d+\//);
-      if (m) resolve(m[0]);
-    });
-    server.on("exit", (code) => reject(new Error("server exited with " + code)));
-    setTimeout(() => reject(new Error("no URL from the server in 60 s")), 60000).unref();
-  });
-  browser = await puppeteer.launch({
-    executablePath: CHROMIUM, headless: true,
-    args: ["--no-sandbox", "--no-proxy-server", "--disable-gpu"],
-  });
-  const page = await browser.newPage();
-  await page.setViewport({ width: 1400, height: 1300 });
-  await page.goto(url);
-  await page.waitForSelector("body[data-ready='1']", { timeout: 60000 });
+await withPage(binary, root, { width: 1400, height: 1300 }, async ({ page, url }) => {
   const rendered = () => page.$eval("body", (b) => Number(b.dataset.rendered));
   // Waits for a render after `act` and returns the zones shown.
   async function after(act) {
@@ -126,7 +100,4 @@ try {
 
   await page.screenshot({ path: shot || path.join(work, "serve_models.png"), fullPage: true });
   console.log("screenshot " + (shot || path.join(work, "serve_models.png")));
-} finally {
-  if (browser) await browser.close();
-  server.kill("SIGTERM");
-}
+});
