@@ -13,7 +13,8 @@ In one run, on one machine (medians of --repeats runs each):
 - H5Dataset: a data.h5 of the same scenarios (generate --format h5 on /dev/shm), read in
   random order by DataLoader(batch_size=256, shuffle=True);
 - PNG folder: images/<index>/upper.png and lower.png (generate's image folders) read with PIL.
-for thesis images and physics images (three views, `what="images"`, the default tier), then
+for thesis images and physics images (three views, `what="images"`, the default tier), and the
+in-kernel and NumPy rows again with only upper, lower and label made (Generator(datasets=...)), then
 memory: RSS over --long features-only scenarios streamed (features-only keeps 10 million
 feasible in minutes; images at the same batch size hold the same buffers, larger).
 Prints a Markdown table (and writes it to --out) with `uptime` before and after.
@@ -37,6 +38,10 @@ import portalsim
 from portalsim.torch import H5Dataset, StreamDataset
 
 MODELS = {"thesis images": dict(what="images"), "physics images": dict(what="images", model="physics")}
+# The same runs with only the MMW views and the label made (Generator(datasets=...)): what a
+# model trained on upper and lower, as StreamDataset's default views, receives.
+MMW = ("upper", "lower", "label")
+SELECTED = {f"{name} ({', '.join(MMW)})": (kw, MMW) for name, kw in MODELS.items()}
 
 
 def rss_mib():
@@ -56,9 +61,9 @@ def median_rate(fn, repeats):
     return statistics.median(rates), rates
 
 
-def numpy_rate(kw, n, batch):
+def numpy_rate(kw, n, batch, datasets=None):
     """(delivered rate, in-kernel rate) of Generator.batch."""
-    gen = portalsim.Generator(seed=1, **kw)
+    gen = portalsim.Generator(seed=1, datasets=datasets, **kw)
     gen.batch(0, batch)  # the kernels' build and the first buffers, not timed
     before = gen.times()
     t0 = time.perf_counter()
@@ -167,6 +172,11 @@ def main():
             rows.append((name, "PNG folder (upper, lower), PIL", r, rs))
             shutil.rmtree(h5)
             shutil.rmtree(png)
+        for name, (kw, datasets) in SELECTED.items():
+            n = counts[name.split(" (")[0]]
+            delivered, kernel = zip(*(numpy_rate(kw, n, a.batch, datasets) for _ in range(a.repeats)))
+            rows.append((name, "in kernel (backend alone)", statistics.median(kernel), kernel))
+            rows.append((name, f"NumPy, Generator.batch({a.batch})", statistics.median(delivered), delivered))
         first, most, last, rate = memory(a.long, 16384)
     finally:
         shutil.rmtree(work, ignore_errors=True)

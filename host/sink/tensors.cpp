@@ -59,26 +59,24 @@ struct Tensor {
 
 // Rows of an int16 per-region tensor: `f` of each region's variant.
 template <class F>
-std::string_view per_region(const SceneBatch& b, size_t lo, size_t hi, std::string& buf, F f) {
-  buf.resize((hi - lo) * kRegions * sizeof(int16_t));
+std::string_view per_region(const SceneBatch& b, size_t lo, size_t hi, char* dst, F f) {
   for (size_t i = lo * kRegions; i < hi * kRegions; ++i) {
     const int16_t v = f(b.objects[i]);
-    std::memcpy(&buf[(i - lo * kRegions) * sizeof(int16_t)], &v, sizeof v);
+    std::memcpy(dst + (i - lo * kRegions) * sizeof(int16_t), &v, sizeof v);
   }
-  return buf;
+  return {dst, (hi - lo) * kRegions * sizeof(int16_t)};
 }
 
 // Scenario i's region r: `of(object_transform(...))`, or `none` where the region is empty.
 template <class T, class F>
-std::string_view per_transform(const ModelSettings& model, const SceneBatch& b, size_t lo, size_t hi, std::string& buf,
-                               T none, F of) {
-  buf.resize((hi - lo) * kRegions * sizeof(T));
+std::string_view per_transform(const ModelSettings& model, const SceneBatch& b, size_t lo, size_t hi, char* dst, T none,
+                               F of) {
   for (size_t i = lo; i < hi; ++i)
     for (int r = 0; r < kRegions; ++r) {
       const T v = b.objects[i * kRegions + r] == kNoObject ? none : of(object_transform(model, b.first_index + i, r));
-      std::memcpy(&buf[((i - lo) * kRegions + r) * sizeof(T)], &v, sizeof v);
+      std::memcpy(dst + ((i - lo) * kRegions + r) * sizeof(T), &v, sizeof v);
     }
-  return buf;
+  return {dst, (hi - lo) * kRegions * sizeof(T)};
 }
 
 }  // namespace
@@ -111,25 +109,25 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
         std::array<uint32_t, 256> rgb{};
         for (size_t i = 0; i < rgb.size(); ++i) std::memcpy(&rgb[i], ctx.palette[i].data(), 3);
         add(s.name, TensorType::u8, {h, w, 3},
-            [k, rgb](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string& buf) {
+            [k, rgb](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, char* d) {
               const ViewImages& v = o.views[k];
               const size_t per = v.pixels_per_image(), n = (hi - lo) * per;
               const uint8_t* p = v.pixels.data() + lo * per;
-              buf.resize(n * 3 + 1);
-              char* d = buf.data();
-              for (size_t i = 0; i < n; ++i) std::memcpy(d + i * 3, &rgb[p[i]], 4);
-              return std::string_view(buf.data(), n * 3);
+              if (n == 0) return std::string_view(d, 0);
+              for (size_t i = 0; i + 1 < n; ++i) std::memcpy(d + i * 3, &rgb[p[i]], 4);
+              std::memcpy(d + (n - 1) * 3, &rgb[p[n - 1]], 3);  // the last: no byte past the rows
+              return std::string_view(d, n * 3);
             });
         add(
             s.name + "_index", TensorType::u8, {h, w},
-            [k](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+            [k](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, char*) {
               return rows_of(o.views[k].pixels, o.views[k].pixels_per_image(), lo, hi);
             },
             true);
       } else {
         add(
             s.name, TensorType::u8, {h, w},
-            [k](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+            [k](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, char*) {
               return rows_of(o.views[k].pixels, o.views[k].pixels_per_image(), lo, hi);
             },
             true);
@@ -141,53 +139,50 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
       add(
           "mask_" + s.name, TensorType::u8, {static_cast<uint64_t>(s.height), static_cast<uint64_t>(s.width)},
           [k, per = static_cast<size_t>(s.pixels())](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi,
-                                                     std::string&) {
-            return rows_of(o.annotations[k].masks, per, lo, hi);
-          },
+                                                     char*) { return rows_of(o.annotations[k].masks, per, lo, hi); },
           true);
     }
   if (opt.features)
     add(
         "features", TensorType::f32, {static_cast<uint64_t>(ctx.layout.image_features())},
-        [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+        [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, char*) {
           return rows_of(o.features, static_cast<size_t>(o.layout.image_features()), lo, hi);
         },
         true);
   if (opt.scenario) {
     add(
         "metal", TensorType::u8, {kZones},
-        [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, std::string&) {
+        [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, char*) {
           return rows_of(o.metal, kZones, lo, hi);
         },
         true);
     add(
         "label", TensorType::u8, {},
-        [](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string&) {
+        [](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char*) {
           return rows_of(b.label, 1, lo, hi);
         },
         true);
-    add("subject", TensorType::u8, {},
-        [](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-          buf.resize(hi - lo);
-          for (size_t i = lo; i < hi; ++i) buf[i - lo] = static_cast<char>(b.subject[i] + 1);
-          return std::string_view(buf);
-        });
+    add("subject", TensorType::u8, {}, [](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+      for (size_t i = lo; i < hi; ++i) dst[i - lo] = static_cast<char>(b.subject[i] + 1);
+      return std::string_view(dst, hi - lo);
+    });
     add("region_object", TensorType::i16, {kRegions},
-        [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-          return per_region(b, lo, hi, buf, [&](int16_t v) {
+        [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+          return per_region(b, lo, hi, dst, [&](int16_t v) {
             return v == kNoObject ? int16_t(-1) : int16_t(cat->variant_list[v].object);
           });
         });
     add("region_orientation", TensorType::i16, {kRegions},
-        [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-          return per_region(b, lo, hi, buf, [&](int16_t v) {
+        [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+          return per_region(b, lo, hi, dst, [&](int16_t v) {
             return v == kNoObject ? int16_t(-1) : int16_t(cat->variant_list[v].variant);
           });
         });
     add("region_label", TensorType::u8, {kRegions},
-        [rule](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-          buf.assign((hi - lo) * kRegions, '\0');
-          if (!rule) return std::string_view(buf);
+        [rule](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+          const std::string_view rows(dst, (hi - lo) * kRegions);
+          std::memset(dst, 0, rows.size());
+          if (!rule) return rows;
           for (size_t i = lo; i < hi; ++i)
             for (int r = 0; r < kRegions; ++r) {
               const int16_t v = b.objects[i * kRegions + r];
@@ -195,25 +190,25 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
               Scenario alone;
               alone.subject = b.subject[i];
               alone.objects[r] = v;
-              buf[(i - lo) * kRegions + r] = (*rule)(alone) ? 1 : 0;
+              dst[(i - lo) * kRegions + r] = (*rule)(alone) ? 1 : 0;
             }
-          return std::string_view(buf);
+          return rows;
         });
     if (ctx.model.transforms()) {
       // Each object's randomised draw (plan.h, object_transform), the numbers scenarios.csv
       // records: float64 so they are the same doubles; identity where a region is empty.
       add("region_rotation", TensorType::f64, {kRegions},
-          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-            return per_transform<double>(model, b, lo, hi, buf, 0.0,
+          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+            return per_transform<double>(model, b, lo, hi, dst, 0.0,
                                          [](const ObjectTransform& x) { return x.rotation; });
           });
       add("region_scale", TensorType::f64, {kRegions},
-          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-            return per_transform<double>(model, b, lo, hi, buf, 1.0, [](const ObjectTransform& x) { return x.scale; });
+          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+            return per_transform<double>(model, b, lo, hi, dst, 1.0, [](const ObjectTransform& x) { return x.scale; });
           });
       add("region_flip", TensorType::u8, {kRegions},
-          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, std::string& buf) {
-            return per_transform<uint8_t>(model, b, lo, hi, buf, 0,
+          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+            return per_transform<uint8_t>(model, b, lo, hi, dst, 0,
                                           [](const ObjectTransform& x) { return uint8_t(x.flip); });
           });
     }
@@ -308,7 +303,7 @@ class TensorSink final : public Sink {
       parallel_for(threads, threads, [&](size_t first, size_t) {
         for (size_t k = first; k < tensors_.size(); k += threads)
           for (const Piece& p : pieces)
-            if (p.t == &tensors_[k]) p.t->file->append(p.t->col.fill(scenes, out, p.lo, p.hi, scratch_[first]));
+            if (p.t == &tensors_[k]) p.t->file->append(p.t->col.rows(scenes, out, p.lo, p.hi, scratch_[first]));
       });
       return;
     }
@@ -321,7 +316,7 @@ class TensorSink final : public Sink {
     // after every piece did about a hundred times a batch.
     const auto make = [&](size_t i) {
       Piece& p = pieces[i];
-      p.rows = p.t->col.fill(scenes, out, p.lo, p.hi, slots_[i % kSlots]);
+      p.rows = p.t->col.rows(scenes, out, p.lo, p.hi, slots_[i % kSlots]);
       order_->feed(p.extent, p.at, p.rows);
     };
     const auto put = [&](const Piece& p) { write_at(fd_, p.rows.data(), p.rows.size(), p.file_at, partial_); };

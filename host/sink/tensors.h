@@ -40,17 +40,23 @@ struct TensorOptions {
   nlohmann::json identity;           // the run's identity (version, catalogue, spec): HDF5 attributes
 };
 
-// The batch's rows [lo, hi) of one tensor: a view of the batch's own memory, or of
-// `scratch` filled here.
-using Fill =
-    std::function<std::string_view(const SceneBatch&, const BatchOutput&, size_t lo, size_t hi, std::string& scratch)>;
+// The batch's rows [lo, hi) of one tensor. A view column returns a view of the batch's own
+// memory and leaves `dst` alone; any other writes the rows into `dst`, (hi - lo) *
+// row_bytes() bytes, and returns them there: Python's arrays are filled in place, with no
+// copy through a scratch buffer.
+using Fill = std::function<std::string_view(const SceneBatch&, const BatchOutput&, size_t lo, size_t hi, char* dst)>;
 
 // One tensor: its data.h5 dataset and how a batch makes its rows. The tensor sink writes
 // these rows to files, and Python (python/) hands them over as NumPy arrays.
 struct TensorColumn {
   H5Dataset ds;
   Fill fill;
-  bool view = false;  // fill returns the batch's own memory, never `scratch`
+  bool view = false;  // fill returns the batch's own memory, never `dst`
+  // Rows [lo, hi): a view, or made in `scratch` (grown to fit).
+  std::string_view rows(const SceneBatch& b, const BatchOutput& o, size_t lo, size_t hi, std::string& scratch) const {
+    if (!view && scratch.size() < (hi - lo) * ds.row_bytes()) scratch.resize((hi - lo) * ds.row_bytes());
+    return fill(b, o, lo, hi, view ? nullptr : scratch.data());
+  }
 };
 
 // The tensors `opt` asks for, in data.h5's order.

@@ -67,14 +67,20 @@ class Generator:
     """generate's scenarios of a spec and seed, a batch at a time, as NumPy arrays.
 
     Keywords are generate's flags (spec, seed, count, what, rule, annotations, any knob...).
+    `datasets` names the data.h5 datasets batch() returns (default: all of them, see
+    `datasets`); only what they need is computed, so ("upper", "lower", "label") renders
+    neither the IR view nor its palette. Each is byte for byte the same as with all made.
     The OpenCL context is made at the first batch, in the process that renders. With
     prefetch (the default), the batch after the one returned renders on a C++ thread while
     Python reads this one.
     """
 
-    def __init__(self, spec=None, seed=None, *, prefetch=True, **keywords):
+    def __init__(self, spec=None, seed=None, *, prefetch=True, datasets=None, **keywords):
         self._keywords = dict(keywords, spec=None if spec is None else str(spec), seed=seed)
-        self._core = _core.Generator(["--out=(python)"] + _flags("generate", self._keywords), prefetch)
+        if isinstance(datasets, str):
+            datasets = [datasets]
+        self._core = _core.Generator(["--out=(python)"] + _flags("generate", self._keywords), prefetch,
+                                     None if datasets is None else [str(d) for d in datasets])
 
     def batch(self, start=0, count=1024, next_start=...):
         """Scenarios start .. start+count: a dict of NumPy arrays keyed and shaped as data.h5's

@@ -199,6 +199,7 @@ class StreamDataset(IterableDataset):
         missing = [v for v in wanted if v not in names]
         if missing:
             raise ValueError(f"views/target: no dataset {', '.join(missing)} (these keywords make {', '.join(sorted(names))})")
+        self._datasets = list(dict.fromkeys(wanted))  # only these are rendered
 
     def __len__(self):
         if self.count is None:
@@ -234,7 +235,7 @@ class StreamDataset(IterableDataset):
         keywords = dict(self.keywords)
         if get_worker_info() is not None:
             keywords.setdefault("threads", _threads_per_worker(workers))
-        gen = portalsim.Generator(**keywords)
+        gen = portalsim.Generator(datasets=self._datasets, **keywords)
         blocks = self.blocks(shard, shards)
         todo = next(blocks, None)
         while todo is not None:

@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstring>
@@ -104,10 +105,9 @@ void make_rows(Rows& r, const std::vector<TensorColumn>& columns, unsigned threa
     size_t column, lo, hi;
   };
   std::vector<Piece> pieces;
-  std::string unused;
   for (size_t k = 0; k < columns.size(); ++k) {
     if (columns[k].view) {
-      r.rows[k] = columns[k].fill(r.scenes, r.out, 0, n, unused);
+      r.rows[k] = columns[k].fill(r.scenes, r.out, 0, n, nullptr);
       continue;
     }
     const size_t row = std::max<size_t>(1, columns[k].ds.row_bytes()), bytes = n * row;
@@ -121,12 +121,11 @@ void make_rows(Rows& r, const std::vector<TensorColumn>& columns, unsigned threa
   }
   const unsigned t = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(pieces.size())));
   parallel_for(t, t, [&](size_t first, size_t) {
-    std::string scratch;
     for (size_t i = first; i < pieces.size(); i += t) {
       const Piece& p = pieces[i];
       const size_t row = columns[p.column].ds.row_bytes();
-      const std::string_view v = columns[p.column].fill(r.scenes, r.out, p.lo, p.hi, scratch);
-      std::memcpy(r.made[p.column].get() + p.lo * row, v.data(), v.size());
+      // Straight into the array's memory: no scratch, no copy.
+      columns[p.column].fill(r.scenes, r.out, p.lo, p.hi, r.made[p.column].get() + p.lo * row);
     }
   });
 }
@@ -150,7 +149,10 @@ void open_backend_here(cli::Session& s, const cli::CommonOptions& common) {
 // generate's run of a spec, a batch at a time, in memory.
 class Engine {
  public:
-  explicit Engine(const std::vector<std::string>& args) : req_(cli::parse_generate(args)) {
+  // `datasets`: the data.h5 datasets to make (all where none are named); only what they
+  // need is computed.
+  Engine(const std::vector<std::string>& args, const std::optional<std::vector<std::string>>& datasets)
+      : req_(cli::parse_generate(args)) {
     cli::open_catalogue(session_, req_.common);
     cli::check_generate(req_.spec, session_.catalogue);
     source_.emplace(req_.spec, session_.catalogue);
@@ -158,9 +160,50 @@ class Engine {
     threads_ = req_.threads ? req_.threads : default_threads();
     ctx_ = plan_sink_context(plan_, session_.catalogue, session_.assets, threads_, req_.spec.image_format);
     columns_ = tensor_columns(ctx_, h5_tensor_options(req_.spec, plan_, source_->rule()));
+    if (datasets) select(*datasets);
   }
   const std::vector<TensorColumn>& columns() const { return columns_; }
   const ScenarioSource& source() const { return *source_; }
+
+  // Keeps the columns named in `names` (data.h5's order stays), and narrows the plan to what
+  // they read: a view is rendered only for its own datasets (or for features), masks only
+  // for mask_*, features and metal zones only when named. Each kept column's bytes are the
+  // same as with every column made: no output depends on another being computed.
+  void select(const std::vector<std::string>& names) {
+    std::vector<TensorColumn> kept;
+    std::vector<bool> found(names.size(), false);
+    for (TensorColumn& c : columns_)
+      for (size_t i = 0; i < names.size(); ++i)
+        if (names[i] == c.ds.name && !found[i]) {
+          found[i] = true;
+          kept.push_back(std::move(c));
+          break;
+        }
+    for (size_t i = 0; i < names.size(); ++i)
+      if (!found[i]) {
+        std::string all;
+        for (const TensorColumn& c : columns_)
+          if (!c.ds.name.empty()) all += (all.empty() ? "" : ", ") + c.ds.name;
+        const bool twice = std::count(names.begin(), names.end(), names[i]) > 1;
+        throw InputError(
+            "datasets: \"" + names[i] + "\" " +
+            (twice ? std::string("is named twice") : "is not a dataset of these keywords (they make " + all + ")"));
+      }
+    if (kept.empty()) throw InputError("datasets: name at least one dataset");
+    columns_ = std::move(kept);
+    const auto named = [&](const std::string& n) { return std::find(names.begin(), names.end(), n) != names.end(); };
+    uint32_t images = 0;
+    bool masks = false;
+    for (size_t k = 0; k < session_.catalogue.sensors.size(); ++k) {
+      const std::string& v = session_.catalogue.sensors[k].name;
+      if (named(v) || named(v + "_index")) images |= 1u << k;
+      masks = masks || named("mask_" + v);
+    }
+    plan_.images &= images;
+    plan_.annotations = plan_.annotations && masks;
+    plan_.features = plan_.features && named("features");
+    plan_.metal = plan_.metal && named("metal");
+  }
   const cli::GenerateRequest& request() const { return req_; }
 
   // Scenarios [start, start + count): their rows. The OpenCL context is made on the first
@@ -212,8 +255,9 @@ class Engine {
 // reads that one.
 class StreamGenerator {
  public:
-  StreamGenerator(const std::vector<std::string>& args, bool prefetch)
-      : engine_(args), pool_(std::make_shared<Pool>()), prefetch_(prefetch) {
+  StreamGenerator(const std::vector<std::string>& args, bool prefetch,
+                  const std::optional<std::vector<std::string>>& datasets)
+      : engine_(args, datasets), pool_(std::make_shared<Pool>()), prefetch_(prefetch) {
     if (prefetch_) worker_ = std::thread([this] { work(); });
   }
   ~StreamGenerator() {
@@ -387,7 +431,8 @@ PYBIND11_MODULE(_core, m) {
     }
   });
   py::class_<StreamGenerator>(m, "Generator")
-      .def(py::init<const std::vector<std::string>&, bool>(), py::arg("args"), py::arg("prefetch") = true)
+      .def(py::init<const std::vector<std::string>&, bool, const std::optional<std::vector<std::string>>&>(),
+           py::arg("args"), py::arg("prefetch") = true, py::arg("datasets") = py::none())
       .def("batch", &StreamGenerator::batch, py::arg("start"), py::arg("count"), py::arg("next"))
       .def_property_readonly("datasets", &StreamGenerator::datasets)
       .def_property_readonly("count", &StreamGenerator::count)

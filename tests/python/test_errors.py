@@ -72,3 +72,15 @@ def test_bad_batches_and_the_interpreter_goes_on():
     with pytest.raises(TypeError):
         gen.batch(-1, 4)
     assert gen.batch(0, 4)["metal"].shape == (4, 19)  # still works
+
+
+@pytest.mark.parametrize("datasets, message", [
+    (["uper"], '"uper" is not a dataset of these keywords (they make upper, lower, ir, ir_index, metal'),
+    (["upper", "upper"], '"upper" is named twice'),
+    ([], "name at least one dataset"),
+    (["mask_upper"], '"mask_upper" is not a dataset'),  # masks need annotations=True
+])
+def test_bad_datasets_name_the_dataset(datasets, message):
+    with pytest.raises(ValueError) as e:
+        portalsim.Generator(seed=1, what="images", datasets=datasets)
+    assert str(e.value).startswith("datasets: ") and message in str(e.value), str(e.value)
