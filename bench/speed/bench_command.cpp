@@ -53,7 +53,10 @@ int bench(const BenchFlags& f) {
   }
   auto rt = std::make_shared<OpenCLRuntime>(OpenCLOptions{f.device, ""});
   OpenCLDeviceInfo device = rt->info();
-  if (f.without_fp64) device.fp64 = false;
+  if (f.without_fp64 && device.fp64) {
+    device.fp64 = false;
+    device.name += " (as without fp64: --without-fp64)";
+  }
   if (!device.fp64 && !f.quiet) std::fprintf(stderr, "portalsim bench: %s\n", fp64_note(speed_paths(), device).c_str());
   const BenchReport report = run_bench(o, rt, device);
   if (f.json)
