@@ -46,6 +46,7 @@ json report_json(const BenchReport& r) {
     jp["key"] = p.path.key;
     jp["title"] = p.path.title;
     jp["batch"] = p.batch;
+    jp["exact_batch"] = p.exact_batch;
     jp["reference_batch"] = p.reference_batch;
     jp["end_to_end_count"] = p.end_to_end_count;
     const auto loop = p.rates.find(Measure::loop);
@@ -121,8 +122,9 @@ std::string report_text(const BenchReport& r) {
            " |\n";
   }
   const Sizes sz = Sizes::of(r.quick);
-  s += "\nKernel, exact tier and plain loop: batches of " + std::to_string(sz.features_batch) + " (features) and " +
-       std::to_string(sz.images_batch) + " (images); fp64 reference: batches of " + std::to_string(sz.reference_batch) +
+  s += "\nKernel and plain loop: batches of " + std::to_string(sz.features_batch) + " (features) and " +
+       std::to_string(sz.images_batch) + " (images); exact tier: " + std::to_string(sz.exact_features_batch) + " and " +
+       std::to_string(sz.exact_images_batch) + "; fp64 reference: " + std::to_string(sz.reference_batch) +
        "; end to end: portalsim generate of " + std::to_string(sz.features_count) + " (features) and " +
        std::to_string(sz.images_count) + " (images) scenarios into " + r.dir +
        ". The physics model has no plain loop.\n";

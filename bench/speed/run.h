@@ -25,7 +25,9 @@ struct BenchOptions {
 
 // Sizes and timings for one run of the table.
 struct Sizes {
-  size_t features_batch, images_batch, reference_batch;
+  size_t features_batch, images_batch;              // kernel and plain loop
+  size_t exact_features_batch, exact_images_batch;  // the exact tier: fp64 is slow on most devices
+  size_t reference_batch;
   uint64_t features_count, images_count;  // end to end
   double min_seconds;                     // each timed measurement runs at least this long
   size_t memory_bytes, disk_bytes;
@@ -34,7 +36,7 @@ struct Sizes {
 
 struct PathResult {
   SpeedPath path;
-  size_t batch = 0, reference_batch = 0;
+  size_t batch = 0, exact_batch = 0, reference_batch = 0;
   uint64_t end_to_end_count = 0;
   double output_bytes = 0;                       // per scenario, in kernel
   double written_bytes = 0;                      // per scenario, end to end
