@@ -72,7 +72,6 @@ double output_bytes_per_scenario(const BatchOutput& out) {
   if (out.n == 0) return 0;
   double bytes = static_cast<double>(out.metal.size()) + sizeof(float) * static_cast<double>(out.features.size());
   for (const ViewImages& v : out.views) bytes += static_cast<double>(v.pixels.size());
-  for (const ViewAnnotations& a : out.annotations) bytes += static_cast<double>(a.masks.size());
   return bytes / static_cast<double>(out.n);
 }
 

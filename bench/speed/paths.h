@@ -32,7 +32,8 @@ Plan images_plan(double sigma);
 // n scenarios of the generator (seed 1), 0 to max_objects objects each.
 SceneBatch make_batch(const Catalogue& cat, size_t n, int max_objects = 4);
 
-// Output bytes per scenario in `out` (views, metal, features, masks).
+// Output bytes per scenario that the device writes into `out` (views, metal, features):
+// not the annotations' masks, which the host paints only where objects lie.
 double output_bytes_per_scenario(const BatchOutput& out);
 
 // A path's plain loop (bench/baseline/), tables made once; for annotations, the image
