@@ -76,7 +76,7 @@ def main():
            report["device"]["name"], report["date"], load[0]))
     if a.record:
         with open(a.record, "w") as f:
-            json.dump(ratios, f, indent=2)
+            json.dump({p: r for p, r in ratios.items() if r}, f, indent=2)  # paths without a loop: none
             f.write("\n")
     if a.check:
         with open(a.check) as f:
