@@ -75,7 +75,7 @@ std::function<int()> add_bench(CLI::App& app) {
   sub->add_option("--device", f->device, "OpenCL device: a substring of its platform or device name (--list-devices)");
   sub->add_flag("--list-devices", f->list_devices, "list the OpenCL devices, with their compute units and fp64");
   sub->add_flag("--json", f->json, "print the results as JSON instead of tables");
-  sub->add_flag("--quick", f->quick, "small batches and counts: seconds, not a minute; for a check that it runs");
+  sub->add_flag("--quick", f->quick, "small batches and counts, for a check that it runs (its rates mean little)");
   sub->add_option("--repetitions", f->repetitions, "repetitions of each measurement; the tables give medians")
       ->check(CLI::Range(1, 100));
   sub->add_option("--dir", f->dir, "folder for the end-to-end runs and the disk test (default: the temporary folder)");
