@@ -20,10 +20,7 @@ double seconds(Clock::time_point t) { return std::chrono::duration<double>(Clock
 // Arg: per-pixel noise sigma (0 = images, 2 = noisy images, as in issue 14's table).
 void BM_ImagesVsBaseline(benchmark::State& state) {
   auto cl = make_opencl_backend(fx().cat, fx().assets, fx().rt);
-  Plan plan;
-  plan.features = false;
-  plan.metal = false;
-  plan.model.pixel_sigma = static_cast<double>(state.range(0));
+  const Plan plan = speed::images_plan(static_cast<double>(state.range(0)));
   const size_t n = 1024;
   const SceneBatch batch = make_batch(n);
   BatchOutput kernel, loop;
@@ -58,7 +55,7 @@ BENCHMARK(BM_ImagesVsBaseline)->Arg(0)->Arg(2)->Unit(benchmark::kMillisecond)->U
 struct FeaturesPair {
   static constexpr size_t n = 16384;
   std::unique_ptr<Backend> cl = make_opencl_backend(fx().cat, fx().assets, fx().rt);
-  Plan plan = features_plan();
+  Plan plan = speed::features_plan();
   SceneBatch batch = make_batch(n);
   BatchOutput kernel, loop;
   baseline::SparseFeatures features{fx().cat, fx().assets, plan.model};
@@ -66,12 +63,6 @@ struct FeaturesPair {
     cl->run(batch, plan, kernel);
     prepare_output(loop, fx().cat, plan, n);
     features.run(batch, loop);
-  }
-  static Plan features_plan() {
-    Plan p;
-    p.images = 0;
-    p.metal = false;
-    return p;
   }
 };
 

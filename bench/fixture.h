@@ -10,6 +10,7 @@
 #include "backend/backend.h"
 #include "backend/opencl/opencl_backend.h"
 #include "scene/generator.h"
+#include "speed/paths.h"
 
 namespace portalsim::bench {
 
@@ -25,15 +26,8 @@ inline Fixture& fx() {
   return f;
 }
 
-// n scenarios of the generator (seed 1), 0 to max_objects objects each.
-inline SceneBatch make_batch(size_t n, int max_objects = 4) {
-  GeneratorSpec spec;
-  spec.max_objects = max_objects;
-  Generator gen(fx().cat, spec, 1);
-  SceneBatch b;
-  for (size_t i = 0; i < n; ++i) b.push(gen(i));
-  return b;
-}
+// n scenarios of the generator (seed 1), 0 to max_objects objects each, as portalsim bench makes them.
+inline SceneBatch make_batch(size_t n, int max_objects = 4) { return speed::make_batch(fx().cat, n, max_objects); }
 
 // Every thread's CPU time so far (PoCL's and the host's), in ms: steadier than wall time
 // on a busy machine.

@@ -2,6 +2,8 @@
 #pragma once
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <map>
+#include <string>
 
 namespace portalsim::cli {
 
@@ -21,7 +23,12 @@ std::function<int()> add_calibrate(CLI::App& app);
 // rank 0 prints every rank's).
 void print_errors(bool on);
 
+// Registers a subcommand and returns the function that runs it, as the add_* above.
+using AddCommand = std::function<std::function<int()>(CLI::App&)>;
+
 // Parses argv and runs the chosen subcommand; prints errors, returns the exit status.
-int run(int argc, char** argv);
+// `more`: subcommands by name from outside this library (tools/portalsim.cpp adds
+// `bench`, whose plain loops are in bench/, not in the core that Python links).
+int run(int argc, char** argv, const std::map<std::string, AddCommand>& more = {});
 
 }  // namespace portalsim::cli

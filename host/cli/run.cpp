@@ -32,7 +32,7 @@ void check_values(const CLI::App& app) {
 
 void print_errors(bool on) { g_print_errors = on; }
 
-int run(int argc, char** argv) {
+int run(int argc, char** argv, const std::map<std::string, AddCommand>& more) {
   CLI::App app{"portalsim: simulated MMW, IR and metal detector outputs for security portal scenarios"};
   app.set_version_flag("--version", std::string("portalsim ") + PORTALSIM_VERSION);
   app.require_subcommand(1);
@@ -47,6 +47,7 @@ int run(int argc, char** argv) {
   commands["knobs"] = add_knobs(app);
   commands["merge"] = add_merge(app);
   commands["calibrate"] = add_calibrate(app);
+  for (const auto& [name, add] : more) commands[name] = add(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -40,19 +40,29 @@ std::string cache_problem() {
   if (::access(dir.c_str(), W_OK) != 0) return "must be writable";
   return "";
 }
-}  // namespace
 
-OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
+OpenCLDeviceInfo describe(const std::string& name, const cl::Device& d) {
+  OpenCLDeviceInfo info;
+  info.name = name;
+  const cl_device_type t = d.getInfo<CL_DEVICE_TYPE>();
+  info.type = (t & CL_DEVICE_TYPE_CPU)           ? "cpu"
+              : (t & CL_DEVICE_TYPE_GPU)         ? "gpu"
+              : (t & CL_DEVICE_TYPE_ACCELERATOR) ? "accelerator"
+                                                 : "other";
+  info.compute_units = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
+  info.fp64 = d.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
+  return info;
+}
+
+// Every device of every platform with its "platform / device" name, in platform order.
+std::vector<std::pair<std::string, cl::Device>> all_devices() {
   std::vector<cl::Platform> platforms;
   try {
     cl::Platform::get(&platforms);
   } catch (const cl::Error&) {
-    platforms.clear();  // no platform at all: said below
+    platforms.clear();  // no platform at all: the caller says so
   }
-  if (platforms.empty())
-    throw EnvironmentError(
-        "no OpenCL platform found (is pocl-opencl-icd installed?); --backend reference works without one");
-  bool found = false;
+  std::vector<std::pair<std::string, cl::Device>> all;
   for (const cl::Platform& p : platforms) {
     std::vector<cl::Device> devices;
     try {
@@ -60,21 +70,41 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
     } catch (const cl::Error&) {
       continue;
     }
-    for (const cl::Device& d : devices) {
-      const std::string name = p.getInfo<CL_PLATFORM_NAME>() + " / " + d.getInfo<CL_DEVICE_NAME>();
-      const bool wanted = options.device.empty() ? (d.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0
-                                                 : name.find(options.device) != std::string::npos;
-      if (wanted) {
-        device_ = d;
-        device_name_ = name;
-        found = true;
-        break;
-      }
-    }
-    if (found) break;
+    for (const cl::Device& d : devices)
+      all.emplace_back(p.getInfo<CL_PLATFORM_NAME>() + " / " + d.getInfo<CL_DEVICE_NAME>(), d);
   }
-  if (!found && !options.device.empty())
-    throw InputError("--device: no OpenCL device matches \"" + options.device + "\"");
+  return all;
+}
+}  // namespace
+
+std::vector<OpenCLDeviceInfo> list_opencl_devices() {
+  std::vector<OpenCLDeviceInfo> list;
+  for (const auto& [name, d] : all_devices()) list.push_back(describe(name, d));
+  return list;
+}
+
+OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
+  const auto devices = all_devices();
+  if (devices.empty())
+    throw EnvironmentError(
+        "no OpenCL platform found (is pocl-opencl-icd installed?); --backend reference works without one");
+  bool found = false;
+  for (const auto& [name, d] : devices) {
+    const bool wanted = options.device.empty() ? (d.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0
+                                               : name.find(options.device) != std::string::npos;
+    if (wanted) {
+      device_ = d;
+      device_name_ = name;
+      found = true;
+      break;
+    }
+  }
+  if (!found && !options.device.empty()) {
+    std::string names;
+    for (const auto& [name, d] : devices) names += (names.empty() ? "" : "; ") + name;
+    throw InputError("--device: no OpenCL device matches \"" + options.device + "\"; the devices are: " + names +
+                     " (portalsim bench --list-devices)");
+  }
   if (!found)
     throw EnvironmentError(
         "no OpenCL CPU device found (is pocl-opencl-icd installed? PoCL also offers none when its "
@@ -122,6 +152,8 @@ void OpenCLRuntime::build_failed(const cl::Program& p, const std::string& option
 bool OpenCLRuntime::has_fp64() const {
   return device_.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
 }
+
+OpenCLDeviceInfo OpenCLRuntime::info() const { return describe(device_name_, device_); }
 
 cl::Program& OpenCLRuntime::program(const std::string& options) {
   auto it = variants_.find(options);

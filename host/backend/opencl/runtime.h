@@ -3,6 +3,7 @@
 #include <CL/opencl.hpp>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "shared.h"
 
@@ -13,6 +14,19 @@ struct OpenCLOptions {
   std::string build_options;   // extra options for clBuildProgram
   unsigned compute_units = 0;  // > 0: a sub-device of this many compute units (threads on PoCL)
 };
+
+// What a device offers, as --list-devices prints it and `portalsim bench` plans by; a
+// plain struct, so that code deciding by it can be tested with a device that is not here.
+struct OpenCLDeviceInfo {
+  std::string name;  // "platform / device": what --device matches a substring of
+  std::string type;  // cpu, gpu, accelerator or other
+  unsigned compute_units = 0;
+  bool fp64 = false;  // cl_khr_fp64: the exact tier and --model physics's metal zones need it
+};
+
+// Every device of every OpenCL platform, in the order --device searches them; empty
+// when there is no platform.
+std::vector<OpenCLDeviceInfo> list_opencl_devices();
 
 class OpenCLRuntime {
  public:
@@ -25,6 +39,7 @@ class OpenCLRuntime {
   cl::Program& program(const std::string& options);
   const std::string& device_name() const { return device_name_; }
   bool has_fp64() const;  // the device offers cl_khr_fp64
+  OpenCLDeviceInfo info() const;
   double build_seconds() const { return build_seconds_; }
   static std::string source();  // kernels/shared.h and the kernels/ files, in CMakeLists.txt's order
 
