@@ -1,3 +1,4 @@
+
 // Stage "mmw_display" (physics model): the raw grid interpolated to the view's pixels, then
 // the display window [min, max] kelvin mapped to gray 0..255, rounded half up and clamped.
 // The interpolation (bilinear or bicubic, raw pixel centres at (c + 1/2) W / raw_width,
@@ -30,31 +31,62 @@ inline float16 mmw_run(global const float* restrict r, global const param* dx, i
   return t;
 }
 
-// Four whole runs of 16 view columns from x0 down the whole view, where every run's band
-// has at most four columns: each run takes the four columns from lo[m] (its band, widened
-// by columns of weight zero), their weights held in registers for all the rows.
-inline void mmw_runs4x4(global const float* restrict rows, global uchar* restrict o, global const param* dx,
-                        const int* lo, int stride, int x0, int H, int W, int RW, float wlo, float scale) {
-  float16 w[4][4];
-#pragma unroll
-  for (int m = 0; m < 4; ++m)
-#pragma unroll
-    for (int k = 0; k < 4; ++k) w[m][k] = LOADF16(global, dx + (lo[m] + k) * stride + x0 + 16 * m);
-  global const float* restrict r = rows;
-  global uchar* ob = o + x0;
-  for (int y = 0; y < H; ++y, r += RW, ob += W) {
+// Runs of 16 view columns whose bands have at most K columns, on view rows [y0, y1): run
+// m (of `count`, 1 or 4, side by side from x0) takes the K columns from lo[m] (its band,
+// widened by columns of weight zero), their weights held in registers for all the rows;
+// four runs make one store of 64 levels. K = 5 holds bilinear bands (a run's 16 pixels
+// span up to 2.1 raw pixels at 200 from 28), K = 8 bicubic ones.
+#define MMW_RUNS_K(K)                                                                                                 \
+  inline void mmw_runs_##K(global const float* restrict rows, global uchar* restrict o, global const param* dx,    \
+                           const int* lo, int count, int stride, int x0, int y0, int y1, int W, int RW, float wlo,  \
+                           float scale) {                                                                           \
+    float16 w[4][K];                                                                                                \
+    _Pragma("unroll") for (int m = 0; m < 4; ++m) _Pragma("unroll") for (int k = 0; k < K; ++k) w[m][k] =          \
+        m < count ? LOADF16(global, dx + (lo[m] + k) * stride + x0 + 16 * m) : 0.0f;                                \
+    global const float* restrict r = rows + (size_t)y0 * RW;                                                        \
+    global uchar* ob = o + (size_t)y0 * W + x0;                                                                     \
+    for (int y = y0; y < y1; ++y, r += RW, ob += W) {                                                               \
+      uchar16 l[4];                                                                                                 \
+      _Pragma("unroll") for (int m = 0; m < 4; ++m) {                                                               \
+        if (m >= count) break;                                                                                      \
+        global const float* rc = r + lo[m];                                                                         \
+        float16 t = 0.0f;                                                                                           \
+        _Pragma("unroll") for (int k = 0; k < K; ++k) t += rc[k] * w[m][k];                                         \
+        l[m] = window_levels16(t, wlo, scale);                                                                      \
+      }                                                                                                             \
+      if (count == 4)                                                                                               \
+        store64(l[0], l[1], l[2], l[3], ob);                                                                        \
+      else                                                                                                          \
+        store16(l[0], ob);                                                                                          \
+    }                                                                                                               \
+  }
+MMW_RUNS_K(5)
+MMW_RUNS_K(8)
+
+// Runs of 16 view columns from x0 on view rows [y0, y1), run m over raw columns
+// [lo[m], hi[m]]: mmw_runs_K where every band has at most 8 columns, else column by column.
+inline void mmw_runs(global const float* restrict rows, global uchar* restrict o, global const param* dx,
+                     const int* lo, const int* hi, int count, int stride, int x0, int y0, int y1, int W, int RW,
+                     float wlo, float scale) {
+  int widest = 0;
+  for (int m = 0; m < count; ++m) widest = max(widest, hi[m] - lo[m] + 1);
+  const int K = widest <= 5 ? 5 : 8;
+  if (widest <= 8 && RW >= K) {
+    int from[4];
+    for (int m = 0; m < count; ++m) from[m] = min(lo[m], RW - K);
+    if (K == 5) return mmw_runs_5(rows, o, dx, from, count, stride, x0, y0, y1, W, RW, wlo, scale);
+    return mmw_runs_8(rows, o, dx, from, count, stride, x0, y0, y1, W, RW, wlo, scale);
+  }
+  global const float* restrict r = rows + (size_t)y0 * RW;
+  global uchar* ob = o + (size_t)y0 * W + x0;
+  for (int y = y0; y < y1; ++y, r += RW, ob += W) {
     uchar16 l[4];
-#pragma unroll
-    for (int m = 0; m < 4; ++m) {
-      global const float* rc = r + lo[m];
-      float16 t = 0.0f;
-      t += rc[0] * w[m][0];
-      t += rc[1] * w[m][1];
-      t += rc[2] * w[m][2];
-      t += rc[3] * w[m][3];
-      l[m] = window_levels16(t, wlo, scale);
-    }
-    store64(l[0], l[1], l[2], l[3], ob);
+    for (int m = 0; m < count; ++m)
+      l[m] = window_levels16(mmw_run(r, dx, lo[m], hi[m], stride, x0 + 16 * m), wlo, scale);
+    if (count == 4)
+      store64(l[0], l[1], l[2], l[3], ob);
+    else
+      store16(l[0], ob);
   }
 }
 #endif
@@ -118,45 +150,29 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
 #else
   const float lo = (float)phys[PS_PHYS_WINDOW_MIN];
   const float scale = 255.0f / ((float)phys[PS_PHYS_WINDOW_MAX] - lo);
-  // Four whole runs (64 pixels, one store64) at a time down the view, then single runs,
-  // then the last W % 16 pixels: one run ending at the view's edge where the view has 16
-  // (over pixels already made, which it makes again alike), else lane by lane.
+  // Bands of 32 view rows (6 KB of levels at 200 pixels a row, which stay in the L1
+  // cache while each run is stored): four whole runs (64 pixels, one store64) at a time,
+  // then single runs, then the last W % 16 pixels as one run ending at the view's edge
+  // (over pixels already made, which it makes again alike). Views under 16 pixels wide
+  // lane by lane.
   const int runs = W / 16;
-  int b = 0;
-  for (; b + 4 <= runs; b += 4) {
-    int band_lo[4];
-    bool narrow = RW >= 4;
-    for (int m = 0; m < 4; ++m) {
-      const int a = (int)dxband[2 * (b + m)], z = (int)dxband[2 * (b + m) + 1];
-      narrow = narrow && z - a < 4;
-      band_lo[m] = min(a, RW - 4);
-    }
-    if (narrow) {
-      mmw_runs4x4(rows, o, dx, band_lo, stride, 16 * b, H, W, RW, lo, scale);
-      continue;
-    }
-    global const float* restrict r = rows;
-    global uchar* ob = o + 16 * b;
-    for (int y = 0; y < H; ++y, r += RW, ob += W) {
-      uchar16 l[4];
-      for (int m = 0; m < 4; ++m)
-        l[m] = window_levels16(
-            mmw_run(r, dx, (int)dxband[2 * (b + m)], (int)dxband[2 * (b + m) + 1], stride, 16 * (b + m)), lo, scale);
-      store64(l[0], l[1], l[2], l[3], ob);
-    }
-  }
-  for (; b < runs; ++b) {
-    global const float* restrict r = rows;
-    global uchar* ob = o + 16 * b;
-    const int c_lo = (int)dxband[2 * b], c_hi = (int)dxband[2 * b + 1];
-    for (int y = 0; y < H; ++y, r += RW, ob += W) store16(window_levels16(mmw_run(r, dx, c_lo, c_hi, stride, 16 * b), lo, scale), ob);
-  }
-  if (16 * runs == W) return;
   global const float* restrict r = rows;
   if (runs > 0) {
-    const int x0 = W - 16, c_lo = (int)dxband[2 * (x0 / 16)], c_hi = (int)dxband[2 * runs + 1];
-    global uchar* ob = o + x0;
-    for (int y = 0; y < H; ++y, r += RW, ob += W) store16(window_levels16(mmw_run(r, dx, c_lo, c_hi, stride, x0), lo, scale), ob);
+    for (int y0 = 0; y0 < H; y0 += 32) {
+      const int y1 = min(y0 + 32, H);
+      int lo4[4], hi4[4], b = 0;
+      for (; b + 4 <= runs; b += 4) {
+        for (int m = 0; m < 4; ++m) lo4[m] = (int)dxband[2 * (b + m)], hi4[m] = (int)dxband[2 * (b + m) + 1];
+        mmw_runs(rows, o, dx, lo4, hi4, 4, stride, 16 * b, y0, y1, W, RW, lo, scale);
+      }
+      for (; b < runs; ++b) {
+        lo4[0] = (int)dxband[2 * b], hi4[0] = (int)dxband[2 * b + 1];
+        mmw_runs(rows, o, dx, lo4, hi4, 1, stride, 16 * b, y0, y1, W, RW, lo, scale);
+      }
+      if (16 * runs == W) continue;
+      lo4[0] = (int)dxband[2 * (runs - 1)], hi4[0] = (int)dxband[2 * runs + 1];
+      mmw_runs(rows, o, dx, lo4, hi4, 1, stride, W - 16, y0, y1, W, RW, lo, scale);
+    }
     return;
   }
   global uchar* ob = o;
