@@ -158,18 +158,29 @@ inline void ir_noisy_block(global const float* restrict T, global uchar* restric
 // kelvin plus sd times its table Gaussian (stage_ir_netd's sum, in its form) goes through
 // the display window (ir_window) in registers, and no noisy field is written or read back.
 // fp32 builds draw 256 pixels at a time (two blocks of gauss128's, their Philox rounds
-// interleaved: gauss128x2) and store 64 levels at once; like the stage kernels, the last
-// pixels past a whole 16 go one by one.
+// interleaved: gauss128x2), or 128 fast draws (fast128, PS_FLAG_FAST_DRAWS), and store 64
+// levels at once; like the stage kernels, the last pixels past a whole 16 go one by one.
 inline void ir_noisy_window(global const preal* restrict T, global uchar* restrict o, global const param* phys,
-                            int pixels, preal sd, uint2 seed, ulong index, int view, global const param* table) {
+                            int pixels, preal sd, uint2 seed, ulong index, int view, global const param* table,
+                            bool fast) {
   const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
   const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
 #if defined(PRECISION_FP64)
   for (int p = 0; p < pixels; ++p) {
-    const preal t = IR_NOISY(T[p] + sd * gauss_cell(seed, index, PS_STREAM_IR_NOISE, view, p, table));
+    const preal g = fast ? fast_cell(seed, index, PS_STREAM_IR_NOISE, view, p)
+                         : gauss_cell(seed, index, PS_STREAM_IR_NOISE, view, p, table);
+    const preal t = IR_NOISY(T[p] + sd * g);
     o[p] = (uchar)clamp(floor((t - lo) * scale + (preal)0.5), (preal)0, (preal)255);
   }
 #else
+  if (fast) {
+    for (int p = 0; p < pixels; p += 128) {
+      float16 g[8];
+      fast128(seed, index, PS_STREAM_IR_NOISE, view, p >> 7, g);
+      ir_noisy_block(T, o, p, pixels, g, sd, lo, scale);
+    }
+    return;
+  }
   for (int p = 0; p < pixels; p += 256) {
     float16 g[8], h[8];
     gauss128x2(seed, index, view, PS_STREAM_IR_NOISE, p >> 7, PS_STREAM_IR_NOISE, (p >> 7) + 1, table, g, h);
@@ -207,7 +218,7 @@ kernel void ir_surface_noise_display_fused(VIEW_STAGE_ARGS) {
   global uchar* o = out + (size_t)i * pixels;
   const preal sd = (preal)phys[PS_PHYS_NETD];
   if (sd > 0)
-    ir_noisy_window(T, o, phys, pixels, sd, seed, index, L.view, phys + L.phys_gauss);
+    ir_noisy_window(T, o, phys, pixels, sd, seed, index, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);
   else
     ir_window(T, o, phys, 0, pixels);
 }

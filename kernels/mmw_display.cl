@@ -1,4 +1,3 @@
-
 // Stage "mmw_display" (physics model): the raw grid interpolated to the view's pixels, then
 // the display window [min, max] kelvin mapped to gray 0..255, rounded half up and clamped.
 // The interpolation (bilinear or bicubic, raw pixel centres at (c + 1/2) W / raw_width,
@@ -32,36 +31,36 @@ inline float16 mmw_run(global const float* restrict r, global const param* dx, i
 }
 
 // Runs of 16 view columns whose bands have at most K columns, on view rows [y0, y1): run
-// m (of `count`, 1 or 4, side by side from x0) takes the K columns from lo[m] (its band,
+// m (of N, 1 or 4, side by side from x0) takes the K columns from lo[m] (its band,
 // widened by columns of weight zero), their weights held in registers for all the rows;
 // four runs make one store of 64 levels. K = 5 holds bilinear bands (a run's 16 pixels
 // span up to 2.1 raw pixels at 200 from 28), K = 8 bicubic ones.
-#define MMW_RUNS_K(K)                                                                                                 \
-  inline void mmw_runs_##K(global const float* restrict rows, global uchar* restrict o, global const param* dx,    \
-                           const int* lo, int count, int stride, int x0, int y0, int y1, int W, int RW, float wlo,  \
-                           float scale) {                                                                           \
-    float16 w[4][K];                                                                                                \
-    _Pragma("unroll") for (int m = 0; m < 4; ++m) _Pragma("unroll") for (int k = 0; k < K; ++k) w[m][k] =          \
-        m < count ? LOADF16(global, dx + (lo[m] + k) * stride + x0 + 16 * m) : 0.0f;                                \
+#define MMW_RUNS_K(K, N)                                                                                            \
+  inline void mmw_runs_##K##x##N(global const float* restrict rows, global uchar* restrict o,                       \
+                                 global const param* dx, const int* lo, int stride, int x0, int y0, int y1, int W, \
+                                 int RW, float wlo, float scale) {                                                 \
+    float16 w[N][K];                                                                                                \
+    _Pragma("unroll") for (int m = 0; m < N; ++m) _Pragma("unroll") for (int k = 0; k < K; ++k) w[m][k] =          \
+        LOADF16(global, dx + (lo[m] + k) * stride + x0 + 16 * m);                                                   \
     global const float* restrict r = rows + (size_t)y0 * RW;                                                        \
     global uchar* ob = o + (size_t)y0 * W + x0;                                                                     \
     for (int y = y0; y < y1; ++y, r += RW, ob += W) {                                                               \
-      uchar16 l[4];                                                                                                 \
-      _Pragma("unroll") for (int m = 0; m < 4; ++m) {                                                               \
-        if (m >= count) break;                                                                                      \
+      uchar16 l[N];                                                                                                 \
+      _Pragma("unroll") for (int m = 0; m < N; ++m) {                                                               \
         global const float* rc = r + lo[m];                                                                         \
         float16 t = 0.0f;                                                                                           \
         _Pragma("unroll") for (int k = 0; k < K; ++k) t += rc[k] * w[m][k];                                         \
         l[m] = window_levels16(t, wlo, scale);                                                                      \
       }                                                                                                             \
-      if (count == 4)                                                                                               \
-        store64(l[0], l[1], l[2], l[3], ob);                                                                        \
-      else                                                                                                          \
-        store16(l[0], ob);                                                                                          \
+      MMW_STORE##N(l, ob);                                                                                          \
     }                                                                                                               \
   }
-MMW_RUNS_K(5)
-MMW_RUNS_K(8)
+#define MMW_STORE4(l, ob) store64(l[0], l[1], l[2], l[3], ob)
+#define MMW_STORE1(l, ob) store16(l[0], ob)
+MMW_RUNS_K(5, 4)
+MMW_RUNS_K(5, 1)
+MMW_RUNS_K(8, 4)
+MMW_RUNS_K(8, 1)
 
 // Runs of 16 view columns from x0 on view rows [y0, y1), run m over raw columns
 // [lo[m], hi[m]]: mmw_runs_K where every band has at most 8 columns, else column by column.
@@ -74,8 +73,15 @@ inline void mmw_runs(global const float* restrict rows, global uchar* restrict o
   if (widest <= 8 && RW >= K) {
     int from[4];
     for (int m = 0; m < count; ++m) from[m] = min(lo[m], RW - K);
-    if (K == 5) return mmw_runs_5(rows, o, dx, from, count, stride, x0, y0, y1, W, RW, wlo, scale);
-    return mmw_runs_8(rows, o, dx, from, count, stride, x0, y0, y1, W, RW, wlo, scale);
+    if (K == 5 && count == 4)
+      mmw_runs_5x4(rows, o, dx, from, stride, x0, y0, y1, W, RW, wlo, scale);
+    else if (K == 5)
+      mmw_runs_5x1(rows, o, dx, from, stride, x0, y0, y1, W, RW, wlo, scale);
+    else if (count == 4)
+      mmw_runs_8x4(rows, o, dx, from, stride, x0, y0, y1, W, RW, wlo, scale);
+    else
+      mmw_runs_8x1(rows, o, dx, from, stride, x0, y0, y1, W, RW, wlo, scale);
+    return;
   }
   global const float* restrict r = rows + (size_t)y0 * RW;
   global uchar* ob = o + (size_t)y0 * W + x0;
@@ -87,6 +93,68 @@ inline void mmw_runs(global const float* restrict rows, global uchar* restrict o
       store64(l[0], l[1], l[2], l[3], ob);
     else
       store16(l[0], ob);
+  }
+}
+#endif
+
+#if defined(PRECISION_FIXED)
+// The fast tier's display: the same linear map taken the other way round, each raw row
+// through the column weights first (RH rows, not H), with the window folded in: the display
+// weights of a view row sum to 1, so the window's offset and gain go on the raw rows, and
+// each view pixel is then its band of interpolated raw rows times their weights (two at
+// 200 from 28, bilinear), floored and clamped. The same sum in another order: the floats
+// round apart, a pixel near x.5 may round the other way (tolerance.h).
+inline uchar16 level16_fast(float16 t) { return convert_uchar16(convert_int16(fmin(fmax(t, 0.0f), 255.0f))); }
+
+inline void mmw_display_fast(global const float* restrict grid, global float* restrict hr, global uchar* restrict o,
+                             global const param* phys, const PsViewLaunch* L) {
+  const int W = L->width, H = L->height, RW = L->raw_width, RH = L->raw_height, stride = L->display_stride;
+  global const param* dx = phys + L->phys_dx;
+  global const param* dxband = phys + L->phys_dxband;
+  global const param* dy = phys + L->phys_dy;
+  global const param* dyband = phys + L->phys_dyband;
+  const float lo = (float)phys[PS_PHYS_WINDOW_MIN];
+  const float scale = 255.0f / ((float)phys[PS_PHYS_WINDOW_MAX] - lo);
+  const int runs = stride / 16;
+  for (int b = 0; b < runs; ++b) {
+    const int c_lo = (int)dxband[2 * b], c_hi = (int)dxband[2 * b + 1];
+    for (int j = 0; j < RH; ++j) {
+      global const float* g = grid + j * RW;
+      float16 t = 0.0f;
+      for (int c = c_lo; c <= c_hi; ++c) t += g[c] * LOADF16(global, dx + c * stride + 16 * b);
+      STOREF16(global, (t - lo) * scale + 0.5f, hr + j * stride + 16 * b);
+    }
+  }
+  const int whole = W / 16;
+  for (int y = 0; y < H; ++y) {
+    const int j0 = (int)dyband[2 * y], j1 = (int)dyband[2 * y + 1];
+    global const param* w = dy + (size_t)y * RH;
+    global uchar* oy = o + (size_t)y * W;
+    int b = 0;
+    for (; b + 4 <= whole; b += 4) {
+      float16 t[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+      for (int j = j0; j <= j1; ++j) {
+        const float wj = (float)w[j];
+#pragma unroll
+        for (int m = 0; m < 4; ++m) t[m] += wj * LOADF16(global, hr + j * stride + 16 * (b + m));
+      }
+      store64(level16_fast(t[0]), level16_fast(t[1]), level16_fast(t[2]), level16_fast(t[3]), oy + 16 * b);
+    }
+    // Single runs, then the last W % 16 pixels: a run ending at the view's edge over
+    // pixels already made (the same values), or lane by lane in views under 16 wide.
+    for (; b <= whole; ++b) {
+      const int x0 = b < whole ? 16 * b : W >= 16 ? W - 16 : 0;
+      if (b == whole && x0 + 16 == 16 * whole && W >= 16) break;
+      float16 t = 0.0f;
+      for (int j = j0; j <= j1; ++j) t += (float)w[j] * LOADF16(global, hr + j * stride + x0);
+      if (W >= 16) {
+        store16(level16_fast(t), oy + x0);
+      } else {
+        uchar l[16];
+        vstore16(level16_fast(t), 0, l);
+        for (int k = 0; k < W; ++k) oy[k] = l[k];
+      }
+    }
   }
 }
 #endif
@@ -105,7 +173,11 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
   global const param* dyband = phys + L.phys_dyband;
   // Scratch (host: mmw_display_scratch): each view row's raw values weighted along y,
   // H x RW, 32 values of room, then (fp32, raw rows of at most 32) the raw grid in rows of 32.
-  global preal* restrict rows = (global preal*)scratch + (size_t)i * PS_MMW_DISPLAY_SCRATCH(H, RW, RH);
+  global preal* restrict rows = (global preal*)scratch + (size_t)i * PS_MMW_DISPLAY_SCRATCH(W, H, RW, RH);
+#if defined(PRECISION_FIXED)
+  mmw_display_fast(grid, rows, o, phys, &L);
+  (void)dx, (void)dxband, (void)dy, (void)dyband, (void)stride;
+#else
 #if !defined(PRECISION_FP64)
   if (RW <= 32) {
     // Rows of 16 or 32 lanes: the raw grid padded to rows of 32 (zeros past RW), then each
@@ -181,5 +253,6 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
     vstore16(window_levels16(mmw_run(r, dx, (int)dxband[0], (int)dxband[1], stride, 0), lo, scale), 0, l);
     for (int k = 0; k < W; ++k) ob[k] = l[k];
   }
+#endif
 #endif
 }
