@@ -118,11 +118,26 @@ inline void mmw_display_fast(global const float* restrict grid, global float* re
   const int runs = stride / 16;
   for (int b = 0; b < runs; ++b) {
     const int c_lo = (int)dxband[2 * b], c_hi = (int)dxband[2 * b + 1];
+    if (c_hi - c_lo < 5 && RW >= 5) {
+      // Five columns (the band widened by columns of weight zero), weights in registers.
+      const int c0 = min(c_lo, RW - 5);
+      float16 w[5];
+#pragma unroll
+      for (int k = 0; k < 5; ++k) w[k] = LOADF16(global, dx + (c0 + k) * stride + 16 * b);
+      for (int j = 0; j < RH; ++j) {
+        global const float* g = grid + j * RW + c0;
+        float16 t = g[0] * w[0];
+#pragma unroll
+        for (int k = 1; k < 5; ++k) t = fma((float16)g[k], w[k], t);
+        STOREF16(global, fma(t - lo, (float16)scale, 0.5f), hr + j * stride + 16 * b);
+      }
+      continue;
+    }
     for (int j = 0; j < RH; ++j) {
       global const float* g = grid + j * RW;
       float16 t = 0.0f;
-      for (int c = c_lo; c <= c_hi; ++c) t += g[c] * LOADF16(global, dx + c * stride + 16 * b);
-      STOREF16(global, (t - lo) * scale + 0.5f, hr + j * stride + 16 * b);
+      for (int c = c_lo; c <= c_hi; ++c) t = fma((float16)g[c], LOADF16(global, dx + c * stride + 16 * b), t);
+      STOREF16(global, fma(t - lo, (float16)scale, 0.5f), hr + j * stride + 16 * b);
     }
   }
   const int whole = W / 16;
@@ -131,12 +146,27 @@ inline void mmw_display_fast(global const float* restrict grid, global float* re
     global const param* w = dy + (size_t)y * RH;
     global uchar* oy = o + (size_t)y * W;
     int b = 0;
+    if (j1 - j0 == 1) {
+      // Two raw rows (bilinear between raw row centres).
+      const float w0 = (float)w[j0], w1 = (float)w[j1];
+      global const float* h0 = hr + j0 * stride;
+      global const float* h1 = hr + j1 * stride;
+      for (; b + 4 <= whole; b += 4) {
+        uchar16 l[4];
+#pragma unroll
+        for (int m = 0; m < 4; ++m) {
+          const int x = 16 * (b + m);
+          l[m] = level16_fast(fma((float16)w1, LOADF16(global, h1 + x), w0 * LOADF16(global, h0 + x)));
+        }
+        store64(l[0], l[1], l[2], l[3], oy + 16 * b);
+      }
+    }
     for (; b + 4 <= whole; b += 4) {
       float16 t[4] = {0.0f, 0.0f, 0.0f, 0.0f};
       for (int j = j0; j <= j1; ++j) {
         const float wj = (float)w[j];
 #pragma unroll
-        for (int m = 0; m < 4; ++m) t[m] += wj * LOADF16(global, hr + j * stride + 16 * (b + m));
+        for (int m = 0; m < 4; ++m) t[m] = fma((float16)wj, LOADF16(global, hr + j * stride + 16 * (b + m)), t[m]);
       }
       store64(level16_fast(t[0]), level16_fast(t[1]), level16_fast(t[2]), level16_fast(t[3]), oy + 16 * b);
     }
@@ -146,7 +176,7 @@ inline void mmw_display_fast(global const float* restrict grid, global float* re
       const int x0 = b < whole ? 16 * b : W >= 16 ? W - 16 : 0;
       if (b == whole && x0 + 16 == 16 * whole && W >= 16) break;
       float16 t = 0.0f;
-      for (int j = j0; j <= j1; ++j) t += (float)w[j] * LOADF16(global, hr + j * stride + x0);
+      for (int j = j0; j <= j1; ++j) t = fma((float16)(float)w[j], LOADF16(global, hr + j * stride + x0), t);
       if (W >= 16) {
         store16(level16_fast(t), oy + x0);
       } else {
