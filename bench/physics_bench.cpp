@@ -1,7 +1,8 @@
 // The physics model against the thesis model, per scenario, in the same run:
 //   ./build/portalsim_bench --benchmark_filter=Model --benchmark_repetitions=3
 // Args: batch size, model (0 thesis, 1 physics), NETD in kelvin (physics only), tier (0
-// standard, 1 fast: physics features-only from the raw grid).
+// standard, 1 fast: physics features-only from the raw grid; physics images with the fast
+// tier's draws and display).
 // The MMW camera's own processing (frames, window, display filter, smoothing), MMW images:
 //   ./build/portalsim_bench --benchmark_filter=MmwCamera --benchmark_repetitions=3
 // The IR camera alone, and its physics chain cut after each stage:
@@ -48,6 +49,7 @@ BENCHMARK_CAPTURE(BM_ModelOpenCL, images, true)
     ->Args({1024, 0, 0, 0})
     ->Args({1024, 1, 0, 0})
     ->Args({1024, 1, 3, 0})
+    ->Args({1024, 1, 3, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_ModelOpenCL, features, false)

@@ -22,14 +22,15 @@ kernel void stage_ir_surface(VIEW_STAGE_ARGS) {
 }
 
 // Stage "ir_netd": Gaussian noise of the IR NETD (kelvin rms) on every view pixel, a table
-// Gaussian each from the counter generator (PS_STREAM_IR_NOISE, PS_GAUSS_ELEMENT). One
-// work-item per scenario: fp32 builds draw 128 pixels at a time (gauss128).
+// Gaussian each from the counter generator (PS_STREAM_IR_NOISE, PS_GAUSS_ELEMENT), or the
+// fast tier's draw (PS_FLAG_FAST_DRAWS). One work-item per scenario: fp32 builds draw 128
+// pixels at a time (gauss128, fast128).
 kernel void stage_ir_netd(VIEW_STAGE_ARGS) {
   VIEW_STAGE_SCENARIO;
   const preal sd = (preal)phys[PS_PHYS_NETD];
   if (sd > 0)
-    gauss_cells_global((global preal*)field + (size_t)i * L.width * L.height, L.width * L.height, sd, true, seed, index,
-                PS_STREAM_IR_NOISE, L.view, phys + L.phys_gauss);
+    noise_cells((global preal*)field + (size_t)i * L.width * L.height, L.width * L.height, sd, seed, index,
+                PS_STREAM_IR_NOISE, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);
 }
 
 // Stage "ir_display": the IR display window, kelvin to temperature index 0..255 (as

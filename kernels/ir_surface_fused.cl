@@ -127,45 +127,65 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
 #define IR_NOISY(t) (t)
 #endif
 
+#if !defined(PRECISION_FP64)
+// Pixels p .. p + 127 of ir_noisy_window (those below `pixels`), their draws g.
+inline void ir_noisy_block(global const float* restrict T, global uchar* restrict o, int p, int pixels,
+                           const float16* g, float sd, float lo, float scale) {
+  if (p + 128 <= pixels) {
+    uchar16 l[8];
+#pragma unroll
+    for (int j = 0; j < 8; ++j) l[j] = window_levels16(IR_NOISY(LOADF16(global, T + p + 16 * j) + sd * g[j]), lo, scale);
+    store64(l[0], l[1], l[2], l[3], o + p);
+    store64(l[4], l[5], l[6], l[7], o + p + 64);
+    return;
+  }
+  for (int j = 0; j < 8; ++j) {
+    const int q = p + 16 * j;
+    if (q + 16 <= pixels) {
+      store16(window_levels16(IR_NOISY(LOADF16(global, T + q) + sd * g[j]), lo, scale), o + q);
+    } else {
+      float t[16];
+      vstore16(g[j], 0, t);
+      for (int k = q; k < pixels; ++k)
+        o[k] = (uchar)clamp(floor((IR_NOISY(T[k] + sd * t[k - q]) - lo) * scale + 0.5f), 0.0f, 255.0f);
+      break;
+    }
+  }
+}
+#endif
+
 // ir_netd then ir_display over a view's whole surface T into o, in one pass: each pixel's
 // kelvin plus sd times its table Gaussian (stage_ir_netd's sum, in its form) goes through
 // the display window (ir_window) in registers, and no noisy field is written or read back.
-// fp32 builds draw 128 pixels at a time (gauss128) and store 64 levels at once; like the
-// stage kernels, the last pixels past a whole 16 go one by one.
+// fp32 builds draw 256 pixels at a time (two blocks of gauss128's, their Philox rounds
+// interleaved: gauss128x2), or 128 fast draws (fast128, PS_FLAG_FAST_DRAWS), and store 64
+// levels at once; like the stage kernels, the last pixels past a whole 16 go one by one.
 inline void ir_noisy_window(global const preal* restrict T, global uchar* restrict o, global const param* phys,
-                            int pixels, preal sd, uint2 seed, ulong index, int view, global const param* table) {
+                            int pixels, preal sd, uint2 seed, ulong index, int view, global const param* table,
+                            bool fast) {
   const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
   const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
 #if defined(PRECISION_FP64)
   for (int p = 0; p < pixels; ++p) {
-    const preal t = IR_NOISY(T[p] + sd * gauss_cell(seed, index, PS_STREAM_IR_NOISE, view, p, table));
+    const preal g = fast ? fast_cell(seed, index, PS_STREAM_IR_NOISE, view, p)
+                         : gauss_cell(seed, index, PS_STREAM_IR_NOISE, view, p, table);
+    const preal t = IR_NOISY(T[p] + sd * g);
     o[p] = (uchar)clamp(floor((t - lo) * scale + (preal)0.5), (preal)0, (preal)255);
   }
 #else
-  for (int p = 0; p < pixels; p += 128) {
-    float16 g[8];
-    gauss128(seed, index, PS_STREAM_IR_NOISE, view, p >> 7, table, g);
-    if (p + 128 <= pixels) {
-      uchar16 l[8];
-#pragma unroll
-      for (int j = 0; j < 8; ++j)
-        l[j] = window_levels16(IR_NOISY(LOADF16(global, T + p + 16 * j) + sd * g[j]), lo, scale);
-      store64(l[0], l[1], l[2], l[3], o + p);
-      store64(l[4], l[5], l[6], l[7], o + p + 64);
-      continue;
+  if (fast) {
+    for (int p = 0; p < pixels; p += 128) {
+      float16 g[8];
+      fast128(seed, index, PS_STREAM_IR_NOISE, view, p >> 7, g);
+      ir_noisy_block(T, o, p, pixels, g, sd, lo, scale);
     }
-    for (int j = 0; j < 8; ++j) {
-      const int q = p + 16 * j;
-      if (q + 16 <= pixels) {
-        store16(window_levels16(IR_NOISY(LOADF16(global, T + q) + sd * g[j]), lo, scale), o + q);
-      } else {
-        float t[16];
-        vstore16(g[j], 0, t);
-        for (int k = q; k < pixels; ++k)
-          o[k] = (uchar)clamp(floor((IR_NOISY(T[k] + sd * t[k - q]) - lo) * scale + 0.5f), 0.0f, 255.0f);
-        break;
-      }
-    }
+    return;
+  }
+  for (int p = 0; p < pixels; p += 256) {
+    float16 g[8], h[8];
+    gauss128x2(seed, index, view, PS_STREAM_IR_NOISE, p >> 7, PS_STREAM_IR_NOISE, (p >> 7) + 1, table, g, h);
+    ir_noisy_block(T, o, p, pixels, g, sd, lo, scale);
+    if (p + 128 < pixels) ir_noisy_block(T, o, p + 128, pixels, h, sd, lo, scale);
   }
 #endif
 }
@@ -198,7 +218,7 @@ kernel void ir_surface_noise_display_fused(VIEW_STAGE_ARGS) {
   global uchar* o = out + (size_t)i * pixels;
   const preal sd = (preal)phys[PS_PHYS_NETD];
   if (sd > 0)
-    ir_noisy_window(T, o, phys, pixels, sd, seed, index, L.view, phys + L.phys_gauss);
+    ir_noisy_window(T, o, phys, pixels, sd, seed, index, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);
   else
     ir_window(T, o, phys, 0, pixels);
 }

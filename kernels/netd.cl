@@ -6,11 +6,174 @@
 // NETD / sqrt(frames).
 inline uint frame_stream(int k) { return k == 0 ? PS_STREAM_RAW_NOISE : PS_STREAM_FRAME_NOISE + (uint)k; }
 
+// The fast tier's draws (PS_FLAG_FAST_DRAWS, kernels/contract.h PS_IH_*): a 16-bit half's
+// two bytes summed, s in 0..510, bent to a near-normal by an odd quintic. Arithmetic only,
+// where the table Gaussian gathers from a 16 KB table.
+inline preal ih_value(uint bits) {
+  const preal t = (preal)((int)(bits & 0xffu) + (int)(bits >> 8) - 255) * ((preal)1 / (preal)255);
+  const preal t2 = t * t;
+  return t * ((preal)PS_IH_C1 + t2 * ((preal)PS_IH_C3 + t2 * (preal)PS_IH_C5));
+}
+
+// Cell p's fast draw: the table Gaussian's word and half (PS_GAUSS_ELEMENT), ih_value.
+inline preal fast_cell(uint2 seed, ulong index, uint stream, int view, int p) {
+  const uint4 r = draw(seed, index, stream, PS_GAUSS_ELEMENT(view, p));
+  const int w = PS_GAUSS_WORD(p);
+  const uint word = w == 0 ? r.x : w == 1 ? r.y : w == 2 ? r.z : r.w;
+  return ih_value((word >> PS_GAUSS_SHIFT(p)) & 0xffffu);
+}
+
+#if !defined(PRECISION_FP64)
+// ih_value of both halves of 16 words at once: each half's byte sum in one lane's 10 bits.
+inline void ih_values16(uint16 word, float16* lo, float16* hi) {
+  const uint16 sums = (word & 0x00ff00ffu) + ((word >> 8) & 0x00ff00ffu);
+  const float16 tl = convert_float16(convert_int16(sums & 0x3ffu) - 255) * (1.0f / 255.0f);
+  const float16 th = convert_float16(convert_int16(sums >> 16) - 255) * (1.0f / 255.0f);
+  const float16 l2 = tl * tl, h2 = th * th;
+  *lo = tl * ((float)PS_IH_C1 + l2 * ((float)PS_IH_C3 + l2 * (float)PS_IH_C5));
+  *hi = th * ((float)PS_IH_C1 + h2 * ((float)PS_IH_C3 + h2 * (float)PS_IH_C5));
+}
+
+// Cells 128 b .. 128 b + 127 of a view's field as fast draws, laid out as gauss128's.
+__attribute__((always_inline)) inline void fast128(uint2 seed, ulong index, uint stream, int view, int b,
+                                                   float16* g) {
+  uint16 c[4];
+  c[0] = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
+         ((uint)(16 * b) + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+  c[1] = (uint16)(stream);
+  c[2] = (uint16)((uint)index);
+  c[3] = (uint16)((uint)(index >> 32));
+  philox16(&c[0], &c[1], &c[2], &c[3], seed);
+#pragma unroll
+  for (int w = 0; w < 4; ++w) ih_values16(c[w], &g[2 * w], &g[2 * w + 1]);
+}
+#endif
+
+// Adds sd times the draws of cells [0, cells) of `stream` to v: table Gaussians, or with
+// `fast` the fast tier's draws. The stage kernels' noise (stage_netd's rows go cell by cell).
+inline void noise_cells(global preal* restrict v, int cells, preal sd, uint2 seed, ulong index, uint stream, int view,
+                        global const param* table, bool fast) {
+  if (!fast) {
+    gauss_cells_global(v, cells, sd, true, seed, index, stream, view, table);
+    return;
+  }
+#if defined(PRECISION_FP64)
+  for (int p = 0; p < cells; ++p) v[p] = v[p] + sd * fast_cell(seed, index, stream, view, p);
+#else
+  for (int p = 0; p < cells; p += 128) {
+    float16 g[8];
+    fast128(seed, index, stream, view, p >> 7, g);
+    for (int j = 0; j < 8; ++j) {
+      const int q = p + 16 * j;
+      if (q + 16 <= cells) {
+        STOREF16(global, LOADF16(global, v + q) + sd * g[j], v + q);
+      } else {
+        float t[16];
+        vstore16(g[j], 0, t);
+        for (int k = q; k < cells; ++k) v[k] = v[k] + sd * t[k - q];
+        break;
+      }
+    }
+  }
+#endif
+}
+
 kernel void stage_netd(VIEW_STAGE_ARGS) {
   RAW_STAGE_ROW;
   const preal sd = (preal)phys[PS_PHYS_NETD] / (preal)L.frames;
   if (sd <= 0) return;
+  const bool fast = L.flags & PS_FLAG_FAST_DRAWS;
   for (int k = 0; k < L.frames; ++k)
     for (int c = 0; c < L.raw_width; ++c)
-      r[c] += sd * gauss_cell(seed, index, frame_stream(k), L.view, j * L.raw_width + c, phys + L.phys_gauss);
+      r[c] += sd * (fast ? fast_cell(seed, index, frame_stream(k), L.view, j * L.raw_width + c)
+                         : gauss_cell(seed, index, frame_stream(k), L.view, j * L.raw_width + c, phys + L.phys_gauss));
+}
+
+#if !defined(PRECISION_FP64)
+// The counters of block b of a view's table Gaussians in `stream` (gauss128's), as 64-bit
+// lanes for PHILOX16_ROUND.
+#define GAUSS_BLOCK_COUNTERS(c0, c1, c2, c3, view, b, stream, index)                                          \
+  ulong16 c0 = convert_ulong16(((uint)(view) << PS_PIXEL_NOISE_VIEW_SHIFT) |                                  \
+                               ((uint)(16 * (b)) + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15))); \
+  ulong16 c1 = (ulong16)(stream), c2 = (ulong16)((uint)(index)), c3 = (ulong16)((uint)((index) >> 32))
+
+// Two blocks of 128 table Gaussians (gauss128's values): block ba of stream sa into g and
+// block bb of stream sb into h, their Philox rounds interleaved so that one block's
+// multiplies fill the other's wait (one block alone is a chain of 10 dependent rounds).
+__attribute__((always_inline)) inline void gauss128x2(uint2 seed, ulong index, int view, uint sa, int ba, uint sb,
+                                                      int bb, global const float* table, float16* g, float16* h) {
+  GAUSS_BLOCK_COUNTERS(a0, a1, a2, a3, view, ba, sa, index);
+  GAUSS_BLOCK_COUNTERS(b0, b1, b2, b3, view, bb, sb, index);
+  uint2 k = seed;
+#pragma unroll
+  for (int r = 0; r < 10; ++r) {
+    PHILOX16_ROUND(a0, a1, a2, a3, k);
+    PHILOX16_ROUND(b0, b1, b2, b3, k);
+    k += (uint2)(0x9E3779B9u, 0xBB67AE85u);
+  }
+  const uint16 wa[4] = {convert_uint16(a0), convert_uint16(a1), convert_uint16(a2), convert_uint16(a3)};
+  const uint16 wb[4] = {convert_uint16(b0), convert_uint16(b1), convert_uint16(b2), convert_uint16(b3)};
+#pragma unroll
+  for (int w = 0; w < 4; ++w) {
+    const uint16 alo = (wa[w] >> (16 - PS_GAUSS_BITS)) & (PS_GAUSS_TABLE - 1), ahi = wa[w] >> (32 - PS_GAUSS_BITS);
+    const uint16 blo = (wb[w] >> (16 - PS_GAUSS_BITS)) & (PS_GAUSS_TABLE - 1), bhi = wb[w] >> (32 - PS_GAUSS_BITS);
+    g[2 * w] = GATHER16(table, alo);
+    g[2 * w + 1] = GATHER16(table, ahi);
+    h[2 * w] = GATHER16(table, blo);
+    h[2 * w + 1] = GATHER16(table, bhi);
+  }
+}
+#endif
+
+// The netd stage over a scenario's whole raw grid v (physics_raw): L.frames frames of sd
+// each added to every cell, frame after frame, as stage_netd's sums. fp32 builds hold a
+// block of 128 cells in registers through all the frames and draw two frames' table
+// Gaussians at once; the fast draws (one frame under the fast tier) go as noise_cells.
+inline void netd_frames(global preal* restrict v, int cells, preal sd, int frames, uint2 seed, ulong index, int view,
+                        global const param* table, bool fast) {
+#if defined(PRECISION_FP64)
+  for (int k = 0; k < frames; ++k) noise_cells(v, cells, sd, seed, index, frame_stream(k), view, table, fast);
+#else
+  if (fast) {
+    for (int k = 0; k < frames; ++k) noise_cells(v, cells, sd, seed, index, frame_stream(k), view, table, true);
+    return;
+  }
+  for (int p = 0; p < cells; p += 128) {
+    const int n = min(cells - p, 128);
+    float16 acc[8];
+#pragma unroll
+    for (int j = 0; j < 8; ++j) {
+      if (16 * j + 16 <= n) {
+        acc[j] = LOADF16(global, v + p + 16 * j);
+      } else {
+        float t[16];
+        for (int q = 0; q < 16; ++q) t[q] = 16 * j + q < n ? v[p + 16 * j + q] : 0.0f;
+        acc[j] = vload16(0, t);
+      }
+    }
+    int k = 0;
+    for (; k + 2 <= frames; k += 2) {
+      float16 g[8], h[8];
+      gauss128x2(seed, index, view, frame_stream(k), p >> 7, frame_stream(k + 1), p >> 7, table, g, h);
+#pragma unroll
+      for (int j = 0; j < 8; ++j) acc[j] = (acc[j] + sd * g[j]) + sd * h[j];
+    }
+    if (k < frames) {
+      float16 g[8];
+      gauss128(seed, index, frame_stream(k), view, p >> 7, table, g);
+#pragma unroll
+      for (int j = 0; j < 8; ++j) acc[j] = acc[j] + sd * g[j];
+    }
+#pragma unroll
+    for (int j = 0; j < 8; ++j) {
+      if (16 * j + 16 <= n) {
+        STOREF16(global, acc[j], v + p + 16 * j);
+      } else {
+        float t[16];
+        vstore16(acc[j], 0, t);
+        for (int q = 0; 16 * j + q < n && q < 16; ++q) v[p + 16 * j + q] = t[q];
+      }
+    }
+  }
+#endif
 }

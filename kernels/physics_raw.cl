@@ -98,7 +98,5 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
 
   // The netd stage: L.frames frames averaged (kernels/netd.cl).
   const preal sd = (preal)phys[PS_PHYS_NETD] / (preal)L.frames;
-  if (sd > 0)
-    for (int k = 0; k < L.frames; ++k)
-      gauss_cells_global(r, cells, sd, true, seed, index, frame_stream(k), L.view, phys + L.phys_gauss);
+  if (sd > 0) netd_frames(r, cells, sd, L.frames, seed, index, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);
 }

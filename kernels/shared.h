@@ -24,6 +24,14 @@
 #define PS_GAUSS_WORD(p) (((p)&127) >> 5)
 #define PS_GAUSS_SHIFT(p) ((((p) >> 4) & 1) * 16)
 #define PS_GAUSS_INDEX(word, p) (((word) >> (PS_GAUSS_SHIFT(p) + 16 - PS_GAUSS_BITS)) & (PS_GAUSS_TABLE - 1))
+/* stage_mmw_display's scratch per scenario, in values: each view row weighted along y (H x
+ * RW), 32 values of room for whole-vector stores, then the raw grid in rows of 32; or (the
+ * fast tier's display) each raw row interpolated along x, RH rows of W rounded up to 16. */
+#define PS_MMW_ROWS_SCRATCH(H, RW, RH) ((size_t)(H) * (size_t)(RW) + 32 + 32 * (size_t)(RH))
+#define PS_MMW_DISPLAY_SCRATCH(W, H, RW, RH)                                                \
+  (PS_MMW_ROWS_SCRATCH(H, RW, RH) > (size_t)(RH) * (size_t)(((W) + 15) / 16 * 16) \
+       ? PS_MMW_ROWS_SCRATCH(H, RW, RH)                                           \
+       : (size_t)(RH) * (size_t)(((W) + 15) / 16 * 16))
 /* physics_features' work space per scenario, in values: the features, band_x zeros, the
  * draws, band_y rows of zeros, Z Lx^T. Up to PS_FEATURE_NOISE_PRIVATE it lives in private
  * memory (the work-item's stack, in cache); larger layouts (small blocks) use global

@@ -47,7 +47,8 @@ Plan camera_plan(const Camera& c, Tier tier) {
 }
 
 // Stated tolerance, as the physics model's (host/plan/tolerance.h): MMW pixels within 1
-// gray level, at most 0.5% of them off by one; features within 1.
+// gray level, at most 0.5% of them off by one; features within 1. In every tier: the fast
+// tier's display (raw rows first) and draws, which the reference follows, included.
 TEST(Camera, KernelsMatchTheReference) {
   const SceneBatch batch = test::batch_of(test::coverage(catalogue(), 24, 6));
   auto ref = make_reference_backend(catalogue(), assets());
@@ -58,7 +59,7 @@ TEST(Camera, KernelsMatchTheReference) {
         Camera{"bicubic", 1, false, bicubic, 0, 28, 28}, Camera{"smooth 3", 1, false, bilinear, 3, 28, 28},
         Camera{"all, 37x13", 6, true, bicubic, 2.5, 37, 13}, Camera{"all, 1x1", 3, true, bicubic, 1, 1, 1},
         Camera{"all, 200x200", 2, true, bicubic, 0.7, 200, 200}})
-    for (Tier tier : {Tier::standard, Tier::exact}) {
+    for (Tier tier : {Tier::standard, Tier::exact, Tier::fast}) {
       SCOPED_TRACE(std::string(c.name) + " " + tier_name(tier));
       const Plan plan = camera_plan(c, tier);
       BatchOutput r, k;

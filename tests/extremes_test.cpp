@@ -250,14 +250,17 @@ ModelSettings model(uint64_t seed, bool pattern, double sigma = 0, int block = 1
   return m;
 }
 
-// The physics model at NETD 0: the raw-grid path's noise is not the reference's draws and
-// is held statistically in Physics.RawGridFeatureNoiseMatchesTheReference. The window is
+// The physics model at NETD 0 and IR NETD 0: the raw-grid path's noise is not the
+// reference's draws and is held statistically in Physics.RawGridFeatureNoiseMatchesTheReference,
+// and the fast tier's images draw their noise its own way, against which the exact tier's
+// reference here is not held (Physics.FastTierDrawsMatchTheReference holds it). The window is
 // 285..305 K, wide enough that flat white and black scenes stay unclipped: the raw-grid
 // features path leaves each pixel's clamping out (the default 290..302 K clips them).
 ModelSettings physics_model(uint64_t seed, int block = 10, int metal_noise = 0) {
   ModelSettings m = model(seed, false, 0.0, block, metal_noise);
   m.model = Model::physics;
   m.netd = 0;
+  m.ir_netd = 0;
   m.window_lo = 285;
   m.window_hi = 305;
   return m;

@@ -12,6 +12,7 @@
 #include "assets/image_io.h"
 #include "backend/compare.h"
 #include "backend/opencl/raw_grid_pooling.h"
+#include "backend/reference/draws.h"
 #include "backend/reference/stages.h"
 #include "backend/stages.h"
 #include "base/error.h"
@@ -88,6 +89,50 @@ TEST(Physics, KernelsMatchTheReferenceInEveryTier) {
     EXPECT_LE(d.mmw.share_differing, 0.005);
     EXPECT_EQ(d.metal_exact, 1.0);
   }
+}
+
+// The fast tier's draws (Plan::physics_draws_approximated): the MMW frames as one draw of
+// NETD / sqrt(frames), every MMW and IR draw an Irwin-Hall one, which the reference draws
+// its own way (reference/draws.cpp, fast_gaussian). All three views with noise against the
+// reference value by value: ten frames, and an IR NETD (0.5 K) at which a wrong draw moves
+// most IR pixels by several levels.
+TEST(Physics, FastTierDrawsMatchTheReference) {
+  const SceneBatch batch = test::batch_of(coverage_set(48));
+  Plan plan = physics_plan();
+  plan.fidelity = tier_fidelity(Tier::fast);
+  plan.model.frames = 10;
+  plan.model.ir_netd = 0.5;
+  BatchOutput r, k;
+  make_reference_backend(catalogue(), assets())->run(batch, plan, r);
+  make_opencl_backend(catalogue(), assets(), test::runtime())->run(batch, plan, k);
+  const OutputDiff d = compare_outputs(k, r);
+  EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, Tier::fast)), "");
+  EXPECT_GT(d.ir.pixels, 0u);
+  EXPECT_LE(d.mmw.max_abs, 1);
+  EXPECT_LE(d.mmw.share_differing, 0.005);
+  EXPECT_LE(d.ir.max_abs, 1);
+  EXPECT_LE(d.ir.share_differing, 0.005);
+}
+
+// The fast draw itself (the reference's, which the test above holds the kernels to): over
+// 2^20 cells, mean 0 and sd 1 within 0.5%, |g| <= 3.365, excess kurtosis near the
+// quintic's -0.010, and within 0.006 of the normal in Kolmogorov-Smirnov distance (the
+// distribution's own is 0.0033; 2^20 draws add about 0.0013).
+TEST(Physics, FastDrawsAreNearlyNormal) {
+  std::vector<double> g;
+  for (int p = 0; p < (1 << 20); ++p) g.push_back(reference::fast_gaussian(7, 3, kStreamIrNoise, 2, p));
+  double m = 0, m2 = 0, m4 = 0, top = 0;
+  for (double v : g) m += v, top = std::max(top, std::fabs(v));
+  m /= double(g.size());
+  for (double v : g) m2 += (v - m) * (v - m), m4 += std::pow(v - m, 4);
+  m2 /= double(g.size()), m4 /= double(g.size());
+  EXPECT_NEAR(m, 0, 0.005);
+  EXPECT_NEAR(std::sqrt(m2), 1, 0.005);
+  EXPECT_LE(top, 3.365);
+  EXPECT_NEAR(m4 / (m2 * m2) - 3, -0.010, 0.03);
+  const SampleComparison c = compare_samples(g);
+  EXPECT_LT(c.ks, 0.006);
+  EXPECT_GT(c.ks, 0.001);  // not the table's normal: it is the approximation
 }
 
 // Features-only runs in every tier against the reference at NETD 0 (rounding only), on the

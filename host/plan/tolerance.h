@@ -78,7 +78,9 @@ inline constexpr std::array kTolerances{
     Bound{Model::physics, Tier::standard, Output::features_only, 1.0 + 1e-4, 0.005 + 1e-4, 1, false,
           "the dense path's features"},
     Bound{Model::physics, Tier::fast, Output::pixels, 2, 0.5, 0.5, false,
-          "MMW: one rounding; IR: the thesis fast tier's 8.8 fixed point"},
+          "MMW: the display's sum taken raw rows first (the same linear map, floats rounded in another order) and one "
+          "rounding; noise: Irwin-Hall draws and the frames as one draw of NETD / sqrt(frames), which the reference "
+          "draws alike (reference/draws.cpp), so only the arithmetic differs"},
     Bound{Model::physics, Tier::fast, Output::features, 1.0 + 1e-4, 0.005 + 1e-4, 1, false,
           "means of MMW pixels within 1, 0.5% of them off (features pool the MMW views only)"},
     Bound{Model::physics, Tier::fast, Output::features_only, 0.75, 0.3, 1, false,

@@ -6,6 +6,7 @@
 
 #include "backend/opencl/gauss_table.h"
 #include "backend/opencl/table_key.h"
+#include "shared.h"
 
 namespace portalsim::opencl {
 
@@ -55,7 +56,7 @@ void axis_weights(int size, int raw, const double* taps, int radius, std::vector
 }  // namespace
 
 size_t mmw_display_scratch(const Sensor& s, int raw_width, int raw_height) {
-  return size_t(s.height) * raw_width + 16 * size_t(raw_height);
+  return PS_MMW_DISPLAY_SCRATCH(s.width, s.height, raw_width, raw_height);
 }
 
 cl::Buffer PhysicsParams::operator()(bool fp64, const Plan& plan, int view, PsViewLaunch& L) {

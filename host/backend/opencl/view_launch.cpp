@@ -30,7 +30,7 @@ PsViewLaunch settings(const Catalogue& cat, const Plan& plan, int view, const De
   L.flags = (s.pattern_noise && plan.model.pattern_noise ? PS_FLAG_PATTERN_NOISE : 0) |
             (plan.pixel_noise_per_pixel() ? PS_FLAG_PIXEL_NOISE : 0) | (plan.model.bilinear ? PS_FLAG_BILINEAR : 0) |
             (plan.model.transforms() ? PS_FLAG_AFFINE : 0) | (plan.model.flip ? PS_FLAG_FLIP : 0) |
-            (tabulated ? PS_FLAG_TABULATED : 0);
+            (tabulated ? PS_FLAG_TABULATED : 0) | (plan.physics_draws_approximated() ? PS_FLAG_FAST_DRAWS : 0);
   L.jitter_x = static_cast<float>(plan.model.jitter * s.jitter_scale_x);
   L.jitter_y = static_cast<float>(plan.model.jitter * s.jitter_scale_y);
   L.rotate_lo = static_cast<float>(plan.model.rotate_lo);

@@ -14,6 +14,11 @@ double normal_quantile(double q);
 // Phi^-1((k + 1/2) / 4096).
 double table_gaussian(uint64_t seed, uint64_t index, uint32_t stream, int view, int p);
 
+// The physics fast tier's draw of the same cell: that half's two bytes summed, s in 0..510,
+// t = (s - 255) / 255, bent to a near-normal by the odd quintic PS_IH_C1 t + PS_IH_C3 t^3 +
+// PS_IH_C5 t^5 (kernels/contract.h).
+double fast_gaussian(uint64_t seed, uint64_t index, uint32_t stream, int view, int p);
+
 // The thesis model's per-pixel sensor noise of pixel p of view `view`: Box-Muller over the
 // first two words of the draw of pixel pair p / 2, cosine for even p, sine for odd.
 double pixel_gaussian(uint64_t seed, uint64_t index, int view, int p);

@@ -56,6 +56,9 @@ struct ViewScene {
   const Scenario& scenario;
   uint64_t index;  // the scenario's global index: the random generator's counter
   std::vector<Placed> placed;
+  // The physics cameras' noise as the fast tier draws it (Plan::physics_draws_approximated):
+  // the MMW frames as one draw of NETD / sqrt(frames), every draw fast_gaussian's.
+  bool fast_draws = false;
 };
 
 ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSettings& model, int view,
