@@ -361,15 +361,22 @@ void AppendFile::submit_full() {
   active_ ^= 1;
 }
 
+std::span<char> AppendFile::room() { return {bufs_[active_] + buf_len_, kBuffer - buf_len_}; }
+
+void AppendFile::commit(size_t n) {
+  XXH3_64bits_update(state_of(hash_), bufs_[active_] + buf_len_, n);
+  bytes_ += n;
+  buf_len_ += n;
+  if (buf_len_ == kBuffer) submit_full();
+}
+
 void AppendFile::append(std::string_view data) {
-  XXH3_64bits_update(state_of(hash_), data.data(), data.size());
-  bytes_ += data.size();
   while (!data.empty()) {
-    const size_t n = std::min(data.size(), kBuffer - buf_len_);
-    std::memcpy(bufs_[active_] + buf_len_, data.data(), n);
-    buf_len_ += n;
+    const std::span<char> r = room();
+    const size_t n = std::min(data.size(), r.size());
+    std::memcpy(r.data(), data.data(), n);
+    commit(n);
     data.remove_prefix(n);
-    if (buf_len_ == kBuffer) submit_full();
   }
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -45,6 +46,10 @@ class AppendFile {
 
   void append(std::string_view data);
   void append(const void* data, size_t n) { append(std::string_view(static_cast<const char*>(data), n)); }
+  // Room for the next bytes, written in place (no copy): at least one byte, in the buffer
+  // the file is written from; commit(n) then appends its first n (n <= room().size()).
+  std::span<char> room();
+  void commit(size_t n);
   uint64_t size() const { return bytes_; }  // bytes appended so far
   // The bytes appended so far, written into the file first (for a checkpoint).
   FileState state() const;
