@@ -152,6 +152,12 @@ std::string_view check_text(std::string_view text, const std::string& source, Bo
 }
 
 void check_line(std::string_view line, const std::string& source, size_t lineno) {
+  // Most lines are printable ASCII: nothing to decode.
+  std::string_view body = line;
+  if (body.ends_with('\n')) body.remove_suffix(body.ends_with("\r\n") ? 2 : 1);
+  bool plain = body.size() < kMaxLineBytes;
+  for (const char c : body) plain &= (c >= 0x20 && c < 0x7F) || c == '\t';
+  if (plain) return;
   check_bytes(line, [&](size_t l, size_t column, const std::string& what) {
     throw InputError(where(source, lineno + l - 1, column) + ": " + what);
   });

@@ -11,11 +11,11 @@
 #pragma once
 #include <array>
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "scene/scene.h"
@@ -38,7 +38,11 @@ class ScenarioRows {
   ScenarioRows(const Catalogue& cat, std::string_view header, const std::string& path, size_t line);
   bool has_transforms() const { return transform_columns_ != 0; }
   // Object tokens already read, per thread: lists repeat a few names millions of times.
-  using Tokens = std::map<std::string, int16_t, std::less<>>;
+  struct TokenHash {
+    using is_transparent = void;
+    size_t operator()(std::string_view s) const { return std::hash<std::string_view>()(s); }
+  };
+  using Tokens = std::unordered_map<std::string, int16_t, TokenHash, std::equal_to<>>;
   // One row (its line end dropped, CRLF too); `t` gets its transforms, if it has any.
   // Checks the row's bytes as check_text does.
   Scenario parse(std::string_view row, size_t line, ListedTransforms* t, Tokens& tokens) const;
