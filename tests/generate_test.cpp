@@ -1091,6 +1091,93 @@ TEST(GenerateBadSpec, ScenarioFileErrorsNameFileLineAndColumn) {
   EXPECT_EQ(sc[1], "1,2,none,iron-rod:v,none,none,none,none,none,none,none,none,none,none,metal-plate,no");
 }
 
+// A list is read as a stream: one over the 64 MiB that catalogues and specs may hold (here
+// made long by comment lines between its rows) runs, its rows as given.
+TEST(GenerateLists, AListOver64MiBRuns) {
+  GenTempDir t;
+  const fs::path big = t.w() / "big.csv";
+  {
+    std::ofstream o(big, std::ios::binary);
+    o << kScenarioHeader;
+    const std::string comment = "#" + std::string(60000, 'c') + "\n";
+    for (int i = 0; i < 1150; ++i) {
+      o << comment;
+      if (i % 100 == 0)
+        o << (i % 200 ? kGunRow : "2,none,rod:v,none,none,none,none,none,none,none,none,none,none,none,no\n");
+    }
+  }
+  ASSERT_GT(fs::file_size(big), 64ull << 20);
+  const fs::path out = t.w() / "big-out";
+  ExpectOk(run_ps(t, gen({"--scenarios", big.string(), "--format", "csv", "--batch", "5", "--quiet"}, out)));
+  const std::vector<std::string> sc = csv_rows(read_all(out / "scenarios.csv"));
+  ASSERT_EQ(sc.size(), 12u);
+  EXPECT_EQ(sc[1], "1,1,gun:h,none,none,none,none,none,none,none,none,none,none,none,none,yes");
+  EXPECT_EQ(sc[2], "2,2,none,iron-rod:v,none,none,none,none,none,none,none,none,none,none,none,no");
+}
+
+// The rows of a long list (no two stretches of it alike), with a row far down it bad.
+std::string long_list(int rows, int bad_row) {
+  std::string text = kScenarioHeader;
+  const char* objects[] = {"gun", "none", "rod:v", "belt-buckle", "none", "pendant"};
+  for (int i = 0; i < rows; ++i) {
+    const uint32_t h = static_cast<uint32_t>(i) * 2654435761u;  // rows that never repeat in step
+    text += std::to_string(1 + (h >> 28) % 4);
+    for (int r = 0; r < 13; ++r) text += std::string(",") + objects[(h >> (r * 2)) % 6];
+    text += i == bad_row ? ",maybe\n" : (i % 3 ? ",no\n" : ",yes\n");
+  }
+  return text;
+}
+
+// With --shard, each shard's rows (read from the list past the others') are the whole run's.
+TEST(GenerateLists, ShardsOfAListConcatenateToTheWholeRun) {
+  GenTempDir t;
+  const fs::path list = t.w() / "list.csv";
+  write_all(list, long_list(500, -1));
+  const Args spec{"--scenarios", list.string(), "--format", "csv", "--batch", "64", "--quiet"};
+  std::vector<Args> commands{gen(spec, t.w() / "whole")};
+  for (int i = 0; i < 3; ++i)
+    commands.push_back(gen(plus(spec, {"--shard", std::to_string(i) + "/3"}), t.w() / ("s" + std::to_string(i))));
+  const std::vector<RunResult> r = run_ps_all(t, commands);
+  for (const RunResult& x : r) ExpectOk(x);
+  std::vector<std::string> csv, scen;
+  for (int i = 0; i < 3; ++i) {
+    const fs::path s = t.w() / ("s" + std::to_string(i));
+    for (const std::string& l : csv_rows(read_all(s / "features.csv"))) csv.push_back(l);
+    for (const std::string& l : csv_rows(read_all(s / "scenarios.csv"))) scen.push_back(l);
+  }
+  EXPECT_EQ(scen.size(), 500u);
+  EXPECT_TRUE(scen == csv_rows(read_all(t.w() / "whole" / "scenarios.csv")));
+  EXPECT_TRUE(csv == csv_rows(read_all(t.w() / "whole" / "features.csv")));
+}
+
+// A bad row far down a long list fails the run with its line before anything is written:
+// no half-written folder, whichever batch it would have come in.
+TEST(GenerateLists, ABadRowLateInALongListFailsBeforeAnyOutput) {
+  GenTempDir t;
+  const fs::path list = t.w() / "late.csv";
+  write_all(list, long_list(20000, 19990));
+  ExpectAllRefused(t, {{{"--scenarios", list.string(), "--format", "csv,npy", "--batch", "1000", "--quiet"},
+                        {at_line(list, 19992), "label", "maybe"},
+                        true}});
+}
+
+// A list-driven run killed mid-run resumes to the files of an uninterrupted one.
+TEST(GenerateLists, KillNineThenResumeMatchesAnUninterruptedRun) {
+  GenTempDir t;
+  const fs::path list = t.w() / "list.csv";
+  write_all(list, long_list(30000, -1));
+  const Args spec{"--scenarios", list.string(), "--block", "40", "--format", "csv,npy", "--batch", "8", "--quiet"};
+  const fs::path dir = t.w() / "killed", ref = t.w() / "ref";
+  const Started reference = start_ps(t, gen(with(spec, "--batch", "1000"), ref));
+  const Started victim = start_ps(t, gen(spec, dir));
+  const portalsim::test::Killed killed = portalsim::test::kill_mid_run(victim, dir, 1, 300);
+  ExpectOk(wait_for(reference));
+  ASSERT_TRUE(killed.result.signaled) << "the run ended before it could be killed\n" << describe_run(killed.result);
+  ASSERT_TRUE(killed.next > 0 && killed.next < 30000) << "the kill must come mid-run: next " << killed.next;
+  ExpectOk(run_ps(t, gen(plus(with(spec, "--batch", "1000"), {"--resume"}), dir)));
+  ExpectSameTree(dir, ref);
+}
+
 // A balanced rule that the up-front check finds possible but that is too rare to draw for an
 // index: the run fails when it reaches that index. The failure must leave no half-written
 // data set behind (the folder was new), or the next attempt is refused as "not empty".

@@ -14,6 +14,7 @@
 #include "plan/tolerance.h"
 #include "run_binary.h"
 #include "scene/generator.h"
+#include "scene/scenario_list.h"
 #include "support.h"
 
 namespace portalsim {

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <utility>
 
 #include "base/error.h"
 
@@ -111,13 +112,18 @@ void check_regular_file(const std::string& path, const std::string& what, size_t
     throw InputError(path + ": the " + what + " is larger than " + size_text(cap));
 }
 
-std::string read_file(const std::string& path, const std::string& what, size_t cap) {
+int open_regular_file(const std::string& path, const std::string& what) {
   // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it.
   Fd f{::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY)};
   if (f.fd < 0) throw InputError(path + ": cannot read the " + what + ": " + std::strerror(errno));
   struct stat st;
   if (::fstat(f.fd, &st) != 0) throw InputError(path + ": cannot read the " + what + ": " + std::strerror(errno));
   if (!S_ISREG(st.st_mode)) throw InputError(path + ": the " + what + " is " + kind_of(st.st_mode) + ", not a file");
+  return std::exchange(f.fd, -1);
+}
+
+std::string read_file(const std::string& path, const std::string& what, size_t cap) {
+  Fd f{open_regular_file(path, what)};
   std::string out;
   char buf[1 << 16];
   for (;;) {
@@ -143,6 +149,18 @@ std::string_view check_text(std::string_view text, const std::string& source, Bo
     throw InputError(where(source, line, column) + ": " + what);
   });
   return text;
+}
+
+void check_line(std::string_view line, const std::string& source, size_t lineno) {
+  // Most lines are printable ASCII: nothing to decode.
+  std::string_view body = line;
+  if (body.ends_with('\n')) body.remove_suffix(body.ends_with("\r\n") ? 2 : 1);
+  bool plain = body.size() < kMaxLineBytes;
+  for (const char c : body) plain &= (c >= 0x20 && c < 0x7F) || c == '\t';
+  if (plain) return;
+  check_bytes(line, [&](size_t l, size_t column, const std::string& what) {
+    throw InputError(where(source, lineno + l - 1, column) + ": " + what);
+  });
 }
 
 std::string read_text_file(const std::string& path, const std::string& what, Bom bom) {

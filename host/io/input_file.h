@@ -9,7 +9,7 @@
 
 namespace portalsim::io {
 
-inline constexpr size_t kMaxTextBytes = 64u << 20;    // catalogue, spec, scenario list, metal.txt
+inline constexpr size_t kMaxTextBytes = 64u << 20;    // catalogue, spec, metal.txt (a scenario list streams)
 inline constexpr size_t kMaxImageBytes = 256u << 20;  // one image file
 inline constexpr size_t kMaxLineBytes = 64u << 10;    // one line of any text file
 
@@ -20,6 +20,10 @@ std::string where(const std::string& source, size_t line, size_t column);
 // larger than `cap` bytes. `what` says what the file is for ("spec file").
 std::string read_file(const std::string& path, const std::string& what, size_t cap);
 
+// The file opened for reading (a descriptor the caller closes), or InputError as
+// read_file gives, for files read as a stream rather than whole.
+int open_regular_file(const std::string& path, const std::string& what);
+
 // Throws InputError unless `path` names a regular file of at most `cap` bytes.
 void check_regular_file(const std::string& path, const std::string& what, size_t cap);
 
@@ -29,6 +33,10 @@ enum class Bom { refuse, skip };
 // CRLF), no line over kMaxLineBytes. A UTF-8 BOM at the start is refused or skipped.
 // Returns the text without the BOM. Throws InputError naming source, line and column.
 std::string_view check_text(std::string_view text, const std::string& source, Bom bom);
+
+// check_text's checks for one line of a longer text, read a piece at a time: `line` (with
+// its line end, where it has one) is line `lineno` of `source`.
+void check_line(std::string_view line, const std::string& source, size_t lineno);
 
 // read_file, then check_text.
 std::string read_text_file(const std::string& path, const std::string& what, Bom bom);

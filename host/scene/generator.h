@@ -34,24 +34,4 @@ class Generator {
   std::optional<ThreatRule> rule_;
 };
 
-// What a listed scenario's row records of its randomised objects (the columns rotation1..13,
-// scale1..13, flip1..13 that scenarios.csv holds when they are on), to be checked
-// against the draws of the run that re-makes it; `where` is "file:line".
-struct ListedTransforms {
-  std::string where;
-  std::array<ObjectTransform, kRegions> t;  // identity where the region has no object
-};
-
-// An explicit list: CSV with a header naming subject, region1..region13 and optionally
-// label (yes/no/positive/negative/1/0), index (ignored: scenario i of the list is index i)
-// and the randomised objects' columns, all 39 or none; with them, `transforms` (if given)
-// gets one entry per scenario. Subjects are 1-based. Errors name file, line, column.
-std::vector<Scenario> read_scenario_file(const Catalogue& cat, const std::string& path,
-                                         std::vector<ListedTransforms>* transforms = nullptr);
-// The same from text already read; `path` names it in errors. Fields hold at most
-// kMaxFieldBytes.
-inline constexpr size_t kMaxFieldBytes = 256;
-std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view text, const std::string& path,
-                                          std::vector<ListedTransforms>* transforms = nullptr);
-
 }  // namespace portalsim

@@ -376,6 +376,9 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   if (first < res.begin || first > res.end)
     throw OutputError(checkpoint_path.string() + ": next: " + std::to_string(first) + " is not in this run's [" +
                       std::to_string(res.begin) + ", " + std::to_string(res.end) + "]; the run cannot be resumed");
+  // A list's rows are read as the run goes; read them all once first, so that a bad row
+  // fails the run before it writes anything.
+  source.check(first, res.end, threads);
   if (start.resuming) {
     res.positive = start.checkpoint["positive"].get<uint64_t>();
     res.negative = start.checkpoint["negative"].get<uint64_t>();

@@ -1,37 +1,23 @@
 #include "schedule/scenario_source.h"
 
+#include <exception>
+#include <mutex>
+
 #include "base/error.h"
 #include "base/parallel.h"
 
 namespace portalsim {
 
-ScenarioSource::ScenarioSource(const RunSpec& spec, const Catalogue& cat) {
+ScenarioSource::ScenarioSource(const RunSpec& spec, const Catalogue& cat) : model_(spec.settings().model) {
   if (!spec.rule.empty()) rule_.emplace(cat, spec.rule, spec.where("rule"));
   if (!spec.scenarios.empty()) {
-    std::vector<ListedTransforms> recorded;
-    listed_ = read_scenario_file(cat, spec.scenarios, &recorded);
-    total_ = listed_.size();
-    // Randomised objects are re-made from (seed, index, knobs), like every draw: a list
-    // that records them must be re-made with the seed and knobs that drew them.
-    const ModelSettings model = spec.settings().model;
-    for (size_t i = 0; i < recorded.size(); ++i)
-      for (int r = 0; r < kRegions; ++r)
-        if (listed_[i].objects[r] != kNoObject && object_transform(model, i, r) != recorded[i].t[r])
-          throw InputError(recorded[i].where + ": region" + std::to_string(r + 1) +
-                           ": its rotation, scale and flip are not what scenario " + std::to_string(i) +
-                           " of this run draws; re-make a list with the --seed, --rotate, --scale and --flip of "
-                           "the run that wrote it, from its first scenario");
+    list_ = std::make_shared<ScenarioListFile>(cat, spec.scenarios);
+    path_ = spec.scenarios;
+    total_ = list_->size();
   } else {
     generator_.emplace(cat, generator_spec(spec, cat), spec.seed);
     total_ = spec.count;
   }
-}
-
-Scenario ScenarioSource::operator()(uint64_t i) const {
-  if (generator_) return (*generator_)(i);
-  Scenario s = listed_[i];
-  if (s.label < 0) s.label = rule_ && (*rule_)(s) ? 1 : 0;
-  return s;
 }
 
 void ScenarioSource::fill(uint64_t at, size_t n, unsigned threads, SceneBatch& b) const {
@@ -39,14 +25,53 @@ void ScenarioSource::fill(uint64_t at, size_t n, unsigned threads, SceneBatch& b
   b.subject.resize(n);
   b.objects.resize(n * kRegions);
   b.label.resize(n);
+  std::vector<Scenario> listed;
+  std::vector<ListedTransforms> recorded;
+  if (list_) {
+    listed.resize(n);
+    if (list_->has_transforms()) recorded.resize(n);
+    list_->read(at, n, threads, listed.data(), recorded.empty() ? nullptr : recorded.data());
+  }
+  // Each part stops at its first bad row; the first of those is reported.
+  std::mutex m;
+  size_t bad_row = n;
+  std::exception_ptr bad;
   parallel_for(n, n >= 1024 ? threads : 1, [&](size_t lo, size_t hi) {
     for (size_t i = lo; i < hi; ++i) {
-      const Scenario s = (*this)(at + i);
+      Scenario s;
+      if (generator_) {
+        s = (*generator_)(at + i);
+      } else {
+        s = listed[i];
+        if (s.label < 0) s.label = rule_ && (*rule_)(s) ? 1 : 0;
+        // Randomised objects are re-made from (seed, index, knobs), like every draw: a list
+        // that records them must be re-made with the seed and knobs that drew them.
+        if (!recorded.empty())
+          for (int r = 0; r < kRegions; ++r)
+            if (s.objects[r] != kNoObject && object_transform(model_, at + i, r) != recorded[i].t[r]) {
+              std::lock_guard<std::mutex> lock(m);
+              if (i < bad_row)
+                bad_row = i, bad = std::make_exception_ptr(InputError(
+                                 path_ + ":" + std::to_string(recorded[i].line) + ": region" + std::to_string(r + 1) +
+                                 ": its rotation, scale and flip are not what scenario " + std::to_string(at + i) +
+                                 " of this run draws; re-make a list with the --seed, --rotate, --scale and --flip of "
+                                 "the run that wrote it, from its first scenario"));
+              return;
+            }
+      }
       b.subject[i] = static_cast<uint8_t>(s.subject);
       std::copy(s.objects.begin(), s.objects.end(), b.objects.begin() + i * kRegions);
       b.label[i] = static_cast<uint8_t>(s.label);
     }
   });
+  if (bad) std::rethrow_exception(bad);
+}
+
+void ScenarioSource::check(uint64_t begin, uint64_t end, unsigned threads) const {
+  if (!list_) return;
+  SceneBatch b;
+  constexpr uint64_t kRows = 1u << 16;
+  for (uint64_t at = begin; at < end; at += kRows) fill(at, static_cast<size_t>(std::min(kRows, end - at)), threads, b);
 }
 
 Plan run_plan(const RunSpec& spec, const Catalogue& cat) {

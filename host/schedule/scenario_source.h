@@ -2,10 +2,12 @@
 // rows. The pipeline writes them to files; Python (python/) hands the same rows over as
 // NumPy arrays, so both give the same bytes for scenario i.
 #pragma once
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "backend/backend.h"
+#include "scene/scenario_list.h"
 #include "schedule/run_spec.h"
 #include "sink/sinks.h"
 #include "sink/tensors.h"
@@ -20,13 +22,19 @@ class ScenarioSource {
   uint64_t total() const { return total_; }
   bool listed() const { return !generator_; }
   const ThreatRule* rule() const { return rule_ ? &*rule_ : nullptr; }
-  Scenario operator()(uint64_t i) const;
-  // Scenarios [at, at + n) into `b` (on `threads` threads).
+  // Scenarios [at, at + n) into `b` (on `threads` threads). A listed source reads them from
+  // its file, and a bad row throws InputError naming its line.
   void fill(uint64_t at, size_t n, unsigned threads, SceneBatch& b) const;
+  // Reads and checks scenarios [begin, end) of a list, keeping none (a generator has nothing
+  // to check): a run checks its range before it writes anything, so a bad row far down a
+  // long list leaves no output behind.
+  void check(uint64_t begin, uint64_t end, unsigned threads) const;
 
  private:
   std::optional<Generator> generator_;
-  std::vector<Scenario> listed_;
+  std::shared_ptr<ScenarioListFile> list_;  // read as a stream: memory stays flat
+  std::string path_;
+  ModelSettings model_;  // the knobs a list's recorded transforms are checked against
   std::optional<ThreatRule> rule_;
   uint64_t total_ = 0;
 };

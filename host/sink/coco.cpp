@@ -126,7 +126,7 @@ class CocoSink final : public Sink {
   std::optional<FileState> final_;
 
   static void append(AppendFile& f, std::vector<std::string>& chunks) {
-    bool first = f.state().bytes == 0;
+    bool first = f.size() == 0;
     for (std::string& c : chunks) {
       if (c.empty()) continue;
       f.append(first ? std::string_view(c).substr(1) : std::string_view(c));

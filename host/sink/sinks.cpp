@@ -77,16 +77,25 @@ class NpySink final : public Sink {
                         names + "class\n");
     }
   }
+  // Each row is assembled where the file is written from (AppendFile::room), but for a row
+  // that would straddle its buffers.
   void write(const SceneBatch& scenes, const BatchOutput& out) override {
     const size_t n = scenes.size(), F = static_cast<size_t>(out.layout.image_features());
-    buf_.resize(n * columns_);
+    const size_t row_bytes = columns_ * sizeof(float);
+    buf_.resize(columns_);
     for (size_t i = 0; i < n; ++i) {
-      float* row = buf_.data() + i * columns_;
+      const std::span<char> room = file_.room();
+      char* row = room.size() >= row_bytes ? room.data() : reinterpret_cast<char*>(buf_.data());
       std::memcpy(row, out.features_of(i), F * sizeof(float));
-      for (int z = 0; z < kZones; ++z) row[F + z] = out.metal_of(i)[z];
-      row[F + kZones] = scenes.label[i] == 1 ? 1.0f : 0.0f;
+      std::array<float, kZones + 1> tail;  // the metal zones, then the class
+      for (int z = 0; z < kZones; ++z) tail[z] = out.metal_of(i)[z];
+      tail[kZones] = scenes.label[i] == 1 ? 1.0f : 0.0f;
+      std::memcpy(row + F * sizeof(float), tail.data(), sizeof tail);
+      if (row == room.data())
+        file_.commit(row_bytes);
+      else
+        file_.append(row, row_bytes);
     }
-    file_.append(buf_.data(), buf_.size() * sizeof(float));
   }
   std::vector<FileState> files() const override { return {file_.state()}; }
   void finish() override { file_.finish(); }

@@ -13,6 +13,7 @@
 #include "cli/validate_tables.h"
 #include "scene/catalogue.h"
 #include "scene/generator.h"
+#include "scene/scenario_list.h"
 #include "schedule/run_spec.h"
 #include "schedule/run_state.h"
 #include "serve/request.h"
