@@ -27,12 +27,17 @@ void write_scenario_folder(const PathOf& path_of, const BatchOutput& b, size_t i
   for (const ViewImages& v : b.views) {
     if (v.empty()) continue;
     const std::string path = path_of(v.name + ext);
-    if (v.palette)
-      write_image(path, colourise(gray(v.of(i), v.width, v.height), palette), opt.png_level);
-    else if (opt.image_format == "png")
+    if (opt.image_format != "png") {
+      const Image img = gray(v.of(i), v.width, v.height);
+      write_image(path, v.palette ? colourise(img, palette) : img, opt.png_level);
+    } else if (v.palette) {
+      thread_local std::vector<uint8_t> rgb;
+      rgb.resize(3 * v.pixels_per_image());
+      colourise(v.of(i), v.pixels_per_image(), palette, rgb.data());
+      write_png(path, rgb.data(), v.width, v.height, 3, opt.png_level);
+    } else {
       write_png(path, v.of(i), v.width, v.height, 1, opt.png_level);
-    else
-      write_image(path, gray(v.of(i), v.width, v.height), opt.png_level);
+    }
   }
   // Annotations: the instance mask (region numbers, always PNG) and the YOLO boxes.
   for (size_t k = 0; k < b.annotations.size(); ++k) {
