@@ -54,7 +54,12 @@ TEST(PngWriter, OpenImageIOReadsBackTheSamePixelsAtEveryLevel) {
   for (const Case& k : kCases)
     for (int level = 0; level <= portalsim::kMaxPngLevel; ++level) {
       SCOPED_TRACE(name_of(k, level));
-      const Image img = test_image(k.w, k.h, k.c, 3);
+      Image img = test_image(k.w, k.h, k.c, 3);
+      // OpenImageIO's reader multiplies colour by alpha (its default for PNG): an opaque
+      // alpha keeps the colour as written. PIL's test below checks any alpha exactly.
+      if (k.c == 2 || k.c == 4)
+        for (size_t p = static_cast<size_t>(k.c) - 1; p < img.pixels.size(); p += static_cast<size_t>(k.c))
+          img.pixels[p] = 255;
       const std::string path = (t.w() / (name_of(k, level) + ".png")).string();
       portalsim::write_image(path, img, level);
       const Image back = portalsim::read_image(path, "test");
