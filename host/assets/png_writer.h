@@ -1,8 +1,8 @@
 // PNG files written in bulk: 8-bit gray, gray+alpha, RGB or RGBA, no row filter, the image data deflated by
 // ISA-L (Debian libisal). Chosen over OpenImageIO's writer (libpng and zlib), libspng
 // and libdeflate by measurement on portalsim's own images (docs/dev/speed-history.md,
-// "PNG folders"): its fastest level takes a third of libdeflate's level 1 CPU time and a
-// sixth of OpenImageIO's, for files a quarter larger than OpenImageIO's.
+// "PNG folders"): per scenario its fastest level takes a third of libdeflate's level-1
+// CPU time and a sixth of OpenImageIO's, for files 28% larger than OpenImageIO's.
 #pragma once
 #include <cstdint>
 #include <string>
