@@ -26,6 +26,7 @@
 #include <thread>
 #include <vector>
 
+#include "assets/image_io.h"
 #include "run_binary.h"
 
 namespace {
@@ -568,8 +569,9 @@ TEST(GenerateDeterminism, FeaturesDoNotDependOnBatchOrThreads) {
 
 TEST(GenerateDeterminism, ImagesAndNoisyFeaturesDoNotDependOnBatchOrThreads) {
   GenTempDir t;
-  const Args spec{"--count",       "20", "--seed",        "11", "--what",   "both",    "--rule", "gun",
-                  "--pixel-noise", "2",  "--metal-noise", "3",  "--format", "csv,npy", "--quiet"};
+  // With annotations: every file of an image folder, masks and YOLO boxes too.
+  const Args spec{"--count",       "20", "--seed",        "11", "--what",   "both",    "--rule",        "gun",
+                  "--pixel-noise", "2",  "--metal-noise", "3",  "--format", "csv,npy", "--annotations", "--quiet"};
   const std::vector<Args> variants{
       {"--batch", "1", "--threads", "1"}, {"--batch", "7", "--threads", "2"}, {"--batch", "1000", "--threads", "2"}};
   std::vector<Args> commands;
@@ -586,7 +588,9 @@ TEST(GenerateDeterminism, ImagesAndNoisyFeaturesDoNotDependOnBatchOrThreads) {
   }
   EXPECT_EQ(entries_of(v0 / "images"), folders);
   EXPECT_EQ(entries_of(v0 / "images" / "00000013"),
-            (std::vector<std::string>{"features.csv", "ir.png", "lower.png", "metal.txt", "threat.txt", "upper.png"}));
+            (std::vector<std::string>{"features.csv", "ir.png", "ir.txt", "lower.png", "lower.txt", "mask_ir.png",
+                                      "mask_lower.png", "mask_upper.png", "metal.txt", "threat.txt", "upper.png",
+                                      "upper.txt"}));
   for (size_t i = 1; i < variants.size(); ++i) {
     SCOPED_TRACE(r[i].command);
     ExpectSameTree(v0, t.w() / (std::string("v") + std::to_string(i)));
@@ -666,7 +670,7 @@ TEST(GenerateShards, RowsConcatenateToTheWholeRun) {
 
 TEST(GenerateShards, ImageFoldersSplitByIndex) {
   GenTempDir t;
-  const Args spec{"--count", "10", "--seed", "4", "--what", "both", "--format", "csv", "--quiet"};
+  const Args spec{"--count", "10", "--seed", "4", "--what", "both", "--format", "csv", "--annotations", "--quiet"};
   std::vector<Args> commands{gen(spec, t.w() / "whole")};
   for (int i = 0; i < 3; ++i)
     commands.push_back(
@@ -684,6 +688,48 @@ TEST(GenerateShards, ImageFoldersSplitByIndex) {
       ExpectSameTree(s / "images" / folder, t.w() / "whole" / "images" / folder);
     }
   }
+}
+
+// --png-level changes the PNGs' bytes, never their pixels, and is part of the run's identity.
+TEST(GeneratePngLevel, ChangesTheBytesNotThePixelsAndIsPartOfTheIdentity) {
+  GenTempDir t;
+  const Args spec{"--count", "6", "--seed", "4", "--what", "images", "--annotations", "--quiet"};
+  const std::vector<std::string> levels{"", "0", "9"};  // the default (1), stored, the smallest
+  std::vector<Args> commands;
+  for (size_t i = 0; i < levels.size(); ++i)
+    commands.push_back(gen(levels[i].empty() ? spec : plus(spec, {"--png-level", levels[i]}),
+                           t.w() / (std::string("l") + std::to_string(i))));
+  for (const RunResult& r : run_ps_all(t, commands)) ExpectOk(r);
+  const fs::path l1 = t.w() / "l0", l0 = t.w() / "l1", l9 = t.w() / "l2";
+  const std::vector<std::string> files = files_under(l1 / "images");
+  ASSERT_EQ(files.size(), 6u * 11);
+  EXPECT_EQ(files_under(l0 / "images"), files);
+  EXPECT_EQ(files_under(l9 / "images"), files);
+  uint64_t bytes1 = 0, bytes0 = 0;
+  for (const std::string& f : files) {
+    SCOPED_TRACE(f);
+    if (fs::path(f).extension() != ".png") {
+      EXPECT_EQ(read_all(l0 / "images" / f), read_all(l1 / "images" / f));
+      continue;
+    }
+    const portalsim::Image a = portalsim::read_image((l1 / "images" / f).string(), "default"),
+                           b = portalsim::read_image((l0 / "images" / f).string(), "level 0"),
+                           c = portalsim::read_image((l9 / "images" / f).string(), "level 9");
+    EXPECT_TRUE(a.pixels == b.pixels && a.pixels == c.pixels && a.channels == c.channels);
+    bytes1 += fs::file_size(l1 / "images" / f);
+    bytes0 += fs::file_size(l0 / "images" / f);
+    if (f.find("upper.png") != std::string::npos && f.find("mask") == std::string::npos) {
+      EXPECT_NE(read_all(l1 / "images" / f), read_all(l9 / "images" / f));
+    }
+  }
+  EXPECT_GT(bytes0, 2 * bytes1) << "level 0 stores, level 1 compresses";
+  EXPECT_EQ(read_json(l1 / "manifest.json")["spec"]["png_level"], 1);
+  EXPECT_EQ(read_json(l0 / "manifest.json")["spec"]["png_level"], 0);
+  EXPECT_EQ(read_json(l9 / "manifest.json")["spec"]["png_level"], 9);
+  // A finished run at level 1 is not "complete" for a command asking level 9.
+  const RunResult r = run_ps(t, gen(plus(spec, {"--png-level", "9", "--resume"}), l1));
+  EXPECT_TRUE(r.exited && r.status != 0) << describe_run(r);
+  EXPECT_TRUE(has(r.err, "png_level")) << describe_run(r);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1010,6 +1056,11 @@ TEST(GenerateBadSpec, OptionErrorsNameTheOption) {
           {{"--count", "5", "--subjects", "0"}, {"subjects", "0"}},
           {{"--count", "0"}, {"count"}},
           {{"--count", "5", "--rule", "gun|laser"}, {"rule", "laser"}},
+          {{"--count", "5", "--what", "images", "--png-level", "10"}, {"--png-level", "\"10\"", "between 0 and 9"}},
+          {{"--count", "5", "--what", "images", "--png-level", "x"}, {"--png-level", "\"x\""}},
+          {{"--count", "5", "--png-level", "3"}, {"--png-level", "image folders"}},
+          {{"--count", "5", "--what", "images", "--format", "h5", "--png-level", "0"},
+           {"--png-level", "image folders"}},
       });
 }
 
@@ -1027,6 +1078,8 @@ TEST(GenerateBadSpec, SpecValuesCheckedLaterStillNameFileAndLine) {
       {"count = 10\nwhat = \"pictures\"\n", 2, {"what", "pictures"}},
       {"count = 10\nformat = \"xls\"\n", 2, {"format", "xls"}},
       {"count = 10\nsubjects = [9]\n", 2, {"subjects", "9"}},
+      {"count = 10\nwhat = \"images\"\npng_level = 12\n", 3, {"png_level", "12"}},
+      {"count = 10\npng_level = 3\n", 2, {"png_level", "image folders"}},
   };
   std::vector<Refusal> cases;
   for (size_t i = 0; i < specs.size(); ++i) {

@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 packages=(build-essential cmake ninja-build pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers
   libopenimageio-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
-  libxxhash-dev libgtest-dev libbenchmark-dev libcpp-httplib-dev libhdf5-dev libboost-dev
+  libxxhash-dev libisal-dev libgtest-dev libbenchmark-dev libcpp-httplib-dev libhdf5-dev libboost-dev
   python3 python3-dev pybind11-dev python3-pybind11 python3-numpy python3-h5py python3-torch python3-pytest python3-pil)
 bash tools/apt-install.sh "${packages[@]}"
 

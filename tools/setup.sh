@@ -9,7 +9,7 @@ packages=(build-essential cmake ninja-build pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
   libopenimageio-dev openimageio-tools
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
-  libxxhash-dev libgtest-dev libbenchmark-dev libcpp-httplib-dev libhdf5-dev libboost-dev
+  libxxhash-dev libisal-dev libgtest-dev libbenchmark-dev libcpp-httplib-dev libhdf5-dev libboost-dev
   openmpi-bin libopenmpi-dev slurm-wlm munge
   weka default-jdk-headless python3 python3-matplotlib python3-scipy python3-h5py python3-numpy python3-torch
   python3-pyld python3-yaml

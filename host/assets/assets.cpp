@@ -1,6 +1,7 @@
 #include "assets/assets.h"
 
 #include <cmath>
+#include <cstring>
 
 #include "assets/image_io.h"
 #include "assets/procedural.h"
@@ -59,9 +60,17 @@ Image to_temperature(const Image& img, const Palette& palette, bool keep_alpha) 
 Image colourise(const Image& temperature, const Palette& palette) {
   Image out(temperature.width, temperature.height, 3);
   const size_t n = static_cast<size_t>(temperature.width) * temperature.height;
+  if (temperature.channels == 1) {
+    colourise(temperature.pixels.data(), n, palette, out.pixels.data());
+    return out;
+  }
   for (size_t i = 0; i < n; ++i)
     for (int c = 0; c < 3; ++c) out.pixels[i * 3 + c] = palette[temperature.pixels[i * temperature.channels]][c];
   return out;
+}
+
+void colourise(const uint8_t* index, size_t n, const Palette& palette, uint8_t* rgb) {
+  for (size_t i = 0; i < n; ++i) std::memcpy(rgb + 3 * i, palette[index[i]].data(), 3);
 }
 
 AssetSet build_assets(const Catalogue& cat) {

@@ -32,5 +32,7 @@ AssetSet build_assets(const Catalogue& cat);
 Image to_gray(const Image& img, bool keep_alpha);
 Image to_temperature(const Image& img, const Palette& palette, bool keep_alpha);
 Image colourise(const Image& temperature, const Palette& palette);
+// The same for `n` one-channel indices into `rgb` (3n bytes).
+void colourise(const uint8_t* index, size_t n, const Palette& palette, uint8_t* rgb);
 
 }  // namespace portalsim

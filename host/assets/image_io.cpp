@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <mutex>
 
+#include "assets/png_writer.h"
 #include "base/error.h"
 #include "io/input_file.h"
 
@@ -123,16 +124,19 @@ Image resize_image(const Image& img, int width, int height) {
   return out;
 }
 
-void write_image(const std::string& path, const Image& img, int jpeg_quality) {
+void write_image(const std::string& path, const Image& img, int png_level, int jpeg_quality) {
+  // PNG through portalsim's own writer (png_writer.h: several times faster for the many
+  // small files of image folders); every other format through OpenImageIO.
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".png" || ext == ".PNG") {
+    write_png(path, img.pixels.data(), img.width, img.height, img.channels, png_level);
+    return;
+  }
   // Failures here are the disk's or the folder's (full, read-only): output errors.
   auto out = OIIO::ImageOutput::create(path);
   if (!out) throw OutputError(path + ": cannot write image: " + OIIO::geterror());
   OIIO::ImageSpec spec = spec_of(img);
   spec.attribute("CompressionQuality", jpeg_quality);
-  // PNG: fast deflate, no row filter. Measured on 500 scenarios: 1.15 s of CPU against
-  // 5.5 s at OpenImageIO's default, for files 15% larger. Data sets are written in bulk.
-  spec.attribute("png:compressionLevel", 1);
-  spec.attribute("png:filter", 8);  // PNG_FILTER_NONE
   if (!out->open(path, spec)) throw OutputError(path + ": cannot write image: " + out->geterror());
   const bool ok = out->write_image(OIIO::TypeDesc::UINT8, img.pixels.data());
   const bool closed = out->close();

@@ -1,8 +1,9 @@
-// Reading and writing image files through OpenImageIO.
+// Reading and writing image files: OpenImageIO, and png_writer.h for PNG output.
 #pragma once
 #include <string>
 
 #include "assets/image.h"
+#include "assets/png_writer.h"
 
 namespace portalsim {
 
@@ -20,7 +21,8 @@ Image read_image(const std::string& path, const std::string& origin);
 // the size already matches.
 Image resize_image(const Image& img, int width, int height);
 
-// Writes by file extension (png, jpg, tif, ...). Throws OutputError on failure.
-void write_image(const std::string& path, const Image& img, int jpeg_quality = 95);
+// Writes by file extension (png, jpg, tif, ...): PNG through png_writer.h at
+// `png_level` (0..9), the rest through OpenImageIO. Throws OutputError on failure.
+void write_image(const std::string& path, const Image& img, int png_level = kDefaultPngLevel, int jpeg_quality = 95);
 
 }  // namespace portalsim

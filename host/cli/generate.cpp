@@ -22,7 +22,7 @@ extern "C" void on_signal(int) { g_stop = true; }
 struct GenerateOptions {
   CommonOptions common;
   RunSpec spec;
-  std::string count, out, spec_file, objects, pool, subjects, formats, shard;
+  std::string count, out, spec_file, objects, pool, subjects, formats, shard, png_level;
   std::map<std::string, std::string> knobs;
   long long batch = 0;
   unsigned threads = 0;
@@ -70,6 +70,12 @@ RunSpec build_spec(GenerateOptions& o) {
   if (given("--what")) spec.what = o.spec.what;
   if (given("--format")) spec.formats = split_list(o.formats);
   if (given("--image-format")) spec.image_format = o.spec.image_format;
+  if (given("--png-level")) {
+    const uint64_t level = io::parse_u64(o.png_level, "--png-level");
+    if (level > kMaxPngLevel)
+      throw InputError("--png-level: \"" + o.png_level + "\" is not between 0 and " + std::to_string(kMaxPngLevel));
+    spec.png_level = static_cast<int>(level);
+  }
   if (given("--compress")) spec.compress = o.spec.compress;
   if (given("--annotations")) spec.annotations = o.spec.annotations;
   if (given("--scenarios")) spec.scenarios = o.spec.scenarios;
@@ -168,6 +174,8 @@ void add_generate_options(CLI::App* sub, GenerateOptions* o) {
   sub->add_flag("--annotations", o->spec.annotations,
                 "per-object boxes and instance masks: annotations.json (COCO), YOLO .txt and mask images");
   sub->add_option("--image-format", o->spec.image_format, "png or jpg (default png)");
+  sub->add_option("--png-level", o->png_level,
+                  "image folders' PNG compression, 0 (none) to 9 (smallest); default 1, the fastest that compresses");
   sub->add_option("--scenarios", o->spec.scenarios, "explicit scenario list (CSV: subject, region1..13, label)");
   add_knob_options(*sub, o->spec.tier, o->knobs);
   sub->add_option("--batch", o->batch, "scenarios per kernel launch (default: about 16 MiB of outputs)");

@@ -545,6 +545,7 @@ std::string regenerate_command(const json& m) {
   if (source != kBuiltInCatalogue) cmd += " --catalogue " + shell_quote(source);
   for (const auto& [key, value] : s.items()) {
     if (key == "scenarios_count" || (base.contains(key) && base[key] == value)) continue;
+    if (key == "png_level" && value == kDefaultPngLevel) continue;      // absent from `base`: it has no image folders
     if (key == "count" && !s.value("scenarios", "").empty()) continue;  // the list's length
     std::string flag = "--" + key;
     std::replace(flag.begin(), flag.end(), '_', '-');

@@ -385,6 +385,7 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   }
   SinkContext ctx = plan_sink_context(plan, cat, assets, threads, spec.image_format);
   ctx.dir = dir;
+  ctx.png_level = spec.png_level;
   ctx.rows = res.end - res.begin;
   ctx.done = first - res.begin;
   std::vector<std::unique_ptr<Sink>> sinks = open_sinks(spec, plan, ctx, source.rule(), identity, start, first);

@@ -25,6 +25,9 @@ nlohmann::json RunSpec::to_json() const {
   j["image_format"] = image_format;
   j["compress"] = compress;
   if (annotations) j["annotations"] = true;  // absent when off: older runs keep their identity
+  // The PNGs' bytes depend on the level (their pixels do not): a resume or a shard at
+  // another level would leave a folder whose files differ from one run's.
+  if (image_folders()) j["png_level"] = png_level;
   // The fidelity changes the numbers (within its tier's tolerance), so it is part of
   // the identity; knobs that never change a bit (pooling) are not.
   const Plan p = settings();
@@ -64,6 +67,13 @@ void RunSpec::validate() const {
   if (annotations && !wants_images()) throw InputError(where("annotations") + ": needs images (--what images or both)");
   if (image_format != "png" && image_format != "jpg")
     throw InputError(where("image_format") + ": \"" + image_format + "\" is not png or jpg");
+  if (png_level < 0 || png_level > kMaxPngLevel)
+    throw InputError(where("png_level") + ": " + std::to_string(png_level) + " is not between 0 and " +
+                     std::to_string(kMaxPngLevel));
+  if (png_level != kDefaultPngLevel && !image_folders())
+    throw InputError(where("png_level") +
+                     ": only applies to image folders (--what images or both, without h5 or npy "
+                     "image tensors)");
   if (balance && rule.empty()) throw InputError(where("balance") + ": needs a threat rule (--rule)");
   (void)settings();  // checks the tier and knobs
 }
@@ -197,6 +207,8 @@ void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
       spec.formats = strings(node, key);
     } else if (key == "image_format") {
       spec.image_format = string(node, key);
+    } else if (key == "png_level") {
+      spec.png_level = static_cast<int>(integer(node, key, 0, kMaxPngLevel));
     } else if (key == "compress") {
       spec.compress = boolean(node, key);
     } else if (key == "annotations") {
@@ -210,7 +222,8 @@ void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
       spec.set_knob_text(key, knob_value(*knob, node, at(node, key)), at(node, key));
     } else {
       std::string known =
-          "count, seed, rule, pool, objects, subjects, balance, what, format, image_format, compress, annotations, "
+          "count, seed, rule, pool, objects, subjects, balance, what, format, image_format, png_level, compress, "
+          "annotations, "
           "scenarios, tier";
       for (const Knob& k : portalsim::knobs()) known += ", " + k.key;
       throw InputError(at(node, key) + ": unknown key (" + known + ")");

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "assets/png_writer.h"
 #include "plan/plan.h"
 #include "scene/generator.h"
 
@@ -25,6 +26,7 @@ struct RunSpec {
   std::string what = "features";  // features | images | both
   std::vector<std::string> formats{"arff"};
   std::string image_format = "png";
+  int png_level = kDefaultPngLevel;          // deflate level of image folders' PNGs (png_writer.h)
   bool compress = false;                     // gzip data.h5's datasets (--format h5)
   bool annotations = false;                  // boxes and masks: annotations.json, YOLO, mask images
   std::string tier = "standard";             // fast | standard | exact; fidelity knobs override it
@@ -50,6 +52,8 @@ struct RunSpec {
   // (format npy with --what images; with --what both, npy is the feature table).
   bool npy_image_tensors() const { return what == "images" && has_format("npy"); }
   bool image_tensors() const { return wants_images() && (has_format("h5") || npy_image_tensors()); }
+  // Images go to images/<index>/ folders.
+  bool image_folders() const { return wants_images() && !image_tensors(); }
   nlohmann::json to_json() const;
   // Sets a knob (checked at once; throws InputError naming `where`).
   void set_knob_text(const std::string& key, const std::string& text, const std::string& where);
@@ -58,7 +62,7 @@ struct RunSpec {
 };
 
 // Reads a TOML spec (keys as the long options: count, seed, rule, pool, objects,
-// subjects, balance, what, format, image_format, scenarios, tier and every knob's key)
+// subjects, balance, what, format, image_format, png_level, scenarios, tier and every knob's key)
 // over `spec`. Errors name the file, line and key.
 void read_spec_file(const std::string& path, RunSpec& spec);
 // The same from text already read; `path` names it in errors.

@@ -6,12 +6,14 @@
 #include <string>
 
 #include "assets/assets.h"
+#include "assets/png_writer.h"
 #include "backend/backend.h"
 
 namespace portalsim {
 
 struct FolderOptions {
   std::string image_format = "png";  // png or jpg
+  int png_level = kDefaultPngLevel;  // the PNGs' deflate level (png_writer.h); masks are PNG with jpg too
 };
 
 // Where each file goes: a staged folder's path(), or a plain folder being built under a

@@ -187,20 +187,29 @@ class ImageSink final : public Sink {
     }
   }
   void write(const SceneBatch& scenes, const BatchOutput& out) override {
+    // Each scenario's folder is written under <name>.tmp and renamed whole. Encoding is
+    // nearly all of the work, on every thread (ctx.threads), beside the kernels computing
+    // the next batch (pipeline.cpp).
+    const FolderOptions opt{ctx_.image_format, ctx_.png_level};
     parallel_for(scenes.size(), ctx_.threads, [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
         const std::string name = image_folder_name(scenes.first_index + i);
-        const fs::path tmp = fs::path(root_) / (name + ".tmp");
+        const std::string tmp = root_ + "/" + name + ".tmp", final_path = root_ + "/" + name;
         std::error_code ec;
-        fs::remove_all(tmp, ec);
-        fs::create_directory(tmp, ec);
-        if (ec) throw OutputError(tmp.string() + ": cannot create: " + ec.message());
-        write_scenario_folder([&](const std::string& f) { return (tmp / f).string(); }, out, i, scenes.label[i] == 1,
-                              ctx_.palette, FolderOptions{ctx_.image_format});
-        const fs::path final_path = fs::path(root_) / name;
-        fs::remove_all(final_path, ec);
+        // Left over only by a failed batch of this run (resume removed older ones).
+        if (!fs::create_directory(tmp, ec) && !ec) {
+          fs::remove_all(tmp, ec);
+          fs::create_directory(tmp, ec);
+        }
+        if (ec) throw OutputError(tmp + ": cannot create: " + ec.message());
+        write_scenario_folder([&](const std::string& f) { return tmp + "/" + f; }, out, i, scenes.label[i] == 1,
+                              ctx_.palette, opt);
         fs::rename(tmp, final_path, ec);
-        if (ec) throw OutputError(final_path.string() + ": cannot move into place: " + ec.message());
+        if (ec) {  // a folder of that name is there already (a retried batch): replace it
+          fs::remove_all(final_path, ec);
+          fs::rename(tmp, final_path, ec);
+        }
+        if (ec) throw OutputError(final_path + ": cannot move into place: " + ec.message());
       }
     });
   }

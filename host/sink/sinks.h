@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "assets/png_writer.h"
 #include "assets/procedural.h"
 #include "backend/backend.h"
 #include "sink/append_file.h"
@@ -35,6 +36,7 @@ struct SinkContext {
   unsigned threads = 1;
   ModelSettings model;  // the model's knobs (scenarios.csv records each object's randomised transform)
   std::string image_format = "png";
+  int png_level = kDefaultPngLevel;            // image folders' PNGs (png_writer.h)
   Palette palette = procedural::ir_palette();  // the IR index as RGB (Plan::palette)
 };
 

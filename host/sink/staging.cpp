@@ -4,9 +4,9 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include "base/error.h"
+#include "io/output_file.h"
 #include "sink/output_folder.h"
 
 namespace portalsim {
@@ -69,17 +69,7 @@ void StagedFolder::commit() {
 
 void write_text_atomic(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw OutputError(path + ": cannot open for writing");
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw OutputError(path + ": write failed (disk full?)");
-    }
-  }
+  io::write_file(tmp, text);
   std::error_code ec;
   fs::rename(tmp, path, ec);
   if (ec) {
