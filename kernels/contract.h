@@ -30,6 +30,13 @@
 #define PS_MR_COL 0
 #define PS_MR_ROW 1
 #define PS_MR_LEN 2
+/* Each object is PS_METAL_SEGMENTS equal dipoles at the midpoints of equal segments of its
+ * drawn long side (docs/model/metal.md). Record of one variant, doubles: its polarizability
+ * tensor (row-major 3x3, cm^3), then its long side's x and z (metres). */
+#define PS_METAL_SEGMENTS 5
+#define PS_MV_LONG_X 9
+#define PS_MV_LONG_Z 10
+#define PS_MV_LEN 11
 
 /* Random streams of the counter generator: each kind of draw has its own, so adding one
  * never shifts another. element = the index within the stream named beside it. */

@@ -49,13 +49,20 @@ kernel void metal_physics(global const double* zone_rec, global const double* re
     global const double* zr = zone_rec + z * PS_MZ_LEN;
     double signal = 0.0;
     for (int o = 0; o < count; ++o) {
-      const double3 ht = metal_dipole(zr[PS_MZ_TX_M], zr[PS_MZ_TX_X], zr[PS_MZ_TX_Z], px[o], pz[o]);
-      const double3 hr = metal_dipole(zr[PS_MZ_RX_M], zr[PS_MZ_RX_X], zr[PS_MZ_RX_Z], px[o], pz[o]);
-      global const double* M = tensors + (size_t)variant[o] * 9;
-      const double v0 = M[0] * ht.x + M[1] * ht.y + M[2] * ht.z;
-      const double v1 = M[3] * ht.x + M[4] * ht.y + M[5] * ht.z;
-      const double v2 = M[6] * ht.x + M[7] * ht.y + M[8] * ht.z;
-      signal += hr.x * v0 + hr.y * v1 + hr.z * v2;
+      // The object's PS_METAL_SEGMENTS dipoles along its long side, summed as the reference.
+      global const double* M = tensors + (size_t)variant[o] * PS_MV_LEN;
+      double sum = 0.0;
+      for (int k = 0; k < PS_METAL_SEGMENTS; ++k) {
+        const double f = ((double)k + 0.5) / PS_METAL_SEGMENTS - 0.5;
+        const double qx = px[o] + f * M[PS_MV_LONG_X], qz = pz[o] + f * M[PS_MV_LONG_Z];
+        const double3 ht = metal_dipole(zr[PS_MZ_TX_M], zr[PS_MZ_TX_X], zr[PS_MZ_TX_Z], qx, qz);
+        const double3 hr = metal_dipole(zr[PS_MZ_RX_M], zr[PS_MZ_RX_X], zr[PS_MZ_RX_Z], qx, qz);
+        const double v0 = M[0] * ht.x + M[1] * ht.y + M[2] * ht.z;
+        const double v1 = M[3] * ht.x + M[4] * ht.y + M[5] * ht.z;
+        const double v2 = M[6] * ht.x + M[7] * ht.y + M[8] * ht.z;
+        sum += hr.x * v0 + hr.y * v1 + hr.z * v2;
+      }
+      signal += sum / PS_METAL_SEGMENTS;
     }
     const double t = zr[PS_MZ_GAIN] * fabs(signal);
     const int deduction = t < PS_METAL_MAX_DEDUCTION ? (int)floor(t + 0.5) : PS_METAL_MAX_DEDUCTION;

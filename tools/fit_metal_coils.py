@@ -22,6 +22,10 @@ The model (README, "Metal detector physics"; host/backend/reference/metal_physic
   drawing, z for "v"). The anisotropy is the object's metal_anisotropy (1: isotropic).
 - Object position: its region's rectangle centre in its MMW view; the two MMW views
   stacked span body_height (upper view on top), x centred on the view.
+- An object is SEGMENTS equal dipoles (M / SEGMENTS each) at the midpoints of equal
+  segments of its drawn long side (the sprite's longer side, in metres; x for a drawing
+  wider than tall, z otherwise, the "v" variant turned): the coils' fields change by a
+  factor of 2-3 over a 25 cm rod, which one point at its centre cannot follow.
 
 Fitted, by least squares: the 19 transmit and 19 receive heights, the 19 zone gains and
 the polarizabilities of trace, small, medium and large metal, to the thesis's three worked
@@ -54,6 +58,7 @@ SOFT = 0.05  # weight of a thesis-table cell against a worked example's zone
 PANEL_A_ZONES = 9
 MAX_NFEV = 400
 FIT_CATEGORIES = ["trace", "small", "medium", "large"]
+SEGMENTS = 5  # dipoles along an object's long side (kernels/contract.h PS_METAL_SEGMENTS)
 
 GUN = [193, 112, 75, 2, 1, 1, 96, 200, 200, 190, 196, 53, 53, 94, 64, 82, 53, 200, 200]
 PIPE = [197, 131, 108, 88, 95, 106, 192, 200, 200, 197, 199, 54, 54, 75, 44, 84, 137, 200, 200]
@@ -86,6 +91,19 @@ def anisotropy(cat, name):
     raise KeyError(name)
 
 
+def long_side(cat, name, variant=""):
+    """The vector (metres, x and z) along a drawing's longer side: an "h" or single drawing
+    as drawn, a "v" variant turned a quarter."""
+    scale = BODY_HEIGHT / (2.0 * cat["images"]["mmw_height"])
+    for o in cat["objects"]:
+        if o["name"] == name:
+            w, h = o["size"]
+            if variant == "v":
+                w, h = h, w
+            return (w * scale, 0.0) if w >= h else (0.0, h * scale)
+    raise KeyError(name)
+
+
 def tensor(m, a, axis):
     """3x3 polarizability, mean m, anisotropy a along axis 0 (x) or 2 (z)."""
     u = np.zeros(3)
@@ -103,7 +121,8 @@ def dipole(moment, coil, p):
 
 
 def zone_signals(tx_h, rx_h, objects):
-    """objects: list of (M, (x, z)). Returns the 19 summed signals."""
+    """objects: list of (M, (x, z)) or (M, (x, z), (lx, lz)), the last the long side that
+    its SEGMENTS dipoles share. Returns the 19 summed signals."""
     side = np.where(np.arange(19) < PANEL_A_ZONES, -1.0, 1.0)
     zero = np.zeros(19)
     tx = np.stack([side * SEPARATION / 2, zero, tx_h], axis=1)
@@ -111,9 +130,14 @@ def zone_signals(tx_h, rx_h, objects):
     mt = np.stack([-side * TX_MOMENT, zero, zero], axis=1)
     mr = np.stack([side * RX_MOMENT, zero, zero], axis=1)
     out = np.zeros(19)
-    for M, (x, h) in objects:
-        p = np.array([x, 0.0, h])
-        out += np.sum(dipole(mr, rx, p) * (dipole(mt, tx, p) @ M.T), axis=1)
+    for o in objects:
+        M, (x, h) = o[0], o[1]
+        lx, lz = o[2] if len(o) > 2 else (0.0, 0.0)
+        n = SEGMENTS if len(o) > 2 else 1
+        for k in range(n):
+            f = (k + 0.5) / n - 0.5
+            p = np.array([x + f * lx, 0.0, h + f * lz])
+            out += np.sum(dipole(mr, rx, p) * (dipole(mt, tx, p) @ M.T), axis=1) / n
     return out
 
 
@@ -136,12 +160,12 @@ class Problem:
         self.cat = cat
         self.pos = region_positions(cat)
         gun_a = anisotropy(cat, "gun")
-        # (list of (category, anisotropy, axis, region), thesis zones)
+        # (list of (category, anisotropy, axis, region, long side), thesis zones)
         examples = [
-            ([("heavy", gun_a, 0, 4)], GUN),
-            ([("large", anisotropy(cat, "iron-pipe"), 0, 3)], PIPE),
-            ([("small", anisotropy(cat, "mobile-phone"), 0, 3), ("trace", anisotropy(cat, "compact-disk"), 0, 7)],
-             PHONE_DISK),
+            ([("heavy", gun_a, 0, 4, long_side(cat, "gun", "h"))], GUN),
+            ([("large", anisotropy(cat, "iron-pipe"), 0, 3, long_side(cat, "iron-pipe"))], PIPE),
+            ([("small", anisotropy(cat, "mobile-phone"), 0, 3, long_side(cat, "mobile-phone")),
+              ("trace", anisotropy(cat, "compact-disk"), 0, 7, long_side(cat, "compact-disk"))], PHONE_DISK),
         ]
         self.examples = examples
         self.fitted = [i for i in range(3) if i != leave_out]
@@ -165,7 +189,7 @@ class Problem:
 
     def example_deductions(self, th, ex):
         tx_h, rx_h, gains, pol = self.unpack(th)
-        objs = [(tensor(pol[c], a, axis), self.pos[r]) for c, a, axis, r in ex]
+        objs = [(tensor(pol[c], a, axis), self.pos[r], side) for c, a, axis, r, side in ex]
         return gains * np.abs(zone_signals(tx_h, rx_h, objs))
 
     def example_zones(self, th, ex):

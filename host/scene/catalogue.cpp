@@ -214,6 +214,14 @@ std::array<double, 9> Catalogue::polarizability(int variant_id) const {
   return t;
 }
 
+std::array<double, 2> Catalogue::long_side(int variant_id) const {
+  const Object& o = object_of(variant_id);
+  const double scale = metal_physics.body_height / (2.0 * images.mmw_height);
+  const bool turned = variant(variant_id).code == "v";
+  const int w = turned ? o.height : o.width, h = turned ? o.width : o.height;
+  return w >= h ? std::array<double, 2>{w * scale, 0.0} : std::array<double, 2>{0.0, h * scale};
+}
+
 std::string normalise_name(std::string_view name) {
   std::string out;
   for (unsigned char c : name)

@@ -144,6 +144,10 @@ struct Catalogue {
   // across, y along the walk, z up): m (I + (a - 1) u u^T) 3 / (a + 2), mean m of its metal
   // category, anisotropy a along its long axis u (z for a "v" drawing, else x).
   std::array<double, 9> polarizability(int variant_id) const;
+  // A variant's long side as the coils see it, metres (x across, z up): the drawing's
+  // longer side (x where it is wider than tall, else z; a "v" drawing turned a quarter) at
+  // the metal model's scale, body_height over the two MMW views' height.
+  std::array<double, 2> long_side(int variant_id) const;
   // "gun:v" for display; "gun" where the object has one drawing.
   std::string variant_name(int variant_id) const;
   // Finds an object by name or alias, ignoring case and punctuation ("Iron Rod",

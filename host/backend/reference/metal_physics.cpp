@@ -46,8 +46,9 @@ std::vector<MetalObject> metal_objects(const Catalogue& cat, const AssetSet& ass
       const Placed& p = vs.placed[next++];
       const Rect rc = sensor.place(s.subject, r);
       const double col = rc.x + rc.w / 2.0, row = row_offset + rc.y + rc.h / 2.0;
+      const std::array<double, 2> side = cat.long_side(s.objects[r]);
       out.push_back({cat.polarizability(s.objects[r]), (col + p.dx - sensor.width / 2.0) * scale,
-                     mp.body_height - (row + p.dy) * scale});
+                     mp.body_height - (row + p.dy) * scale, side[0], side[1]});
     }
     row_offset += sensor.height;
   }
@@ -58,15 +59,20 @@ double zone_signal(const MetalPhysics& mp, int zone, const MetalObject& o) {
   const double side = zone < PS_METAL_PANEL_A_ZONES ? -1.0 : 1.0;
   const Vec tx{side * mp.panel_separation / 2.0, 0.0, mp.tx_height[zone]};
   const Vec rx{-side * mp.panel_separation / 2.0, 0.0, mp.rx_height[zone]};
-  const Vec p{o.x, 0.0, o.z};
-  // Both coils' moments point into the portal.
-  const Vec ht = dipole({-side * mp.tx_moment, 0.0, 0.0}, tx, p);
-  const Vec hr = dipole({side * mp.rx_moment, 0.0, 0.0}, rx, p);
   const std::array<double, 9>& M = o.tensor;
-  const double v0 = M[0] * ht.x + M[1] * ht.y + M[2] * ht.z;
-  const double v1 = M[3] * ht.x + M[4] * ht.y + M[5] * ht.z;
-  const double v2 = M[6] * ht.x + M[7] * ht.y + M[8] * ht.z;
-  return hr.x * v0 + hr.y * v1 + hr.z * v2;
+  double sum = 0;
+  for (int k = 0; k < PS_METAL_SEGMENTS; ++k) {
+    const double f = (k + 0.5) / PS_METAL_SEGMENTS - 0.5;  // along the long side, -1/2 .. 1/2
+    const Vec p{o.x + f * o.lx, 0.0, o.z + f * o.lz};
+    // Both coils' moments point into the portal.
+    const Vec ht = dipole({-side * mp.tx_moment, 0.0, 0.0}, tx, p);
+    const Vec hr = dipole({side * mp.rx_moment, 0.0, 0.0}, rx, p);
+    const double v0 = M[0] * ht.x + M[1] * ht.y + M[2] * ht.z;
+    const double v1 = M[3] * ht.x + M[4] * ht.y + M[5] * ht.z;
+    const double v2 = M[6] * ht.x + M[7] * ht.y + M[8] * ht.z;
+    sum += hr.x * v0 + hr.y * v1 + hr.z * v2;
+  }
+  return sum / PS_METAL_SEGMENTS;
 }
 
 void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m, const Scenario& s,

@@ -114,13 +114,16 @@ void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSett
 // x across the portal, z up; y = 0), its region's centre in the stacked MMW views, moved
 // with the subject's height as the composite's place (Sensor::place), plus the
 // composite's placement jitter.
+// It is PS_METAL_SEGMENTS dipoles of tensor / PS_METAL_SEGMENTS each, at the midpoints of
+// equal segments of its long side (lx, lz) about (x, z).
 struct MetalObject {
   std::array<double, 9> tensor;
   double x, z;
+  double lx = 0, lz = 0;
 };
 std::vector<MetalObject> metal_objects(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m,
                                        const Scenario& s, uint64_t index);
-// One object's H_R^T M H_T in zone `zone` (0-based), before the gain.
+// One object's H_R^T M H_T in zone `zone` (0-based), summed over its dipoles, before the gain.
 double zone_signal(const MetalPhysics& mp, int zone, const MetalObject& o);
 
 }  // namespace portalsim::reference

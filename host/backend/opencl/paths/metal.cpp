@@ -7,8 +7,8 @@
 
 namespace portalsim::opencl {
 
-// The coil model's tables (kernels/shared.h, PS_MZ_* and PS_MR_*) and each variant's
-// polarizability tensor, as the reference computes them.
+// The coil model's tables (kernels/contract.h, PS_MZ_*, PS_MR_* and PS_MV_*): each variant's
+// polarizability tensor and long side, as the reference takes them from the catalogue.
 MetalPath::MetalPath(Device& d) : d_(d) {
   const Catalogue& cat = d.cat;
   if (!cat.metal_physics.present) return;
@@ -41,8 +41,11 @@ MetalPath::MetalPath(Device& d) : d_(d) {
         }
     row_offset += s.height;
   }
-  for (size_t v = 0; v < cat.variant_list.size(); ++v)
+  for (size_t v = 0; v < cat.variant_list.size(); ++v) {
     for (double e : cat.polarizability(static_cast<int>(v))) tensors.push_back(e);
+    for (double e : cat.long_side(static_cast<int>(v))) tensors.push_back(e);
+  }
+  static_assert(PS_MV_LEN == 11 && PS_MV_LONG_X == 9 && PS_MV_LONG_Z == 10);
   zone_rec_ = constant(d.ctx(), zones);
   region_rec_ = constant(d.ctx(), regions);
   tensors_ = constant(d.ctx(), tensors);
