@@ -14,7 +14,8 @@ void write_stage_fields(const std::string& dir, const Catalogue& cat, const Asse
                         const Scenario& scene, uint64_t index) {
   for (size_t v = 0; v < cat.sensors.size(); ++v) {
     const Sensor& sensor = cat.sensors[v];
-    const reference::ViewScene vs = reference::view_scene(cat, assets, plan.model, static_cast<int>(v), scene, index);
+    reference::ViewScene vs = reference::view_scene(cat, assets, plan.model, static_cast<int>(v), scene, index);
+    vs.draw = plan.fidelity.draw;
     reference::Field field;
     const std::vector<std::string>& chain = sensor.chain_for(plan.model.model);
     for (size_t k = 0; k < chain.size(); ++k) {

@@ -29,7 +29,8 @@ class ReferenceBackend final : public Backend {
       for (int k = 0; k < views; ++k) {
         const Sensor& sensor = cat_.sensors[k];
         if (!plan.renders(sensor, k)) continue;
-        const reference::ViewScene vs = reference::view_scene(cat_, assets_, plan.model, k, s, index);
+        reference::ViewScene vs = reference::view_scene(cat_, assets_, plan.model, k, s, index);
+        vs.draw = plan.fidelity.draw;
         for (const std::string& stage : sensor.chain_for(plan.model.model)) view_stage(stage).reference(vs, field);
         images[k].assign(field.v.begin(), field.v.end());  // display left whole numbers 0..255
         if (plan.image(k))

@@ -56,6 +56,7 @@ struct ViewScene {
   const Scenario& scenario;
   uint64_t index;  // the scenario's global index: the random generator's counter
   std::vector<Placed> placed;
+  NoiseDraw draw = NoiseDraw::box_muller;  // the plan's pixel noise draw (Fidelity::draw)
 };
 
 ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSettings& model, int view,
