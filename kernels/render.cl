@@ -338,11 +338,11 @@ kernel void render_view(VIEW_STAGE_ARGS) {
   // least 16 pixels (with Box-Muller pixel noise, rows of at least 32 that start on a pair).
   const int noisy = (L.flags & PS_FLAG_PIXEL_NOISE) != 0;
 #if defined(NOISE_DRAW_IH)
-  const int pairs_ok = 1;
+  const int vector_ok = W >= 16;  // Irwin-Hall draws are per pixel: no pairs to keep
 #else
-  const int pairs_ok = W >= 32 && (W & 1) == 0;
+  const int vector_ok = noisy ? W >= 32 && (W & 1) == 0 : W >= 16;
 #endif
-  if (!(L.flags & (PS_FLAG_BILINEAR | PS_FLAG_AFFINE)) && W >= 16 && (!noisy || pairs_ok)) {
+  if (!(L.flags & (PS_FLAG_BILINEAR | PS_FLAG_AFFINE)) && vector_ok) {
     ViewLayers V;
     view_layers(&V, rec, noise_offsets, &L);
     const float gain = pattern_gain(rec, noise_gains);

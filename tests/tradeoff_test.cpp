@@ -185,10 +185,11 @@ void noise_columns_are_measured(const json& report, const fs::path& out) {
                 4 * std::sqrt(24 / n));
     EXPECT_LE(r["noise_ks"].get<double>(),
               r["noise_ks_critical"].get<double>() + (ih ? kIrwinHallDistribution.ks_from_normal : 0));
-    if (ih)
+    if (ih) {
       EXPECT_LE(r["noise_max_abs"].get<double>(), 3.365 + kIrwinHallDrawAbs);
-    else if (r["model"] == "thesis")  // 20,480 normal draws pass 3.365 about 16 times
+    } else if (r["model"] == "thesis") {  // 20,480 normal draws pass 3.365 about 16 times
       EXPECT_GT(r["noise_max_abs"].get<double>(), 3.37);
+    }
     EXPECT_EQ(r.contains("same_draw_mmw_max_abs"), ih);
     if (ih) {
       EXPECT_EQ(r["images_held_to"], "the reference with the tier's noise_draw");
