@@ -303,12 +303,14 @@ int tradeoff(TradeoffOptions& o) {
         // distribution instead (tests/camera_test.cpp); the error columns still show the cost.
         Plan tier_images = images_plan(model);
         tier_images.fidelity = f;
-        r["frames_approximated"] = tier_images.frames_approximated();
+        // The thesis model has no camera frames (the frames knob is the physics camera's).
+        const bool frames_approximated = m == Model::physics && tier_images.frames_approximated();
+        r["frames_approximated"] = frames_approximated;
         // A tier with other pixel draws than the reference's is held to the reference
         // following them; its error columns stay against the model's reference.
         const bool other_draws = m == Model::thesis && model.pixel_sigma > 0 && f.draw != NoiseDraw::box_muller;
         r["images_held_to"] = other_draws ? "the reference with the tier's noise_draw" : "the model's reference";
-        if (!tier_images.frames_approximated()) {
+        if (!frames_approximated) {
           const OutputDiff held = other_draws ? compare_outputs(*img_out, same_draw_ref(f.draw)) : img_err;
           if (other_draws) {
             r["same_draw_mmw_max_abs"] = held.mmw.max_abs;
