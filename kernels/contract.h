@@ -49,6 +49,7 @@
 #define PS_STREAM_IR_NOISE 7u      /* physics: IR noise per pixel; element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_TRANSFORM 8u     /* randomised objects: rotation, scale, flip; element = region */
 #define PS_STREAM_FEATURE_NOISE 9u /* physics features-only: NETD noise in feature space; PS_GAUSS_ELEMENT */
+#define PS_STREAM_PIXEL_NOISE_FAST 10u /* per-pixel sensor noise, Irwin-Hall draws; PS_GAUSS_ELEMENT */
 #define PS_STREAM_GENERATE 16u     /* scenario generators (host only) */
 /* physics: frame k >= 1 of the MMW camera's integration draws its NETD from stream
  * PS_STREAM_FRAME_NOISE + k (frame 0 from PS_STREAM_RAW_NOISE); element: PS_GAUSS_ELEMENT */
@@ -66,11 +67,11 @@
  * the L1 cache, where 16 bits (256 KB) made every gather miss it; sd 1 - 1.6e-4. */
 #define PS_GAUSS_BITS 12
 #define PS_GAUSS_TABLE (1 << PS_GAUSS_BITS)
-/* The physics fast tier's draws (PS_FLAG_FAST_DRAWS, docs/model/tiers.md): the same 16-bit
- * half of the same word as the table Gaussian's, its two bytes summed, s in 0..510,
- * t = (s - 255) / 255, g = t (C1 + t^2 (C3 + t^2 C5)): an Irwin-Hall sum of two uniforms
- * bent by an odd quintic fitted to the normal's quantiles (sd 1, excess kurtosis -0.010,
- * Kolmogorov-Smirnov distance 0.0033 to the normal, |g| <= 3.365), with no table. */
+/* The Irwin-Hall draw (docs/model/determinism.md): the thesis model's pixel noise under
+ * noise_draw irwin-hall, and the physics fast tier's NETD and IR draws (PS_FLAG_FAST_DRAWS).
+ * A cell's 16-bit half (the table Gaussians' layout), its two bytes summed, s in 0..510,
+ * t = (s - 255) / 255, g = t (C1 + t^2 (C3 + t^2 C5)): an odd quintic fitted to the normal's
+ * quantiles (sd 1, excess kurtosis -0.010, KS distance 0.0033, |g| <= 3.365), no table. */
 #define PS_IH_C1 2.3740347
 #define PS_IH_C3 (-0.85662049)
 #define PS_IH_C5 1.8473553

@@ -35,6 +35,16 @@ inline void render_row(global const uchar* atlas, global const uchar* base, glob
   int x = 0;
   for (; x + 16 <= x0; x += 16) store16(load16(base + x), row + x);
   for (; x < x0; ++x) row[x] = base[x];
+#if defined(NOISE_DRAW_IH)
+  if (L->flags & PS_FLAG_PIXEL_NOISE) {
+    for (; x < W; ++x) {
+      real v = composite_pixel(&Ly, atlas, from_pixel(base[x]), x, alpha);
+      v = pattern_noise(&T, atlas, tile_size, gain, v, x);
+      row[x] = to_pixel(add_gauss(v, sigma, ih_pixel(seed, index, L->view, y * W + x)));
+    }
+    return;
+  }
+#endif
   if (L->flags & PS_FLAG_PIXEL_NOISE) {
     // The whole row, a Box-Muller pair (one Philox draw) per two pixels, no branch per
     // pixel. Pairs follow the pixel index y*W + x, so an odd W starts rows mid-pair.
@@ -246,6 +256,37 @@ __attribute__((always_inline)) inline void noisy16(global const uchar* atlas, gl
   }
 }
 
+#if defined(NOISE_DRAW_IH)
+// With pixel noise every pixel is drawn, in flat runs of 128 pixels (one set of 16 Philox
+// draws), 16 at a time; the last HW % 16 pixels as one run of 16 that overlaps the one
+// before it, its draws taken pixel by pixel.
+inline void render_noisy(global const uchar* atlas, global const uchar* base, global uchar* img, const ViewLayers* V,
+                         const PsViewLaunch* L, float gain, param alpha, param sigma, uint2 seed, ulong index) {
+  const int W = L->width, H = L->height, tile = L->tile_size, HW = W * H;
+  RowLayers R[2];  // rows y and y + 1, R[cur] is row y
+  int y = 0, x = 0, cur = 0;
+  row_layers(&R[0], V, tile, 0);
+  row_layers(&R[1], V, tile, 1);
+  int c = 0;
+  while (c + 16 <= HW) {
+    float16 g[8];
+    ih128(seed, index, L->view, c >> 7, g);
+    for (int h = 0; h < 8 && c + 16 <= HW; ++h, c += 16)
+      noisy16(atlas, base, img, V, R, &cur, &y, &x, c, W, tile, gain, alpha, sigma, g[h]);
+  }
+  if (c < HW) {
+    const int p = HW - 16;
+    y = p / W;
+    x = p - y * W;
+    cur = 0;
+    row_layers(&R[0], V, tile, y);
+    row_layers(&R[1], V, tile, y + 1);
+    float t[16];
+    for (int k = 0; k < 16; ++k) t[k] = ih_pixel(seed, index, L->view, p + k);
+    noisy16(atlas, base, img, V, R, &cur, &y, &x, p, W, tile, gain, alpha, sigma, vload16(0, t));
+  }
+}
+#else
 // With pixel noise every pixel is drawn, in flat runs of 64 pixels (32 Box-Muller pairs
 // of the pixel index, so HW must be even; two Philox chains that overlap), then of 32; the
 // last run overlaps the one before it.
@@ -279,6 +320,7 @@ inline void render_noisy(global const uchar* atlas, global const uchar* base, gl
   }
 }
 #endif
+#endif
 
 kernel void render_view(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
@@ -293,9 +335,14 @@ kernel void render_view(VIEW_STAGE_ARGS) {
 
 #if defined(VECTOR_RENDER)
   // The vector paths: integer placement (no sub-pixel or affine sprites), and rows of at
-  // least 16 pixels (with pixel noise, rows of at least 32 that start on a Box-Muller pair).
+  // least 16 pixels (with Box-Muller pixel noise, rows of at least 32 that start on a pair).
   const int noisy = (L.flags & PS_FLAG_PIXEL_NOISE) != 0;
-  if (!(L.flags & (PS_FLAG_BILINEAR | PS_FLAG_AFFINE)) && (noisy ? W >= 32 && (W & 1) == 0 : W >= 16)) {
+#if defined(NOISE_DRAW_IH)
+  const int vector_ok = W >= 16;  // Irwin-Hall draws are per pixel: no pairs to keep
+#else
+  const int vector_ok = noisy ? W >= 32 && (W & 1) == 0 : W >= 16;
+#endif
+  if (!(L.flags & (PS_FLAG_BILINEAR | PS_FLAG_AFFINE)) && vector_ok) {
     ViewLayers V;
     view_layers(&V, rec, noise_offsets, &L);
     const float gain = pattern_gain(rec, noise_gains);

@@ -183,6 +183,45 @@ __attribute__((always_inline)) inline void gauss128(uint2 seed, ulong index, uin
 }
 #endif
 
+// The Irwin-Hall pixel draw (noise_draw irwin-hall, the fast tier; kernels/contract.h, PS_IH_*):
+// cell p's 16-bit half in the table Gaussians' layout (stream PS_STREAM_PIXEL_NOISE_FAST), its
+// two bytes summed, s, and d = s - 255 taken through the odd quintic. Eight pixels to one
+// Philox draw where Box-Muller takes two, and no log, root or sincos. d is exact in
+// integers, so the float steps are one multiply and the written fma()s, alike for 1 and 16.
+inline greal ih_shape(int d) {
+  const greal t = (greal)d * ((greal)1 / (greal)255), t2 = t * t;
+  return t * fma(t2, fma(t2, (greal)PS_IH_C5, (greal)PS_IH_C3), (greal)PS_IH_C1);
+}
+inline greal ih_pixel(uint2 seed, ulong index, int view, int p) {
+  const uint4 r = draw(seed, index, PS_STREAM_PIXEL_NOISE_FAST, PS_GAUSS_ELEMENT(view, p));
+  const int w = PS_GAUSS_WORD(p);
+  const uint h = (w == 0 ? r.x : w == 1 ? r.y : w == 2 ? r.z : r.w) >> PS_GAUSS_SHIFT(p);
+  return ih_shape((int)(h & 0xffu) + (int)((h >> 8) & 0xffu) - 255);
+}
+#if !defined(PRECISION_FP64)
+inline float16 ih_shape16(int16 d) {
+  const float16 t = convert_float16(d) * (1.0f / 255.0f), t2 = t * t;
+  return t * fma(t2, fma(t2, (float16)((float)PS_IH_C5), (float16)((float)PS_IH_C3)), (float16)((float)PS_IH_C1));
+}
+// The Irwin-Hall draws of pixels 128 b .. 128 b + 127 of a view: g[j] holds pixels
+// 128 b + 16 j .. + 15. Both halves' byte sums come from one masked add per word.
+__attribute__((always_inline)) inline void ih128(uint2 seed, ulong index, int view, int b, float16* g) {
+  uint16 c[4];
+  c[0] = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
+         ((uint)(16 * b) + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+  c[1] = (uint16)(PS_STREAM_PIXEL_NOISE_FAST);
+  c[2] = (uint16)((uint)index);
+  c[3] = (uint16)((uint)(index >> 32));
+  philox16(&c[0], &c[1], &c[2], &c[3], seed);
+#pragma unroll
+  for (int w = 0; w < 4; ++w) {
+    const int16 s = as_int16((c[w] & 0x00ff00ffu) + ((c[w] >> 8) & 0x00ff00ffu));
+    g[2 * w] = ih_shape16((s & 0xffff) - 255);
+    g[2 * w + 1] = ih_shape16((s >> 16) - 255);
+  }
+}
+#endif
+
 // Adds sd times the table Gaussians of cells [0, cells) to v (one scenario's field), or,
 // where !accumulate, writes them there: gauss_cells_global and gauss_cells_private.
 #if defined(PRECISION_FP64)
@@ -225,9 +264,38 @@ kernel void stage_sensor_noise(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;
   if (!(L.flags & PS_FLAG_PIXEL_NOISE)) return;
   const int p0 = y * L.width;
+#if defined(NOISE_DRAW_IH)
+  for (int x = 0; x < L.width; ++x)
+    field[row0 + x] = add_gauss(field[row0 + x], sigma, ih_pixel(seed, index, L.view, p0 + x));
+#else
   for (int x = 0; x < L.width; ++x) {
     const int p = p0 + x;
     const greal2 g = gauss_pair(seed, index, L.view, p >> 1);
     field[row0 + x] = add_gauss(field[row0 + x], sigma, (p & 1) ? g.y : g.x);
+  }
+#endif
+}
+
+// The unit draws of a sensor model's per-pixel noise as this build makes them (`portalsim
+// tradeoff`'s distribution columns): pixels [0, cells) of view 0 of scenario first + i, one
+// work-item per scenario. Thesis: the pixel noise (Box-Muller, or Irwin-Hall under
+// NOISE_DRAW_IH); physics: the MMW raw noise's table Gaussians (table: the host's quantiles).
+kernel void noise_draws(uint seed_lo, uint seed_hi, ulong first, int physics, int cells, global const param* table,
+                        global float* out) {
+  const size_t i = get_global_id(0);
+  const uint2 seed = (uint2)(seed_lo, seed_hi);
+  const ulong index = first + i;
+  global float* o = out + i * (size_t)cells;
+  for (int p = 0; p < cells; ++p) {
+    if (physics) {
+      o[p] = (float)gauss_cell(seed, index, PS_STREAM_RAW_NOISE, 0, p, table);
+      continue;
+    }
+#if defined(NOISE_DRAW_IH)
+    o[p] = (float)ih_pixel(seed, index, 0, p);
+#else
+    const greal2 g = gauss_pair(seed, index, 0, p >> 1);
+    o[p] = (float)((p & 1) ? g.y : g.x);
+#endif
   }
 }

@@ -11,9 +11,11 @@
 #include <string_view>
 #include <vector>
 
+#include "backend/compare.h"
 #include "backend/opencl/gauss_table.h"
 #include "backend/opencl/runtime.h"
 #include "backend/reference/draws.h"
+#include "plan/tolerance.h"
 
 namespace portalsim {
 namespace embedded {
@@ -257,6 +259,109 @@ kernel void pixels(global const ulong* seed, global const ulong* index, global c
       "pixels", n, input(rt, seed), input(rt, index), input(rt, view), input(rt, pixel), out);
   const std::vector<float> got = read<float>(rt, out, n);
   for (size_t i = 0; i < n; ++i) EXPECT_NEAR(got[i], kPixelCases[i].g, 2e-5) << "pixel " << kPixelCases[i].pixel;
+}
+
+// The Irwin-Hall pixel draw (noise_draw irwin-hall), worked by hand from determinism.md
+// outside the project (Python: its own Philox4x32-10, checked against the Box-Muller table's
+// words, then the element, word, half, byte sum s and the quintic in double).
+struct IrwinHallCase {
+  uint64_t seed, index;
+  int view, pixel;
+  uint32_t element;
+  int word, half;
+  uint32_t w;  // the word
+  int s;       // its half's two bytes summed
+  double g;
+};
+constexpr IrwinHallCase kIrwinHallCases[] = {
+    {0x0ull, 0x0ull, 0, 0, 0x0u, 0, 0, 0xdcd5b333u, 230, -0.231958019446},
+    {0x1352505ull, 0x7ull, 0, 17, 0x1u, 0, 1, 0xeb39d7e5u, 292, 0.341969775996},
+    {0x7ull, 0x75bcd15ull, 2, 40, 0x20000008u, 1, 0, 0x7a33ae4au, 248, -0.065151888865},
+    {0xdeadbeefcafef00dull, 0x10000000003ull, 1, 77, 0x1000000du, 2, 0, 0xb6b9f7d5u, 460, 2.083790849101},
+    {0x5ull, 0x2ull, 1, 127, 0x1000000fu, 3, 1, 0xf70b3718u, 258, 0.027928425553},
+    {0x5ull, 0x2ull, 1, 133, 0x10000015u, 0, 0, 0x80958ed5u, 355, 0.896466028029},
+    {0x63ull, 0x200000000ull, 2, 1000, 0x20000078u, 3, 0, 0xfa141d12u, 47, -2.138631262265},
+    {0xffffffffffffffffull, 0xcull, 0, 39999, 0x138fu, 1, 1, 0x254efa91u, 115, -1.253780953433},
+};
+
+TEST(Philox, IrwinHallHandComputed) {
+  OpenCLRuntime rt;
+  std::vector<cl_ulong> seed, index;
+  std::vector<cl_int> view, pixel;
+  for (const IrwinHallCase& c : kIrwinHallCases) {
+    SCOPED_TRACE("pixel " + std::to_string(c.pixel));
+    const uint32_t w = draw(c.seed, c.index, kStreamPixelNoiseFast, c.element)[c.word];
+    EXPECT_EQ(w, c.w);
+    const uint32_t h = c.half ? w >> 16 : w & 0xffffu;
+    EXPECT_EQ(int(h & 0xffu) + int(h >> 8), c.s);
+    EXPECT_NEAR(reference::pixel_irwin_hall(c.seed, c.index, c.view, c.pixel), c.g, 1e-11);
+    seed.push_back(c.seed);
+    index.push_back(c.index);
+    view.push_back(c.view);
+    pixel.push_back(c.pixel);
+  }
+  // The kernels' ih_pixel, and ih128 (the fused path's 128 at once) at the same pixel.
+  const size_t n = seed.size();
+  cl::Buffer out(rt.context(), CL_MEM_WRITE_ONLY, 2 * n * sizeof(float));
+  run(rt, R"(
+kernel void ih(global const ulong* seed, global const ulong* index, global const int* view,
+               global const int* pixel, global float* out) {
+  const size_t i = get_global_id(0);
+  const uint2 key = (uint2)((uint)seed[i], (uint)(seed[i] >> 32));
+  out[2 * i] = ih_pixel(key, index[i], view[i], pixel[i]);
+  float16 g[8];
+  ih128(key, index[i], view[i], pixel[i] >> 7, g);
+  float t[128];
+  for (int j = 0; j < 8; ++j) vstore16(g[j], j, t);
+  out[2 * i + 1] = t[pixel[i] & 127];
+})",
+      "ih", n, input(rt, seed), input(rt, index), input(rt, view), input(rt, pixel), out);
+  const std::vector<float> got = read<float>(rt, out, 2 * n);
+  for (size_t i = 0; i < n; ++i) {
+    EXPECT_NEAR(got[2 * i], kIrwinHallCases[i].g, kIrwinHallDrawAbs) << "pixel " << kIrwinHallCases[i].pixel;
+    EXPECT_EQ(got[2 * i + 1], got[2 * i]) << "ih128 against ih_pixel, pixel " << kIrwinHallCases[i].pixel;
+  }
+}
+
+// 2^20 Irwin-Hall draws (2,048 scenarios, 4 views, the 128 pixels of block 7 of each): the
+// kernels' ih128 equal the reference's pixel_irwin_hall within kIrwinHallDrawAbs, and their
+// sample's moments and KS distance from the normal are the exact distribution's
+// (kIrwinHallDistribution) within sampling error.
+TEST(Philox, IrwinHallKernelsFollowTheReferenceAndTheDistribution) {
+  OpenCLRuntime rt;
+  constexpr int kScenarios = 2048, kViews = 4;
+  constexpr uint64_t kSeed = 0x9e3779b97f4a7c15ull, kFirst = 1000;
+  const size_t groups = size_t(kScenarios) * kViews, n = groups * 128;
+  cl::Buffer out(rt.context(), CL_MEM_WRITE_ONLY, n * sizeof(float));
+  run(rt, R"(
+kernel void ih_sample(ulong seed, ulong first, global float* out) {
+  const size_t i = get_global_id(0);
+  float16 g[8];
+  ih128((uint2)((uint)seed, (uint)(seed >> 32)), first + i / 4, (int)(i % 4), 7, g);
+  for (int j = 0; j < 8; ++j) vstore16(g[j], 8 * i + j, out);
+})",
+      "ih_sample", groups, cl_ulong(kSeed), cl_ulong(kFirst), out);
+  const std::vector<float> got = read<float>(rt, out, n);
+  std::vector<double> kernel(got.begin(), got.end()), ref(n);
+  double worst = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const size_t i = k / 128;
+    ref[k] = reference::pixel_irwin_hall(kSeed, kFirst + i / 4, int(i % 4), 7 * 128 + int(k % 128));
+    worst = std::max(worst, std::abs(kernel[k] - ref[k]));
+  }
+  EXPECT_LE(worst, kIrwinHallDrawAbs) << "kernel against reference, largest difference";
+  const DrawDistribution& e = kIrwinHallDistribution;
+  const double dn = double(n);
+  for (const auto* sample : {&kernel, &ref}) {
+    SCOPED_TRACE(sample == &kernel ? "kernels" : "reference");
+    const Distribution d = distribution(*sample);
+    EXPECT_NEAR(d.mean, e.mean, 4 / std::sqrt(dn));
+    EXPECT_NEAR(d.sd, e.sd, 4 / std::sqrt(2 * dn));
+    EXPECT_NEAR(d.skewness, e.skewness, 4 * std::sqrt(6 / dn));
+    EXPECT_NEAR(d.excess_kurtosis, e.excess_kurtosis, 4 * std::sqrt(24 / dn));
+    EXPECT_LE(d.ks, e.ks_from_normal + d.ks_critical);
+    EXPECT_LE(*std::max_element(sample->begin(), sample->end()), 3.365 + kIrwinHallDrawAbs);
+  }
 }
 
 TEST(Philox, DrawLayoutSeparatesEveryArgument) {

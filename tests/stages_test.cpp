@@ -60,6 +60,8 @@ TEST(Stages, FusedRenderEqualsTheChainOfStageKernels) {
     Tier tier;
     double sigma, jitter;
     bool bilinear;
+    bool box_muller = false;  // the fast tier with the standard tier's draws
+    bool irwin_hall = false;  // fp32 and fp64 with the fast tier's draws
   };
   for (const Case& c :
        {Case{"standard", Tier::standard, 0, 0, false}, Case{"standard noisy", Tier::standard, 2.5, 0, false},
@@ -70,7 +72,10 @@ TEST(Stages, FusedRenderEqualsTheChainOfStageKernels) {
         // rows, and runs of noisy pixels that cross a row end with layers on both rows.
         Case{"standard over the edges", Tier::standard, 0, 60, false},
         Case{"standard noisy over the edges", Tier::standard, 2, 60, false},
-        Case{"fast noisy over the edges", Tier::fast, 3, 60, false}}) {
+        Case{"fast noisy over the edges", Tier::fast, 3, 60, false},
+        Case{"fast noisy, Box-Muller", Tier::fast, 2, 0, false, true},
+        Case{"standard noisy, Irwin-Hall", Tier::standard, 2, 0, false, false, true},
+        Case{"exact noisy, Irwin-Hall", Tier::exact, 2, 0, false, false, true}}) {
     SCOPED_TRACE(c.name);
     Plan plan;
     plan.model.seed = 11;
@@ -79,6 +84,8 @@ TEST(Stages, FusedRenderEqualsTheChainOfStageKernels) {
     plan.model.bilinear = c.bilinear;
     plan.fidelity = tier_fidelity(c.tier);
     plan.fidelity.pooling = Pooling::dense;
+    if (c.box_muller) plan.fidelity.draw = NoiseDraw::box_muller;
+    if (c.irwin_hall) plan.fidelity.draw = NoiseDraw::irwin_hall;
     BatchOutput fused, staged;
     cl->run(batch, plan, fused);
     plan.fidelity.fused = false;
@@ -112,13 +119,19 @@ TEST(Stages, EachStageKernelMatchesItsReference) {
     plan.model.pixel_sigma = 3;
     plan.fidelity.fused = false;
     BatchOutput r, k;
-    ref->run(batch, plan, r);
-    cl->run(batch, plan, k);
-    const OutputDiff d = compare_outputs(k, r);
-    EXPECT_LE(d.mmw.max_abs, 1);
-    EXPECT_LE(d.ir.max_abs, 1);
-    EXPECT_LE(d.mmw.share_differing, 1e-3);
-    EXPECT_LE(d.ir.share_differing, 1e-3);
+    // Sensor noise under both pixel draws (the reference follows the plan's).
+    for (NoiseDraw draw : {NoiseDraw::irwin_hall, NoiseDraw::box_muller}) {
+      if (stage.name != "sensor_noise" && draw == NoiseDraw::irwin_hall) continue;
+      SCOPED_TRACE(draw == NoiseDraw::irwin_hall ? "irwin-hall" : "box-muller");
+      plan.fidelity.draw = draw;
+      ref->run(batch, plan, r);
+      cl->run(batch, plan, k);
+      const OutputDiff d = compare_outputs(k, r);
+      EXPECT_LE(d.mmw.max_abs, 1);
+      EXPECT_LE(d.ir.max_abs, 1);
+      EXPECT_LE(d.mmw.share_differing, 1e-3);
+      EXPECT_LE(d.ir.share_differing, 1e-3);
+    }
     // The stage did something: without it the images differ.
     Catalogue bare = catalogue();
     for (Sensor& s : bare.sensors) s.chain = {"composite", "display"};

@@ -109,7 +109,8 @@ void thesis_rows_keep_their_layout(const json& report, const fs::path& out) {
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "model,tier,precision,features_per_s,images_per_s,mmw_max_abs,mmw_rmse_mean,mmw_psnr_db,"
             "mmw_share_off_by_more_than_1,ir_max_abs,feature_max_abs,feature_mean_abs,metal_exact_rate,"
-            "label_exact_rate,j48_accuracy,j48_case2_accuracy,within_tolerance");
+            "label_exact_rate,j48_accuracy,j48_case2_accuracy,within_tolerance,noise_draw,noise_sd,noise_skewness,"
+            "noise_excess_kurtosis,noise_ks,noise_max_abs,j48_images_accuracy,j48_images_case2_accuracy");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 9);
   EXPECT_NE(csv.find("\nthesis,reference,fp64 (CPU reference),"), std::string::npos);
   EXPECT_NE(csv.find("\nphysics,fast,fixed16,"), std::string::npos);
@@ -165,6 +166,49 @@ void errors_are_against_the_same_models_reference(const json& report, const fs::
   EXPECT_NE(test::slurp(out / "thesis-reference-case2.arff"), test::slurp(out / "physics-reference-case2.arff"));
 }
 
+// The noise's distribution columns are measured per row, from the draws each row's code
+// makes: the fast tier's thesis draws are Irwin-Hall (bounded at 3.365), the others
+// Box-Muller; every sample's moments and KS distance are a unit normal's within sampling
+// error (plus the Irwin-Hall draw's own, plan/tolerance.h). Its images are held to the
+// reference following its draws, and J48 scores the features of its images.
+void noise_columns_are_measured(const json& report, const fs::path& out) {
+  for (const json& r : report["rows"]) {
+    SCOPED_TRACE(r["model"].get<std::string>() + " " + r["name"].get<std::string>());
+    const double n = r["noise_draws"].get<double>();
+    ASSERT_EQ(n, kCount * 512.0);
+    const bool ih = r["model"] == "thesis" && r["name"] == "fast";
+    EXPECT_EQ(r["noise_draw"], ih ? "irwin-hall" : r["model"] == "thesis" ? "box-muller" : "table Gaussian");
+    EXPECT_NEAR(r["noise_mean"].get<double>(), 0, 4 / std::sqrt(n));
+    EXPECT_NEAR(r["noise_sd"].get<double>(), 1, 4 / std::sqrt(2 * n));
+    EXPECT_NEAR(r["noise_skewness"].get<double>(), 0, 4 * std::sqrt(6 / n));
+    EXPECT_NEAR(r["noise_excess_kurtosis"].get<double>(), ih ? kIrwinHallDistribution.excess_kurtosis : 0,
+                4 * std::sqrt(24 / n));
+    EXPECT_LE(r["noise_ks"].get<double>(),
+              r["noise_ks_critical"].get<double>() + (ih ? kIrwinHallDistribution.ks_from_normal : 0));
+    if (ih) {
+      EXPECT_LE(r["noise_max_abs"].get<double>(), 3.365 + kIrwinHallDrawAbs);
+    } else if (r["model"] == "thesis") {  // 20,480 normal draws pass 3.365 about 16 times
+      EXPECT_GT(r["noise_max_abs"].get<double>(), 3.37);
+    }
+    EXPECT_EQ(r.contains("same_draw_mmw_max_abs"), ih);
+    if (ih) {
+      EXPECT_EQ(r["images_held_to"], "the reference with the tier's noise_draw");
+      EXPECT_LE(r["same_draw_mmw_max_abs"].get<int>(), 2);
+      // Against the Box-Muller reference the noise itself differs: about sigma sqrt 2.
+      EXPECT_GT(r["mmw_rmse_mean"].get<double>(), 1.5);
+      EXPECT_TRUE(fs::is_regular_file(out / "thesis-fast-images-case1.arff"));
+      EXPECT_TRUE(fs::is_regular_file(out / "thesis-fast-images-case2.arff"));
+    }
+    EXPECT_TRUE(r["j48_images_accuracy"].is_number());
+    EXPECT_TRUE(r["j48_images_case2_accuracy"].is_number());
+  }
+  // Draws that are the same code give the same sample (the exact and standard tiers and the
+  // reference draw Box-Muller from the same words; float against double).
+  const json& ref = row(report, "thesis", "reference");
+  EXPECT_NEAR(row(report, "thesis", "standard")["noise_sd"].get<double>(), ref["noise_sd"].get<double>(), 1e-5);
+  EXPECT_NE(row(report, "thesis", "fast")["noise_sd"].get<double>(), ref["noise_sd"].get<double>());
+}
+
 // One default run (both models, classifier on) of kCount scenarios; ctest runs each test
 // in its own process, so the checks share one test.
 TEST(TradeoffModels, BothModelsByDefault) {
@@ -185,6 +229,10 @@ TEST(TradeoffModels, BothModelsByDefault) {
   {
     SCOPED_TRACE("errors are against the same model's reference");
     errors_are_against_the_same_models_reference(report, out);
+  }
+  {
+    SCOPED_TRACE("noise columns are measured");
+    noise_columns_are_measured(report, out);
   }
 }
 

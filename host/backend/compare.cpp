@@ -149,4 +149,26 @@ SampleComparison compare_samples(std::vector<double> a, std::vector<double> b) {
   return c;
 }
 
+Distribution distribution(const std::vector<double>& v) {
+  Distribution d;
+  const SampleComparison c = compare_samples(v);
+  d.mean = c.mean_a;
+  d.sd = c.sd_a;
+  d.ks = c.ks;
+  d.ks_critical = c.ks_critical;
+  double m2 = 0, m3 = 0, m4 = 0;
+  for (double x : v) {
+    const double e = x - d.mean, e2 = e * e;
+    m2 += e2;
+    m3 += e2 * e;
+    m4 += e2 * e2;
+  }
+  if (v.empty() || m2 == 0) return d;
+  const double n = double(v.size());
+  m2 /= n;
+  d.skewness = m3 / n / std::pow(m2, 1.5);
+  d.excess_kurtosis = m4 / n / (m2 * m2) - 3;
+  return d;
+}
+
 }  // namespace portalsim

@@ -46,4 +46,11 @@ struct SampleComparison {
 };
 SampleComparison compare_samples(std::vector<double> a, std::vector<double> b = {});
 
+// A sample's distribution against the standard normal: its moments and the KS distance.
+struct Distribution {
+  double mean = 0, sd = 0, skewness = 0, excess_kurtosis = 0;
+  double ks = 0, ks_critical = 0;  // as compare_samples(v)
+};
+Distribution distribution(const std::vector<double>& v);
+
 }  // namespace portalsim

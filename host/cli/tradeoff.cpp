@@ -7,12 +7,15 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <utility>
 
 #include "backend/compare.h"
+#include "backend/opencl/noise_draws.h"
 #include "backend/opencl/opencl_backend.h"
+#include "backend/reference/draws.h"
 #include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
@@ -20,6 +23,7 @@
 #include "io/input_file.h"
 #include "plan/knobs.h"
 #include "scene/generator.h"
+#include "scene/philox.h"
 #include "sink/sinks.h"
 #include "sink/staging.h"
 
@@ -151,6 +155,36 @@ SceneBatch thesis_case(const Catalogue& cat, int which, uint64_t seed, uint64_t 
   return batch;
 }
 
+// The noise's distribution columns: the unit draws of the model's per-pixel noise (thesis:
+// pixel noise; physics: the MMW raw noise's table Gaussians) over up to 2,048 scenarios of
+// 512 pixels, as the fp64 reference (no tier) or the tier's kernels make them.
+constexpr size_t kDrawScenarios = 2048;
+constexpr int kDrawCells = 512;
+
+std::vector<double> reference_draws(Model m, uint64_t seed, size_t scenarios) {
+  std::vector<double> v;
+  v.reserve(scenarios * kDrawCells);
+  for (uint64_t i = 0; i < scenarios; ++i)
+    for (int p = 0; p < kDrawCells; ++p)
+      v.push_back(m == Model::physics ? reference::table_gaussian(seed, i, kStreamRawNoise, 0, p)
+                                      : reference::pixel_gaussian(seed, i, 0, p));
+  return v;
+}
+
+void put_distribution(json& r, const std::vector<double>& draws) {
+  const Distribution d = distribution(draws);
+  double max_abs = 0;
+  for (double g : draws) max_abs = std::max(max_abs, std::abs(g));
+  r["noise_draws"] = draws.size();
+  r["noise_mean"] = d.mean;
+  r["noise_sd"] = d.sd;
+  r["noise_skewness"] = d.skewness;
+  r["noise_excess_kurtosis"] = d.excess_kurtosis;
+  r["noise_ks"] = d.ks;
+  r["noise_ks_critical"] = d.ks_critical;
+  r["noise_max_abs"] = max_abs;
+}
+
 int tradeoff(TradeoffOptions& o) {
   if (o.count < 10 || o.count > 1000000) throw InputError("--count: must be between 10 and 1000000");
   if (o.out.empty()) throw InputError("--out: empty folder name");
@@ -202,13 +236,33 @@ int tradeoff(TradeoffOptions& o) {
     std::fflush(stdout);
     auto reference = make_reference_backend(cat, s.assets);
     const Timed ref = run_timed(*reference, batch, images_plan(model), 256, 0.0);
+    const size_t draw_scenarios = std::min<size_t>(o.count, kDrawScenarios);
+    // The reference following a tier's approximate pixel draws (Fidelity::draw), made once
+    // per draw: the tier's images are held to it (the reference's Box-Muller draws are
+    // other numbers, value by value).
+    std::map<NoiseDraw, BatchOutput> same_draw_refs;
+    auto same_draw_ref = [&](NoiseDraw d) -> const BatchOutput& {
+      auto it = same_draw_refs.find(d);
+      if (it != same_draw_refs.end()) return it->second;
+      Plan p = images_plan(model);
+      p.fidelity.draw = d;
+      reference->run(batch, p, same_draw_refs[d]);
+      return same_draw_refs[d];
+    };
     // The reference renders every image for features too: one rate serves both.
+    // img_feats, img_feats2: the features of the images runs of cases 1 and 2 where they are
+    // not the features-only run's (the block-mean noise model), for J48 on them.
     auto add_row = [&](const std::string& name, std::optional<Tier> tier, double feat_rate, double img_rate,
                        const OutputDiff& img_err, const OutputDiff& feat_err, const BatchOutput& feats,
-                       const BatchOutput& feats2) {
-      json r;
+                       const BatchOutput& feats2, const BatchOutput* img_feats, const BatchOutput* img_feats2,
+                       const BatchOutput* img_out) {
+      json& r = rows.back();  // holds the noise's distribution columns already
       r["model"] = mname;
       r["name"] = name;
+      // What the noise's distribution columns sample (put_distribution).
+      r["noise_draw"] = m == Model::physics                                          ? "table Gaussian"
+                        : tier && tier_fidelity(*tier).draw == NoiseDraw::irwin_hall ? "irwin-hall"
+                                                                                     : "box-muller";
       r["features_per_s"] = feat_rate;
       r["images_per_s"] = img_rate;
       r["mmw_max_abs"] = img_err.mmw.max_abs;
@@ -249,9 +303,22 @@ int tradeoff(TradeoffOptions& o) {
         // distribution instead (tests/camera_test.cpp); the error columns still show the cost.
         Plan tier_images = images_plan(model);
         tier_images.fidelity = f;
-        r["frames_approximated"] = tier_images.frames_approximated();
-        if (!tier_images.frames_approximated())
-          if (const std::string broke = check_tolerance(img_err, tol); !broke.empty()) why += "images run: " + broke;
+        // The thesis model has no camera frames (the frames knob is the physics camera's).
+        const bool frames_approximated = m == Model::physics && tier_images.frames_approximated();
+        r["frames_approximated"] = frames_approximated;
+        // A tier with other pixel draws than the reference's is held to the reference
+        // following them; its error columns stay against the model's reference.
+        const bool other_draws = m == Model::thesis && model.pixel_sigma > 0 && f.draw != NoiseDraw::box_muller;
+        r["images_held_to"] = other_draws ? "the reference with the tier's noise_draw" : "the model's reference";
+        if (!frames_approximated) {
+          const OutputDiff held = other_draws ? compare_outputs(*img_out, same_draw_ref(f.draw)) : img_err;
+          if (other_draws) {
+            r["same_draw_mmw_max_abs"] = held.mmw.max_abs;
+            r["same_draw_mmw_rmse_mean"] = held.mmw.rmse_mean;
+            r["same_draw_mmw_share_differing"] = held.mmw.share_differing;
+          }
+          if (const std::string broke = check_tolerance(held, tol); !broke.empty()) why += "images run: " + broke;
+        }
         if (const std::string broke = check_tolerance(feat_checked, tol); !broke.empty())
           why += "features run: " + broke;
       } else {
@@ -261,21 +328,33 @@ int tradeoff(TradeoffOptions& o) {
       if (!why.empty()) r["tolerance_note"] = why;
       r["j48_accuracy"] = nullptr;
       r["j48_case2_accuracy"] = nullptr;
+      r["j48_images_accuracy"] = nullptr;
+      r["j48_images_case2_accuracy"] = nullptr;
       if (o.classifier) {
         j48(r, "j48_accuracy", mname + "-" + name + "-case1.arff", batch, feats);
         j48(r, "j48_case2_accuracy", mname + "-" + name + "-case2.arff", case2, feats2);
+        // Features pooled from the images run: the features-only run's own where they are
+        // the same numbers, else J48 on them.
+        if (img_feats) {
+          j48(r, "j48_images_accuracy", mname + "-" + name + "-images-case1.arff", batch, *img_feats);
+          j48(r, "j48_images_case2_accuracy", mname + "-" + name + "-images-case2.arff", case2, *img_feats2);
+        } else {
+          r["j48_images_accuracy"] = r["j48_accuracy"];
+          r["j48_images_case2_accuracy"] = r["j48_case2_accuracy"];
+        }
       }
-      rows.push_back(r);
       auto pct = [&](const char* key) {
         char text[32] = "-";
         if (!r[key].is_null()) std::snprintf(text, sizeof text, "%.1f%%", r[key].get<double>());
         return std::string(text);
       };
       std::printf(
-          "  %-9s features %10.0f/s  images %8.0f/s  MMW max %d rmse %.4f  feature max %.4g  metal %.4f  J48 case 1 %s "
-          "case 2 %s%s\n",
+          "  %-9s features %10.0f/s  images %8.0f/s  MMW max %d rmse %.4f  feature max %.4g  metal %.4f  noise sd %.4f "
+          "kurtosis %+.3f KS %.4f  J48 case 1 %s case 2 %s (from images %s, %s)%s\n",
           name.c_str(), feat_rate, img_rate, img_err.mmw.max_abs, img_err.mmw.rmse_mean, feat_err.feature_max_abs,
-          feat_err.metal_exact, pct("j48_accuracy").c_str(), pct("j48_case2_accuracy").c_str(),
+          feat_err.metal_exact, r["noise_sd"].get<double>(), r["noise_excess_kurtosis"].get<double>(),
+          r["noise_ks"].get<double>(), pct("j48_accuracy").c_str(), pct("j48_case2_accuracy").c_str(),
+          pct("j48_images_accuracy").c_str(), pct("j48_images_case2_accuracy").c_str(),
           why.empty() ? "" : ("  OUT OF TOLERANCE: " + why).c_str());
       std::fflush(stdout);
     };
@@ -286,8 +365,10 @@ int tradeoff(TradeoffOptions& o) {
       return out;
     };
     const OutputDiff self = compare_outputs(ref.out, ref.out);
+    // The reference's features come from its images: the same numbers either way.
+    put_distribution(rows.emplace_back(), reference_draws(m, model.seed, draw_scenarios));
     add_row("reference", std::nullopt, ref.rate, ref.rate, self, self, ref.out,
-            case2_features(*reference, features_plan(model)));
+            case2_features(*reference, features_plan(model)), nullptr, nullptr, &ref.out);
     for (Tier t : {Tier::exact, Tier::standard, Tier::fast}) {
       const Fidelity f = tier_fidelity(t);
       auto cl = make_opencl_backend(cat, s.assets, rt);
@@ -295,8 +376,13 @@ int tradeoff(TradeoffOptions& o) {
       ip.fidelity = fp.fidelity = f;
       const Timed img = run_timed(*cl, batch, ip, 1024, 0.3);
       const Timed feat = run_timed(*cl, batch, fp, 16384, 0.3);
+      put_distribution(rows.emplace_back(), opencl::noise_draws(*rt, f, m, model.seed, 0, draw_scenarios, kDrawCells));
+      const bool images_own_features = o.classifier && img.out.features != feat.out.features;
+      BatchOutput img2;
+      if (images_own_features) cl->run(case2, ip, img2);
       add_row(tier_name(t), t, feat.rate, img.rate, compare_outputs(img.out, ref.out),
-              compare_outputs(feat.out, ref.out), feat.out, case2_features(*cl, fp));
+              compare_outputs(feat.out, ref.out), feat.out, case2_features(*cl, fp),
+              images_own_features ? &img.out : nullptr, images_own_features ? &img2 : nullptr, &img.out);
     }
   }
 
@@ -323,19 +409,25 @@ int tradeoff(TradeoffOptions& o) {
   std::string csv =
       "model,tier,precision,features_per_s,images_per_s,mmw_max_abs,mmw_rmse_mean,mmw_psnr_db,"
       "mmw_share_off_by_more_than_1,ir_max_abs,feature_max_abs,feature_mean_abs,metal_exact_rate,label_exact_rate,"
-      "j48_accuracy,j48_case2_accuracy,within_tolerance\n";
+      "j48_accuracy,j48_case2_accuracy,within_tolerance,noise_draw,noise_sd,noise_skewness,noise_excess_kurtosis,"
+      "noise_ks,noise_max_abs,j48_images_accuracy,j48_images_case2_accuracy\n";
   auto opt = [](const json& v) { return v.is_null() ? std::string() : std::to_string(v.get<double>()); };
   for (const json& r : rows) {
-    char line[512];
-    std::snprintf(line, sizeof line, "%s,%s,%s,%.0f,%.0f,%d,%.6f,%.3f,%.8f,%d,%.6g,%.6g,%.6f,%.6f,%s,%s,%s\n",
-                  r["model"].get<std::string>().c_str(), r["name"].get<std::string>().c_str(),
-                  r["precision"].get<std::string>().c_str(), r["features_per_s"].get<double>(),
-                  r["images_per_s"].get<double>(), r["mmw_max_abs"].get<int>(), r["mmw_rmse_mean"].get<double>(),
-                  r["mmw_psnr_db"].get<double>(), r["mmw_share_off_by_more_than_1"].get<double>(),
-                  r["ir_max_abs"].get<int>(), r["feature_max_abs"].get<double>(), r["feature_mean_abs"].get<double>(),
-                  r["metal_exact_rate"].get<double>(), r["label_exact_rate"].get<double>(),
-                  opt(r["j48_accuracy"]).c_str(), opt(r["j48_case2_accuracy"]).c_str(),
-                  r["within_tolerance"].get<bool>() ? "yes" : "no");
+    char line[768];
+    std::snprintf(
+        line, sizeof line,
+        "%s,%s,%s,%.0f,%.0f,%d,%.6f,%.3f,%.8f,%d,%.6g,%.6g,%.6f,%.6f,%s,%s,%s,%s,%.6f,%.6f,%.6f,%.6f,%.4f,%s,"
+        "%s\n",
+        r["model"].get<std::string>().c_str(), r["name"].get<std::string>().c_str(),
+        r["precision"].get<std::string>().c_str(), r["features_per_s"].get<double>(), r["images_per_s"].get<double>(),
+        r["mmw_max_abs"].get<int>(), r["mmw_rmse_mean"].get<double>(), r["mmw_psnr_db"].get<double>(),
+        r["mmw_share_off_by_more_than_1"].get<double>(), r["ir_max_abs"].get<int>(), r["feature_max_abs"].get<double>(),
+        r["feature_mean_abs"].get<double>(), r["metal_exact_rate"].get<double>(), r["label_exact_rate"].get<double>(),
+        opt(r["j48_accuracy"]).c_str(), opt(r["j48_case2_accuracy"]).c_str(),
+        r["within_tolerance"].get<bool>() ? "yes" : "no", r["noise_draw"].get<std::string>().c_str(),
+        r["noise_sd"].get<double>(), r["noise_skewness"].get<double>(), r["noise_excess_kurtosis"].get<double>(),
+        r["noise_ks"].get<double>(), r["noise_max_abs"].get<double>(), opt(r["j48_images_accuracy"]).c_str(),
+        opt(r["j48_images_case2_accuracy"]).c_str());
     csv += line;
   }
   write_text_atomic(folder.path("tradeoff.csv"), csv);

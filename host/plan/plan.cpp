@@ -69,6 +69,7 @@ Fidelity tier_fidelity(Tier t) {
       f.precision = Precision::fixed16;
       f.fast_math = true;
       f.noise = NoiseModel::block_mean;
+      f.draw = NoiseDraw::irwin_hall;
       break;
   }
   return f;

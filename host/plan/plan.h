@@ -73,6 +73,10 @@ enum class Precision { fp32, fp64, fixed16 };
 // Per-pixel sensor noise, or (features-only runs) its effect on each mean drawn
 // directly: N(0, sigma^2 / pixels), ignoring rounding and clipping.
 enum class NoiseModel { per_pixel, block_mean };
+// How the thesis model's per-pixel sensor noise is drawn (docs/model/determinism.md):
+// Box-Muller, two pixels to a Philox draw; or Irwin-Hall, eight pixels to a draw, the two
+// bytes of a 16-bit half summed and shaped by a quintic (not quite normal: |g| <= 3.37).
+enum class NoiseDraw { box_muller, irwin_hall };
 
 // The speed/accuracy knobs of the OpenCL backend (README, "Fidelity tiers"). None of
 // them changes what is modelled; each changes how closely the kernels follow the fp64
@@ -82,6 +86,7 @@ struct Fidelity {
   Pooling pooling = Pooling::sparse;
   bool fast_math = false;  // -cl-fast-relaxed-math
   NoiseModel noise = NoiseModel::per_pixel;
+  NoiseDraw draw = NoiseDraw::box_muller;
   // Camera views rendered by the fast view paths where their gates apply (backend/opencl/
   // paths/), or all by the chain of stage kernels, one launch per stage; the same bits.
   bool fused = true;

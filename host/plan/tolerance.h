@@ -105,6 +105,21 @@ inline constexpr std::array kTolerances{
     Bound{Model::physics, Tier::fast, Output::masks, 0, 0, 0, false, "one host function for both backends"},
 };
 
+// The Irwin-Hall pixel draw (noise_draw irwin-hall; docs/model/determinism.md): the kernels
+// compute it in float, the reference in double, from the same bits. |g| <= 3.37, where a
+// float ulp is 2.4e-7, and t, t^2, two fma()s and a multiply each round once: 5 half-ulps of
+// the largest value, 6e-7, with margin.
+inline constexpr double kIrwinHallDrawAbs = 2e-6;
+// Its distribution, exact over the 511 byte sums (determinism.md, worked in double): the
+// statistics that tests and `portalsim tradeoff` hold a sample of n draws to, each within 4
+// of its sampling sds (sd of the mean 1/sqrt(n), of the sd 1/sqrt(2n), of the skewness
+// sqrt(6/n), of the excess kurtosis sqrt(24/n)); the sample's KS distance from the normal
+// within the exact one plus the 0.001 critical value (compare_samples).
+struct DrawDistribution {
+  double mean, sd, skewness, excess_kurtosis, ks_from_normal;
+};
+inline constexpr DrawDistribution kIrwinHallDistribution{0.0, 1.0, 0.0, -0.010137, 0.0032609};
+
 inline const char* output_name(Output o) {
   switch (o) {
     case Output::pixels:

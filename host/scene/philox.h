@@ -40,6 +40,7 @@ enum Stream : uint32_t {
   kStreamIrNoise = PS_STREAM_IR_NOISE,
   kStreamTransform = PS_STREAM_TRANSFORM,
   kStreamFeatureNoise = PS_STREAM_FEATURE_NOISE,
+  kStreamPixelNoiseFast = PS_STREAM_PIXEL_NOISE_FAST,
   kStreamGenerate = PS_STREAM_GENERATE,
 };
 

@@ -32,8 +32,10 @@ nlohmann::json RunSpec::to_json() const {
   // the identity; knobs that never change a bit (pooling) are not.
   const Plan p = settings();
   j["tier"] = tier;
+  // noise_draw is absent at Box-Muller, as before it existed: standard and exact runs keep
+  // their identity and bytes; the fast tier's (Irwin-Hall) names it.
   for (const Knob& k : portalsim::knobs())
-    if (k.identity) j[k.key] = k.get(p);
+    if (k.identity && !(k.key == "noise_draw" && p.fidelity.draw == NoiseDraw::box_muller)) j[k.key] = k.get(p);
   return j;
 }
 

@@ -7,6 +7,7 @@ std::string build_options(const Fidelity& f) {
                   : f.precision == Precision::fixed16 ? "-DPRECISION_FIXED"
                                                       : "";
   if (f.fast_math) o += " -cl-fast-relaxed-math";
+  if (f.draw == NoiseDraw::irwin_hall) o += " -DNOISE_DRAW_IH";
   return o;
 }
 

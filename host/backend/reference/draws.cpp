@@ -36,23 +36,29 @@ double normal_quantile(double q) {
 
 // Cells go 128 to a block of 16 draws side by side: cell p is in block p / 128, draw
 // p % 16 of it, word (p % 128) / 32, half (p / 16) % 2 (low first).
-double table_gaussian(uint64_t seed, uint64_t index, uint32_t stream, int view, int p) {
+namespace {
+uint32_t cell_half(uint64_t seed, uint64_t index, uint32_t stream, int view, int p) {
   const uint32_t block = static_cast<uint32_t>(p) / 128, in_block = static_cast<uint32_t>(p) % 128;
   const uint32_t element = (static_cast<uint32_t>(view) << PS_PIXEL_NOISE_VIEW_SHIFT) | (16 * block + in_block % 16);
   const uint32_t word = draw(seed, index, stream, element)[in_block / 32];
-  const uint32_t half = (in_block / 16) % 2 == 0 ? word & 0xffffu : word >> 16;
-  const uint32_t k = half >> (16 - PS_GAUSS_BITS);
+  return (in_block / 16) % 2 == 0 ? word & 0xffffu : word >> 16;
+}
+}  // namespace
+
+double table_gaussian(uint64_t seed, uint64_t index, uint32_t stream, int view, int p) {
+  const uint32_t k = cell_half(seed, index, stream, view, p) >> (16 - PS_GAUSS_BITS);
   return normal_quantile((k + 0.5) / PS_GAUSS_TABLE);
 }
 
 // The cell's half as table_gaussian finds it, its bytes' sum through the quintic.
 double fast_gaussian(uint64_t seed, uint64_t index, uint32_t stream, int view, int p) {
-  const uint32_t block = static_cast<uint32_t>(p) / 128, in_block = static_cast<uint32_t>(p) % 128;
-  const uint32_t element = (static_cast<uint32_t>(view) << PS_PIXEL_NOISE_VIEW_SHIFT) | (16 * block + in_block % 16);
-  const uint32_t word = draw(seed, index, stream, element)[in_block / 32];
-  const uint32_t half = (in_block / 16) % 2 == 0 ? word & 0xffffu : word >> 16;
+  const uint32_t half = cell_half(seed, index, stream, view, p);
   const double t = (static_cast<double>(half & 0xffu) + static_cast<double>(half >> 8) - 255.0) / 255.0;
   return t * (PS_IH_C1 + t * t * (PS_IH_C3 + t * t * PS_IH_C5));
+}
+
+double pixel_irwin_hall(uint64_t seed, uint64_t index, int view, int p) {
+  return fast_gaussian(seed, index, kStreamPixelNoiseFast, view, p);
 }
 
 double pixel_gaussian(uint64_t seed, uint64_t index, int view, int p) {

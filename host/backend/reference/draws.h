@@ -23,4 +23,9 @@ double fast_gaussian(uint64_t seed, uint64_t index, uint32_t stream, int view, i
 // first two words of the draw of pixel pair p / 2, cosine for even p, sine for odd.
 double pixel_gaussian(uint64_t seed, uint64_t index, int view, int p);
 
+// The thesis model's per-pixel sensor noise under noise_draw irwin-hall (the fast tier), pixel
+// p of view `view`: the table Gaussians' 16-bit half of p in stream PS_STREAM_PIXEL_NOISE_FAST,
+// its two bytes summed to s, t = (s - 255) / 255, g = t (C1 + t^2 (C3 + t^2 C5)).
+double pixel_irwin_hall(uint64_t seed, uint64_t index, int view, int p);
+
 }  // namespace portalsim::reference

@@ -59,6 +59,7 @@ struct ViewScene {
   // The physics cameras' noise as the fast tier draws it (Plan::physics_draws_approximated):
   // the MMW frames as one draw of NETD / sqrt(frames), every draw fast_gaussian's.
   bool fast_draws = false;
+  NoiseDraw draw = NoiseDraw::box_muller;  // the plan's pixel noise draw (Fidelity::draw)
 };
 
 ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSettings& model, int view,

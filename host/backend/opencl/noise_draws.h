@@ -1,0 +1,18 @@
+// The unit draws of a sensor model's per-pixel noise as a fidelity variant's kernels make
+// them (kernels/sensor_noise.cl, noise_draws), for `portalsim tradeoff`'s distribution
+// columns: the thesis model's pixel noise (the variant's noise_draw), the physics model's
+// MMW raw-noise table Gaussians.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "backend/opencl/runtime.h"
+#include "plan/plan.h"
+
+namespace portalsim::opencl {
+
+// Pixels [0, cells) of view 0 of scenarios first .. first + scenarios - 1, scenario by scenario.
+std::vector<double> noise_draws(OpenCLRuntime& rt, const Fidelity& f, Model model, uint64_t seed, uint64_t first,
+                                size_t scenarios, int cells);
+
+}  // namespace portalsim::opencl
