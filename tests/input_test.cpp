@@ -329,12 +329,12 @@ TEST(ContainedRead, ReturnsTheChildsBytesAndTurnsItsDeathIntoAnInputError) {
                std::runtime_error);
 }
 
-// tests/fuzz/libhdf5/h5hg-read-overflow.h5 makes libhdf5 1.10.8 read past a heap buffer
+// tests/fuzz/crashes/h5/h5hg-read-overflow.h5 makes libhdf5 1.10.8 read past a heap buffer
 // (H5HG_read); both commands that read a user's data.h5 refuse it, naming it, with exit 3.
 TEST(InputFiles, DataH5ThatOverflowsLibhdf5IsRefusedNamingIt) {
   TempDir t;
   const fs::path h5 = t.w() / "data.h5";
-  spit(h5, slurp(fs::path(PORTALSIM_SOURCE_DIR) / "tests" / "fuzz" / "libhdf5" / "h5hg-read-overflow.h5"));
+  spit(h5, slurp(fs::path(PORTALSIM_SOURCE_DIR) / "tests" / "fuzz" / "crashes" / "h5" / "h5hg-read-overflow.h5"));
   const fs::path out = t.w() / "out";
   ExpectExit(run(t, {"validate", "--sim", h5.string(), "--real", h5.string(), "--out", out.string()}), 3,
              {h5.string() + ": "});

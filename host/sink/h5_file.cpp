@@ -456,7 +456,7 @@ void write_h5(const std::string& dir, const H5Layout& layout, const std::vector<
 namespace {
 
 // The two readers below run in a child (io::read_contained): libhdf5 1.10.8 reads past a
-// heap buffer on some corrupt files (tests/fuzz/libhdf5/), and any data.h5 may be foreign.
+// heap buffer on some corrupt files (tests/fuzz/crashes/h5/), and any data.h5 may be foreign.
 H5Layout layout_here(const std::string& path) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   Ids ids;
