@@ -329,17 +329,23 @@ TEST(ContainedRead, ReturnsTheChildsBytesAndTurnsItsDeathIntoAnInputError) {
                std::runtime_error);
 }
 
-// tests/fuzz/crashes/h5/h5hg-read-overflow.h5 makes libhdf5 1.10.8 read past a heap buffer
-// (H5HG_read); both commands that read a user's data.h5 refuse it, naming it, with exit 3.
-TEST(InputFiles, DataH5ThatOverflowsLibhdf5IsRefusedNamingIt) {
+// Two data.h5 files that break libhdf5 1.10.8 (tests/fuzz/crashes/h5/): one makes it read
+// past a heap buffer (H5HG_read), one makes it spin for ever. Both commands that read a
+// user's data.h5 refuse them, naming them, with exit 3; the spin ends at the child's CPU
+// limit (5 s), the run's limit below is a hang detector.
+TEST(InputFiles, DataH5ThatBreaksLibhdf5IsRefusedNamingIt) {
   TempDir t;
-  const fs::path h5 = t.w() / "data.h5";
-  spit(h5, slurp(fs::path(PORTALSIM_SOURCE_DIR) / "tests" / "fuzz" / "crashes" / "h5" / "h5hg-read-overflow.h5"));
+  const fs::path crashes = fs::path(PORTALSIM_SOURCE_DIR) / "tests" / "fuzz" / "crashes" / "h5";
+  const fs::path h5 = t.w() / "data.h5", spins = t.w() / "spins.h5";
+  spit(h5, slurp(crashes / "h5hg-read-overflow.h5"));
+  spit(spins, slurp(crashes / "libhdf5-spins.h5"));
   const fs::path out = t.w() / "out";
   ExpectExit(run(t, {"validate", "--sim", h5.string(), "--real", h5.string(), "--out", out.string()}), 3,
              {h5.string() + ": "});
   ExpectExit(run(t, {"calibrate", "--real", h5.string(), "--out", (out / "camera.toml").string()}), 3,
              {h5.string() + ": "});
+  ExpectExit(run(t, {"validate", "--sim", spins.string(), "--real", spins.string(), "--out", out.string()}, 300), 3,
+             {spins.string() + ": libhdf5 died reading it (signal 24"});
   EXPECT_FALSE(fs::exists(out));
 }
 

@@ -1,5 +1,7 @@
 #include "io/contained.h"
 
+#include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -29,9 +31,21 @@ bool write_all(int fd, const char* p, size_t n) {
   return true;
 }
 
-[[noreturn]] void child(int fd, const std::function<std::string()>& read) {
+// CPU seconds a child may use: 5, and 1 more per 16 MiB of the file. Reading a data.h5's
+// layout takes milliseconds, and 16 MiB of its rows (gzip) a tenth of a second; libhdf5
+// spins for ever on some damaged files (tests/fuzz/crashes/h5/libhdf5-spins.h5), and
+// SIGXCPU then ends the child.
+rlim_t cpu_seconds(const std::string& path) {
+  struct stat st {};
+  const uint64_t bytes = ::stat(path.c_str(), &st) == 0 ? static_cast<uint64_t>(st.st_size) : 0;
+  return static_cast<rlim_t>(5 + (bytes >> 24));
+}
+
+[[noreturn]] void child(int fd, rlim_t cpu_limit, const std::function<std::string()>& read) {
   // A crash ends the child with its signal, whatever handlers the parent set.
-  for (int s : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL}) std::signal(s, SIG_DFL);
+  for (int s : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL, SIGXCPU}) std::signal(s, SIG_DFL);
+  const rlimit cpu{cpu_limit, cpu_limit + 1};
+  ::setrlimit(RLIMIT_CPU, &cpu);
   if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(nullptr);
   std::string out;
   try {
@@ -59,6 +73,7 @@ std::string how_it_ended(int status) {
 }  // namespace
 
 std::string read_contained(const std::string& path, const std::string& what, const std::function<std::string()>& read) {
+  const rlim_t cpu_limit = cpu_seconds(path);
   int fds[2];
   if (::pipe(fds) != 0) throw std::runtime_error("cannot make a pipe: " + std::string(std::strerror(errno)));
   const pid_t pid = ::fork();
@@ -69,7 +84,7 @@ std::string read_contained(const std::string& path, const std::string& what, con
   }
   if (pid == 0) {
     ::close(fds[0]);
-    child(fds[1], read);
+    child(fds[1], cpu_limit, read);
   }
   ::close(fds[1]);
   std::string got;
