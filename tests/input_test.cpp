@@ -332,7 +332,7 @@ TEST(ContainedRead, ReturnsTheChildsBytesAndTurnsItsDeathIntoAnInputError) {
 // Two data.h5 files that break libhdf5 1.10.8 (tests/fuzz/crashes/h5/): one makes it read
 // past a heap buffer (H5HG_read), one makes it spin for ever. Both commands that read a
 // user's data.h5 refuse them, naming them, with exit 3; the spin ends at the child's CPU
-// limit (5 s), the run's limit below is a hang detector.
+// limit (2 s), the run's limit below is a hang detector.
 TEST(InputFiles, DataH5ThatBreaksLibhdf5IsRefusedNamingIt) {
   TempDir t;
   const fs::path crashes = fs::path(PORTALSIM_SOURCE_DIR) / "tests" / "fuzz" / "crashes" / "h5";

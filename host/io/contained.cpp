@@ -31,14 +31,14 @@ bool write_all(int fd, const char* p, size_t n) {
   return true;
 }
 
-// CPU seconds a child may use: 5, and 1 more per 16 MiB of the file. Reading a data.h5's
+// CPU seconds a child may use: 2, and 1 more per 16 MiB of the file. Reading a data.h5's
 // layout takes milliseconds, and 16 MiB of its rows (gzip) a tenth of a second; libhdf5
 // spins for ever on some damaged files (tests/fuzz/crashes/h5/libhdf5-spins.h5), and
 // SIGXCPU then ends the child.
 rlim_t cpu_seconds(const std::string& path) {
   struct stat st {};
   const uint64_t bytes = ::stat(path.c_str(), &st) == 0 ? static_cast<uint64_t>(st.st_size) : 0;
-  return static_cast<rlim_t>(5 + (bytes >> 24));
+  return static_cast<rlim_t>(2 + (bytes >> 24));
 }
 
 [[noreturn]] void child(int fd, rlim_t cpu_limit, const std::function<std::string()>& read) {

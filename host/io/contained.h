@@ -13,7 +13,7 @@ namespace portalsim::io {
 // there is thrown here with its message, any other exception as std::runtime_error. A
 // child that ends any other way (a signal, a sanitizer's report, an exit) is an InputError
 // naming `path`: the file is damaged, or not one `what` can read. A child that spins is
-// ended after 5 s of CPU time and 1 s more per 16 MiB of `path` (SIGXCPU). The child ends with _exit, so it flushes
+// ended after 2 s of CPU time and 1 s more per 16 MiB of `path` (SIGXCPU). The child ends with _exit, so it flushes
 // nothing the parent holds open.
 std::string read_contained(const std::string& path, const std::string& what, const std::function<std::string()>& read);
 
