@@ -8,12 +8,15 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "base/error.h"
 #include "fuzz/targets.h"
+#include "io/contained.h"
 #include "io/input_file.h"
 #include "io/toml_input.h"
 #include "run_binary.h"
@@ -293,6 +296,57 @@ TEST(InputFiles, ImageDeclaringTooManyPixelsIsRefusedBeforeDecoding) {
   // fail with the decoder's own message instead, which names no size.
   ExpectExit(run(t, {"features", dir.string(), "--out", (t.w() / "f.csv").string()}, 30), 3,
              {(dir / "upper.png").string(), "16384x16384"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Foreign data.h5 files: libhdf5 reads them in a child (io/contained.h), so its crash on a
+// damaged file is that file's input error.
+
+// The message of the InputError that read_contained throws, or "" when it returns.
+std::string contained_error(const std::function<std::string()>& read) {
+  try {
+    portalsim::io::read_contained("f.h5", "libhdf5", read);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ContainedRead, ReturnsTheChildsBytesAndTurnsItsDeathIntoAnInputError) {
+  std::string big(1 << 20, 'a');  // more than a pipe holds
+  big[12345] = '\0';
+  EXPECT_EQ(portalsim::io::read_contained("f.h5", "libhdf5", [&] { return big; }), big);
+  EXPECT_EQ(contained_error([]() -> std::string { throw InputError("f.h5: dataset x is missing"); }),
+            "f.h5: dataset x is missing");
+  EXPECT_TRUE(has(contained_error([]() -> std::string {
+                    std::raise(SIGSEGV);
+                    return "";
+                  }),
+                  "f.h5: libhdf5 died reading it (signal 11"));
+  EXPECT_TRUE(
+      has(contained_error([]() -> std::string { ::_exit(0); }), "f.h5: libhdf5 died reading it (exit status 0)"));
+  EXPECT_THROW(portalsim::io::read_contained("f.h5", "libhdf5", []() -> std::string { throw std::logic_error("bug"); }),
+               std::runtime_error);
+}
+
+// Two data.h5 files that break libhdf5 1.10.8 (tests/fuzz/crashes/h5/): one makes it read
+// past a heap buffer (H5HG_read), one makes it spin for ever. Both commands that read a
+// user's data.h5 refuse them, naming them, with exit 3; the spin ends at the child's CPU
+// limit (2 s), the run's limit below is a hang detector.
+TEST(InputFiles, DataH5ThatBreaksLibhdf5IsRefusedNamingIt) {
+  TempDir t;
+  const fs::path crashes = fs::path(PORTALSIM_SOURCE_DIR) / "tests" / "fuzz" / "crashes" / "h5";
+  const fs::path h5 = t.w() / "data.h5", spins = t.w() / "spins.h5";
+  spit(h5, slurp(crashes / "h5hg-read-overflow.h5"));
+  spit(spins, slurp(crashes / "libhdf5-spins.h5"));
+  const fs::path out = t.w() / "out";
+  ExpectExit(run(t, {"validate", "--sim", h5.string(), "--real", h5.string(), "--out", out.string()}), 3,
+             {h5.string() + ": "});
+  ExpectExit(run(t, {"calibrate", "--real", h5.string(), "--out", (out / "camera.toml").string()}), 3,
+             {h5.string() + ": "});
+  ExpectExit(run(t, {"validate", "--sim", spins.string(), "--real", spins.string(), "--out", out.string()}, 300), 3,
+             {spins.string() + ": libhdf5 died reading it (signal 24"});
+  EXPECT_FALSE(fs::exists(out));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -173,5 +173,31 @@ TEST(OpenCLRuntime, APoclCacheThatIsAFileIsNamed) {
   EXPECT_FALSE(fs::exists(t.w() / "o"));
 }
 
+// PORTALSIM_KERNEL_PROGRAM (tools/mutate.sh) replaces the built-in program with a file's:
+// the file is what PoCL builds, and a file that cannot be read is named (exit 5).
+TEST(OpenCLRuntime, KernelProgramFromTheEnvironmentIsTheOneBuilt) {
+  namespace fs = std::filesystem;
+  test::TempDir t;
+  const std::string program = OpenCLRuntime::source();
+  ASSERT_NE(program.find("kernel void stage_window"), std::string::npos);
+  test::spit(t.w() / "same.cl", program);
+  test::spit(t.w() / "broken.cl", program + "\nthis is not OpenCL\n");
+  const auto simulate = [&](const fs::path& file, const std::string& out) {
+    return test::finish(test::start_program(t.cap(), "/usr/bin/env",
+                                            {"PORTALSIM_KERNEL_PROGRAM=" + file.string(), PORTALSIM_BINARY, "simulate",
+                                             "gun", "--out", (t.w() / out).string()}));
+  };
+  const test::Result same = simulate(t.w() / "same.cl", "same");
+  EXPECT_TRUE(same.exited && same.status == 0) << test::describe(same);
+  const test::Result broken = simulate(t.w() / "broken.cl", "broken");
+  EXPECT_TRUE(broken.exited && broken.status != 0) << test::describe(broken);
+  EXPECT_NE(broken.err.find("OpenCL program build failed"), std::string::npos) << broken.err;
+  const test::Result missing = simulate(t.w() / "missing.cl", "missing");
+  EXPECT_TRUE(missing.exited && missing.status == 5) << test::describe(missing);
+  EXPECT_NE(missing.err.find("PORTALSIM_KERNEL_PROGRAM=" + (t.w() / "missing.cl").string()), std::string::npos)
+      << missing.err;
+  EXPECT_FALSE(fs::exists(t.w() / "broken") || fs::exists(t.w() / "missing"));
+}
+
 }  // namespace
 }  // namespace portalsim

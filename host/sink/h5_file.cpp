@@ -13,8 +13,10 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <stdexcept>
 
 #include "base/error.h"
+#include "io/contained.h"
 
 namespace portalsim {
 
@@ -451,7 +453,11 @@ void write_h5(const std::string& dir, const H5Layout& layout, const std::vector<
   if (ec) throw OutputError(final_path + ": cannot move into place: " + ec.message());
 }
 
-H5Layout read_h5_layout(const std::string& path) {
+namespace {
+
+// The two readers below run in a child (io::read_contained): libhdf5 1.10.8 reads past a
+// heap buffer on some corrupt files (tests/fuzz/crashes/h5/), and any data.h5 may be foreign.
+H5Layout layout_here(const std::string& path) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   Ids ids;
   const hid_t file = ids.keep(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
@@ -512,7 +518,8 @@ H5Layout read_h5_layout(const std::string& path) {
   return layout;
 }
 
-void read_h5_rows(const std::string& path, const H5Dataset& t, uint64_t first, uint64_t n, char* out) {
+void rows_here(const std::string& path, const H5Dataset& t, uint64_t first, uint64_t n, char* out) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   Ids ids;
   const hid_t file = ids.keep(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
   if (file < 0) throw InputError(path + ": cannot open");
@@ -527,6 +534,71 @@ void read_h5_rows(const std::string& path, const H5Dataset& t, uint64_t first, u
   if (H5Dread(ds, type_info(t.type).memory, mspace, fspace, H5P_DEFAULT, out) < 0)
     throw InputError(path + ": dataset " + t.name + ": cannot read rows " + std::to_string(first) + ".." +
                      std::to_string(first + n));
+}
+
+void pack(io::Packer& p, const H5Layout& l) {
+  p.u64(l.rows);
+  p.u64(l.compress);
+  p.u64(l.attributes.size());
+  for (const H5Attribute& a : l.attributes) {
+    p.str(a.name);
+    p.strs(a.values);
+    p.u64(a.scalar);
+  }
+  p.u64(l.datasets.size());
+  for (const H5Dataset& d : l.datasets) {
+    p.str(d.name);
+    p.u64(static_cast<uint64_t>(d.type));
+    p.u64(d.dims.size());
+    for (uint64_t v : d.dims) p.u64(v);
+    p.strs(d.columns);
+  }
+}
+
+H5Layout unpack(io::Unpacker& u) {
+  H5Layout l;
+  l.rows = u.u64();
+  l.compress = u.u64() != 0;
+  l.attributes.resize(u.u64());
+  for (H5Attribute& a : l.attributes) {
+    a.name = u.str();
+    a.values = u.strs();
+    a.scalar = u.u64() != 0;
+  }
+  l.datasets.resize(u.u64());
+  for (H5Dataset& d : l.datasets) {
+    d.name = u.str();
+    d.type = static_cast<TensorType>(u.u64());
+    d.dims.resize(u.u64());
+    for (uint64_t& v : d.dims) v = u.u64();
+    d.columns = u.strs();
+  }
+  return l;
+}
+
+}  // namespace
+
+H5Layout read_h5_layout(const std::string& path) {
+  const std::string bytes = io::read_contained(path, "libhdf5", [&] {
+    io::Packer p;
+    pack(p, layout_here(path));
+    return p.bytes;
+  });
+  io::Unpacker u(bytes);
+  H5Layout l = unpack(u);
+  if (!u.done()) throw std::runtime_error(path + ": the contained reader sent back more than a layout");
+  return l;
+}
+
+void read_h5_rows(const std::string& path, const H5Dataset& t, uint64_t first, uint64_t n, char* out) {
+  const size_t bytes = static_cast<size_t>(n * t.row_bytes());
+  const std::string rows = io::read_contained(path, "libhdf5", [&] {
+    std::string b(bytes, '\0');
+    rows_here(path, t, first, n, b.data());
+    return b;
+  });
+  if (rows.size() != bytes) throw std::runtime_error(path + ": the contained reader sent back the wrong row count");
+  std::memcpy(out, rows.data(), bytes);
 }
 
 }  // namespace portalsim

@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string_view>
 
@@ -18,7 +20,19 @@ namespace embedded {
 extern const std::string_view kernel_program;
 }
 
-std::string OpenCLRuntime::source() { return std::string(embedded::kernel_program); }
+// PORTALSIM_KERNEL_PROGRAM names a file that replaces the built-in program as a whole:
+// tools/mutate.sh runs the suites on mutated kernels this way, without a relink.
+std::string OpenCLRuntime::source() {
+  const char* file = std::getenv("PORTALSIM_KERNEL_PROGRAM");
+  if (!file || !*file) return std::string(embedded::kernel_program);
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in || text.str().empty())
+    throw EnvironmentError(std::string("PORTALSIM_KERNEL_PROGRAM=") + file +
+                           ": cannot read a kernel program there; unset it to use the built-in kernels");
+  return text.str();
+}
 
 namespace {
 // Where PoCL keeps compiled kernels: POCL_CACHE_DIR, else $XDG_CACHE_HOME/pocl, else ~/.cache/pocl.

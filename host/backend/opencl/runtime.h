@@ -41,7 +41,10 @@ class OpenCLRuntime {
   bool has_fp64() const;  // the device offers cl_khr_fp64
   OpenCLDeviceInfo info() const;
   double build_seconds() const { return build_seconds_; }
-  static std::string source();  // kernels/shared.h and the kernels/ files, in CMakeLists.txt's order
+  // kernels/shared.h and the kernels/ files, in CMakeLists.txt's order; or the file
+  // PORTALSIM_KERNEL_PROGRAM names (tools/mutate.sh). Throws EnvironmentError where that
+  // cannot be read.
+  static std::string source();
 
  private:
   [[noreturn]] void build_failed(const cl::Program& p, const std::string& options) const;
