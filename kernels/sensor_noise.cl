@@ -275,27 +275,3 @@ kernel void stage_sensor_noise(VIEW_STAGE_ARGS) {
   }
 #endif
 }
-
-// The unit draws of a sensor model's per-pixel noise as this build makes them (`portalsim
-// tradeoff`'s distribution columns): pixels [0, cells) of view 0 of scenario first + i, one
-// work-item per scenario. Thesis: the pixel noise (Box-Muller, or Irwin-Hall under
-// NOISE_DRAW_IH); physics: the MMW raw noise's table Gaussians (table: the host's quantiles).
-kernel void noise_draws(uint seed_lo, uint seed_hi, ulong first, int physics, int cells, global const param* table,
-                        global float* out) {
-  const size_t i = get_global_id(0);
-  const uint2 seed = (uint2)(seed_lo, seed_hi);
-  const ulong index = first + i;
-  global float* o = out + i * (size_t)cells;
-  for (int p = 0; p < cells; ++p) {
-    if (physics) {
-      o[p] = (float)gauss_cell(seed, index, PS_STREAM_RAW_NOISE, 0, p, table);
-      continue;
-    }
-#if defined(NOISE_DRAW_IH)
-    o[p] = (float)ih_pixel(seed, index, 0, p);
-#else
-    const greal2 g = gauss_pair(seed, index, 0, p >> 1);
-    o[p] = (float)((p & 1) ? g.y : g.x);
-#endif
-  }
-}

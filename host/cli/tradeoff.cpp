@@ -156,7 +156,7 @@ SceneBatch thesis_case(const Catalogue& cat, int which, uint64_t seed, uint64_t 
 }
 
 // The noise's distribution columns: the unit draws of the model's per-pixel noise (thesis:
-// pixel noise; physics: the MMW raw noise's table Gaussians) over up to 2,048 scenarios of
+// pixel noise; physics: the MMW raw noise, table Gaussians or the fast tier's draws) over up to 2,048 scenarios of
 // 512 pixels, as the fp64 reference (no tier) or the tier's kernels make them.
 constexpr size_t kDrawScenarios = 2048;
 constexpr int kDrawCells = 512;
@@ -260,9 +260,9 @@ int tradeoff(TradeoffOptions& o) {
       r["model"] = mname;
       r["name"] = name;
       // What the noise's distribution columns sample (put_distribution).
-      r["noise_draw"] = m == Model::physics                                          ? "table Gaussian"
-                        : tier && tier_fidelity(*tier).draw == NoiseDraw::irwin_hall ? "irwin-hall"
-                                                                                     : "box-muller";
+      const bool irwin_hall = tier && (m == Model::physics ? opencl::physics_fast_draws(tier_fidelity(*tier))
+                                                           : tier_fidelity(*tier).draw == NoiseDraw::irwin_hall);
+      r["noise_draw"] = irwin_hall ? "irwin-hall" : m == Model::physics ? "table Gaussian" : "box-muller";
       r["features_per_s"] = feat_rate;
       r["images_per_s"] = img_rate;
       r["mmw_max_abs"] = img_err.mmw.max_abs;
