@@ -40,17 +40,17 @@
 
 /* Random streams of the counter generator: each kind of draw has its own, so adding one
  * never shifts another. element = the index within the stream named beside it. */
-#define PS_STREAM_NOISE_PATTERN 1u /* which MMW noise pattern a scenario gets; element 0 */
-#define PS_STREAM_METAL_NOISE 2u   /* metal detector noise; element = zone */
-#define PS_STREAM_PIXEL_NOISE 3u   /* per-pixel sensor noise; element = view << 28 | pixel / 2 */
-#define PS_STREAM_BLOCK_NOISE 4u   /* block-mean noise model; element = feature */
-#define PS_STREAM_JITTER 5u        /* sprite placement jitter; element = region */
-#define PS_STREAM_RAW_NOISE 6u     /* physics: MMW noise per raw pixel; element: PS_GAUSS_ELEMENT */
-#define PS_STREAM_IR_NOISE 7u      /* physics: IR noise per pixel; element: PS_GAUSS_ELEMENT */
-#define PS_STREAM_TRANSFORM 8u     /* randomised objects: rotation, scale, flip; element = region */
-#define PS_STREAM_FEATURE_NOISE 9u /* physics features-only: NETD noise in feature space; PS_GAUSS_ELEMENT */
+#define PS_STREAM_NOISE_PATTERN 1u     /* which MMW noise pattern a scenario gets; element 0 */
+#define PS_STREAM_METAL_NOISE 2u       /* metal detector noise; element = zone */
+#define PS_STREAM_PIXEL_NOISE 3u       /* per-pixel sensor noise; element = view << 28 | pixel / 2 */
+#define PS_STREAM_BLOCK_NOISE 4u       /* block-mean noise model; element = feature */
+#define PS_STREAM_JITTER 5u            /* sprite placement jitter; element = region */
+#define PS_STREAM_RAW_NOISE 6u         /* physics: MMW noise per raw pixel; element: PS_GAUSS_ELEMENT */
+#define PS_STREAM_IR_NOISE 7u          /* physics: IR noise per pixel; element: PS_GAUSS_ELEMENT */
+#define PS_STREAM_TRANSFORM 8u         /* randomised objects: rotation, scale, flip; element = region */
+#define PS_STREAM_FEATURE_NOISE 9u     /* physics features-only: NETD noise in feature space; PS_GAUSS_ELEMENT */
 #define PS_STREAM_PIXEL_NOISE_FAST 10u /* per-pixel sensor noise, Irwin-Hall draws; PS_GAUSS_ELEMENT */
-#define PS_STREAM_GENERATE 16u     /* scenario generators (host only) */
+#define PS_STREAM_GENERATE 16u         /* scenario generators (host only) */
 /* physics: frame k >= 1 of the MMW camera's integration draws its NETD from stream
  * PS_STREAM_FRAME_NOISE + k (frame 0 from PS_STREAM_RAW_NOISE); element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_FRAME_NOISE 32u
@@ -79,9 +79,9 @@
 #define PS_FLAG_PATTERN_NOISE 1
 #define PS_FLAG_PIXEL_NOISE 2
 #define PS_FLAG_BILINEAR 4
-#define PS_FLAG_AFFINE 8     /* randomised objects: sprites sampled through their inverse affine map */
-#define PS_FLAG_FLIP 16      /* with PS_FLAG_AFFINE: mirror each object with probability 1/2 */
-#define PS_FLAG_TABULATED 32 /* physics features-only: scenarios the object tables cover skip physics_raw */
+#define PS_FLAG_AFFINE 8      /* randomised objects: sprites sampled through their inverse affine map */
+#define PS_FLAG_FLIP 16       /* with PS_FLAG_AFFINE: mirror each object with probability 1/2 */
+#define PS_FLAG_TABULATED 32  /* physics features-only: scenarios the object tables cover skip physics_raw */
 #define PS_FLAG_FAST_DRAWS 64 /* physics: NETD and IR noise as Irwin-Hall draws (PS_IH_*), not the table */
 
 /* Footprint record of the sparse features path, per (variant, region, subject), ints. */

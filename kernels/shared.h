@@ -28,7 +28,7 @@
  * RW), 32 values of room for whole-vector stores, then the raw grid in rows of 32; or (the
  * fast tier's display) each raw row interpolated along x, RH rows of W rounded up to 16. */
 #define PS_MMW_ROWS_SCRATCH(H, RW, RH) ((size_t)(H) * (size_t)(RW) + 32 + 32 * (size_t)(RH))
-#define PS_MMW_DISPLAY_SCRATCH(W, H, RW, RH)                                                \
+#define PS_MMW_DISPLAY_SCRATCH(W, H, RW, RH)                                      \
   (PS_MMW_ROWS_SCRATCH(H, RW, RH) > (size_t)(RH) * (size_t)(((W) + 15) / 16 * 16) \
        ? PS_MMW_ROWS_SCRATCH(H, RW, RH)                                           \
        : (size_t)(RH) * (size_t)(((W) + 15) / 16 * 16))

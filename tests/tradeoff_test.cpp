@@ -168,9 +168,9 @@ void errors_are_against_the_same_models_reference(const json& report, const fs::
 
 // The noise's distribution columns are measured per row, from the draws each row's code
 // makes: the fast tier's draws are Irwin-Hall in both models (bounded at 3.365), the others
-// Box-Muller (thesis) or table Gaussians (physics); every sample's moments and KS distance are a unit normal's within sampling
-// error (plus the Irwin-Hall draw's own, plan/tolerance.h). Its images are held to the
-// reference following its draws, and J48 scores the features of its images.
+// Box-Muller (thesis) or table Gaussians (physics); every sample's moments and KS distance are a unit normal's within
+// sampling error (plus the Irwin-Hall draw's own, plan/tolerance.h). Its images are held to the reference following its
+// draws, and J48 scores the features of its images.
 void noise_columns_are_measured(const json& report, const fs::path& out) {
   for (const json& r : report["rows"]) {
     SCOPED_TRACE(r["model"].get<std::string>() + " " + r["name"].get<std::string>());
