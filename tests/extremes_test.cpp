@@ -943,6 +943,30 @@ TEST(ExtremeImageSize, OddViewsEndTheFastTiersNoisyRunsAlike) {
   }
 }
 
+// The standard tier's Box-Muller pixel noise on odd views: the fused kernel's row path (an
+// odd width makes rows start mid-pair) equals the chain of stage kernels, whose noise stage
+// finds each pixel's pair on its own, pixel by pixel.
+TEST(ExtremeImageSize, OddViewsPairTheBoxMullerNoiseAsTheStages) {
+  std::string text = default_text();
+  for (const char* key : {"mmw_width", "ir_width"}) text = set_image_key(text, key, "37");
+  for (const char* key : {"mmw_height", "ir_height"}) text = set_image_key(text, key, "23");
+  text = map_rects(text, [](int, bool, Rect) { return Rect{0, 0, 37, 23}; });
+  auto w = make_world(text);
+  const SceneBatch batch = test::batch_of(coverage(w->cat, 40, 4), 7);
+  Plan plan = images_plan(model(63, true, 3.0, 1), Tier::standard);
+  ASSERT_EQ(plan.fidelity.draw, NoiseDraw::box_muller);
+  BatchOutput fused, staged, ref;
+  w->cl->run(batch, plan, fused);
+  w->ref->run(batch, plan, ref);
+  EXPECT_EQ(check_tolerance(compare_outputs(fused, ref), model_tolerance(Model::thesis, Tier::standard)), "");
+  plan.fidelity.fused = false;
+  w->cl->run(batch, plan, staged);
+  for (size_t k = 0; k < fused.views.size(); ++k) {
+    ASSERT_EQ(fused.views[k].pixels.size(), batch.size() * 37 * 23) << fused.views[k].name;
+    EXPECT_EQ(fused.views[k].pixels, staged.views[k].pixels) << fused.views[k].name;
+  }
+}
+
 // A 4096x4096 catalogue: the default's rectangles, object sizes and noise tile scaled by 20
 // (IR 2048x4096), one subject to keep the procedural images quick.
 World& world_4096() {
