@@ -918,23 +918,22 @@ TEST(ExtremeImageSize, OneByOne) {
   }
 }
 
-// Views of 37x23 pixels (851, not a multiple of 16): the fast tier's Irwin-Hall vector path
-// ends on a run of 16 that overlaps the one before it, its draws taken pixel by pixel. The
-// fused kernel equals the chain of stage kernels to the bit, and the reference following
-// the draws within the tier's bounds.
-TEST(ExtremeImageSize, OddViewsEndTheFastTiersNoisyRunsAlike) {
+// Views of 37x23 pixels (851, odd and not a multiple of 16), noisy in `tier`, whose draw is
+// `draw`: the fused kernel equals the chain of stage kernels to the bit, and the reference
+// following the draws within the tier's bounds.
+void odd_views_render_as_the_stages(Tier tier, NoiseDraw draw) {
   std::string text = default_text();
   for (const char* key : {"mmw_width", "ir_width"}) text = set_image_key(text, key, "37");
   for (const char* key : {"mmw_height", "ir_height"}) text = set_image_key(text, key, "23");
   text = map_rects(text, [](int, bool, Rect) { return Rect{0, 0, 37, 23}; });
   auto w = make_world(text);
   const SceneBatch batch = test::batch_of(coverage(w->cat, 40, 4), 7);
-  Plan plan = images_plan(model(63, true, 3.0, 1), Tier::fast);
-  ASSERT_EQ(plan.fidelity.draw, NoiseDraw::irwin_hall);
+  Plan plan = images_plan(model(63, true, 3.0, 1), tier);
+  ASSERT_EQ(plan.fidelity.draw, draw);
   BatchOutput fused, staged, ref;
   w->cl->run(batch, plan, fused);
   w->ref->run(batch, plan, ref);
-  EXPECT_EQ(check_tolerance(compare_outputs(fused, ref), model_tolerance(Model::thesis, Tier::fast)), "");
+  EXPECT_EQ(check_tolerance(compare_outputs(fused, ref), model_tolerance(Model::thesis, tier)), "");
   plan.fidelity.fused = false;
   w->cl->run(batch, plan, staged);
   for (size_t k = 0; k < fused.views.size(); ++k) {
@@ -943,28 +942,16 @@ TEST(ExtremeImageSize, OddViewsEndTheFastTiersNoisyRunsAlike) {
   }
 }
 
-// The standard tier's Box-Muller pixel noise on odd views: the fused kernel's row path (an
-// odd width makes rows start mid-pair) equals the chain of stage kernels, whose noise stage
-// finds each pixel's pair on its own, pixel by pixel.
+// The fast tier's Irwin-Hall vector path ends on a run of 16 that overlaps the one before
+// it, its draws taken pixel by pixel.
+TEST(ExtremeImageSize, OddViewsEndTheFastTiersNoisyRunsAlike) {
+  odd_views_render_as_the_stages(Tier::fast, NoiseDraw::irwin_hall);
+}
+
+// The standard tier's Box-Muller noise takes the fused kernel's row path, where an odd width
+// makes rows start mid-pair; the noise stage finds each pixel's pair on its own.
 TEST(ExtremeImageSize, OddViewsPairTheBoxMullerNoiseAsTheStages) {
-  std::string text = default_text();
-  for (const char* key : {"mmw_width", "ir_width"}) text = set_image_key(text, key, "37");
-  for (const char* key : {"mmw_height", "ir_height"}) text = set_image_key(text, key, "23");
-  text = map_rects(text, [](int, bool, Rect) { return Rect{0, 0, 37, 23}; });
-  auto w = make_world(text);
-  const SceneBatch batch = test::batch_of(coverage(w->cat, 40, 4), 7);
-  Plan plan = images_plan(model(63, true, 3.0, 1), Tier::standard);
-  ASSERT_EQ(plan.fidelity.draw, NoiseDraw::box_muller);
-  BatchOutput fused, staged, ref;
-  w->cl->run(batch, plan, fused);
-  w->ref->run(batch, plan, ref);
-  EXPECT_EQ(check_tolerance(compare_outputs(fused, ref), model_tolerance(Model::thesis, Tier::standard)), "");
-  plan.fidelity.fused = false;
-  w->cl->run(batch, plan, staged);
-  for (size_t k = 0; k < fused.views.size(); ++k) {
-    ASSERT_EQ(fused.views[k].pixels.size(), batch.size() * 37 * 23) << fused.views[k].name;
-    EXPECT_EQ(fused.views[k].pixels, staged.views[k].pixels) << fused.views[k].name;
-  }
+  odd_views_render_as_the_stages(Tier::standard, NoiseDraw::box_muller);
 }
 
 // A 4096x4096 catalogue: the default's rectangles, object sizes and noise tile scaled by 20
