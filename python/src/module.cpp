@@ -170,28 +170,16 @@ class Engine {
   // for mask_*, features and metal zones only when named. Each kept column's bytes are the
   // same as with every column made: no output depends on another being computed.
   void select(const std::vector<std::string>& names) {
-    std::vector<TensorColumn> kept;
-    std::vector<bool> found(names.size(), false);
-    for (TensorColumn& c : columns_)
-      for (size_t i = 0; i < names.size(); ++i)
-        if (names[i] == c.ds.name && !found[i]) {
-          found[i] = true;
-          kept.push_back(std::move(c));
-          break;
-        }
-    for (size_t i = 0; i < names.size(); ++i)
-      if (!found[i]) {
-        std::string all;
-        for (const TensorColumn& c : columns_)
-          if (!c.ds.name.empty()) all += (all.empty() ? "" : ", ") + c.ds.name;
-        const bool twice = std::count(names.begin(), names.end(), names[i]) > 1;
-        throw InputError(
-            "datasets: \"" + names[i] + "\" " +
-            (twice ? std::string("is named twice") : "is not a dataset of these keywords (they make " + all + ")"));
-      }
-    if (kept.empty()) throw InputError("datasets: name at least one dataset");
-    columns_ = std::move(kept);
     const auto named = [&](const std::string& n) { return std::find(names.begin(), names.end(), n) != names.end(); };
+    std::string all;
+    for (const TensorColumn& c : columns_) all += (all.empty() ? "" : ", ") + c.ds.name;
+    for (const std::string& n : names) {
+      if (std::count(names.begin(), names.end(), n) > 1) throw InputError("datasets: \"" + n + "\" is named twice");
+      if (std::none_of(columns_.begin(), columns_.end(), [&](const TensorColumn& c) { return c.ds.name == n; }))
+        throw InputError("datasets: \"" + n + "\" is not a dataset of these keywords (they make " + all + ")");
+    }
+    if (names.empty()) throw InputError("datasets: name at least one dataset");
+    std::erase_if(columns_, [&](const TensorColumn& c) { return !named(c.ds.name); });
     uint32_t images = 0;
     bool masks = false;
     for (size_t k = 0; k < session_.catalogue.sensors.size(); ++k) {
