@@ -8,14 +8,10 @@
 # and torch: call /usr/bin/python3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# To build the core and the module (configuring the build folder as tools/setup.sh does needs
-# GoogleTest and Google Benchmark too), and to use the package: NumPy, h5py and PyTorch.
-packages=(build-essential cmake ninja-build pkg-config
-  pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers
-  libopenimageio-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
-  libxxhash-dev libisal-dev libgtest-dev libbenchmark-dev libcpp-httplib-dev libhdf5-dev libboost-dev
-  python3 python3-dev pybind11-dev python3-pybind11 python3-numpy python3-h5py python3-torch python3-pytest python3-pil)
-bash tools/apt-install.sh "${packages[@]}"
+# The core and the module (configuring the build folder as tools/setup.sh does), and NumPy,
+# h5py and PyTorch to use the package.
+source tools/packages.sh
+bash tools/apt-install.sh "${core_packages[@]}" "${python_packages[@]}"
 
 build_dir=${PORTALSIM_BUILD_DIR:-build}
 generator=()
