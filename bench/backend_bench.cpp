@@ -33,7 +33,7 @@ Plan plan_for(Path path, int block) {
       p.images = 0;
       p.features = false;
       break;
-    case kMetalPhysics:  // the coil model (README, "Metal detector physics")
+    case kMetalPhysics:  // the coil model (docs/model/metal.md)
       p.images = 0;
       p.features = false;
       p.model.model = Model::physics;

@@ -13,7 +13,7 @@
 /* Most sprites one camera view draws: one per region. */
 #define PS_MAX_LAYERS PS_REGIONS
 
-/* The metal detector under --model physics (README, "Metal detector physics"). */
+/* The metal detector under --model physics (docs/model/metal.md). */
 #define PS_METAL_PANEL_A_ZONES 9 /* zones 1..9 transmit from panel A (x < 0), the rest from B */
 /* Record of one zone's coils, doubles: transmit and receive coil position (x, z, metres;
  * y = 0) and moment (along x, A m^2), then the zone's gain. */

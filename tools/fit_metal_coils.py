@@ -2,7 +2,7 @@
 """Fits the physics model of the walk-through metal detector and writes [metal.physics]
 in scenarios/catalogue.toml (between the "metal physics" markers).
 
-The model (README, "Metal detector physics"; host/backend/reference/metal_physics.cpp):
+The model (docs/model/metal.md; host/backend/reference/metal_physics.cpp):
 
 - Portal coordinates in metres: x across the portal (panel A, the subject's right, at
   x = -separation/2; panel B at +separation/2), y along the walk (0: every coil and object

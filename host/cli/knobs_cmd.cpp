@@ -1,4 +1,4 @@
-// portalsim knobs: the model's and the tiers' knobs as a Markdown table (the README's).
+// portalsim knobs: the model's and the tiers' knobs as a Markdown table (docs/reference/knobs.md).
 #include <cstdio>
 
 #include "cli/commands.h"

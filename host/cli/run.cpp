@@ -9,7 +9,7 @@ namespace portalsim::cli {
 
 namespace {
 
-// Exit codes (README, "Exit codes"): a bad flag or value 2, a bad input file 3, an
+// Exit codes (docs/reference/exit-codes.md): a bad flag or value 2, a bad input file 3, an
 // output problem 4, a missing OpenCL environment 5, anything else 1. Errors in flag
 // values name the flag first.
 constexpr int kUsage = 2, kBadInput = 3, kOutput = 4, kEnvironment = 5, kInternal = 1;

@@ -1,4 +1,4 @@
-// portalsim serve: the thesis's GUI as a local web page (README, "serve").
+// portalsim serve: the thesis's GUI as a local web page (docs/guide/serve.md).
 #include <unistd.h>
 
 #include <csignal>

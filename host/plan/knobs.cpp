@@ -86,7 +86,7 @@ Knob range(std::string key, double lo, double hi, bool symmetric, std::string un
 
 std::vector<Knob> declare() {
   std::vector<Knob> k;
-  // The sensor model (README, "The model"); defaults are the thesis's.
+  // The sensor model (docs/model/thesis.md); defaults are the thesis's.
   k.push_back(choice(
       "model", {"thesis", "physics"},
       "the sensor model: the thesis's composite (its exact examples), or the physically based one (apparent "
@@ -190,7 +190,7 @@ std::vector<Knob> declare() {
       "the index itself is unchanged",
       false, true, [](Plan& p, double v) { p.palette = static_cast<procedural::PaletteName>(v); },
       [](const Plan& p) { return procedural::palette_name(p.palette); }));
-  // The fidelity tiers' knobs (README, "Fidelity tiers"): each overrides --tier.
+  // The fidelity tiers' knobs (docs/model/tiers.md): each overrides --tier.
   k.push_back(choice(
       "precision", {"fp32", "fp64", "fixed16"},
       "the kernels' pixel arithmetic: fp32; fp64 with the reference's formulas; 8.8 fixed point in "

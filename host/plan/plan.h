@@ -15,7 +15,7 @@ namespace portalsim {
 // convolution (a = -1/2), edges held.
 enum class DisplayFilter { bilinear, bicubic };
 
-// The knobs of the sensor model (README, "The model"). Defaults are the thesis's.
+// The knobs of the sensor model (docs/model/thesis.md). Defaults are the thesis's.
 struct ModelSettings {
   uint64_t seed = 0;
   Model model = Model::thesis;
@@ -28,7 +28,7 @@ struct ModelSettings {
   // sampling. The noise tiles stay where the unmoved sprite would be.
   bool bilinear = false;
   double jitter = 0.0;
-  // Randomised objects (README, "Randomised objects"): each object turns by an angle
+  // Randomised objects (docs/model/randomised-objects.md): each object turns by an angle
   // uniform in [rotate_lo, rotate_hi] degrees about its sprite's centre (counter-clockwise
   // as seen in the image), scales by a factor uniform in [scale_lo, scale_hi], and with
   // `flip` is mirrored left to right with probability 1/2; drawn per (scenario, region)
@@ -37,7 +37,7 @@ struct ModelSettings {
   double rotate_lo = 0.0, rotate_hi = 0.0;
   double scale_lo = 1.0, scale_hi = 1.0;
   bool flip = false;
-  // The physics model (README, "The physics model"); ignored by the thesis model.
+  // The physics model (docs/model/physics-mmw.md); ignored by the thesis model.
   double illumination = 293.0;          // K: what the body and objects reflect (the room, indoors)
   double netd = 3.0;                    // K rms: MMW sensor noise per raw pixel
   int raw_width = 28, raw_height = 28;  // the MMW camera's raw grid over each view
@@ -78,7 +78,7 @@ enum class NoiseModel { per_pixel, block_mean };
 // bytes of a 16-bit half summed and shaped by a quintic (not quite normal: |g| <= 3.37).
 enum class NoiseDraw { box_muller, irwin_hall };
 
-// The speed/accuracy knobs of the OpenCL backend (README, "Fidelity tiers"). None of
+// The speed/accuracy knobs of the OpenCL backend (docs/model/tiers.md). None of
 // them changes what is modelled; each changes how closely the kernels follow the fp64
 // reference, and how fast.
 struct Fidelity {

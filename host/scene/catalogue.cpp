@@ -325,7 +325,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     s.build = rd.number(t, "build", f, 0.5, 1.5, 1.0);
     // Stature about the 1.75 m body of [metal.physics]: 0.85..1.15 is about 1.49 m to
     // 2.01 m, most adults. Within it the drawn head stays below the upper view's top edge
-    // and every region's place stays in its own view (README, "Subjects").
+    // and every region's place stays in its own view (docs/model/subjects.md).
     s.height = rd.number(t, "height", f, 0.85, 1.15, 1.0);
     s.mmw_level = rd.integer(t, "mmw_level", f, 0, 255, 150);
     s.ir_core = rd.integer(t, "ir_core", f, 0, 255, 215);

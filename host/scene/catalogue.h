@@ -45,7 +45,7 @@ struct Variant {
   ImageSource mmw, ir;
 };
 
-// A material of the physics model (README, "The physics model"): its emissivity at 94 GHz
+// A material of the physics model (docs/model/physics-mmw.md): its emissivity at 94 GHz
 // and how fast it warms on the body. The catalogue gives each value's source.
 struct Material {
   std::string name;
@@ -100,8 +100,8 @@ struct ImagesConfig {
   int noise_size = 64;
 };
 
-// The walk-through metal detector under --model physics ([metal.physics]; README, "Metal
-// detector physics"). Zones 1..PS_METAL_PANEL_A_ZONES transmit from panel A (x < 0, the
+// The walk-through metal detector under --model physics ([metal.physics];
+// docs/model/metal.md). Zones 1..PS_METAL_PANEL_A_ZONES transmit from panel A (x < 0, the
 // subject's right), the others from panel B; each receives on the other panel.
 struct MetalPhysics {
   bool present = false;                                 // the catalogue has [metal.physics]

@@ -22,7 +22,7 @@ struct Rect {
 // Which sprites and palette a view uses: the camera it belongs to.
 enum class Camera : int { mmw = 0, ir = 1 };
 // Which sensor model renders a scenario: the thesis's composite, or the physically based
-// one (README, "The physics model"). Each camera view has a stage chain per model.
+// one (docs/model/physics-mmw.md). Each camera view has a stage chain per model.
 enum class Model { thesis = 0, physics = 1 };
 const char* model_name(Model m);
 constexpr int kCameras = 2;

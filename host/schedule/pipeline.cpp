@@ -304,7 +304,7 @@ void write_manifest(const std::string& dir, std::vector<std::unique_ptr<Sink>>& 
 
 // About 16 MiB of outputs: the batch being written and the next being computed fit in a
 // 32 MiB last-level cache together, so the writer mostly reads the kernels' output from the
-// cache rather than from memory (README, "Tensors for deep learning", Speed).
+// cache rather than from memory (docs/guide/deep-learning.md).
 size_t default_batch(const Plan& plan, const Catalogue& cat) {
   size_t bytes = 64 + kZones;
   for (size_t k = 0; k < cat.sensors.size(); ++k)

@@ -1,4 +1,4 @@
-// The rules every command's output folder follows (README, "Output folders"): it is a
+// The rules every command's output folder follows (docs/reference/outputs.md, "Output folders"): it is a
 // folder, a symlink to one, or does not exist yet; a file or a dangling symlink is
 // refused and never removed; one run at a time holds it, through a lock in .portalsim/.
 #pragma once

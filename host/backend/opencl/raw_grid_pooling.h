@@ -5,7 +5,7 @@
 // grid, block size). What this leaves out of the dense path: each pixel's rounding to a
 // gray level, and its clamping to 0..255 (the mean is clamped instead). Rounding moves a
 // mean by well under a level; clamping matters where the window cuts pixels off, as it
-// does the room behind the body under sensor noise (the README gives the measured error).
+// does the room behind the body under sensor noise (docs/model/physics-mmw.md gives the measured error).
 // The noise-free raw grid is the dense path's to the bit (the same physics_raw), or, where
 // a scenario's objects stand at their places apart from each other, the sum of tabulated
 // responses (the subject's bare features plus each object's change, made once by

@@ -1,4 +1,4 @@
-// Metal zones under --model physics (README, "Metal detector physics"): each zone is a
+// Metal zones under --model physics (docs/model/metal.md): each zone is a
 // transmit coil on its own panel and a receive coil on the other, both magnetic dipoles;
 // an object at p with polarizability tensor M gives H_R(p)^T M H_T(p) (Marsh et al. 2014),
 // and the objects' signals add. Plain double precision, one zone and object at a time.

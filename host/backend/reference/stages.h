@@ -76,7 +76,7 @@ void pattern_noise(const ViewScene& vs, Field& f);  // the scenario's MMW noise 
 void sensor_noise(const ViewScene& vs, Field& f);   // per-pixel Gaussian noise, Box-Muller
 void display(const ViewScene& vs, Field& f);        // round half up, clamp to 0..255
 
-// The physics model's MMW chain (README, "The physics model"), in order.
+// The physics model's MMW chain (docs/model/physics-mmw.md), in order.
 void radiometry(const ViewScene& vs, Field& f);   // apparent temperature, K, objects under clothing
 void optics(const ViewScene& vs, Field& f);       // Gaussian PSF of the Airy core's FWHM, edges held
 void sample(const ViewScene& vs, Field& f);       // integrate onto the raw grid (the field shrinks)
@@ -84,7 +84,7 @@ void netd(const ViewScene& vs, Field& f);         // frames averaged, each NETD 
 void window(const ViewScene& vs, Field& f);       // automatic window: raw grid onto the fixed window's scale
 void mmw_display(const ViewScene& vs, Field& f);  // interpolate to the view, smooth, window to gray, round
 
-// The physics model's IR chain (README, "The physics model: IR camera"), in order.
+// The physics model's IR chain (docs/model/physics-ir.md), in order.
 void contact_shadow(const ViewScene& vs, Field& f);  // dT of objects under clothing, K, alone
 void heat_spread(const ViewScene& vs, Field& f);     // Gaussian of ir_spread_mm over the shadow
 void ir_surface(const ViewScene& vs, Field& f);      // plus the bare body's surface, K
