@@ -359,6 +359,25 @@ void expect_block_mean_noise(World& w, const SceneBatch& batch, const ModelSetti
       u = normal_cdf((x - mu) / s);
     z.push_back(reference::normal_quantile(std::clamp(u, 1e-300, 1 - 1e-16)));
   }
+  // 0. The draws themselves, value by value where the feature is not clamped: the reference's
+  // Box-Muller of the same Philox words (reference::block_mean_gaussian), within the
+  // tolerance of plan/tolerance.h plus the two features' float rounding.
+  size_t draws = 0, wrong = 0;
+  double worst = 0;
+  for (size_t k = 0; k < o.features.size(); ++k) {
+    const double x = o.features[k], mu = quiet.features[k];
+    if (x <= 0 || x >= 255) continue;
+    const double s = m.pixel_sigma / std::sqrt(c[k % c.size()]);
+    const double g = reference::block_mean_gaussian(m.seed, batch.first_index + k / c.size(), int(k % c.size()));
+    const double ulps = 2 * (std::nextafter(float(std::max(x, mu)), 1e9f) - float(std::max(x, mu)));
+    const double e = std::abs(x - mu - s * g);
+    ++draws;
+    if (e > s * (kBlockMeanDrawAbs + kBlockMeanDrawRel * std::abs(g)) + ulps) {
+      if (wrong++ == 0) worst = e / s;
+    }
+  }
+  EXPECT_GT(draws, 0u);
+  EXPECT_EQ(wrong, 0u) << "block-mean draws off the reference's Box-Muller, the first by " << worst << " sd";
   const SampleComparison d = compare_samples(z);
   const double n = double(z.size());
   EXPECT_NEAR(d.mean_a, 0.0, 4 / std::sqrt(n)) << "block-mean draws: mean";

@@ -97,6 +97,29 @@ TEST(Parity, NoiseStagePatterns) {
   EXPECT_EQ(with.cl.view("ir").pixels, without.cl.view("ir").pixels) << "the thesis's noise patterns are MMW only";
 }
 
+// The built-in patterns fade to 128 (no change) at their border, so a tile's edge rows and
+// columns add nothing there; a catalogue's own image need not. Patterns of random bytes
+// make every tile row and column count (mutation 10 of tools/mutations.txt skips the last).
+TEST(Parity, NoiseStagePatternsWithoutAQuietBorder) {
+  AssetSet noisy = assets();
+  for (size_t k = 0; k < noisy.noise.size(); ++k)
+    for (size_t p = 0; p < noisy.noise[k].pixels.size(); ++p)
+      noisy.noise[k].pixels[p] = static_cast<uint8_t>(draw(77, k, 98, p)[0] & 0xff);
+  const auto scenes = coverage_set(200, 13);
+  const SceneBatch batch = test::batch_of(scenes);
+  for (bool fused : {true, false}) {  // the fused render's tiles, and the stage kernel's
+    SCOPED_TRACE(fused ? "fused" : "stage chain");
+    Plan plan = images_only(true, 0);
+    plan.fidelity.fused = fused;
+    Outputs o;
+    make_reference_backend(catalogue(), noisy)->run(batch, plan, o.ref);
+    make_opencl_backend(catalogue(), noisy, test::runtime())->run(batch, plan, o.cl);
+    expect_images_within_one(o, "pattern noise, random tiles");
+    const Outputs builtin = run_both(scenes, plan);
+    EXPECT_NE(o.cl.view("upper").pixels, builtin.cl.view("upper").pixels) << "the replaced patterns must be used";
+  }
+}
+
 TEST(Parity, NoiseStagePerPixelGaussian) {
   const auto scenes = coverage_set(200, 4);
   const Outputs o = run_both(scenes, images_only(true, 6.0), 1ull << 40);

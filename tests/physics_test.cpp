@@ -95,23 +95,34 @@ TEST(Physics, KernelsMatchTheReferenceInEveryTier) {
 // NETD / sqrt(frames), every MMW and IR draw an Irwin-Hall one, which the reference draws
 // its own way (reference/draws.cpp, fast_gaussian). All three views with noise against the
 // reference value by value: ten frames, and an IR NETD (0.5 K) at which a wrong draw moves
-// most IR pixels by several levels.
+// most IR pixels by several levels. The draws follow --noise-draw alone, as the thesis
+// model's do: the standard tier with irwin-hall draws them too (its frames one by one).
 TEST(Physics, FastTierDrawsMatchTheReference) {
   const SceneBatch batch = test::batch_of(coverage_set(48));
-  Plan plan = physics_plan();
-  plan.fidelity = tier_fidelity(Tier::fast);
-  plan.model.frames = 10;
-  plan.model.ir_netd = 0.5;
-  BatchOutput r, k;
-  make_reference_backend(catalogue(), assets())->run(batch, plan, r);
-  make_opencl_backend(catalogue(), assets(), test::runtime())->run(batch, plan, k);
-  const OutputDiff d = compare_outputs(k, r);
-  EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, Tier::fast)), "");
-  EXPECT_GT(d.ir.pixels, 0u);
-  EXPECT_LE(d.mmw.max_abs, 1);
-  EXPECT_LE(d.mmw.share_differing, 0.005);
-  EXPECT_LE(d.ir.max_abs, 1);
-  EXPECT_LE(d.ir.share_differing, 0.005);
+  Plan standard = physics_plan();
+  standard.model.frames = 10;
+  standard.model.ir_netd = 0.5;
+  Plan fast = standard, standard_ih = standard;
+  fast.fidelity = tier_fidelity(Tier::fast);
+  standard_ih.fidelity.draw = NoiseDraw::irwin_hall;
+  ASSERT_TRUE(fast.physics_draws_approximated() && standard_ih.physics_draws_approximated());
+  ASSERT_FALSE(standard.physics_draws_approximated());
+  BatchOutput box_muller;
+  make_opencl_backend(catalogue(), assets(), test::runtime())->run(batch, standard, box_muller);
+  for (const Plan* plan : {&fast, &standard_ih}) {
+    SCOPED_TRACE(plan == &fast ? "fast tier" : "standard tier, noise_draw irwin-hall");
+    BatchOutput r, k;
+    make_reference_backend(catalogue(), assets())->run(batch, *plan, r);
+    make_opencl_backend(catalogue(), assets(), test::runtime())->run(batch, *plan, k);
+    const OutputDiff d = compare_outputs(k, r);
+    EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, Tier::fast)), "");
+    EXPECT_GT(d.ir.pixels, 0u);
+    EXPECT_LE(d.mmw.max_abs, 1);
+    EXPECT_LE(d.mmw.share_differing, 0.005);
+    EXPECT_LE(d.ir.max_abs, 1);
+    EXPECT_LE(d.ir.share_differing, 0.005);
+    EXPECT_NE(k.view("ir").pixels, box_muller.view("ir").pixels) << "the draws must not be the table's";
+  }
 }
 
 // The fast draw itself (the reference's, which the test above holds the kernels to): over

@@ -260,8 +260,7 @@ int tradeoff(TradeoffOptions& o) {
       r["model"] = mname;
       r["name"] = name;
       // What the noise's distribution columns sample (put_distribution).
-      const bool irwin_hall = tier && (m == Model::physics ? opencl::physics_fast_draws(tier_fidelity(*tier))
-                                                           : tier_fidelity(*tier).draw == NoiseDraw::irwin_hall);
+      const bool irwin_hall = tier && tier_fidelity(*tier).draw == NoiseDraw::irwin_hall;
       r["noise_draw"] = irwin_hall ? "irwin-hall" : m == Model::physics ? "table Gaussian" : "box-muller";
       r["features_per_s"] = feat_rate;
       r["images_per_s"] = img_rate;

@@ -216,9 +216,9 @@ std::vector<Knob> declare() {
       [](const Plan& p) { return p.fidelity.noise == NoiseModel::block_mean ? "block-mean" : "per-pixel"; }));
   k.push_back(choice(
       "noise_draw", {"box-muller", "irwin-hall"},
-      "thesis: how each pixel's sensor noise is drawn: Box-Muller (normal), or Irwin-Hall, eight pixels to a "
-      "Philox draw (two bytes summed, shaped by a quintic: sd 1, KS distance 0.0033 from the normal, none beyond 3.37 "
-      "sd)",
+      "how the sensor noise is drawn: Box-Muller (thesis) or the quantile table (physics), both normal; or "
+      "Irwin-Hall (both models), eight values to a Philox draw (two bytes summed, shaped by a quintic: sd 1, KS "
+      "distance 0.0033 from the normal, none beyond 3.37 sd)",
       true, true, [](Plan& p, double v) { p.fidelity.draw = static_cast<NoiseDraw>(v); },
       [](const Plan& p) { return p.fidelity.draw == NoiseDraw::irwin_hall ? "irwin-hall" : "box-muller"; }));
   return k;

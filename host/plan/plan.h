@@ -139,10 +139,10 @@ struct Plan {
   // The MMW camera's frames as the kernels draw them: one each, or (block-mean noise model,
   // the fast tier) one draw of NETD / sqrt(frames).
   bool frames_approximated() const { return fidelity.noise == NoiseModel::block_mean && model.frames > 1; }
-  // The physics cameras' noise draws (MMW NETD, IR NETD) as the block-mean noise model (the
-  // fast tier) draws them: Irwin-Hall draws without the table (kernels/contract.h,
-  // PS_IH_*); the reference draws them alike.
-  bool physics_draws_approximated() const { return fidelity.noise == NoiseModel::block_mean; }
+  // The physics cameras' noise draws (MMW NETD, IR NETD) under noise_draw irwin-hall (the
+  // fast tier's), the knob the thesis model's pixel noise follows: Irwin-Hall draws without
+  // the table (kernels/contract.h, PS_IH_*); the reference draws them alike.
+  bool physics_draws_approximated() const { return fidelity.draw == NoiseDraw::irwin_hall; }
 };
 
 // The layout of a feature row: the blocks of each pooled view in turn (row-major,

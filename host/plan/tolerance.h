@@ -126,6 +126,14 @@ struct DrawDistribution {
 };
 inline constexpr DrawDistribution kIrwinHallDistribution{0.0, 1.0, 0.0, -0.010137, 0.0032609};
 
+// The block-mean noise model's draws (the thesis fast tier's features-only runs with pixel
+// noise), recovered from a feature as (feature - noise-free feature) / (sigma / sqrt(c)):
+// Box-Muller in float under -cl-fast-relaxed-math, where log, cos and sin may lose a few
+// ulps each (|g| <= 5.8: 1e-5), and the feature's float rounding (1.5e-5 at 255) over
+// sigma / sqrt(c) (at least 0.02 in the tests: 1e-3). A draw's error within
+// kBlockMeanDrawAbs + kBlockMeanDrawRel |g|, plus that rounding, with margin.
+inline constexpr double kBlockMeanDrawAbs = 1e-4, kBlockMeanDrawRel = 1e-4;
+
 inline const char* output_name(Output o) {
   switch (o) {
     case Output::pixels:

@@ -15,8 +15,7 @@ void write_stage_fields(const std::string& dir, const Catalogue& cat, const Asse
   for (size_t v = 0; v < cat.sensors.size(); ++v) {
     const Sensor& sensor = cat.sensors[v];
     reference::ViewScene vs = reference::view_scene(cat, assets, plan.model, static_cast<int>(v), scene, index);
-    vs.fast_draws = plan.physics_draws_approximated();
-    vs.draw = plan.fidelity.draw;
+    vs.follow(plan);
     reference::Field field;
     const std::vector<std::string>& chain = sensor.chain_for(plan.model.model);
     for (size_t k = 0; k < chain.size(); ++k) {

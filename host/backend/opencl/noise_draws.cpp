@@ -5,12 +5,6 @@
 
 namespace portalsim::opencl {
 
-bool physics_fast_draws(const Fidelity& f) {
-  Plan p;
-  p.fidelity = f;
-  return p.physics_draws_approximated();
-}
-
 std::vector<double> noise_draws(OpenCLRuntime& rt, const Fidelity& f, Model model, uint64_t seed, uint64_t first,
                                 size_t scenarios, int cells) {
   Kernels K(rt, f);
@@ -27,7 +21,7 @@ std::vector<double> noise_draws(OpenCLRuntime& rt, const Fidelity& f, Model mode
   k.setArg(1, static_cast<cl_uint>(seed >> 32));
   k.setArg(2, static_cast<cl_ulong>(first));
   k.setArg(3, static_cast<cl_int>(model == Model::physics));
-  k.setArg(4, static_cast<cl_int>(physics_fast_draws(f)));
+  k.setArg(4, static_cast<cl_int>(f.draw == NoiseDraw::irwin_hall));
   k.setArg(5, static_cast<cl_int>(cells));
   k.setArg(6, table);
   k.setArg(7, out);

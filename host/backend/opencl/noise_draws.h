@@ -1,7 +1,7 @@
 // The unit draws of a sensor model's per-pixel noise as a fidelity variant's kernels make
 // them (kernels/sensor_noise.cl, noise_draws), for `portalsim tradeoff`'s distribution
 // columns: the thesis model's pixel noise (the variant's noise_draw), the physics model's
-// MMW raw noise (table Gaussians, or the fast tier's draws: physics_fast_draws).
+// MMW raw noise (table Gaussians, or under irwin-hall the fast tier's draws).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -10,9 +10,6 @@
 #include "plan/plan.h"
 
 namespace portalsim::opencl {
-
-// Whether the physics model's noise under `f` is the fast tier's draw (Plan::physics_draws_approximated).
-bool physics_fast_draws(const Fidelity& f);
 
 // Pixels [0, cells) of view 0 of scenarios first .. first + scenarios - 1, scenario by scenario.
 std::vector<double> noise_draws(OpenCLRuntime& rt, const Fidelity& f, Model model, uint64_t seed, uint64_t first,

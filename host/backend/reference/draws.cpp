@@ -70,4 +70,12 @@ double pixel_gaussian(uint64_t seed, uint64_t index, int view, int p) {
   return p % 2 == 0 ? rad * std::cos(kTwoPi * u2) : rad * std::sin(kTwoPi * u2);
 }
 
+double block_mean_gaussian(uint64_t seed, uint64_t index, int q) {
+  const Philox4 r = draw(seed, index, kStreamBlockNoise, static_cast<uint32_t>(q - q % 2));
+  const double u1 = 1.0 - uniform24(r[0]), u2 = uniform24(r[1]);
+  const double rad = std::sqrt(-2.0 * std::log(u1));
+  constexpr double kTwoPi = 6.283185307179586;
+  return q % 2 == 0 ? rad * std::cos(kTwoPi * u2) : rad * std::sin(kTwoPi * u2);
+}
+
 }  // namespace portalsim::reference

@@ -28,4 +28,9 @@ double pixel_gaussian(uint64_t seed, uint64_t index, int view, int p);
 // its two bytes summed to s, t = (s - 255) / 255, g = t (C1 + t^2 (C3 + t^2 C5)).
 double pixel_irwin_hall(uint64_t seed, uint64_t index, int view, int p);
 
+// The block-mean noise model's draw of feature q of a row (the thesis fast tier's features-only
+// runs with pixel noise): Box-Muller over the first two words of the draw of element
+// q - q % 2 in stream PS_STREAM_BLOCK_NOISE, cosine for even q, sine for odd.
+double block_mean_gaussian(uint64_t seed, uint64_t index, int q);
+
 }  // namespace portalsim::reference

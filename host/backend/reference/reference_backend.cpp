@@ -30,8 +30,7 @@ class ReferenceBackend final : public Backend {
         const Sensor& sensor = cat_.sensors[k];
         if (!plan.renders(sensor, k)) continue;
         reference::ViewScene vs = reference::view_scene(cat_, assets_, plan.model, k, s, index);
-        vs.fast_draws = plan.physics_draws_approximated();
-        vs.draw = plan.fidelity.draw;
+        vs.follow(plan);
         for (const std::string& stage : sensor.chain_for(plan.model.model)) view_stage(stage).reference(vs, field);
         images[k].assign(field.v.begin(), field.v.end());  // display left whole numbers 0..255
         if (plan.image(k))

@@ -56,10 +56,15 @@ struct ViewScene {
   const Scenario& scenario;
   uint64_t index;  // the scenario's global index: the random generator's counter
   std::vector<Placed> placed;
-  // The physics cameras' noise as the fast tier draws it (Plan::physics_draws_approximated):
-  // the MMW frames as one draw of NETD / sqrt(frames), every draw fast_gaussian's.
-  bool fast_draws = false;
-  NoiseDraw draw = NoiseDraw::box_muller;  // the plan's pixel noise draw (Fidelity::draw)
+  // How the plan draws the noise: the pixel draw (Fidelity::draw), which the physics
+  // cameras' NETD follows too (fast_gaussian's under irwin-hall: Plan::physics_draws_approximated),
+  // and the MMW frames as one draw of NETD / sqrt(frames) (Plan::frames_approximated).
+  NoiseDraw draw = NoiseDraw::box_muller;
+  bool frames_as_one = false;
+  void follow(const Plan& plan) {
+    draw = plan.fidelity.draw;
+    frames_as_one = plan.frames_approximated();
+  }
 };
 
 ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSettings& model, int view,
