@@ -13,6 +13,7 @@
 
 #include "backend/compare.h"
 #include "backend/opencl/gauss_table.h"
+#include "backend/opencl/noise_draws.h"
 #include "backend/opencl/runtime.h"
 #include "backend/reference/draws.h"
 #include "plan/tolerance.h"
@@ -310,7 +311,7 @@ kernel void ih(global const ulong* seed, global const ulong* index, global const
   const uint2 key = (uint2)((uint)seed[i], (uint)(seed[i] >> 32));
   out[2 * i] = ih_pixel(key, index[i], view[i], pixel[i]);
   float16 g[8];
-  ih128(key, index[i], view[i], pixel[i] >> 7, g);
+  ih128(key, index[i], PS_STREAM_PIXEL_NOISE_FAST, view[i], pixel[i] >> 7, g);
   float t[128];
   for (int j = 0; j < 8; ++j) vstore16(g[j], j, t);
   out[2 * i + 1] = t[pixel[i] & 127];
@@ -337,7 +338,7 @@ TEST(Philox, IrwinHallKernelsFollowTheReferenceAndTheDistribution) {
 kernel void ih_sample(ulong seed, ulong first, global float* out) {
   const size_t i = get_global_id(0);
   float16 g[8];
-  ih128((uint2)((uint)seed, (uint)(seed >> 32)), first + i / 4, (int)(i % 4), 7, g);
+  ih128((uint2)((uint)seed, (uint)(seed >> 32)), first + i / 4, PS_STREAM_PIXEL_NOISE_FAST, (int)(i % 4), 7, g);
   for (int j = 0; j < 8; ++j) vstore16(g[j], 8 * i + j, out);
 })",
       "ih_sample", groups, cl_ulong(kSeed), cl_ulong(kFirst), out);
@@ -361,6 +362,45 @@ kernel void ih_sample(ulong seed, ulong first, global float* out) {
     EXPECT_NEAR(d.excess_kurtosis, e.excess_kurtosis, 4 * std::sqrt(24 / dn));
     EXPECT_LE(d.ks, e.ks_from_normal + d.ks_critical);
     EXPECT_LE(*std::max_element(sample->begin(), sample->end()), 3.365 + kIrwinHallDrawAbs);
+  }
+}
+
+// What `portalsim tradeoff` samples for its noise columns (opencl::noise_draws) is each
+// model's own draw, value by value: the physics MMW raw noise in its stream (table
+// Gaussians, or Irwin-Hall under the fast tier) and the thesis pixel noise (Irwin-Hall in
+// the fast tier). Draws of another stream would have the same distribution and pass any
+// statistical check (mutation 46 of tools/mutations.txt).
+TEST(Philox, TradeoffSamplesEachModelsOwnDraws) {
+  OpenCLRuntime rt;
+  constexpr uint64_t kSeed = 0x5eed5eed12345ull, kFirst = 77;
+  constexpr size_t kScenarios = 16;
+  constexpr int kCells = 1000;
+  struct Case {
+    const char* name;
+    Model model;
+    Tier tier;
+    double (*ref)(uint64_t, uint64_t, int);
+    double tolerance;
+  };
+  const Case cases[] = {
+      {"physics, fast tier", Model::physics, Tier::fast,
+       [](uint64_t s, uint64_t i, int p) { return reference::fast_gaussian(s, i, kStreamRawNoise, 0, p); },
+       kIrwinHallDrawAbs},
+      {"physics, standard tier", Model::physics, Tier::standard,
+       [](uint64_t s, uint64_t i, int p) { return reference::table_gaussian(s, i, kStreamRawNoise, 0, p); },
+       kTableGaussianAbs},
+      {"thesis, fast tier", Model::thesis, Tier::fast,
+       [](uint64_t s, uint64_t i, int p) { return reference::pixel_irwin_hall(s, i, 0, p); }, kIrwinHallDrawAbs},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::vector<double> got =
+        opencl::noise_draws(rt, tier_fidelity(c.tier), c.model, kSeed, kFirst, kScenarios, kCells);
+    ASSERT_EQ(got.size(), kScenarios * kCells);
+    double worst = 0;
+    for (size_t k = 0; k < got.size(); ++k)
+      worst = std::max(worst, std::abs(got[k] - c.ref(kSeed, kFirst + k / kCells, int(k % kCells))));
+    EXPECT_LE(worst, c.tolerance);
   }
 }
 

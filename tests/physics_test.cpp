@@ -680,6 +680,40 @@ TEST(Physics, NoContrastWhenEverythingIsAtBodyTemperature) {
   EXPECT_LE(worst, 1);
 }
 
+// The automatic window on a grid flatter than PS_WINDOW_MIN_SPAN (1 K between its 1st and
+// 99th percentiles): a body filling the view and 0.2 K of noise. The window is then the
+// minimum span from the 1st percentile, and the kernels must hold it as the reference does
+// (mutation 45 of tools/mutations.txt halves it: twice the contrast).
+TEST(Physics, AutoWindowOnAFlatGridKeepsItsMinimumSpan) {
+  const FlatWorld w;
+  Plan plan = physics_plan();
+  plan.model.window_auto = true;
+  plan.model.netd = 0.2;
+  plan.model.frames = 1;
+  const SceneBatch batch = test::batch_of(std::vector<Scenario>(8));
+  ASSERT_EQ(batch.at(0).subject, 0) << "subject-1's upper view is the flat one";
+  reference::Field raw = raw_grid(w, plan.model, batch.at(0));
+  reference::netd(reference::view_scene(w.cat, w.assets, plan.model, 0, batch.at(0), 0), raw);
+  std::vector<double> sorted = raw.v;
+  std::sort(sorted.begin(), sorted.end());
+  const int n = int(sorted.size());
+  ASSERT_LT(sorted[size_t(std::lround(0.99 * (n - 1)))] - sorted[size_t(std::lround(0.01 * (n - 1)))], 1.0)
+      << "the grid must be flatter than the minimum span";
+  for (Tier tier : {Tier::standard, Tier::exact, Tier::fast}) {
+    SCOPED_TRACE(tier_name(tier));
+    plan.fidelity = tier_fidelity(tier);
+    BatchOutput r, k;
+    make_reference_backend(w.cat, w.assets)->run(batch, plan, r);
+    make_opencl_backend(w.cat, w.assets, test::runtime())->run(batch, plan, k);
+    const OutputDiff d = compare_outputs(k, r);
+    EXPECT_LE(d.mmw.max_abs, 1);
+    EXPECT_LE(d.mmw.share_differing, 0.005);
+    const std::vector<uint8_t>& px = k.view("upper").pixels;
+    const auto [lo, hi] = std::minmax_element(px.begin(), px.begin() + 200 * 200);
+    EXPECT_GT(*hi - *lo, 20) << "the noise must show";
+  }
+}
+
 TEST(Physics, Extremes) {
   const SceneBatch batch = test::batch_of(scenes(4));
   auto cl = make_opencl_backend(catalogue(), assets(), test::runtime());

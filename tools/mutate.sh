@@ -60,6 +60,8 @@ run_suites() {
   done
 }
 
+# Every mutation's text still in its file (ctest mutation_list), before an hour of runs.
+"$py" "$root/tools/mutant_program.py" "$root" --check "$list" >/dev/null
 echo "== building portalsim and portalsim_tests in $build"
 cmake --build "$build" -j "${PORTALSIM_MUTATE_JOBS:-2}" --target portalsim_tests portalsim >"$work/build.log" 2>&1 ||
   { tail -30 "$work/build.log"; exit 1; }

@@ -116,6 +116,9 @@ inline constexpr std::array kTolerances{
 // float ulp is 2.4e-7, and t, t^2, two fma()s and a multiply each round once: 5 half-ulps of
 // the largest value, 6e-7, with margin.
 inline constexpr double kIrwinHallDrawAbs = 2e-6;
+// The table Gaussian (the physics cameras' NETD): the kernels read a float table of the
+// reference's double quantiles, |g| <= 3.67: half a float ulp there is 2.4e-7.
+inline constexpr double kTableGaussianAbs = 5e-7;
 // Its distribution, exact over the 511 byte sums (determinism.md, worked in double): the
 // statistics that tests and `portalsim tradeoff` hold a sample of n draws to, each within 4
 // of its sampling sds (sd of the mean 1/sqrt(n), of the sd 1/sqrt(2n), of the skewness
