@@ -24,7 +24,7 @@ kernel void stage_ir_surface(VIEW_STAGE_ARGS) {
 // Stage "ir_netd": Gaussian noise of the IR NETD (kelvin rms) on every view pixel, a table
 // Gaussian each from the counter generator (PS_STREAM_IR_NOISE, PS_GAUSS_ELEMENT), or the
 // fast tier's draw (PS_FLAG_FAST_DRAWS). One work-item per scenario: fp32 builds draw 128
-// pixels at a time (gauss128, fast128).
+// pixels at a time (gauss128, ih128).
 kernel void stage_ir_netd(VIEW_STAGE_ARGS) {
   VIEW_STAGE_SCENARIO;
   const preal sd = (preal)phys[PS_PHYS_NETD];

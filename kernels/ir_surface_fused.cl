@@ -158,7 +158,7 @@ inline void ir_noisy_block(global const float* restrict T, global uchar* restric
 // kelvin plus sd times its table Gaussian (stage_ir_netd's sum, in its form) goes through
 // the display window (ir_window) in registers, and no noisy field is written or read back.
 // fp32 builds draw 256 pixels at a time (two blocks of gauss128's, their Philox rounds
-// interleaved: gauss128x2), or 128 fast draws (fast128, PS_FLAG_FAST_DRAWS), and store 64
+// interleaved: gauss128x2), or 128 fast draws (ih128, PS_FLAG_FAST_DRAWS), and store 64
 // levels at once; like the stage kernels, the last pixels past a whole 16 go one by one.
 inline void ir_noisy_window(global const preal* restrict T, global uchar* restrict o, global const param* phys,
                             int pixels, preal sd, uint2 seed, ulong index, int view, global const param* table,
@@ -167,7 +167,7 @@ inline void ir_noisy_window(global const preal* restrict T, global uchar* restri
   const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
 #if defined(PRECISION_FP64)
   for (int p = 0; p < pixels; ++p) {
-    const preal g = fast ? fast_cell(seed, index, PS_STREAM_IR_NOISE, view, p)
+    const preal g = fast ? ih_cell(seed, index, PS_STREAM_IR_NOISE, view, p)
                          : gauss_cell(seed, index, PS_STREAM_IR_NOISE, view, p, table);
     const preal t = IR_NOISY(T[p] + sd * g);
     o[p] = (uchar)clamp(floor((t - lo) * scale + (preal)0.5), (preal)0, (preal)255);
@@ -176,7 +176,7 @@ inline void ir_noisy_window(global const preal* restrict T, global uchar* restri
   if (fast) {
     for (int p = 0; p < pixels; p += 128) {
       float16 g[8];
-      fast128(seed, index, PS_STREAM_IR_NOISE, view, p >> 7, g);
+      ih128(seed, index, PS_STREAM_IR_NOISE, view, p >> 7, g);
       ir_noisy_block(T, o, p, pixels, g, sd, lo, scale);
     }
     return;

@@ -6,48 +6,8 @@
 // NETD / sqrt(frames).
 inline uint frame_stream(int k) { return k == 0 ? PS_STREAM_RAW_NOISE : PS_STREAM_FRAME_NOISE + (uint)k; }
 
-// The fast tier's draws (PS_FLAG_FAST_DRAWS, kernels/contract.h PS_IH_*): a 16-bit half's
-// two bytes summed, s in 0..510, bent to a near-normal by an odd quintic. Arithmetic only,
-// where the table Gaussian gathers from a 16 KB table.
-inline preal ih_value(uint bits) {
-  const preal t = (preal)((int)(bits & 0xffu) + (int)(bits >> 8) - 255) * ((preal)1 / (preal)255);
-  const preal t2 = t * t;
-  return t * ((preal)PS_IH_C1 + t2 * ((preal)PS_IH_C3 + t2 * (preal)PS_IH_C5));
-}
-
-// Cell p's fast draw: the table Gaussian's word and half (PS_GAUSS_ELEMENT), ih_value.
-inline preal fast_cell(uint2 seed, ulong index, uint stream, int view, int p) {
-  const uint4 r = draw(seed, index, stream, PS_GAUSS_ELEMENT(view, p));
-  const int w = PS_GAUSS_WORD(p);
-  const uint word = w == 0 ? r.x : w == 1 ? r.y : w == 2 ? r.z : r.w;
-  return ih_value((word >> PS_GAUSS_SHIFT(p)) & 0xffffu);
-}
-
-#if !defined(PRECISION_FP64)
-// ih_value of both halves of 16 words at once: each half's byte sum in one lane's 10 bits.
-inline void ih_values16(uint16 word, float16* lo, float16* hi) {
-  const uint16 sums = (word & 0x00ff00ffu) + ((word >> 8) & 0x00ff00ffu);
-  const float16 tl = convert_float16(convert_int16(sums & 0x3ffu) - 255) * (1.0f / 255.0f);
-  const float16 th = convert_float16(convert_int16(sums >> 16) - 255) * (1.0f / 255.0f);
-  const float16 l2 = tl * tl, h2 = th * th;
-  *lo = tl * ((float)PS_IH_C1 + l2 * ((float)PS_IH_C3 + l2 * (float)PS_IH_C5));
-  *hi = th * ((float)PS_IH_C1 + h2 * ((float)PS_IH_C3 + h2 * (float)PS_IH_C5));
-}
-
-// Cells 128 b .. 128 b + 127 of a view's field as fast draws, laid out as gauss128's.
-__attribute__((always_inline)) inline void fast128(uint2 seed, ulong index, uint stream, int view, int b,
-                                                   float16* g) {
-  uint16 c[4];
-  c[0] = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
-         ((uint)(16 * b) + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
-  c[1] = (uint16)(stream);
-  c[2] = (uint16)((uint)index);
-  c[3] = (uint16)((uint)(index >> 32));
-  philox16(&c[0], &c[1], &c[2], &c[3], seed);
-#pragma unroll
-  for (int w = 0; w < 4; ++w) ih_values16(c[w], &g[2 * w], &g[2 * w + 1]);
-}
-#endif
+// The fast tier's draws (PS_FLAG_FAST_DRAWS): sensor_noise.cl's Irwin-Hall draws (ih_cell,
+// ih128) of the table Gaussians' cells and streams.
 
 // Adds sd times the draws of cells [0, cells) of `stream` to v: table Gaussians, or with
 // `fast` the fast tier's draws. The stage kernels' noise (stage_netd's rows go cell by cell).
@@ -58,11 +18,11 @@ inline void noise_cells(global preal* restrict v, int cells, preal sd, uint2 see
     return;
   }
 #if defined(PRECISION_FP64)
-  for (int p = 0; p < cells; ++p) v[p] = v[p] + sd * fast_cell(seed, index, stream, view, p);
+  for (int p = 0; p < cells; ++p) v[p] = v[p] + sd * ih_cell(seed, index, stream, view, p);
 #else
   for (int p = 0; p < cells; p += 128) {
     float16 g[8];
-    fast128(seed, index, stream, view, p >> 7, g);
+    ih128(seed, index, stream, view, p >> 7, g);
     for (int j = 0; j < 8; ++j) {
       const int q = p + 16 * j;
       if (q + 16 <= cells) {
@@ -85,7 +45,7 @@ kernel void stage_netd(VIEW_STAGE_ARGS) {
   const bool fast = L.flags & PS_FLAG_FAST_DRAWS;
   for (int k = 0; k < L.frames; ++k)
     for (int c = 0; c < L.raw_width; ++c)
-      r[c] += sd * (fast ? fast_cell(seed, index, frame_stream(k), L.view, j * L.raw_width + c)
+      r[c] += sd * (fast ? ih_cell(seed, index, frame_stream(k), L.view, j * L.raw_width + c)
                          : gauss_cell(seed, index, frame_stream(k), L.view, j * L.raw_width + c, phys + L.phys_gauss));
 }
 

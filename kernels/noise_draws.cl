@@ -2,8 +2,8 @@
 // tradeoff`'s distribution columns): pixels [0, cells) of view 0 of scenario first + i, one
 // work-item per scenario. Thesis: the pixel noise (Box-Muller, or Irwin-Hall under
 // NOISE_DRAW_IH; kernels/sensor_noise.cl); physics: the MMW raw noise, as table Gaussians
-// (table: the host's quantiles) or, with fast_draws, as the fast tier's draws (netd.cl).
-// After netd.cl in the program, whose fast_cell it calls.
+// (table: the host's quantiles) or, with fast_draws, as the fast tier's Irwin-Hall draws
+// (sensor_noise.cl's ih_cell).
 kernel void noise_draws(uint seed_lo, uint seed_hi, ulong first, int physics, int fast_draws, int cells,
                         global const param* table, global float* out) {
   const size_t i = get_global_id(0);
@@ -12,7 +12,7 @@ kernel void noise_draws(uint seed_lo, uint seed_hi, ulong first, int physics, in
   global float* o = out + i * (size_t)cells;
   for (int p = 0; p < cells; ++p) {
     if (physics) {
-      o[p] = fast_draws ? (float)fast_cell(seed, index, PS_STREAM_RAW_NOISE, 0, p)
+      o[p] = fast_draws ? (float)ih_cell(seed, index, PS_STREAM_RAW_NOISE, 0, p)
                         : (float)gauss_cell(seed, index, PS_STREAM_RAW_NOISE, 0, p, table);
       continue;
     }

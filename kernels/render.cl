@@ -270,7 +270,7 @@ inline void render_noisy(global const uchar* atlas, global const uchar* base, gl
   int c = 0;
   while (c + 16 <= HW) {
     float16 g[8];
-    ih128(seed, index, L->view, c >> 7, g);
+    ih128(seed, index, PS_STREAM_PIXEL_NOISE_FAST, L->view, c >> 7, g);
     for (int h = 0; h < 8 && c + 16 <= HW; ++h, c += 16)
       noisy16(atlas, base, img, V, R, &cur, &y, &x, c, W, tile, gain, alpha, sigma, g[h]);
   }

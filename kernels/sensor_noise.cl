@@ -183,33 +183,39 @@ __attribute__((always_inline)) inline void gauss128(uint2 seed, ulong index, uin
 }
 #endif
 
-// The Irwin-Hall pixel draw (noise_draw irwin-hall, the fast tier; kernels/contract.h, PS_IH_*):
-// cell p's 16-bit half in the table Gaussians' layout (stream PS_STREAM_PIXEL_NOISE_FAST), its
-// two bytes summed, s, and d = s - 255 taken through the odd quintic. Eight pixels to one
-// Philox draw where Box-Muller takes two, and no log, root or sincos. d is exact in
+// The Irwin-Hall draw (noise_draw irwin-hall, the fast tier's; kernels/contract.h, PS_IH_*),
+// of both models: cell p's 16-bit half in the table Gaussians' layout, its two bytes summed,
+// s, and d = s - 255 taken through the odd quintic. Eight cells to one Philox draw where
+// Box-Muller takes two, no log, root or sincos, and no table to gather from. d is exact in
 // integers, so the float steps are one multiply and the written fma()s, alike for 1 and 16.
+// The thesis model's pixel noise draws from PS_STREAM_PIXEL_NOISE_FAST (ih_pixel), the
+// physics cameras' NETD from their table Gaussians' streams (netd.cl, ir_surface*.cl).
 inline greal ih_shape(int d) {
   const greal t = (greal)d * ((greal)1 / (greal)255), t2 = t * t;
   return t * fma(t2, fma(t2, (greal)PS_IH_C5, (greal)PS_IH_C3), (greal)PS_IH_C1);
 }
-inline greal ih_pixel(uint2 seed, ulong index, int view, int p) {
-  const uint4 r = draw(seed, index, PS_STREAM_PIXEL_NOISE_FAST, PS_GAUSS_ELEMENT(view, p));
+inline greal ih_cell(uint2 seed, ulong index, uint stream, int view, int p) {
+  const uint4 r = draw(seed, index, stream, PS_GAUSS_ELEMENT(view, p));
   const int w = PS_GAUSS_WORD(p);
   const uint h = (w == 0 ? r.x : w == 1 ? r.y : w == 2 ? r.z : r.w) >> PS_GAUSS_SHIFT(p);
   return ih_shape((int)(h & 0xffu) + (int)((h >> 8) & 0xffu) - 255);
+}
+inline greal ih_pixel(uint2 seed, ulong index, int view, int p) {
+  return ih_cell(seed, index, PS_STREAM_PIXEL_NOISE_FAST, view, p);
 }
 #if !defined(PRECISION_FP64)
 inline float16 ih_shape16(int16 d) {
   const float16 t = convert_float16(d) * (1.0f / 255.0f), t2 = t * t;
   return t * fma(t2, fma(t2, (float16)((float)PS_IH_C5), (float16)((float)PS_IH_C3)), (float16)((float)PS_IH_C1));
 }
-// The Irwin-Hall draws of pixels 128 b .. 128 b + 127 of a view: g[j] holds pixels
-// 128 b + 16 j .. + 15. Both halves' byte sums come from one masked add per word.
-__attribute__((always_inline)) inline void ih128(uint2 seed, ulong index, int view, int b, float16* g) {
+// The Irwin-Hall draws of cells 128 b .. 128 b + 127 of a view's field in `stream`: g[j]
+// holds cells 128 b + 16 j .. + 15. Both halves' byte sums come from one masked add per word.
+__attribute__((always_inline)) inline void ih128(uint2 seed, ulong index, uint stream, int view, int b,
+                                                 float16* g) {
   uint16 c[4];
   c[0] = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
          ((uint)(16 * b) + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
-  c[1] = (uint16)(PS_STREAM_PIXEL_NOISE_FAST);
+  c[1] = (uint16)(stream);
   c[2] = (uint16)((uint)index);
   c[3] = (uint16)((uint)(index >> 32));
   philox16(&c[0], &c[1], &c[2], &c[3], seed);
