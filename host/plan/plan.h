@@ -73,9 +73,10 @@ enum class Precision { fp32, fp64, fixed16 };
 // Per-pixel sensor noise, or (features-only runs) its effect on each mean drawn
 // directly: N(0, sigma^2 / pixels), ignoring rounding and clipping.
 enum class NoiseModel { per_pixel, block_mean };
-// How the thesis model's per-pixel sensor noise is drawn (docs/model/determinism.md):
-// Box-Muller, two pixels to a Philox draw; or Irwin-Hall, eight pixels to a draw, the two
-// bytes of a 16-bit half summed and shaped by a quintic (not quite normal: |g| <= 3.37).
+// How the sensor noise is drawn (docs/model/determinism.md): the normal draws, Box-Muller
+// (thesis pixels, two to a Philox draw) or the quantile table (physics NETD); or for both
+// models Irwin-Hall, eight values to a draw, the two bytes of a 16-bit half summed and
+// shaped by a quintic (not quite normal: |g| <= 3.37).
 enum class NoiseDraw { box_muller, irwin_hall };
 
 // The speed/accuracy knobs of the OpenCL backend (docs/model/tiers.md). None of
