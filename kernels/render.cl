@@ -256,6 +256,15 @@ __attribute__((always_inline)) inline void noisy16(global const uchar* atlas, gl
   }
 }
 
+// A flat run of pixels starting at pixel p: its (x, y), and rows y and y + 1 in R (R[0] is row y).
+inline void run_from(RowLayers* R, const ViewLayers* V, int tile, int W, int p, int* y, int* x, int* cur) {
+  *y = p / W;
+  *x = p - *y * W;
+  *cur = 0;
+  row_layers(&R[0], V, tile, *y);
+  row_layers(&R[1], V, tile, *y + 1);
+}
+
 #if defined(NOISE_DRAW_IH)
 // With pixel noise every pixel is drawn, in flat runs of 128 pixels (one set of 16 Philox
 // draws), 16 at a time; the last HW % 16 pixels as one run of 16 that overlaps the one
@@ -264,9 +273,8 @@ inline void render_noisy(global const uchar* atlas, global const uchar* base, gl
                          const PsViewLaunch* L, float gain, param alpha, param sigma, uint2 seed, ulong index) {
   const int W = L->width, H = L->height, tile = L->tile_size, HW = W * H;
   RowLayers R[2];  // rows y and y + 1, R[cur] is row y
-  int y = 0, x = 0, cur = 0;
-  row_layers(&R[0], V, tile, 0);
-  row_layers(&R[1], V, tile, 1);
+  int y, x, cur;
+  run_from(R, V, tile, W, 0, &y, &x, &cur);
   int c = 0;
   while (c + 16 <= HW) {
     float16 g[8];
@@ -276,11 +284,7 @@ inline void render_noisy(global const uchar* atlas, global const uchar* base, gl
   }
   if (c < HW) {
     const int p = HW - 16;
-    y = p / W;
-    x = p - y * W;
-    cur = 0;
-    row_layers(&R[0], V, tile, y);
-    row_layers(&R[1], V, tile, y + 1);
+    run_from(R, V, tile, W, p, &y, &x, &cur);
     float t[16];
     for (int k = 0; k < 16; ++k) t[k] = ih_pixel(seed, index, L->view, p + k);
     noisy16(atlas, base, img, V, R, &cur, &y, &x, p, W, tile, gain, alpha, sigma, vload16(0, t));
@@ -294,9 +298,8 @@ inline void render_noisy(global const uchar* atlas, global const uchar* base, gl
                          const PsViewLaunch* L, float gain, param alpha, param sigma, uint2 seed, ulong index) {
   const int W = L->width, H = L->height, tile = L->tile_size, HW = W * H;
   RowLayers R[2];  // rows y and y + 1, R[cur] is row y
-  int y = 0, x = 0, cur = 0;
-  row_layers(&R[0], V, tile, 0);
-  row_layers(&R[1], V, tile, 1);
+  int y, x, cur;
+  run_from(R, V, tile, W, 0, &y, &x, &cur);
   int c = 0;
   for (; c + 64 <= HW; c += 64) {
     float16 g[4];
@@ -306,13 +309,7 @@ inline void render_noisy(global const uchar* atlas, global const uchar* base, gl
   }
   for (; c < HW; c += 32) {
     const int p = min(c, HW - 32);
-    if (p != c) {
-      y = p / W;
-      x = p - y * W;
-      cur = 0;
-      row_layers(&R[0], V, tile, y);
-      row_layers(&R[1], V, tile, y + 1);
-    }
+    if (p != c) run_from(R, V, tile, W, p, &y, &x, &cur);
     float16 g[2];
     gauss32(seed, index, PS_STREAM_PIXEL_NOISE, L->view, p >> 1, &g[0], &g[1]);
     for (int h = 0; h < 2; ++h)

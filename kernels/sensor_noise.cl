@@ -118,10 +118,11 @@ __attribute__((always_inline)) inline void box_muller16(uint16 r0, uint16 r1, fl
   *g1 = shuffle2(c, s, (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
 }
 
-// The counters of pairs pair .. pair + 15 of a stream.
-inline void pair_counters16(uint16* c, ulong index, uint stream, int view, int pair) {
+// The counters of elements first .. first + 15 of a view in a stream: 16 Box-Muller pairs,
+// or the 16 draws of a block of 128 cells in the table Gaussians' layout (first = 16 b).
+inline void counters16(uint16* c, ulong index, uint stream, int view, int first) {
   c[0] = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
-         ((uint)pair + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+         ((uint)first + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
   c[1] = (uint16)(stream);
   c[2] = (uint16)((uint)index);
   c[3] = (uint16)((uint)(index >> 32));
@@ -132,7 +133,7 @@ inline void pair_counters16(uint16* c, ulong index, uint stream, int view, int p
 __attribute__((always_inline)) inline void gauss32(uint2 seed, ulong index, uint stream, int view, int pair,
                                                    float16* g0, float16* g1) {
   uint16 c[4];
-  pair_counters16(c, index, stream, view, pair);
+  counters16(c, index, stream, view, pair);
   philox16(&c[0], &c[1], &c[2], &c[3], seed);
   box_muller16(c[0], c[1], g0, g1);
 }
@@ -141,8 +142,8 @@ __attribute__((always_inline)) inline void gauss32(uint2 seed, ulong index, uint
 __attribute__((always_inline)) inline void gauss64(uint2 seed, ulong index, uint stream, int view, int pair,
                                                    float16* g) {
   uint16 a[4], b[4];
-  pair_counters16(a, index, stream, view, pair);
-  pair_counters16(b, index, stream, view, pair + 16);
+  counters16(a, index, stream, view, pair);
+  counters16(b, index, stream, view, pair + 16);
   philox16x2(a, b, seed);
   box_muller16(a[0], a[1], &g[0], &g[1]);
   box_muller16(b[0], b[1], &g[2], &g[3]);
@@ -153,11 +154,14 @@ __attribute__((always_inline)) inline void gauss64(uint2 seed, ulong index, uint
 // per cell, eight cells to one draw of the generator where Box-Muller takes two, and no
 // log or sincos. The table (phys + L.phys_gauss, built on the host) holds the 4,096
 // equally likely values Phi^-1((k + 1/2) / 4096): |g| <= 3.67, sd 1 - 1.6e-4.
-inline preal gauss_cell(uint2 seed, ulong index, uint stream, int view, int p, global const param* table) {
+// Cell p's word of its draw in the table Gaussians' layout (PS_GAUSS_ELEMENT, PS_GAUSS_WORD).
+inline uint cell_word(uint2 seed, ulong index, uint stream, int view, int p) {
   const uint4 r = draw(seed, index, stream, PS_GAUSS_ELEMENT(view, p));
   const int w = PS_GAUSS_WORD(p);
-  const uint word = w == 0 ? r.x : w == 1 ? r.y : w == 2 ? r.z : r.w;
-  return (preal)table[PS_GAUSS_INDEX(word, p)];
+  return w == 0 ? r.x : w == 1 ? r.y : w == 2 ? r.z : r.w;
+}
+inline preal gauss_cell(uint2 seed, ulong index, uint stream, int view, int p, global const param* table) {
+  return (preal)table[PS_GAUSS_INDEX(cell_word(seed, index, stream, view, p), p)];
 }
 
 #if !defined(PRECISION_FP64)
@@ -168,11 +172,7 @@ inline preal gauss_cell(uint2 seed, ulong index, uint stream, int view, int p, g
 __attribute__((always_inline)) inline void gauss128(uint2 seed, ulong index, uint stream, int view, int b,
                                                     global const float* table, float16* g) {
   uint16 c[4];
-  c[0] = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
-         ((uint)(16 * b) + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
-  c[1] = (uint16)(stream);
-  c[2] = (uint16)((uint)index);
-  c[3] = (uint16)((uint)(index >> 32));
+  counters16(c, index, stream, view, 16 * b);
   philox16(&c[0], &c[1], &c[2], &c[3], seed);
 #pragma unroll
   for (int w = 0; w < 4; ++w) {
@@ -195,9 +195,7 @@ inline greal ih_shape(int d) {
   return t * fma(t2, fma(t2, (greal)PS_IH_C5, (greal)PS_IH_C3), (greal)PS_IH_C1);
 }
 inline greal ih_cell(uint2 seed, ulong index, uint stream, int view, int p) {
-  const uint4 r = draw(seed, index, stream, PS_GAUSS_ELEMENT(view, p));
-  const int w = PS_GAUSS_WORD(p);
-  const uint h = (w == 0 ? r.x : w == 1 ? r.y : w == 2 ? r.z : r.w) >> PS_GAUSS_SHIFT(p);
+  const uint h = cell_word(seed, index, stream, view, p) >> PS_GAUSS_SHIFT(p);
   return ih_shape((int)(h & 0xffu) + (int)((h >> 8) & 0xffu) - 255);
 }
 inline greal ih_pixel(uint2 seed, ulong index, int view, int p) {
@@ -213,11 +211,7 @@ inline float16 ih_shape16(int16 d) {
 __attribute__((always_inline)) inline void ih128(uint2 seed, ulong index, uint stream, int view, int b,
                                                  float16* g) {
   uint16 c[4];
-  c[0] = ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) |
-         ((uint)(16 * b) + (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
-  c[1] = (uint16)(stream);
-  c[2] = (uint16)((uint)index);
-  c[3] = (uint16)((uint)(index >> 32));
+  counters16(c, index, stream, view, 16 * b);
   philox16(&c[0], &c[1], &c[2], &c[3], seed);
 #pragma unroll
   for (int w = 0; w < 4; ++w) {

@@ -262,6 +262,17 @@ PS_KERNEL_ARGS(AnalyticNoiseArgs, PS_ANALYTIC_NOISE_ARGS)
   X(cl::Buffer, noise)              \
   X(cl::Buffer, scratch)
 PS_KERNEL_ARGS(PhysicsFeaturesArgs, PS_PHYSICS_FEATURES_ARGS)
+
+// kernels/noise_draws.cl (portalsim tradeoff's noise samples)
+#define PS_NOISE_DRAWS_ARGS(X) \
+  X(cl_uint, seed_lo)          \
+  X(cl_uint, seed_hi)          \
+  X(cl_ulong, first)           \
+  X(cl_int, physics)           \
+  X(cl_int, cells)             \
+  X(cl::Buffer, table)         \
+  X(cl::Buffer, out)
+PS_KERNEL_ARGS(NoiseDrawsArgs, PS_NOISE_DRAWS_ARGS)
 // clang-format on
 
 #undef PS_KERNEL_ARGS

@@ -61,21 +61,24 @@ double pixel_irwin_hall(uint64_t seed, uint64_t index, int view, int p) {
   return fast_gaussian(seed, index, kStreamPixelNoiseFast, view, p);
 }
 
-double pixel_gaussian(uint64_t seed, uint64_t index, int view, int p) {
-  const uint32_t element = (static_cast<uint32_t>(view) << PS_PIXEL_NOISE_VIEW_SHIFT) | static_cast<uint32_t>(p / 2);
-  const Philox4 r = draw(seed, index, kStreamPixelNoise, element);
+namespace {
+// Box-Muller over the first two words of r: u1 = 1 - uniform24(w0) in (0, 1], u2 =
+// uniform24(w1); the cosine, or the sine for the pair's second value.
+double box_muller(const Philox4& r, bool second) {
   const double u1 = 1.0 - uniform24(r[0]), u2 = uniform24(r[1]);
   const double rad = std::sqrt(-2.0 * std::log(u1));
   constexpr double kTwoPi = 6.283185307179586;
-  return p % 2 == 0 ? rad * std::cos(kTwoPi * u2) : rad * std::sin(kTwoPi * u2);
+  return second ? rad * std::sin(kTwoPi * u2) : rad * std::cos(kTwoPi * u2);
+}
+}  // namespace
+
+double pixel_gaussian(uint64_t seed, uint64_t index, int view, int p) {
+  const uint32_t element = (static_cast<uint32_t>(view) << PS_PIXEL_NOISE_VIEW_SHIFT) | static_cast<uint32_t>(p / 2);
+  return box_muller(draw(seed, index, kStreamPixelNoise, element), p % 2 != 0);
 }
 
 double block_mean_gaussian(uint64_t seed, uint64_t index, int q) {
-  const Philox4 r = draw(seed, index, kStreamBlockNoise, static_cast<uint32_t>(q - q % 2));
-  const double u1 = 1.0 - uniform24(r[0]), u2 = uniform24(r[1]);
-  const double rad = std::sqrt(-2.0 * std::log(u1));
-  constexpr double kTwoPi = 6.283185307179586;
-  return q % 2 == 0 ? rad * std::cos(kTwoPi * u2) : rad * std::sin(kTwoPi * u2);
+  return box_muller(draw(seed, index, kStreamBlockNoise, static_cast<uint32_t>(q - q % 2)), q % 2 != 0);
 }
 
 }  // namespace portalsim::reference
