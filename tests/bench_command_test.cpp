@@ -22,11 +22,10 @@ using portalsim::OpenCLDeviceInfo;
 using portalsim::speed::Measure;
 using portalsim::test::describe;
 using portalsim::test::finish;
+using portalsim::test::has;
 using portalsim::test::Result;
 using portalsim::test::start;
 using portalsim::test::TempDir;
-
-bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 bool positive(const json& v) { return v.is_number() && std::isfinite(v.get<double>()) && v.get<double>() > 0; }
 

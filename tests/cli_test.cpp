@@ -38,6 +38,7 @@ using Args = std::vector<std::string>;
 
 using portalsim::test::describe;
 using portalsim::test::finish;
+using portalsim::test::has;
 using portalsim::test::quoted;
 using portalsim::test::Result;
 using portalsim::test::Running;
@@ -90,8 +91,6 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return parts;
 }
 
-bool contains(const std::string& hay, const std::string& needle) { return hay.find(needle) != std::string::npos; }
-
 struct ImageShape {
   bool ok = false;
   int width = 0, height = 0, channels = 0;
@@ -118,7 +117,7 @@ void ExpectSuccess(const Result& r) {
   EXPECT_FALSE(r.timed_out) << describe(r);
   EXPECT_FALSE(r.signaled) << describe(r);
   EXPECT_TRUE(r.exited && r.status == 0) << describe(r);
-  EXPECT_FALSE(contains(r.err, "error")) << describe(r);
+  EXPECT_FALSE(has(r.err, "error")) << describe(r);
 }
 
 // The lines of stderr that carry a message (CLI11's "Run with --help" hint is not one).
@@ -145,7 +144,7 @@ void ExpectCleanFailure(const Result& r, const fs::path& out, bool out_existed,
   EXPECT_TRUE(r.exited);
   EXPECT_NE(r.status, 0) << "a rejected command must exit non-zero";
   EXPECT_EQ(message_lines(r.err).size(), 1u) << "stderr should hold exactly one message";
-  for (const std::string& n : needles) EXPECT_TRUE(contains(r.err, n)) << "stderr does not name \"" << n << "\"";
+  for (const std::string& n : needles) EXPECT_TRUE(has(r.err, n)) << "stderr does not name \"" << n << "\"";
   EXPECT_EQ(r.out, "") << "nothing should be printed on stdout";
   std::error_code ec;
   if (out_existed) {
@@ -255,7 +254,7 @@ TEST(CliSimulate, GunWritesExactlyTheSixFiles) {
   EXPECT_EQ(names_in(t.w()), (std::vector<std::string>{"out"})) << "nothing may be left beside the output folder";
   EXPECT_EQ(slurp(out / "metal.txt"), std::string(kGunMetal) + "\n");
   EXPECT_EQ(slurp(out / "threat.txt"), "no\n");
-  EXPECT_TRUE(contains(r.out, kGunMetal)) << describe(r);
+  EXPECT_TRUE(has(r.out, kGunMetal)) << describe(r);
 
   for (const char* view : {"upper.png", "lower.png"}) {
     const ImageShape s = shape_of(out / view);
@@ -309,7 +308,7 @@ TEST(CliSimulate, ThreatYesAndBlockSize) {
   EXPECT_EQ(header.size(), row.size());
   EXPECT_EQ(header.size(), 2u * 10 * 10 + 13 + 19 + 1) << "--block 20 gives 10x10 blocks per view";
   EXPECT_EQ(row.back(), "positive");
-  EXPECT_TRUE(contains(r.out, "threat yes")) << describe(r);
+  EXPECT_TRUE(has(r.out, "threat yes")) << describe(r);
 }
 
 TEST(CliSimulate, JpgImageFormat) {
@@ -442,8 +441,8 @@ TEST(CliLabels, RuleNamingAnObjectPresent) {
   const Result r = run(t, simulate({"gun", "--rule", "gun"}, out));
   ExpectSuccess(r);
   EXPECT_EQ(slurp(out / "threat.txt"), "yes\n");
-  EXPECT_TRUE(contains(slurp(out / "features.csv"), ",positive\n"));
-  EXPECT_TRUE(contains(r.out, "threat yes")) << describe(r);
+  EXPECT_TRUE(has(slurp(out / "features.csv"), ",positive\n"));
+  EXPECT_TRUE(has(r.out, "threat yes")) << describe(r);
 }
 
 TEST(CliLabels, RuleAllOf) {
@@ -455,9 +454,9 @@ TEST(CliLabels, RuleAllOf) {
   ExpectSuccess(r[0]);
   ExpectSuccess(r[1]);
   EXPECT_EQ(slurp(t.w() / "rod" / "threat.txt"), "no\n") << "only the rod: the rule does not hold";
-  EXPECT_TRUE(contains(slurp(t.w() / "rod" / "features.csv"), ",negative\n"));
+  EXPECT_TRUE(has(slurp(t.w() / "rod" / "features.csv"), ",negative\n"));
   EXPECT_EQ(slurp(t.w() / "both" / "threat.txt"), "yes\n") << "rod and plate: the rule holds";
-  EXPECT_TRUE(contains(slurp(t.w() / "both" / "features.csv"), ",positive\n"));
+  EXPECT_TRUE(has(slurp(t.w() / "both" / "features.csv"), ",positive\n"));
   ExpectCleanFailure(r[2], t.w() / "conflict", false, {"--rule", "--threat"});
 }
 
@@ -591,7 +590,7 @@ TEST(CliBadInput, EmptyOutNamesTheOption) {
   EXPECT_TRUE(r.exited);
   EXPECT_NE(r.status, 0);
   EXPECT_EQ(message_lines(r.err).size(), 1u);
-  EXPECT_TRUE(contains(r.err, "--out")) << "an empty output folder name must be reported as --out";
+  EXPECT_TRUE(has(r.err, "--out")) << "an empty output folder name must be reported as --out";
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -618,7 +617,7 @@ TEST(CliOutput, OutIsARegularFile) {
   EXPECT_TRUE(r.exited);
   EXPECT_NE(r.status, 0);
   EXPECT_EQ(message_lines(r.err).size(), 1u);
-  EXPECT_TRUE(contains(r.err, file.string()));
+  EXPECT_TRUE(has(r.err, file.string()));
   EXPECT_EQ(slurp(file), "keep me\n") << "the file must be left alone";
   EXPECT_EQ(names_in(t.w()), (std::vector<std::string>{"afile"}));
 }
@@ -712,7 +711,7 @@ TEST(CliOutput, FeaturesOnAFullDiskLeavesNoPartialFile) {
   SCOPED_TRACE(describe(x.r));
   EXPECT_TRUE(x.r.exited);
   EXPECT_EQ(x.r.status, 4);
-  EXPECT_TRUE(contains(x.r.err, table.string()));
+  EXPECT_TRUE(has(x.r.err, table.string()));
   EXPECT_TRUE(x.left.empty()) << "left behind: " << testing::PrintToString(x.left);
 }
 
@@ -811,7 +810,7 @@ TEST(CliCatalogueFile, DuplicateObjectName) {
   ASSERT_GT(name_line, 1);
   const Result r = run(t, simulate({"--catalogue", cat.string(), "gun"}, t.w() / "out"));
   ExpectCleanFailure(r, t.w() / "out", false, {cat.string() + ":", "objects[2]", "gun"});
-  EXPECT_TRUE(contains(r.err, at_line(cat, name_line)) || contains(r.err, at_line(cat, name_line - 1)))
+  EXPECT_TRUE(has(r.err, at_line(cat, name_line)) || has(r.err, at_line(cat, name_line - 1)))
       << "the message must give the line of the duplicate entry (" << name_line << " or " << name_line - 1
       << "): " << r.err;
 }
@@ -918,7 +917,7 @@ TEST(CliCatalogueCmd, ListsObjectsAndRegions) {
         std::any_of(objects.begin(), objects.end(),
                     [&](const std::string& l) { return split(l.substr(l.find_first_not_of(' ')), ' ')[0] == name; }))
         << name << " is not listed";
-  EXPECT_TRUE(contains(r.out, "left-chest"));
+  EXPECT_TRUE(has(r.out, "left-chest"));
   EXPECT_TRUE(names_in(t.w()).empty()) << "listing writes nothing";
 }
 
@@ -939,7 +938,7 @@ TEST(CliCatalogueCmd, ImagesWritesEveryImage) {
     EXPECT_EQ(s.format, "png");
     if (n.rfind("subject", 0) == 0) {
       ++subject_images;
-      const bool ir = contains(n, "_ir.");
+      const bool ir = has(n, "_ir.");
       EXPECT_EQ(s.width, ir ? 100 : 200);
       EXPECT_EQ(s.height, 200);
       EXPECT_EQ(s.channels, ir ? 3 : 1);
@@ -969,7 +968,7 @@ TEST(CliCatalogueCmd, ImagesIntoAFileIsRejected) {
   SCOPED_TRACE(describe(r));
   EXPECT_FALSE(r.signaled);
   EXPECT_NE(r.status, 0);
-  EXPECT_TRUE(contains(r.err, (file / "images").string()));
+  EXPECT_TRUE(has(r.err, (file / "images").string()));
   EXPECT_EQ(slurp(file), "keep me\n");
 }
 

@@ -576,13 +576,12 @@ void check_opaque(const Image& sprite, const Rect& rect, const uint8_t* img, con
 // Running the binary (as tests/cli_test.cpp does).
 
 using portalsim::test::describe;
+using portalsim::test::has;
 using portalsim::test::Result;
 using portalsim::test::Running;
 using portalsim::test::slurp;
 using portalsim::test::spit;
 using portalsim::test::start;
-
-bool contains(const std::string& hay, const std::string& needle) { return hay.find(needle) != std::string::npos; }
 
 struct Rejection {
   std::vector<std::string> args;  // without --out
@@ -609,8 +608,7 @@ void expect_all_rejected(const std::vector<Rejection>& cases) {
     EXPECT_FALSE(r.timed_out);
     EXPECT_FALSE(r.signaled) << "killed by signal " << r.signal;
     EXPECT_TRUE(r.exited && r.status != 0) << "a command with a bad number must be rejected";
-    for (const std::string& n : cases[i].needles)
-      EXPECT_TRUE(contains(r.err, n)) << "stderr does not name \"" << n << "\"";
+    for (const std::string& n : cases[i].needles) EXPECT_TRUE(has(r.err, n)) << "stderr does not name \"" << n << "\"";
     EXPECT_EQ(r.out, "") << "nothing should be printed on stdout";
     std::error_code ec;
     EXPECT_FALSE(fs::exists(outs[i], ec)) << outs[i] << " must not be left behind";
@@ -1246,9 +1244,9 @@ TEST(ExtremeRejection, CatalogueNumbers) {
       ADD_FAILURE() << "accepted: " << c.to;
     } catch (const InputError& e) {
       const std::string msg = e.what();
-      EXPECT_TRUE(contains(msg, "test.toml:" + std::to_string(line) + ":")) << msg;
-      EXPECT_TRUE(contains(msg, c.field)) << msg;
-      for (const std::string& x : c.extra) EXPECT_TRUE(contains(msg, x)) << msg;
+      EXPECT_TRUE(has(msg, "test.toml:" + std::to_string(line) + ":")) << msg;
+      EXPECT_TRUE(has(msg, c.field)) << msg;
+      for (const std::string& x : c.extra) EXPECT_TRUE(has(msg, x)) << msg;
     } catch (const std::exception& e) {
       ADD_FAILURE() << "not an InputError: " << e.what();
     }

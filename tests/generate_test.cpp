@@ -45,7 +45,7 @@ const auto& write_all = portalsim::test::spit;
 // A fresh folder under /tmp for one test: w/ is the workspace, cap/ holds captured output.
 using GenTempDir = portalsim::test::TempDir;
 
-bool has(const std::string& hay, const std::string& needle) { return hay.find(needle) != std::string::npos; }
+using portalsim::test::has;
 
 std::vector<std::string> split_on(const std::string& text, char sep) {
   std::vector<std::string> parts;

@@ -26,6 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 using portalsim::InputError;
 using portalsim::test::describe;
+using portalsim::test::has;
 using portalsim::test::Result;
 using portalsim::test::slurp;
 using portalsim::test::spit;
@@ -35,8 +36,6 @@ using Args = std::vector<std::string>;
 Result run(const TempDir& t, const Args& args, int limit_s = 60) {
   return portalsim::test::finish(portalsim::test::start(t.cap(), args), limit_s);
 }
-
-bool has(const std::string& hay, const std::string& needle) { return hay.find(needle) != std::string::npos; }
 
 // The message of the InputError that check_text throws, or "" when it accepts.
 std::string text_error(std::string_view text, portalsim::io::Bom bom = portalsim::io::Bom::refuse) {

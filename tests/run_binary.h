@@ -89,6 +89,9 @@ struct Result {
   std::string out, err;
 };
 
+// Whether `needle` occurs in `hay` (messages and outputs the tests read).
+inline bool has(const std::string& hay, const std::string& needle) { return hay.find(needle) != std::string::npos; }
+
 inline std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::ostringstream s;
