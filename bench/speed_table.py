@@ -3,6 +3,7 @@
 reference, measured in one run of `portalsim bench --json`, printed as a markdown table.
 
   python3 bench/speed_table.py [--portalsim build/portalsim] [--repetitions 3] [--quick]
+  python3 bench/speed_table.py --json bench.json        # a saved `portalsim bench --json`, not run again
   python3 bench/speed_table.py --record bench/speed_history.json   # keep this run's ratios
   python3 bench/speed_table.py --check bench/speed_history.json    # exit 1 on a regression
   python3 bench/speed_table.py --previous /tmp/old/portalsim        # add the previous build's kernels
@@ -46,6 +47,7 @@ def ratio(a, b, form="%.2fx"):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--portalsim", default="build/portalsim")
+    ap.add_argument("--json", help="read this saved output of `portalsim bench --json` instead of running it")
     ap.add_argument("--repetitions", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="portalsim bench --quick: small batches")
     ap.add_argument("--device", help="portalsim bench --device")
@@ -54,7 +56,12 @@ def main():
     ap.add_argument("--check")
     ap.add_argument("--previous", help="the previous commit's portalsim, run in the same session")
     a = ap.parse_args()
-    report = run(a.portalsim, a)
+    if a.json:
+        with open(a.json) as f:
+            report = json.load(f)
+        a.repetitions = report.get("repetitions", a.repetitions)
+    else:
+        report = run(a.portalsim, a)
     previous = {p["key"]: p for p in run(a.previous, a)["paths"]} if a.previous else None
     rows, ratios = [], {}
     for p in report["paths"]:
@@ -72,7 +79,7 @@ def main():
     print("\n".join(rows))
     load = report["host"]["load_average"]
     print("\nMedians of %d runs of %s bench%s on %s, %s, load average %.1f." %
-          (a.repetitions, a.portalsim, " and of " + a.previous + " bench" if a.previous else "",
+          (a.repetitions, a.json or a.portalsim, " and of " + a.previous + " bench" if a.previous else "",
            report["device"]["name"], report["date"], load[0]))
     if a.record:
         with open(a.record, "w") as f:
