@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "base/error.h"
+#include "base/sizes.h"
 #include "run_binary.h"
 #include "scene/scenario_list.h"
 #include "sink/append_file.h"
@@ -148,7 +149,7 @@ std::string row(int subject, const std::string& first, const std::string& label)
 }
 
 struct PieceReset {
-  ~PieceReset() { ScenarioListFile::set_piece_bytes_for_tests(16u << 20, 1u << 16); }
+  ~PieceReset() { ScenarioListFile::set_piece_bytes_for_tests(kIoPieceBytes, 1u << 16); }
 };
 
 fs::path write_list(const Folder& dir, const std::string& text) {

@@ -470,7 +470,9 @@ void Annotator::operator()(const ModelSettings& model, const SceneBatch& batch, 
   std::vector<Work>& spare = kept_->spare;
   std::vector<std::pair<size_t, Work>> done;  // by first scenario
   std::mutex work_mutex;
-  parallel_for(n, n >= 256 ? threads : 1, [&](size_t lo, size_t hi) {
+  // Below this many scenarios a batch is done before threads would have started.
+  constexpr size_t kThreadedScenarios = 256;
+  parallel_for(n, n >= kThreadedScenarios ? threads : 1, [&](size_t lo, size_t hi) {
     Work work;
     {
       const std::lock_guard<std::mutex> lock(work_mutex);

@@ -67,16 +67,6 @@ bool clipped(uint8_t v) { return v == 0 || v == 255; }
 
 }  // namespace
 
-std::vector<double> interpolation_matrix(int size, int raw) {
-  std::vector<double> a(static_cast<size_t>(size) * raw, 0.0);
-  const std::vector<Tap> tp = taps(size, raw);
-  for (int x = 0; x < size; ++x) {
-    a[static_cast<size_t>(x) * raw + tp[x].c0] += 1.0 - tp[x].t;
-    a[static_cast<size_t>(x) * raw + tp[x].c1] += tp[x].t;
-  }
-  return a;
-}
-
 GridAxis raw_grid_axis(const std::vector<const std::vector<uint8_t>*>& images, int width, int height, bool along_x) {
   const int size = along_x ? width : height, lines = along_x ? height : width;
   // Every 4th line is plenty: a wrong grid leaves its residual on every line.

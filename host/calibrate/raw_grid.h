@@ -8,11 +8,6 @@
 
 namespace portalsim::calibrate {
 
-// The bilinear interpolation from `raw` raw pixels to `size` view pixels as a size x raw
-// matrix (row-major): view pixel x's centre at (x + 1/2) raw / size - 1/2 on the raw axis,
-// held to the outermost raw centres.
-std::vector<double> interpolation_matrix(int size, int raw);
-
 struct GridAxis {
   int raw = 0;                // raw pixels along the axis: the fewest that fit
   std::vector<double> ms;     // mean square residual (gray^2) for 1 .. size raw pixels

@@ -18,64 +18,76 @@ std::string format_number(double v) {
 
 Knob integer(std::string key, int lo, int hi, std::string unit, std::string help,
              std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{
-      std::move(key), KnobKind::integer, double(lo), double(hi), {}, std::move(unit), std::move(help), false, true,
-      std::move(set), std::move(get),    false,      {},         {}};
+  return Knob{.key = std::move(key),
+              .kind = KnobKind::integer,
+              .min = double(lo),
+              .max = double(hi),
+              .unit = std::move(unit),
+              .help = std::move(help),
+              .set = std::move(set),
+              .get = std::move(get)};
 }
 
 Knob number(std::string key, double lo, double hi, std::string unit, std::string help,
             std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key), KnobKind::number, lo,    hi, {}, std::move(unit), std::move(help), false, true,
-              std::move(set), std::move(get),   false, {}, {}};
+  return Knob{.key = std::move(key),
+              .kind = KnobKind::number,
+              .min = lo,
+              .max = hi,
+              .unit = std::move(unit),
+              .help = std::move(help),
+              .set = std::move(set),
+              .get = std::move(get)};
 }
 
 Knob on_off(std::string key, std::string help, bool fidelity, std::function<void(Plan&, double)> set,
             std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key),
-              KnobKind::on_off,
-              0,
-              1,
-              {"on", "off"},
-              "",
-              std::move(help),
-              fidelity,
-              true,
-              std::move(set),
-              std::move(get),
-              false,
-              {},
-              {}};
+  return Knob{.key = std::move(key),
+              .kind = KnobKind::on_off,
+              .min = 0,
+              .max = 1,
+              .choices = {"on", "off"},
+              .help = std::move(help),
+              .fidelity = fidelity,
+              .set = std::move(set),
+              .get = std::move(get)};
 }
 
 Knob grid(std::string key, int lo, int hi, std::string unit, std::string help, std::function<void(Plan&, double)> set,
           std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key), KnobKind::grid, double(lo), double(hi), {}, std::move(unit), std::move(help), false, true,
-              std::move(set), std::move(get), false,      {},         {}};
+  return Knob{.key = std::move(key),
+              .kind = KnobKind::grid,
+              .min = double(lo),
+              .max = double(hi),
+              .unit = std::move(unit),
+              .help = std::move(help),
+              .set = std::move(set),
+              .get = std::move(get)};
 }
 
 Knob choice(std::string key, std::vector<std::string> choices, std::string help, bool fidelity, bool identity,
             std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{std::move(key),
-              KnobKind::choice,
-              0,
-              0,
-              std::move(choices),
-              "",
-              std::move(help),
-              fidelity,
-              identity,
-              std::move(set),
-              std::move(get),
-              false,
-              {},
-              {}};
+  return Knob{.key = std::move(key),
+              .kind = KnobKind::choice,
+              .choices = std::move(choices),
+              .help = std::move(help),
+              .fidelity = fidelity,
+              .identity = identity,
+              .set = std::move(set),
+              .get = std::move(get)};
 }
 
 // A range A..B of numbers within [lo, hi]; `symmetric`: one number X means -X..X.
 Knob range(std::string key, double lo, double hi, bool symmetric, std::string unit, std::string help,
            std::function<void(Plan&, double, double)> set, std::function<std::pair<double, double>(const Plan&)> get) {
-  Knob k{std::move(key), KnobKind::range, lo, hi, {}, std::move(unit), std::move(help), false, true, {}, {},
-         symmetric,      std::move(set),  {}};
+  Knob k{.key = std::move(key),
+         .kind = KnobKind::range,
+         .min = lo,
+         .max = hi,
+         .unit = std::move(unit),
+         .help = std::move(help),
+         .symmetric = symmetric,
+         .set_range = std::move(set)};
   k.get = [get = std::move(get), symmetric](const Plan& p) -> nlohmann::json {
     const auto [a, b] = get(p);
     if (symmetric ? a == -b : a == b) return format_number(b);

@@ -14,27 +14,28 @@ namespace portalsim {
 
 enum class KnobKind { integer, number, on_off, choice, grid, range };
 
+// Filled by field name (designated initializers): each field left out takes its default.
 struct Knob {
-  std::string key;  // spec-file key and manifest entry; the flag is "--" + key with '-' for '_'
-  KnobKind kind;
-  double min = 0, max = 0;           // integer and number; each side of a grid; each end of a range
-  std::vector<std::string> choices;  // choice
-  std::string unit;                  // integer and number, for the help and the README
-  std::string help;
+  std::string key{};  // spec-file key and manifest entry; the flag is "--" + key with '-' for '_'
+  KnobKind kind{};
+  double min = 0, max = 0;             // integer and number; each side of a grid; each end of a range
+  std::vector<std::string> choices{};  // choice
+  std::string unit{};                  // integer and number, for the help and the README
+  std::string help{};
   bool fidelity = false;  // overrides the tier (its default comes from the tier)
   bool identity = true;   // part of a data set's identity (checked on --resume)
   // Sets the knob from a checked value: the number, 0/1 for on_off, the choice's index, or
   // width * 65536 + height for a grid ("WxH").
-  std::function<void(Plan&, double)> set;
+  std::function<void(Plan&, double)> set{};
   // The knob's value in `plan`: a number, a bool (on_off) or the choice's name.
-  std::function<nlohmann::json(const Plan&)> get;
+  std::function<nlohmann::json(const Plan&)> get{};
   // A range ("A..B", A <= B) is set by set_range instead of set; one number X means X..X,
   // or -X..X for a symmetric range (get then gives the short form back where it applies).
   bool symmetric = false;
-  std::function<void(Plan&, double, double)> set_range;
+  std::function<void(Plan&, double, double)> set_range{};
   // A range that also takes this one word ("auto"), set as set_range(NaN, NaN); its A..B
   // must then have A < B.
-  std::string word;
+  std::string word{};
 
   std::string flag() const;
   // "0 .. 1000 gray levels", "on, off", "fp32, fp64, fixed16", "X or A..B, each 0.1 .. 10".

@@ -10,6 +10,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "base/sizes.h"
 #include "io/input_file.h"
 
 namespace portalsim {
@@ -65,7 +66,7 @@ size_t split_fields(std::string_view line, std::vector<std::string>& f, const st
 constexpr std::array<const char*, 3> kTransformColumns = {"rotation", "scale", "flip"};
 
 // Pieces of the file read at a time, and rows between marks (tests lower both).
-std::atomic<size_t> g_piece_bytes{16u << 20};
+std::atomic<size_t> g_piece_bytes{kIoPieceBytes};
 std::atomic<uint64_t> g_mark_rows{1u << 16};
 
 }  // namespace

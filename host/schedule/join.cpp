@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "base/error.h"
+#include "base/sizes.h"
 #include "io/input_file.h"
 #include "schedule/dataset_card.h"
 #include "schedule/identity.h"
@@ -182,7 +183,7 @@ void copy_range(const std::string& src, const json& recorded, uint64_t from, uin
                 uint64_t to, XXH3_state_t* written) {
   std::ifstream in(src, std::ios::binary);
   const Xxh3 h = new_xxh3();
-  std::vector<char> buf(16u << 20);
+  std::vector<char> buf(kIoPieceBytes);
   uint64_t at = 0;
   const uint64_t end = from + bytes;
   while (at < end) {
@@ -464,7 +465,7 @@ JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir
         const Piece& p = t.pieces[k];
         if (t.dataset >= 0) {
           const H5Dataset& d = h5.datasets[static_cast<size_t>(t.dataset)];
-          const uint64_t row = d.row_bytes(), block = std::max<uint64_t>(1, (16u << 20) / std::max<uint64_t>(1, row));
+          const uint64_t row = d.row_bytes(), block = std::max<uint64_t>(1, kIoPieceBytes / std::max<uint64_t>(1, row));
           for (uint64_t r = 0; r < p.bytes; r += block) {
             const uint64_t n = std::min(block, p.bytes - r);
             buf.resize(static_cast<size_t>(n * row));

@@ -14,6 +14,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "base/sizes.h"
 #include "schedule/dataset_card.h"
 #include "schedule/identity.h"
 #include "schedule/run_state.h"
@@ -313,7 +314,7 @@ size_t default_batch(const Plan& plan, const Catalogue& cat) {
   if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
   // A multiple of data.h5's chunk rows: a batch ends where a chunk does, so no piece of it
   // waits in memory for the next batch before the file's hash can take it (file_order_hash.h).
-  const size_t rows = std::clamp<size_t>((16u << 20) / bytes, kH5ChunkRows, 16384);
+  const size_t rows = std::clamp<size_t>(kIoPieceBytes / bytes, kH5ChunkRows, 16384);
   return (rows + kH5ChunkRows / 2) / kH5ChunkRows * kH5ChunkRows;
 }
 

@@ -108,14 +108,6 @@ class MpiRanks final : public Ranks {
 
 std::unique_ptr<Ranks> single_rank() { return std::make_unique<SingleRank>(); }
 
-bool built_with_mpi() {
-#ifdef PORTALSIM_MPI
-  return true;
-#else
-  return false;
-#endif
-}
-
 Ranks* mpi_ranks() {
   if (!launched_by_mpi()) return nullptr;
 #ifdef PORTALSIM_MPI

@@ -16,7 +16,6 @@ class Ranks {
   virtual int size() const = 0;
   // Every rank's `mine`, in rank order, on every rank.
   virtual std::vector<std::string> all_gather(const std::string& mine) = 0;
-  void barrier() { all_gather(""); }
   // Runs `f` on this rank. When it throws on any rank, every rank throws: alone, the
   // error itself; among several, an error of the first failing rank's kind whose message
   // names each failing rank ("rank 1: ...; rank 2: ...").
@@ -30,8 +29,5 @@ std::unique_ptr<Ranks> single_rank();
 // The first call initialises MPI, which stays up until the process exits. Throws
 // EnvironmentError when launched so but built without MPI.
 Ranks* mpi_ranks();
-
-// Whether this build has MPI (CMake found it).
-bool built_with_mpi();
 
 }  // namespace portalsim

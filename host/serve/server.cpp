@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "base/error.h"
+#include "base/sizes.h"
 #include "io/input_file.h"
 #include "plan/knobs.h"
 #include "serve/knob_fields.h"
@@ -37,6 +38,9 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 
 namespace {
+
+// A file the page may open through /api: larger ones are opened from disk.
+constexpr uintmax_t kMaxServedFileBytes = 64 * kMiB;
 
 std::string read_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -303,7 +307,9 @@ struct Server::Impl {
     }
     std::error_code ec;
     if (!fs::is_regular_file(p, ec)) throw InputError("file: \"" + rel + "\" is not a file under --root");
-    if (fs::file_size(p, ec) > (64u << 20)) throw InputError("file: \"" + rel + "\" is over 64 MiB; open it from disk");
+    if (fs::file_size(p, ec) > kMaxServedFileBytes)
+      throw InputError("file: \"" + rel + "\" is over " + std::to_string(kMaxServedFileBytes / kMiB) +
+                       " MiB; open it from disk");
     const std::string ext = p.extension().string();
     const char* type = ext == ".png" ? "image/png" : ext == ".json" ? "application/json" : "text/plain";
     res.set_content(read_file(p), type);

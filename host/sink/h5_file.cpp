@@ -16,6 +16,7 @@
 #include <stdexcept>
 
 #include "base/error.h"
+#include "base/sizes.h"
 #include "io/contained.h"
 
 namespace portalsim {
@@ -397,7 +398,7 @@ void write_h5(const std::string& dir, const H5Layout& layout, const std::vector<
     if (!in.read(magic, sizeof magic)) throw OutputError(src + ": cannot read its .npy header");
     const size_t header = 10 + static_cast<unsigned char>(magic[8]) + 256u * static_cast<unsigned char>(magic[9]);
     in.seekg(static_cast<std::streamoff>(header));
-    const size_t row = t.row_bytes(), block = std::max<size_t>(1, (16u << 20) / std::max<size_t>(1, row));
+    const size_t row = t.row_bytes(), block = std::max<size_t>(1, kIoPieceBytes / std::max<size_t>(1, row));
     for (uint64_t first = 0; first < layout.rows; first += block) {
       const size_t n = static_cast<size_t>(std::min<uint64_t>(block, layout.rows - first));
       buf.resize(n * row);

@@ -12,10 +12,17 @@
 #include "backend/opencl/paths/paths.h"
 #include "backend/opencl/raw_grid_pooling.h"
 #include "backend/opencl/table_key.h"
+#include "base/sizes.h"
 
 namespace portalsim::opencl {
 
 namespace {
+
+// The pair tables index (subjects x (variants x regions)^2) cells: past this many, the
+// tables would outgrow the memory they save, and the untabulated kernel runs instead.
+constexpr size_t kMaxTabulatedPairs = size_t{1} << 26;
+// Global scratch for work spaces too large for private memory, per launch.
+constexpr size_t kMaxScratchBytes = 64 * kMiB;
 
 // Whether two boxes, widened by the bilinear fringe, meet (kernels/physics_raw.cl, layers_meet).
 bool boxes_meet(const Rect& a, const Rect& b) {
@@ -65,7 +72,7 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const DeviceBatc
   // (variants x regions)^2) stays small.
   const size_t combos = cat.variant_list.size() * kRegions;
   const bool tabulated =
-      plan.model.jitter <= 0 && !plan.model.transforms() && cat.subjects.size() * combos * combos <= (size_t(1) << 26);
+      plan.model.jitter <= 0 && !plan.model.transforms() && cat.subjects.size() * combos * combos <= kMaxTabulatedPairs;
   cl::Context& ctx = d_.ctx();
   for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
     const int view = lay.pooled[slot];
@@ -74,11 +81,11 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const DeviceBatc
     raw_grid(v);
     const auto& d = t.dims.s;
     const size_t per = PS_FEATURE_SPACE(size_t(d[0]), size_t(d[1]), size_t(d[2]), size_t(d[3]), size_t(d[4]));
-    // Work spaces too large for private memory take global scratch, 64 MiB at most: a
-    // launch per that many scenarios (the kernel indexes it from its launch's offset).
+    // Work spaces too large for private memory take global scratch, kMaxScratchBytes at
+    // most: a launch per that many scenarios (the kernel indexes it from its launch's offset).
     const size_t rb = K.real_bytes();
     const size_t chunk = per > PS_FEATURE_NOISE_PRIVATE
-                             ? std::max<size_t>(kLocalSize, (size_t(64) << 20) / (per * rb) / kLocalSize * kLocalSize)
+                             ? std::max<size_t>(kLocalSize, kMaxScratchBytes / (per * rb) / kLocalSize * kLocalSize)
                              : padded(b.n);
     cl::Buffer& scratch =
         scratch_.at_least(ctx, per > PS_FEATURE_NOISE_PRIVATE ? std::min(chunk, padded(b.n)) * per * rb : 1);
