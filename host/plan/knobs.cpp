@@ -16,28 +16,29 @@ std::string format_number(double v) {
   return std::string(buf, r.ptr);
 }
 
-Knob integer(std::string key, int lo, int hi, std::string unit, std::string help,
+// A knob of numbers within [lo, hi] (integer, number; each side of a grid).
+Knob bounded(KnobKind kind, std::string key, double lo, double hi, std::string unit, std::string help,
              std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
   return Knob{.key = std::move(key),
-              .kind = KnobKind::integer,
-              .min = double(lo),
-              .max = double(hi),
-              .unit = std::move(unit),
-              .help = std::move(help),
-              .set = std::move(set),
-              .get = std::move(get)};
-}
-
-Knob number(std::string key, double lo, double hi, std::string unit, std::string help,
-            std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{.key = std::move(key),
-              .kind = KnobKind::number,
+              .kind = kind,
               .min = lo,
               .max = hi,
               .unit = std::move(unit),
               .help = std::move(help),
               .set = std::move(set),
               .get = std::move(get)};
+}
+
+Knob integer(std::string key, int lo, int hi, std::string unit, std::string help,
+             std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
+  return bounded(KnobKind::integer, std::move(key), lo, hi, std::move(unit), std::move(help), std::move(set),
+                 std::move(get));
+}
+
+Knob number(std::string key, double lo, double hi, std::string unit, std::string help,
+            std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
+  return bounded(KnobKind::number, std::move(key), lo, hi, std::move(unit), std::move(help), std::move(set),
+                 std::move(get));
 }
 
 Knob on_off(std::string key, std::string help, bool fidelity, std::function<void(Plan&, double)> set,
@@ -55,14 +56,8 @@ Knob on_off(std::string key, std::string help, bool fidelity, std::function<void
 
 Knob grid(std::string key, int lo, int hi, std::string unit, std::string help, std::function<void(Plan&, double)> set,
           std::function<nlohmann::json(const Plan&)> get) {
-  return Knob{.key = std::move(key),
-              .kind = KnobKind::grid,
-              .min = double(lo),
-              .max = double(hi),
-              .unit = std::move(unit),
-              .help = std::move(help),
-              .set = std::move(set),
-              .get = std::move(get)};
+  return bounded(KnobKind::grid, std::move(key), lo, hi, std::move(unit), std::move(help), std::move(set),
+                 std::move(get));
 }
 
 Knob choice(std::string key, std::vector<std::string> choices, std::string help, bool fidelity, bool identity,
