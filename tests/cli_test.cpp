@@ -272,6 +272,21 @@ TEST(CliSimulate, GunWritesExactlyTheSixFiles) {
   EXPECT_EQ(ir.channels, 3);
 }
 
+// --timing names the path each view took, as the backend chose it (OpenCLPaths.* hold the
+// choices themselves); generate names the features path of a features-only run.
+TEST(CliSimulate, TimingNamesThePathEachViewTook) {
+  TempDir t;
+  const Result r = run(t, simulate({"--model", "physics", "--timing", "none", "none", "none", "gun"}, t.w() / "out"));
+  ExpectSuccess(r);
+  EXPECT_TRUE(has(r.out,
+                  "\npaths: upper: physics_raw (fixed window), lower: physics_raw (fixed window), "
+                  "ir: ir_fused (surface, noise and display fused), features: pooled from the rendered views\n"))
+      << describe(r);
+  const Result g = run(t, {"generate", "--count", "8", "--timing", "--out", (t.w() / "set").string()});
+  ExpectSuccess(g);
+  EXPECT_TRUE(has(g.out, "\npaths: features: thesis_sparse_features\n")) << describe(g);
+}
+
 TEST(CliSimulate, FeaturesCsvHasHeaderAndOneMatchingRow) {
   TempDir t;
   const fs::path out = t.w() / "out";

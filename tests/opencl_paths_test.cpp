@@ -44,6 +44,36 @@ TEST(OpenCLPaths, EachViewTakesTheFirstPathWhoseGateApplies) {
   EXPECT_STREQ(opencl::view_path(plan, other.sensors[0]).name(), "stage_chain");
 }
 
+// Each gate decides its path's variant too (render() decides nothing), and the backend's
+// paths(), which --timing prints, names what run() takes, view by view.
+TEST(OpenCLPaths, EachGateDecidesItsVariantAndTimingNamesIt) {
+  const Catalogue& cat = catalogue();
+  Plan plan = test::physics_plan();
+  const Sensor &upper = cat.sensors[0], &ir = cat.sensors[2];
+  EXPECT_EQ(opencl::describe("physics_raw", opencl::view_route(plan, upper).gate), "physics_raw (fixed window)");
+  plan.model.window_auto = true;
+  EXPECT_EQ(opencl::describe("physics_raw", opencl::view_route(plan, upper).gate), "physics_raw (automatic window)");
+  plan.model.ir_netd = 0.05;
+  EXPECT_STREQ(opencl::view_route(plan, ir).gate.variant_name, "surface, noise and display fused");
+  plan.model.ir_netd = 0;
+  EXPECT_STREQ(opencl::view_route(plan, ir).gate.variant_name, "surface and display fused");
+
+  auto cl = make_opencl_backend(cat, assets(), test::runtime());
+  Plan features = test::physics_plan();
+  features.images = 0;
+  features.fidelity = tier_fidelity(Tier::fast);
+  EXPECT_EQ(cl->paths(features), (std::vector<std::string>{"features: physics_raw_features (tabulated)"}));
+  features.model.jitter = 3;  // objects move: no pair tables
+  EXPECT_EQ(cl->paths(features), (std::vector<std::string>{"features: physics_raw_features (untabulated)"}));
+  Plan thesis;
+  thesis.images = 1u << 2;  // the IR view alone, and the MMW views pooled for the features
+  EXPECT_EQ(cl->paths(thesis),
+            (std::vector<std::string>{"upper: thesis_images", "lower: thesis_images", "ir: thesis_images",
+                                      "features: pooled from the rendered views"}));
+  thesis.features = false;
+  EXPECT_EQ(cl->paths(thesis), (std::vector<std::string>{"ir: thesis_images"}));
+}
+
 // A features-only physics run under the block-mean model (the fast tier's), on views whose
 // chain physics_raw does not implement: its gate fails, so the views are rendered stage by
 // stage and pooled, and the features are the reference's within the physics model's dense

@@ -56,6 +56,9 @@ class Backend {
   virtual std::string name() const = 0;
   // Fills `out` with what `plan` asks for; `out`'s buffers are reused across calls.
   virtual void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) = 0;
+  // How run() makes `plan`'s outputs, as --timing names it: per rendered view and for the
+  // features, the path taken ("upper: physics_raw (fixed window)").
+  virtual std::vector<std::string> paths(const Plan& plan) const = 0;
 
  protected:
   // The annotations `plan` asks for (the same function for every backend), or none.

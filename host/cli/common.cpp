@@ -52,6 +52,12 @@ void open_catalogue(Session& s, const CommonOptions& o) {
   s.assets_seconds = since(t0);
 }
 
+void print_paths(const Backend& backend, const Plan& plan) {
+  std::string line = "paths:";
+  for (const std::string& p : backend.paths(plan)) line += (line.size() > 6 ? ", " : " ") + p;
+  std::printf("%s\n", line.c_str());
+}
+
 void open_backend(Session& s, const CommonOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   if (o.backend == "reference") {

@@ -47,6 +47,8 @@ Session open_session(const CommonOptions& o);
 // Catalogue and assets only (no backend yet): lets a command check its arguments first.
 void open_catalogue(Session& s, const CommonOptions& o);
 void open_backend(Session& s, const CommonOptions& o);
+// --timing's line of the paths `backend` takes for `plan` ("paths: upper: thesis_images, ...").
+void print_paths(const Backend& backend, const Plan& plan);
 
 // Every base image, sprite and noise pattern of the session, as `portalsim catalogue
 // --images` writes them; a subject's view is named by subject_image_name.

@@ -11,6 +11,7 @@
 #include "io/input_file.h"
 #include "schedule/pipeline.h"
 #include "schedule/ranked_run.h"
+#include "schedule/scenario_source.h"
 
 namespace portalsim::cli {
 
@@ -147,6 +148,7 @@ int generate(GenerateOptions& o) {
     std::printf("timing: compute %.3f s (%.0f scenarios/s), waiting for the writer %.3f s%s\n", r.compute_seconds,
                 r.compute_seconds > 0 ? r.done / r.compute_seconds : 0.0, r.write_wait_seconds,
                 s.runtime ? (", kernel build " + std::to_string(s.runtime->build_seconds()) + " s").c_str() : "");
+  if (o.common.timing) print_paths(*s.backend, run_plan(spec, s.catalogue));
   if (r.interrupted) {
     std::fprintf(stderr, "portalsim: interrupted; %s is consistent, run the same command with --resume to finish it\n",
                  o.out.c_str());

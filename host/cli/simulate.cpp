@@ -64,6 +64,7 @@ int simulate(SimulateOptions& o) {
     if (s.runtime)
       std::printf(" (kernel build %.4f s on %s)", s.runtime->build_seconds(), s.runtime->device_name().c_str());
     std::printf(", run %.4f s, write %.4f s, total %.4f s\n", run_seconds, write_seconds, total);
+    print_paths(*s.backend, plan);
   }
   return 0;
 }

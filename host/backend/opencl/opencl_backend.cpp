@@ -44,26 +44,25 @@ class OpenCLBackend final : public Backend {
     q.enqueueWriteBuffer(b.objects, CL_FALSE, 0, n * kRegions * sizeof(int16_t), batch.objects.data());
 
     // Features are written straight into the caller's rows, as kept images are.
-    FeaturePath* features_path = plan.features ? features_path_for(plan, lay) : nullptr;
+    const Route r = route(plan, lay);
     cl::Buffer feats;
     if (plan.features) feats = wrap(ctx, out.features);
-    if (features_path) features_path->features(K, plan, b, feats);
+    if (r.features) r.features->features(K, plan, r.features_gate, b, feats);
 
     // Each camera view the plan needs: rendered into the caller's buffer when its images
     // are kept (PoCL on the CPU writes there directly), else into a device buffer that
     // only pooling reads.
-    const bool pooling = plan.features && !features_path;
+    const bool pooling = plan.features && !r.features;
     std::vector<cl::Buffer> rendered(cat_.sensors.size());
     for (size_t k = 0; k < cat_.sensors.size(); ++k) {
-      const Sensor& s = cat_.sensors[k];
+      const ViewRoute& vr = r.views[k];
+      if (!vr.path) continue;
       const int view = static_cast<int>(k);
-      const bool keep = plan.image(view);
-      if (!keep && !(pooling && s.pooled)) continue;
-      rendered[k] = keep ? wrap(ctx, out.views[k].pixels) : device_.pooled_only[k].at_least(ctx, n * s.pixels());
-      const ViewPath& path = view_path(plan, s);
-      ViewLaunch v(device_, K, plan, view, b, rendered[k], path.uses_field());
+      rendered[k] = plan.image(view) ? wrap(ctx, out.views[k].pixels)
+                                     : device_.pooled_only[k].at_least(ctx, n * cat_.sensors[k].pixels());
+      ViewLaunch v(device_, K, plan, view, b, rendered[k], vr.path->uses_field());
       v.run("place_view", n);  // one placement record per scenario, read by every row after
-      path.render(v);
+      vr.path->render(v, vr.gate);
     }
     if (pooling)
       for (size_t slot = 0; slot < lay.pooled.size(); ++slot)
@@ -81,15 +80,46 @@ class OpenCLBackend final : public Backend {
     q.finish();
   }
 
+  std::vector<std::string> paths(const Plan& plan) const override {
+    const Route r = route(plan, FeatureLayout::of(cat_, plan.model.block));
+    std::vector<std::string> taken;
+    for (size_t k = 0; k < cat_.sensors.size(); ++k)
+      if (r.views[k].path)
+        taken.push_back(cat_.sensors[k].name + ": " + describe(r.views[k].path->name(), r.views[k].gate));
+    if (plan.features)
+      taken.push_back(r.features ? "features: " + describe(r.features->name(), r.features_gate)
+                                 : std::string("features: pooled from the rendered views"));
+    return taken;
+  }
+
  private:
-  // The first features path whose gate applies to every pooled view; null: pool renders.
-  FeaturePath* features_path_for(const Plan& plan, const FeatureLayout& lay) {
-    for (const auto& p : features_paths_) {
-      bool all = !lay.pooled.empty();
-      for (int view : lay.pooled) all = all && p->applies(plan, cat_.sensors[view]);
-      if (all) return p.get();
+  // Every choice of paths run() makes for `plan`, made here alone: the features path, and
+  // for each view that is rendered, its path (null: the view is not rendered).
+  struct Route {
+    FeaturePath* features = nullptr;  // null: the rendered views are pooled
+    Gate features_gate;
+    std::vector<ViewRoute> views;
+  };
+  Route route(const Plan& plan, const FeatureLayout& lay) const {
+    Route r;
+    // The first features path whose gate applies to every pooled view.
+    if (plan.features && !lay.pooled.empty())
+      for (const auto& p : features_paths_) {
+        bool all = true;
+        for (int view : lay.pooled) all = all && p->applies(plan, cat_.sensors[view]);
+        if (all) {
+          r.features = p.get();
+          r.features_gate = p->gate(plan, cat_.sensors[lay.pooled[0]]);
+          break;
+        }
+      }
+    const bool pooling = plan.features && !r.features;
+    r.views.resize(cat_.sensors.size());
+    for (size_t k = 0; k < cat_.sensors.size(); ++k) {
+      const Sensor& s = cat_.sensors[k];
+      if (plan.image(static_cast<int>(k)) || (pooling && s.pooled)) r.views[k] = view_route(plan, s);
     }
-    return nullptr;
+    return r;
   }
 
   const Catalogue& cat_;

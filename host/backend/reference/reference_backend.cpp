@@ -15,6 +15,13 @@ class ReferenceBackend final : public Backend {
     for (const Sensor& s : cat.sensors) check_chain(s);
   }
   std::string name() const override { return "reference"; }
+  std::vector<std::string> paths(const Plan& plan) const override {
+    std::vector<std::string> taken;
+    for (size_t k = 0; k < cat_.sensors.size(); ++k)
+      if (plan.renders(cat_.sensors[k], static_cast<int>(k))) taken.push_back(cat_.sensors[k].name + ": fp64 stages");
+    if (plan.features) taken.push_back("features: pooled from the rendered views");
+    return taken;
+  }
 
   void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) override {
     const size_t n = batch.size();

@@ -18,17 +18,24 @@ class IrFused final : public ViewPath {
     static const std::vector<std::string> stages = {"contact_shadow", "heat_spread", "ir_surface"};
     return stages;
   }
-  bool applies(const Plan& plan, const Sensor& sensor) const override {
+  enum Variant { kThenStages, kDisplayFused, kNoiseDisplayFused };
+  Gate gate(const Plan& plan, const Sensor& sensor) const override {
     const std::vector<std::string>& c = sensor.chain_for(plan.model.model);
-    return plan.fidelity.fused && c.size() > chain().size() && std::equal(chain().begin(), chain().end(), c.begin());
+    if (!plan.fidelity.fused || c.size() <= chain().size() || !std::equal(chain().begin(), chain().end(), c.begin()))
+      return {};
+    // The stages after the fused ones; ir_netd at 0 K draws nothing.
+    std::vector<std::string> rest(c.begin() + static_cast<std::ptrdiff_t>(chain().size()), c.end());
+    if (plan.model.ir_netd == 0) std::erase(rest, "ir_netd");
+    if (rest == std::vector<std::string>{"ir_display"})
+      return {.runs = true, .variant = kDisplayFused, .variant_name = "surface and display fused"};
+    if (rest == std::vector<std::string>{"ir_netd", "ir_display"})
+      return {.runs = true, .variant = kNoiseDisplayFused, .variant_name = "surface, noise and display fused"};
+    return {.runs = true, .variant = kThenStages, .variant_name = "surface fused, then the stage kernels"};
   }
   bool uses_field() const override { return true; }
-  void render(ViewLaunch& v) const override {
-    std::vector<std::string> rest(v.chain.begin() + static_cast<std::ptrdiff_t>(chain().size()), v.chain.end());
-    if (v.plan.model.ir_netd == 0) std::erase(rest, "ir_netd");
-    if (rest == std::vector<std::string>{"ir_display"}) return v.run("ir_surface_display_fused", v.batch.n);
-    if (rest == std::vector<std::string>{"ir_netd", "ir_display"})
-      return v.run("ir_surface_noise_display_fused", v.batch.n);
+  void render(ViewLaunch& v, const Gate& g) const override {
+    if (g.variant == kDisplayFused) return v.run("ir_surface_display_fused", v.batch.n);
+    if (g.variant == kNoiseDisplayFused) return v.run("ir_surface_noise_display_fused", v.batch.n);
     v.run("ir_surface_fused", v.batch.n);
     run_stages(v, chain().size());
   }

@@ -1,8 +1,9 @@
 // The OpenCL backend's declared paths (docs/dev/architecture.md). A view path renders one
 // camera view; a features path makes the feature rows of features-only runs without
 // rendering. Each fast path declares the chain of stages it implements and one gate,
-// applies(plan, sensor): the one place that decides whether it runs. Where no fast path's
-// gate applies, the stage chain renders the view and pooling makes the features.
+// gate(plan, sensor): the one place that decides whether it runs and which of its variants
+// (the kernels it launches) runs. Where no fast path's gate applies, the stage chain
+// renders the view and pooling makes the features. --timing names each view's choice.
 #pragma once
 #include <CL/opencl.hpp>
 #include <memory>
@@ -16,23 +17,41 @@
 
 namespace portalsim::opencl {
 
+// A path's whole decision for one view under a plan: whether it runs, and which of its
+// variants; render() and features() act on it and decide nothing more.
+struct Gate {
+  bool runs = false;
+  int variant = 0;
+  const char* variant_name = "";  // for --timing; empty where the path has one variant
+};
+
 class ViewPath {
  public:
   virtual ~ViewPath() = default;
   virtual const char* name() const = 0;
   // The stages it implements, in order (the IR path: the chain's first stages).
   virtual const std::vector<std::string>& chain() const = 0;
-  virtual bool applies(const Plan& plan, const Sensor& sensor) const = 0;
+  virtual Gate gate(const Plan& plan, const Sensor& sensor) const = 0;
+  bool applies(const Plan& plan, const Sensor& sensor) const { return gate(plan, sensor).runs; }
   // Whether its kernels pass a field of reals between them (else they write the pixels).
   virtual bool uses_field() const = 0;
-  // Renders the view, after place_view has written its records.
-  virtual void render(ViewLaunch& v) const = 0;
+  // Renders the view as its gate decided, after place_view has written its records.
+  virtual void render(ViewLaunch& v, const Gate& g) const = 0;
+};
+
+// A view's path and its gate's decision.
+struct ViewRoute {
+  const ViewPath* path = nullptr;
+  Gate gate;
 };
 
 // The view paths in the order they are tried; the last, the stage chain, applies to all.
 const std::vector<const ViewPath*>& view_paths();
-// The first view path whose gate applies.
-const ViewPath& view_path(const Plan& plan, const Sensor& sensor);
+// The first view path whose gate applies, and its decision.
+ViewRoute view_route(const Plan& plan, const Sensor& sensor);
+inline const ViewPath& view_path(const Plan& plan, const Sensor& sensor) { return *view_route(plan, sensor).path; }
+// "physics_raw (fixed window)": a path's name and its variant's, as --timing shows them.
+std::string describe(const char* path, const Gate& g);
 
 // The fast view paths (paths/*.cpp) and the general one.
 const ViewPath& thesis_images_path();
@@ -49,11 +68,12 @@ class FeaturePath {
  public:
   virtual ~FeaturePath() = default;
   virtual const char* name() const = 0;
-  // Whether it makes `plan`'s features of the pooled view `sensor`; the path runs where
-  // its gate applies to every pooled view.
-  virtual bool applies(const Plan& plan, const Sensor& sensor) const = 0;
-  // Writes the batch's image features (blocks and regions) into `features`.
-  virtual void features(Kernels& K, const Plan& plan, const DeviceBatch& b, cl::Buffer& features) = 0;
+  // Whether it makes `plan`'s features of the pooled view `sensor`, and how; the path runs
+  // where its gate applies to every pooled view.
+  virtual Gate gate(const Plan& plan, const Sensor& sensor) const = 0;
+  bool applies(const Plan& plan, const Sensor& sensor) const { return gate(plan, sensor).runs; }
+  // Writes the batch's image features (blocks and regions) into `features`, as `g` decided.
+  virtual void features(Kernels& K, const Plan& plan, const Gate& g, const DeviceBatch& b, cl::Buffer& features) = 0;
 };
 
 std::unique_ptr<FeaturePath> thesis_sparse_features_path(Device& d);

@@ -15,13 +15,16 @@ class PhysicsRaw final : public ViewPath {
     static const std::vector<std::string> stages = {"radiometry", "optics", "sample", "netd", "window", "mmw_display"};
     return stages;
   }
-  bool applies(const Plan& plan, const Sensor& sensor) const override {
-    return plan.fidelity.fused && sensor.chain_for(plan.model.model) == chain();
+  enum Variant { kFixedWindow, kAutoWindow };
+  Gate gate(const Plan& plan, const Sensor& sensor) const override {
+    if (!plan.fidelity.fused || sensor.chain_for(plan.model.model) != chain()) return {};
+    if (plan.model.window_auto) return {.runs = true, .variant = kAutoWindow, .variant_name = "automatic window"};
+    return {.runs = true, .variant = kFixedWindow, .variant_name = "fixed window"};
   }
   bool uses_field() const override { return false; }
-  void render(ViewLaunch& v) const override {
+  void render(ViewLaunch& v, const Gate& g) const override {
     run_raw_grid(v);
-    if (v.plan.model.window_auto) v.run("stage_window", v.batch.n);
+    if (g.variant == kAutoWindow) v.run("stage_window", v.batch.n);
     v.run("stage_mmw_display", v.batch.n);
   }
 };

@@ -40,10 +40,18 @@ class PhysicsRawFeatures final : public FeaturePath {
  public:
   explicit PhysicsRawFeatures(Device& d) : d_(d) {}
   const char* name() const override { return "physics_raw_features"; }
-  bool applies(const Plan& plan, const Sensor& sensor) const override {
-    return plan.physics_sparse_features() && physics_raw_path().applies(quiet(plan), sensor);
+  enum Variant { kUntabulated, kTabulated };
+  Gate gate(const Plan& plan, const Sensor& sensor) const override {
+    if (!plan.physics_sparse_features() || !physics_raw_path().applies(quiet(plan), sensor)) return {};
+    // Tables where objects stand at their places, and while the pairs' index (subjects x
+    // (variants x regions)^2) stays small.
+    const size_t combos = d_.cat.variant_list.size() * kRegions;
+    if (plan.model.jitter <= 0 && !plan.model.transforms() &&
+        d_.cat.subjects.size() * combos * combos <= kMaxTabulatedPairs)
+      return {.runs = true, .variant = kTabulated, .variant_name = "tabulated"};
+    return {.runs = true, .variant = kUntabulated, .variant_name = "untabulated"};
   }
-  void features(Kernels& K, const Plan& plan, const DeviceBatch& b, cl::Buffer& feats) override;
+  void features(Kernels& K, const Plan& plan, const Gate& g, const DeviceBatch& b, cl::Buffer& feats) override;
 
  private:
   struct Tables {
@@ -64,15 +72,12 @@ class PhysicsRawFeatures final : public FeaturePath {
   Grown scratch_;
 };
 
-void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const DeviceBatch& b, cl::Buffer& feats) {
+void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const Gate& g, const DeviceBatch& b,
+                                  cl::Buffer& feats) {
   const Catalogue& cat = d_.cat;
   const FeatureLayout lay = FeatureLayout::of(cat, plan.model.block);
   const Plan q = quiet(plan);
-  // Tables where objects stand at their places, and while the pairs' index (subjects x
-  // (variants x regions)^2) stays small.
-  const size_t combos = cat.variant_list.size() * kRegions;
-  const bool tabulated =
-      plan.model.jitter <= 0 && !plan.model.transforms() && cat.subjects.size() * combos * combos <= kMaxTabulatedPairs;
+  const bool tabulated = g.variant == kTabulated;
   cl::Context& ctx = d_.ctx();
   for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
     const int view = lay.pooled[slot];

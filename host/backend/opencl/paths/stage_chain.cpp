@@ -14,9 +14,9 @@ class StageChain final : public ViewPath {
     static const std::vector<std::string> any;  // whatever the view's chain is
     return any;
   }
-  bool applies(const Plan&, const Sensor&) const override { return true; }
+  Gate gate(const Plan&, const Sensor&) const override { return {.runs = true}; }
   bool uses_field() const override { return true; }
-  void render(ViewLaunch& v) const override { run_stages(v, 0); }
+  void render(ViewLaunch& v, const Gate&) const override { run_stages(v, 0); }
 };
 
 }  // namespace
@@ -37,10 +37,14 @@ const std::vector<const ViewPath*>& view_paths() {
   return paths;
 }
 
-const ViewPath& view_path(const Plan& plan, const Sensor& sensor) {
+ViewRoute view_route(const Plan& plan, const Sensor& sensor) {
   for (const ViewPath* p : view_paths())
-    if (p->applies(plan, sensor)) return *p;
-  return stage_chain_path();
+    if (const Gate g = p->gate(plan, sensor); g.runs) return {p, g};
+  return {&stage_chain_path(), stage_chain_path().gate(plan, sensor)};
+}
+
+std::string describe(const char* path, const Gate& g) {
+  return *g.variant_name ? std::string(path) + " (" + g.variant_name + ")" : std::string(path);
 }
 
 }  // namespace portalsim::opencl

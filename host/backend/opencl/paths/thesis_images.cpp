@@ -14,11 +14,11 @@ class ThesisImages final : public ViewPath {
     static const std::vector<std::string> stages = {"composite", "pattern_noise", "sensor_noise", "display"};
     return stages;
   }
-  bool applies(const Plan& plan, const Sensor& sensor) const override {
-    return plan.fidelity.fused && sensor.chain_for(plan.model.model) == chain();
+  Gate gate(const Plan& plan, const Sensor& sensor) const override {
+    return {.runs = plan.fidelity.fused && sensor.chain_for(plan.model.model) == chain()};
   }
   bool uses_field() const override { return false; }
-  void render(ViewLaunch& v) const override { v.run("render_view", v.batch.n); }
+  void render(ViewLaunch& v, const Gate&) const override { v.run("render_view", v.batch.n); }
 };
 
 }  // namespace

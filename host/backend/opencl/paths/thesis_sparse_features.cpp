@@ -19,11 +19,11 @@ class ThesisSparseFeatures final : public FeaturePath {
   explicit ThesisSparseFeatures(Device& d) : d_(d) {}
   const char* name() const override { return "thesis_sparse_features"; }
   // The chain the tables implement: thesis_images's.
-  bool applies(const Plan& plan, const Sensor& sensor) const override {
-    return plan.sparse_features() && sensor.camera == Camera::mmw &&
-           sensor.chain_for(plan.model.model) == thesis_images_path().chain();
+  Gate gate(const Plan& plan, const Sensor& sensor) const override {
+    return {.runs = plan.sparse_features() && sensor.camera == Camera::mmw &&
+                    sensor.chain_for(plan.model.model) == thesis_images_path().chain()};
   }
-  void features(Kernels& K, const Plan& plan, const DeviceBatch& b, cl::Buffer& feats) override;
+  void features(Kernels& K, const Plan& plan, const Gate& g, const DeviceBatch& b, cl::Buffer& feats) override;
 
  private:
   struct Tables {
@@ -153,7 +153,8 @@ ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Pla
   return t;
 }
 
-void ThesisSparseFeatures::features(Kernels& K, const Plan& plan, const DeviceBatch& b, cl::Buffer& feats) {
+void ThesisSparseFeatures::features(Kernels& K, const Plan& plan, const Gate&, const DeviceBatch& b,
+                                    cl::Buffer& feats) {
   const Tables& t = tables(K, plan);
   const Catalogue& cat = d_.cat;
   const DeviceCatalogue& c = d_.data;
