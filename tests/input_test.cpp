@@ -418,7 +418,7 @@ TEST(OutputFolder, ResumingAFinishedRunWithOtherParametersNamesEveryDifference) 
   other[2] = "6";
   other[4] = "2";
   other.push_back("--resume");
-  ExpectExit(run(t, other), 2, {"--resume", "spec.count (5 there, 6 now)", "spec.seed (\"1\" there, \"2\" now)"});
+  ExpectExit(run(t, other), 2, {"--resume", "spec.count: 5 in the folder, 6 now", "spec.seed: 1 in the folder, 2 now"});
   EXPECT_EQ(slurp(out / "manifest.json"), manifest);
   Args same = base;
   same.push_back("--resume");
