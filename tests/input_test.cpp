@@ -361,6 +361,16 @@ TEST(ExitCodes, UsageInputAndOutputErrorsAreTold) {
   ExpectExit(run(t, {"simulate", "gun", "--rule", "gun\xFF", "--out", out.string()}), 2, {"--rule", "invalid UTF-8"});
   ExpectExit(run(t, {"generate", "--spec", (t.w() / "missing.toml").string(), "--out", out.string()}), 3,
              {"missing.toml"});
+  // An unknown object: on the command line a usage error (2), in a file bad input (3) (issue 36).
+  ExpectExit(run(t, {"simulate", "none", "nope", "--backend", "reference", "--out", out.string()}), 2,
+             {"objects: region 2: unknown object \"nope\""});
+  ExpectExit(run(t, {"generate", "--count", "5", "--pool", "gun,nope", "--quiet", "--backend", "reference", "--out",
+                     out.string()}),
+             2, {"--pool", "unknown object \"nope\""});
+  spit(t.w() / "pool.toml", "count = 5\npool = [\"gun\", \"nope\"]\n");
+  ExpectExit(run(t, {"generate", "--spec", (t.w() / "pool.toml").string(), "--quiet", "--backend", "reference", "--out",
+                     out.string()}),
+             3, {"pool.toml", "unknown object \"nope\""});
   spit(t.w() / "afile", "keep me\n");
   ExpectExit(run(t, {"generate", "--count", "5", "--quiet", "--out", (t.w() / "afile").string()}), 4, {"afile"});
   EXPECT_EQ(slurp(t.w() / "afile"), "keep me\n");
