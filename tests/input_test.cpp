@@ -513,4 +513,20 @@ TEST(Environment, ReadOnlyPoclCacheIsNamed) {
   EXPECT_TRUE(has(r.err, "writable"));
 }
 
+// PoCL's cache folder missing on a read-only file system: PoCL then offers no platform, and
+// the message must name the cache and what to set, not ask to install PoCL (issue 36).
+TEST(Environment, MissingPoclCacheOnAReadOnlyFileSystemIsNamed) {
+  TempDir t;
+  const fs::path mount = t.w() / "ro", cache = mount / "pocl";
+  const std::string cmd = "POCL_CACHE_DIR=" + portalsim::test::quoted(cache.string()) + " " + PORTALSIM_BINARY +
+                          " simulate gun --out " + portalsim::test::quoted((t.w() / "o").string());
+  const Result r = portalsim::test::run_on_tmpfs(t.cap(), mount, "1m", true, cmd);
+  SCOPED_TRACE(describe(r));
+  EXPECT_TRUE(r.exited && r.status == 5) << "5: the OpenCL environment";
+  EXPECT_TRUE(has(r.err, "PoCL's kernel cache, " + cache.string() + ", is missing and cannot be made"));
+  EXPECT_TRUE(has(r.err, "POCL_CACHE_DIR, or XDG_CACHE_HOME, must name a writable folder"));
+  EXPECT_FALSE(has(r.err, "is pocl-opencl-icd installed")) << "PoCL is installed: its cache is what failed";
+  EXPECT_FALSE(fs::exists(t.w() / "o"));
+}
+
 }  // namespace
