@@ -106,6 +106,10 @@ TEST(BenchCommand, WithoutFp64SkipsTheExactTierAndPhysicsEndToEnd) {
   const json &features = j["paths"][0], &physics = j["paths"][1];
   EXPECT_FALSE(j["device"]["fp64"].get<bool>());
   EXPECT_TRUE(j.contains("fp64_note"));
+  // The note on stderr speaks of the paths asked for, as the report's does (issue 36).
+  EXPECT_TRUE(has(r.err, "portalsim bench: " + j["fp64_note"].get<std::string>())) << "stderr and the report differ";
+  for (const char* other : {"noisy_images", "annotations", ", images"})
+    EXPECT_FALSE(has(r.err, other)) << "the note names a path not asked for: " << other;
   for (const json* p : {&features, &physics}) {
     EXPECT_TRUE((*p)["exact"].contains("skipped"));
     check_measured(*p, "kernel", 3);

@@ -799,6 +799,10 @@ void ExpectSignalStopsConsistentlyAndResumes(int sig) {
   EXPECT_EQ(k.status, 130) << "an interrupted run exits with 130";
   EXPECT_TRUE(has(k.err, "--resume")) << "the message must say how to continue";
   EXPECT_EQ(stderr_messages(k.err).size(), 1u);
+  // The summary line must not read as a finished run's: it says it was interrupted and how
+  // to finish (issue 36).
+  EXPECT_TRUE(has(k.out, "interrupted after ")) << "the summary must say the run was interrupted";
+  EXPECT_TRUE(has(k.out, "--resume")) << "the summary must say how to finish the run";
   const long long next = checkpoint_next(dir);
   EXPECT_GT(next, 0);
   EXPECT_LT(next, 30000);

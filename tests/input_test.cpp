@@ -361,6 +361,16 @@ TEST(ExitCodes, UsageInputAndOutputErrorsAreTold) {
   ExpectExit(run(t, {"simulate", "gun", "--rule", "gun\xFF", "--out", out.string()}), 2, {"--rule", "invalid UTF-8"});
   ExpectExit(run(t, {"generate", "--spec", (t.w() / "missing.toml").string(), "--out", out.string()}), 3,
              {"missing.toml"});
+  // An unknown object: on the command line a usage error (2), in a file bad input (3) (issue 36).
+  ExpectExit(run(t, {"simulate", "none", "nope", "--backend", "reference", "--out", out.string()}), 2,
+             {"objects: region 2: unknown object \"nope\""});
+  ExpectExit(run(t, {"generate", "--count", "5", "--pool", "gun,nope", "--quiet", "--backend", "reference", "--out",
+                     out.string()}),
+             2, {"--pool", "unknown object \"nope\""});
+  spit(t.w() / "pool.toml", "count = 5\npool = [\"gun\", \"nope\"]\n");
+  ExpectExit(run(t, {"generate", "--spec", (t.w() / "pool.toml").string(), "--quiet", "--backend", "reference", "--out",
+                     out.string()}),
+             3, {"pool.toml", "unknown object \"nope\""});
   spit(t.w() / "afile", "keep me\n");
   ExpectExit(run(t, {"generate", "--count", "5", "--quiet", "--out", (t.w() / "afile").string()}), 4, {"afile"});
   EXPECT_EQ(slurp(t.w() / "afile"), "keep me\n");
@@ -418,7 +428,7 @@ TEST(OutputFolder, ResumingAFinishedRunWithOtherParametersNamesEveryDifference) 
   other[2] = "6";
   other[4] = "2";
   other.push_back("--resume");
-  ExpectExit(run(t, other), 2, {"--resume", "spec.count (5 there, 6 now)", "spec.seed (\"1\" there, \"2\" now)"});
+  ExpectExit(run(t, other), 2, {"--resume", "spec.count: 5 in the folder, 6 now", "spec.seed: 1 in the folder, 2 now"});
   EXPECT_EQ(slurp(out / "manifest.json"), manifest);
   Args same = base;
   same.push_back("--resume");
@@ -501,6 +511,22 @@ TEST(Environment, ReadOnlyPoclCacheIsNamed) {
   EXPECT_TRUE(r.exited && r.status == 5) << "5: the OpenCL environment";
   EXPECT_TRUE(has(r.err, cache.string())) << "the message must name the cache folder";
   EXPECT_TRUE(has(r.err, "writable"));
+}
+
+// PoCL's cache folder missing on a read-only file system: PoCL then offers no platform, and
+// the message must name the cache and what to set, not ask to install PoCL (issue 36).
+TEST(Environment, MissingPoclCacheOnAReadOnlyFileSystemIsNamed) {
+  TempDir t;
+  const fs::path mount = t.w() / "ro", cache = mount / "pocl";
+  const std::string cmd = "POCL_CACHE_DIR=" + portalsim::test::quoted(cache.string()) + " " + PORTALSIM_BINARY +
+                          " simulate gun --out " + portalsim::test::quoted((t.w() / "o").string());
+  const Result r = portalsim::test::run_on_tmpfs(t.cap(), mount, "1m", true, cmd);
+  SCOPED_TRACE(describe(r));
+  EXPECT_TRUE(r.exited && r.status == 5) << "5: the OpenCL environment";
+  EXPECT_TRUE(has(r.err, "PoCL's kernel cache, " + cache.string() + ", is missing and cannot be made"));
+  EXPECT_TRUE(has(r.err, "POCL_CACHE_DIR, or XDG_CACHE_HOME, must name a writable folder"));
+  EXPECT_FALSE(has(r.err, "is pocl-opencl-icd installed")) << "PoCL is installed: its cache is what failed";
+  EXPECT_FALSE(fs::exists(t.w() / "o"));
 }
 
 }  // namespace

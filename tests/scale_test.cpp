@@ -124,7 +124,10 @@ TEST(Merge, RefusesPartsThatDoNotFit) {
   const std::string half = part("half", spec, "0/2");
   const fs::path out = t.w() / "out";
 
-  ExpectRefused(ps(t, {"merge", p0, other_seed, p2, "--out", out.string()}), out, 3, {"seed4", "spec.seed"});
+  // The message reads plainly: which part, against which, what differs and how (issue 36).
+  ExpectRefused(
+      ps(t, {"merge", p0, other_seed, p2, "--out", out.string()}), out, 3,
+      {"part " + other_seed + " differs from the first part " + p0 + " in spec.seed: 4 here, 3 in the first"});
   ExpectRefused(ps(t, {"merge", p0, other_format, p2, "--out", out.string()}), out, 3, {"arff", "spec.format"});
   ExpectRefused(ps(t, {"merge", p0, p2, "--out", out.string()}), out, 3, {"no part holds scenarios [33, 66)"});
   ExpectRefused(ps(t, {"merge", p0, p1, "--out", out.string()}), out, 3, {"[66, 100)"});

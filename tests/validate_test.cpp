@@ -7,7 +7,10 @@
 #include <random>
 #include <tuple>
 
+#include "base/error.h"
 #include "cli/validate_stats.h"
+#include "cli/validate_tables.h"
+#include "io/table_fields.h"
 #include "run_binary.h"
 
 namespace {
@@ -505,6 +508,55 @@ TEST(Validate, BadInputGetsAMessageAndNoReport) {
   EXPECT_NE(r.err.find("java not found"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(d / "out"));
   fs::remove_all(d);
+}
+
+// The tables' fields go through the one CSV/ARFF reader (io/table_fields.h): a quoted field
+// holds commas and blanks, in CSV "" is a quote, in ARFF '...' and \ escapes (issue 36).
+TEST(ValidateTables, QuotedFieldsAreOneField) {
+  using portalsim::cli::parse_arff;
+  using portalsim::cli::parse_csv;
+  std::istringstream csv("\"a,b\",c,class\n1,2,\"gun, \"\"loaded\"\"\"\n3,4,none\n");
+  const portalsim::cli::Table c = parse_csv(csv, "t.csv");
+  EXPECT_EQ(c.names, (std::vector<std::string>{"a,b", "c", "class"}));
+  ASSERT_EQ(c.rows.size(), 2u);
+  EXPECT_EQ(c.rows[0].back(), "gun, \"loaded\"");
+
+  std::istringstream arff(
+      "@relation t\n@attribute 'a b' numeric\n@ATTRIBUTE \"c,d\" numeric\n@attribute class {'it\\'s',none}\n"
+      "@data\n1,2,'it\\'s'\n3,4,none\n");
+  const portalsim::cli::Table a = parse_arff(arff, "t.arff");
+  EXPECT_EQ(a.names, (std::vector<std::string>{"a b", "c,d", "class"}));
+  EXPECT_EQ(a.name_lines, (std::vector<int>{2, 3, 4}));
+  ASSERT_EQ(a.rows.size(), 2u);
+  EXPECT_EQ(a.rows[0].back(), "it's");
+
+  // Bad quoting is refused naming the file, line and column.
+  const auto error = [](const std::string& text, bool is_csv) {
+    std::istringstream in(text);
+    try {
+      (void)(is_csv ? parse_csv(in, "bad") : parse_arff(in, "bad"));
+    } catch (const portalsim::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(error("a,b,class\n1,\"2,gun\n", true), "bad:2: column 2: a quoted field is not closed on its line");
+  EXPECT_EQ(error("a,b,class\n1,2\"x\",gun\n", true),
+            "bad:2: column 2: a quote inside an unquoted field: quote the whole field, and double each quote in it");
+  EXPECT_EQ(error("@attribute 'a numeric\n@attribute class {x}\n@data\n", false),
+            "bad:1: @attribute: a quoted field is not closed on its line");
+}
+
+TEST(TableFields, CsvAndArffQuoting) {
+  using portalsim::io::Quoting;
+  using portalsim::io::split_fields;
+  EXPECT_EQ(split_fields(" a , \"b,c\" ,\"\"\"\",", Quoting::csv, "f", 1),
+            (std::vector<std::string>{"a", "b,c", "\"", ""}));
+  EXPECT_EQ(split_fields("'x,y',\"z\\\"\",w", Quoting::arff, "f", 1), (std::vector<std::string>{"x,y", "z\"", "w"}));
+  EXPECT_EQ(split_fields("", Quoting::csv, "f", 1), (std::vector<std::string>{""}));
+  const portalsim::io::ArffAttribute at = portalsim::io::arff_attribute("@attribute 'a b' {x, y}", "f", 1);
+  EXPECT_EQ(at.name, "a b");
+  EXPECT_EQ(at.type, "{x, y}");
 }
 
 }  // namespace

@@ -24,8 +24,7 @@ struct BenchFlags {
 };
 
 int list_devices() {
-  const std::vector<OpenCLDeviceInfo> devices = list_opencl_devices();
-  if (devices.empty()) throw EnvironmentError("no OpenCL platform found (is pocl-opencl-icd installed?)");
+  const std::vector<OpenCLDeviceInfo> devices = list_opencl_devices();  // throws when there is none
   for (const OpenCLDeviceInfo& d : devices)
     std::printf("%s\t%s, %u compute units, fp64 %s\n", d.name.c_str(), d.type.c_str(), d.compute_units,
                 d.fp64 ? "yes" : "no");
@@ -41,23 +40,15 @@ int bench(const BenchFlags& f) {
   o.dir = f.dir.empty() ? std::filesystem::temp_directory_path().string() : f.dir;
   std::error_code ec;
   if (!std::filesystem::is_directory(o.dir, ec)) throw InputError("--dir: " + o.dir + " is not a folder");
-  std::vector<std::string> known;
-  for (const SpeedPath& p : speed_paths()) known.push_back(p.key);
-  for (const std::string& key : split_list(f.paths)) {
-    if (std::find(known.begin(), known.end(), key) == known.end()) {
-      std::string all;
-      for (const std::string& k : known) all += (all.empty() ? "" : ", ") + k;
-      throw InputError("--paths: \"" + key + "\" is not one of " + all);
-    }
-    o.paths.push_back(key);
-  }
+  o.paths = split_list(f.paths);
+  const std::vector<SpeedPath> chosen = chosen_paths(o.paths);  // checks the keys before the device opens
   auto rt = std::make_shared<OpenCLRuntime>(OpenCLOptions{f.device, ""});
   OpenCLDeviceInfo device = rt->info();
   if (f.without_fp64 && device.fp64) {
     device.fp64 = false;
     device.name += " (as without fp64: --without-fp64)";
   }
-  if (!device.fp64 && !f.quiet) std::fprintf(stderr, "portalsim bench: %s\n", fp64_note(speed_paths(), device).c_str());
+  if (!device.fp64 && !f.quiet) std::fprintf(stderr, "portalsim bench: %s\n", fp64_note(chosen, device).c_str());
   const BenchReport report = run_bench(o, rt, device);
   if (f.json)
     std::printf("%s\n", report_json(report).dump(2).c_str());

@@ -1,7 +1,9 @@
 #include "speed/paths.h"
 
+#include <algorithm>
 #include <stdexcept>
 
+#include "base/error.h"
 #include "base/parallel.h"
 #include "baseline.h"
 #include "scene/generator.h"
@@ -57,6 +59,20 @@ std::vector<SpeedPath> speed_paths() {
   ap.annotations = true;
   add("annotations", "images with boxes and instance masks", annotated, ap);
   return paths;
+}
+
+std::vector<SpeedPath> chosen_paths(const std::vector<std::string>& keys) {
+  const std::vector<SpeedPath> all = speed_paths();
+  for (const std::string& key : keys)
+    if (std::none_of(all.begin(), all.end(), [&](const SpeedPath& p) { return p.key == key; })) {
+      std::string names;
+      for (const SpeedPath& p : all) names += (names.empty() ? "" : ", ") + p.key;
+      throw InputError("--paths: \"" + key + "\" is not one of " + names);
+    }
+  std::vector<SpeedPath> chosen;
+  for (const SpeedPath& p : all)
+    if (keys.empty() || std::find(keys.begin(), keys.end(), p.key) != keys.end()) chosen.push_back(p);
+  return chosen;
 }
 
 SceneBatch make_batch(const Catalogue& cat, size_t n, int max_objects) {

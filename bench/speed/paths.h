@@ -24,6 +24,9 @@ struct SpeedPath {
 
 // features, images, noisy_images, physics_images, annotations, in that order.
 std::vector<SpeedPath> speed_paths();
+// The paths `keys` names (--paths's keys; empty: all), in speed_paths()'s order: what
+// `portalsim bench` measures and its notes speak of. Throws InputError naming an unknown key.
+std::vector<SpeedPath> chosen_paths(const std::vector<std::string>& keys);
 // The features-only plan of issue 14 (thesis, sparse pooling, block 10, no metal).
 Plan features_plan();
 // Every camera view's images, no features or metal, per-pixel noise sigma `sigma`.

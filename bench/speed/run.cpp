@@ -123,21 +123,19 @@ BenchReport run_bench(const BenchOptions& o, std::shared_ptr<OpenCLRuntime> rt, 
   auto kernels = make_opencl_backend(cat, assets, rt);
   auto reference = make_reference_backend(cat, assets);
 
-  for (const SpeedPath& p : speed_paths())
-    if (o.paths.empty() || std::find(o.paths.begin(), o.paths.end(), p.key) != o.paths.end()) {
-      PathResult r;
-      r.path = p;
-      const bool features = p.kernel.images == 0;
-      r.batch = features ? sz.features_batch : sz.images_batch;
-      r.exact_batch = features ? sz.exact_features_batch : sz.exact_images_batch;
-      r.reference_batch = sz.reference_batch;
-      r.end_to_end_count = features ? sz.features_count : sz.images_count;
-      for (Measure m : kMeasures)
-        if (std::string why = why_not(p, m, device); !why.empty()) r.skipped[m] = why;
-      rep.paths.push_back(std::move(r));
-    }
-  std::vector<SpeedPath> chosen;
-  for (const PathResult& r : rep.paths) chosen.push_back(r.path);
+  const std::vector<SpeedPath> chosen = chosen_paths(o.paths);
+  for (const SpeedPath& p : chosen) {
+    PathResult r;
+    r.path = p;
+    const bool features = p.kernel.images == 0;
+    r.batch = features ? sz.features_batch : sz.images_batch;
+    r.exact_batch = features ? sz.exact_features_batch : sz.exact_images_batch;
+    r.reference_batch = sz.reference_batch;
+    r.end_to_end_count = features ? sz.features_count : sz.images_count;
+    for (Measure m : kMeasures)
+      if (std::string why = why_not(p, m, device); !why.empty()) r.skipped[m] = why;
+    rep.paths.push_back(std::move(r));
+  }
   rep.fp64_note = fp64_note(chosen, device);
 
   int steps = 2;  // memory and disk

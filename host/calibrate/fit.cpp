@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "backend/reference/stages.h"
 #include "base/error.h"
@@ -368,6 +369,23 @@ ModelSettings fitted_model(const ModelSettings& model, const CameraFit& fit) {
   m.display_filter = DisplayFilter::bilinear;
   m.smooth = 0;
   return m;
+}
+
+std::string not_camera_like(const Captures& captures, const CameraFit& fit) {
+  const auto g = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", v);
+    return std::string(text);
+  };
+  std::string why;
+  const auto add = [&](const std::string& w) { why += (why.empty() ? "" : ", and ") + w; };
+  if (!captures.views.empty() && fit.raw_w == captures.views[0].width && fit.raw_h == captures.views[0].height)
+    add("the fitted raw grid, " + std::to_string(fit.raw_w) + "x" + std::to_string(fit.raw_h) +
+        ", is the view's own size (no coarser grid reproduces the images)");
+  if (fit.noise_gray < kMinCameraNoiseGray)
+    add("the noise, " + g(fit.noise_gray) + " gray levels per raw pixel, is under " + g(kMinCameraNoiseGray) +
+        " of a gray level");
+  return why;
 }
 
 }  // namespace portalsim::calibrate

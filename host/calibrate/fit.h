@@ -38,6 +38,16 @@ struct CameraFit {
 CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const AssetSet& assets,
                      const ModelSettings& model);
 
+// Noise under this many gray levels per raw pixel: quieter than any camera (rendered
+// images, such as the thesis model's, have next to none).
+inline constexpr double kMinCameraNoiseGray = 0.1;
+
+// Why `fit` does not look like a raw-grid camera's, or "" where it does: its raw grid is the
+// view's own size (no coarser grid reproduces the images, so they were not interpolated from
+// one), or its noise is under kMinCameraNoiseGray. `calibrate` refuses such captures unless
+// told to fit them anyway (--accept-non-camera).
+std::string not_camera_like(const Captures& captures, const CameraFit& fit);
+
 // The aperture (m) whose Airy core is `fwhm_pixels` wide in a view `width` pixels across.
 double aperture_for_fwhm(const Catalogue& cat, int width, double fwhm_pixels);
 

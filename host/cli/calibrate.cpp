@@ -32,6 +32,7 @@ namespace fs = std::filesystem;
 struct Options {
   std::string real, out = "camera.toml", catalogue, assets;
   uint64_t seed = 1;
+  bool accept_non_camera = false;
 };
 
 std::string read_text(const std::string& path) {
@@ -122,6 +123,11 @@ int run_calibrate(const Options& o) {
   const AssetSet assets = build_assets(cat);
   const ModelSettings model;
   const calibrate::CameraFit fit = calibrate::fit_camera(captures, cat, assets, model);
+  if (const std::string why = calibrate::not_camera_like(captures, fit); !why.empty() && !o.accept_non_camera)
+    throw InputError(o.real +
+                     ": these do not look like a raw-grid camera's captures (rendered images, such as the "
+                     "thesis model's, do not): " +
+                     why + "; nothing written (--accept-non-camera fits them anyway)");
   const calibrate::Simulated sim = calibrate::simulate_captures(captures, fit, cat, assets, model, o.seed);
 
   const fs::path out(o.out);
@@ -165,6 +171,9 @@ std::function<int()> add_calibrate(CLI::App& app) {
   cmd->add_option("--catalogue", o->catalogue, "Catalogue TOML whose subjects the captures show (default built-in)");
   cmd->add_option("--assets", o->assets, "Folder in which the catalogue's image files are looked up first");
   cmd->add_option("--seed", o->seed, "Seed of the report's simulated images (default 1)");
+  cmd->add_flag("--accept-non-camera", o->accept_non_camera,
+                "Fit captures that do not look like a raw-grid camera's (a raw grid the view's own size, or noise "
+                "under 0.1 gray level), which are otherwise refused");
   return [o] { return run_calibrate(*o); };
 }
 

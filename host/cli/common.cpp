@@ -79,6 +79,10 @@ Session open_session(const CommonOptions& o) {
 void parse_args(CLI::App& app, const std::vector<std::string>& args) {
   try {
     app.parse(std::vector<std::string>(args.rbegin(), args.rend()));  // CLI11 takes them last first
+  } catch (const CLI::CallForHelp&) {                                 // CLI11's what() here is for its own main()
+    // (the apps of parse_generate and parse_simulate are described "portalsim generate"...)
+    const std::string command = app.get_description().empty() ? "portalsim COMMAND" : app.get_description();
+    throw InputError("--help: not available here; `" + command + " --help` lists the flags");
   } catch (const CLI::ParseError& e) {
     throw InputError(e.what());
   }

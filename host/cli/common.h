@@ -32,7 +32,7 @@ void add_knob_options(CLI::App& app, std::string& tier, std::map<std::string, st
 std::map<std::string, std::string> given_knobs(const CLI::App& app, const std::map<std::string, std::string>& values);
 
 // Parses `args` into `app` and checks every value as the command line does; a parse error
-// becomes InputError with CLI11's message.
+// becomes InputError with CLI11's message (--help, which asks for none, a message of ours).
 void parse_args(CLI::App& app, const std::vector<std::string>& args);
 
 // The catalogue, its assets and a backend, with the time each took.

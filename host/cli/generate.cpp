@@ -137,13 +137,16 @@ int generate(GenerateOptions& o) {
     return 0;
   }
   const double rate = r.seconds > 0 ? r.done / r.seconds : 0;
-  std::printf(
-      "%s: %llu scenarios [%llu, %llu) in %.2f s, %.0f scenarios/s (%s backend, batch %zu%s); "
-      "positive %llu, negative %llu\n",
-      o.out.c_str(), static_cast<unsigned long long>(r.done), static_cast<unsigned long long>(r.begin),
-      static_cast<unsigned long long>(r.end), r.seconds, rate, s.backend->name().c_str(), r.batch,
-      ranked ? (", " + std::to_string(ranks->size()) + (ranks->size() == 1 ? " rank" : " ranks")).c_str() : "",
-      static_cast<unsigned long long>(r.positive), static_cast<unsigned long long>(r.negative));
+  // An interrupted run's summary says so first, and how to finish it: it must not read as a
+  // finished run's.
+  const std::string range = "[" + std::to_string(r.begin) + ", " + std::to_string(r.end) + ")";
+  const std::string what = r.interrupted ? "interrupted after " + std::to_string(r.done) + " scenarios of " + range
+                                         : std::to_string(r.done) + " scenarios " + range;
+  std::printf("%s: %s in %.2f s, %.0f scenarios/s (%s backend, batch %zu%s); positive %llu, negative %llu%s\n",
+              o.out.c_str(), what.c_str(), r.seconds, rate, s.backend->name().c_str(), r.batch,
+              ranked ? (", " + std::to_string(ranks->size()) + (ranks->size() == 1 ? " rank" : " ranks")).c_str() : "",
+              static_cast<unsigned long long>(r.positive), static_cast<unsigned long long>(r.negative),
+              r.interrupted ? " so far; not finished: run the same command with --resume to finish it" : "");
   if (o.common.timing)
     std::printf("timing: compute %.3f s (%.0f scenarios/s), waiting for the writer %.3f s%s\n", r.compute_seconds,
                 r.compute_seconds > 0 ? r.done / r.compute_seconds : 0.0, r.write_wait_seconds,

@@ -11,7 +11,7 @@ namespace {
 
 // Exit codes (docs/reference/exit-codes.md): a bad flag or value 2, a bad input file 3, an
 // output problem 4, a missing OpenCL environment 5, anything else 1. Errors in flag
-// values name the flag first.
+// values name the flag first, errors in positional arguments their name.
 constexpr int kUsage = 2, kBadInput = 3, kOutput = 4, kEnvironment = 5, kInternal = 1;
 
 bool g_print_errors = true;
@@ -26,6 +26,17 @@ void check_values(const CLI::App& app) {
   for (const CLI::Option* o : app.get_options())
     for (const std::string& v : o->results()) io::check_flag_value(v, o->get_name());
   for (const CLI::App* sub : app.get_subcommands()) check_values(*sub);
+}
+
+// Whether an error message starts by naming a command-line argument of `command`: a flag
+// ("--pool: ...") or a positional argument ("objects: ..."). Such an error is a usage error;
+// an error naming a file (and its line) is bad input.
+bool names_an_argument(std::string_view message, const CLI::App* command) {
+  if (message.starts_with("--")) return true;
+  if (!command) return false;
+  for (const CLI::Option* o : command->get_options())
+    if (o->get_positional() && message.starts_with(o->get_name() + ":")) return true;
+  return false;
 }
 
 }  // namespace
@@ -59,11 +70,15 @@ int run(int argc, char** argv, const std::map<std::string, AddCommand>& more) {
   } catch (const InputError& e) {
     return fail(e.what(), kUsage);
   }
+  const CLI::App* command = nullptr;
   try {
     for (const auto& [name, fn] : commands)
-      if (app.got_subcommand(name)) return fn();
+      if (app.got_subcommand(name)) {
+        command = app.get_subcommand(name);
+        return fn();
+      }
   } catch (const InputError& e) {
-    return fail(e.what(), std::string_view(e.what()).starts_with("--") ? kUsage : kBadInput);
+    return fail(e.what(), names_an_argument(e.what(), command) ? kUsage : kBadInput);
   } catch (const OutputError& e) {
     return fail(e.what(), kOutput);
   } catch (const EnvironmentError& e) {

@@ -5,10 +5,10 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
-#include <sstream>
 
 #include "base/error.h"
 #include "io/input_file.h"
+#include "io/table_fields.h"
 #include "sink/feature_rows.h"
 #include "sink/h5_file.h"
 
@@ -20,17 +20,6 @@ std::string trim(const std::string& s) {
   const size_t a = s.find_first_not_of(" \t\r");
   if (a == std::string::npos) return "";
   return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
-}
-
-std::string unquote(std::string s) {
-  if (s.size() >= 2 && (s[0] == '\'' || s[0] == '"') && s.back() == s[0]) return s.substr(1, s.size() - 2);
-  return s;
-}
-
-std::vector<std::string> fields(const std::string& line) {
-  std::vector<std::string> f = split_commas(line);
-  for (auto& v : f) v = unquote(v);
-  return f;
 }
 
 void check_row(const std::string& path, int line, const Table& t, const std::vector<std::string>& f) {
@@ -49,8 +38,8 @@ void check_row(const std::string& path, int line, const Table& t, const std::vec
 }
 
 // One data line, checked against the header and kept.
-void add_row(Table& t, int line, const std::string& text) {
-  std::vector<std::string> f = fields(text);
+void add_row(Table& t, int line, const std::string& text, io::Quoting quoting) {
+  std::vector<std::string> f = io::split_fields(text, quoting, t.path, static_cast<size_t>(line));
   check_row(t.path, line, t, f);
   t.classes.insert(f.back());
   t.rows.push_back(std::move(f));
@@ -69,10 +58,7 @@ Table parse_arff(std::istream& in, const std::string& path) {
     const std::string l = lower(t);
     if (!data) {
       if (l.rfind("@attribute", 0) == 0) {
-        std::istringstream words(t.substr(10));
-        std::string name;
-        words >> name;
-        a.names.push_back(unquote(name));
+        a.names.push_back(io::arff_attribute(t, path, static_cast<size_t>(n)).name);
         a.name_lines.push_back(n);
       } else if (l.rfind("@data", 0) == 0) {
         data = true;
@@ -81,7 +67,7 @@ Table parse_arff(std::istream& in, const std::string& path) {
       continue;
     }
     if (t[0] == '{') throw InputError(path + ":" + std::to_string(n) + ": sparse instances are not supported");
-    add_row(a, n, t);
+    add_row(a, n, t, io::Quoting::arff);
   }
   if (!data) throw InputError(path + ": no @data section");
   return a;
@@ -98,10 +84,10 @@ Table parse_csv(std::istream& in, const std::string& path) {
     const std::string t = trim(line);
     if (t.empty()) continue;
     if (!a.names.empty()) {
-      add_row(a, n, t);
+      add_row(a, n, t, io::Quoting::csv);
       continue;
     }
-    a.names = fields(t);
+    a.names = io::split_fields(t, io::Quoting::csv, path, static_cast<size_t>(n));
     a.name_lines.assign(a.names.size(), n);
     if (a.names.size() < 2)
       throw InputError(path + ":" + std::to_string(n) + ": needs at least one attribute and a class");

@@ -25,8 +25,8 @@ Table read_arff(const std::string& path);
 Table read_csv(const std::string& path);
 Table read_h5_table(const std::string& path);
 
-// Lower case (ASCII), and comma-separated items with blanks trimmed: the readers' own,
-// shared with validate's option lists.
+// Lower case (ASCII), and comma-separated items with blanks trimmed (validate's option
+// lists; the tables' fields go through io/table_fields.h).
 std::string lower(std::string s);
 std::vector<std::string> split_commas(const std::string& line);
 

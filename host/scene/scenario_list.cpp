@@ -12,6 +12,7 @@
 #include "base/parallel.h"
 #include "base/sizes.h"
 #include "io/input_file.h"
+#include "io/table_fields.h"
 
 namespace portalsim {
 
@@ -26,41 +27,7 @@ std::string_view without_line_end(std::string_view l) {
 // One line's fields (the line without its line end) into f[0..count), reusing f's strings.
 // Throws InputError "path:line: column k: why".
 size_t split_fields(std::string_view line, std::vector<std::string>& f, const std::string& path, size_t lineno) {
-  size_t count = 0;
-  const auto fail = [&](const std::string& why) {
-    throw InputError(path + ":" + std::to_string(lineno) + ": column " + std::to_string(count + 1) + ": " + why);
-  };
-  const auto blank = [&](size_t k) {
-    while (k < line.size() && (line[k] == ' ' || line[k] == '\t')) ++k;
-    return k;
-  };
-  for (size_t at = 0;; ++at) {  // `at`: where the field starts, after the previous comma
-    if (f.size() <= count) f.emplace_back();
-    std::string& field = f[count];
-    field.clear();
-    size_t k = blank(at);
-    if (k < line.size() && line[k] == '"') {
-      for (++k;; ++k) {
-        if (k >= line.size()) fail("a quoted field is not closed on its line");
-        if (line[k] == '"' && (k + 1 >= line.size() || line[k + 1] != '"')) break;
-        if (line[k] == '"') ++k;  // "" is one quote
-        field.push_back(line[k]);
-      }
-      k = blank(k + 1);
-      if (k < line.size() && line[k] != ',') fail("text after the closing quote of a quoted field");
-    } else {
-      const size_t end = std::min(line.find(',', k), line.size());
-      field.assign(line.substr(k, end - k));
-      if (field.find('"') != std::string::npos)
-        fail("a quote inside an unquoted field: quote the whole field, and double each quote in it");
-      field.erase(field.find_last_not_of(" \t") + 1);
-      k = end;
-    }
-    if (field.size() > kMaxFieldBytes) fail("field longer than " + std::to_string(kMaxFieldBytes) + " bytes");
-    ++count;
-    if (k >= line.size()) return count;
-    at = k;
-  }
+  return io::split_fields(line, f, io::Quoting::csv, path, lineno, kMaxFieldBytes);
 }
 
 constexpr std::array<const char*, 3> kTransformColumns = {"rotation", "scale", "flip"};

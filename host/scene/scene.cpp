@@ -40,8 +40,7 @@ Scenario parse_object_list(const Catalogue& cat, const std::vector<std::string>&
                      std::to_string(kRegions) + " regions (one object per region, \"none\" for empty)");
   Scenario s;
   for (size_t i = 0; i < tokens.size(); ++i)
-    s.objects[i] = parse_object_token(cat, tokens[i],
-                                      "object " + std::to_string(i + 1) + " (region " + std::to_string(i + 1) + ")");
+    s.objects[i] = parse_object_token(cat, tokens[i], "objects: region " + std::to_string(i + 1));
   return s;
 }
 

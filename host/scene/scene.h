@@ -58,6 +58,8 @@ struct SceneBatch {
 // "none" for an empty region, "name:v" / "name:h" for a variant. `where` prefixes errors
 // (e.g. "argument 3" or "scenes.csv:12: region3").
 int16_t parse_object_token(const Catalogue& cat, const std::string& token, const std::string& where);
+// The tokens of simulate's positional argument `objects`: errors start "objects: region N"
+// (the command line names the argument, so that an unknown object there is a usage error).
 Scenario parse_object_list(const Catalogue& cat, const std::vector<std::string>& tokens);
 
 }  // namespace portalsim

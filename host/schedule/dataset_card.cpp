@@ -9,6 +9,7 @@
 #include <set>
 
 #include "base/error.h"
+#include "io/table_fields.h"
 #include "plan/knobs.h"
 #include "schedule/run_spec.h"
 #include "sink/h5_file.h"
@@ -122,13 +123,19 @@ std::vector<std::string> split(const std::string& text, char sep) {
 std::vector<std::string> arff_attributes(const fs::path& p) {
   std::ifstream in = open_input(p);
   std::vector<std::string> names;
+  size_t n = 0;
   for (std::string line; std::getline(in, line);) {
+    ++n;
     if (line.starts_with("@data")) break;
     if (!line.starts_with("@attribute ")) continue;
-    const std::string rest = line.substr(11);
-    names.push_back(rest.substr(0, rest.find(' ')));
+    names.push_back(io::arff_attribute(line, p.string(), n).name);
   }
   return names;
+}
+
+// A CSV file's column names: its header's fields.
+std::vector<std::string> csv_columns(const fs::path& p) {
+  return io::split_fields(first_line(p), io::Quoting::csv, p.string(), 1);
 }
 
 std::vector<std::string> lines_of(const fs::path& p) {
@@ -353,7 +360,7 @@ void describe_table(Description& d, const fs::path& dir, const std::string& name
   const std::string set = fs::path(name).stem().string() + "_" + fs::path(name).extension().string().substr(1);
   json fields = json::array();
   if (name.ends_with(".csv")) {
-    for (const std::string& c : split(first_line(dir / name), ','))
+    for (const std::string& c : csv_columns(dir / name))
       fields.push_back(column_field(set, c, name, c, c == "subject" || c == "index" ? "sc:Integer" : "sc:Text"));
     if (name == "features.csv")
       for (json& f : fields) f["dataType"] = f["name"] == "class" ? "sc:Text" : "sc:Float";

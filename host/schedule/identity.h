@@ -9,9 +9,15 @@
 
 namespace portalsim {
 
-// "spec.seed (1 there, 2 now), spec.count (...)": every entry that differs, one level
-// into objects; empty when equal.
-std::string differing_keys(const nlohmann::json& was, const nlohmann::json& now, const std::string& prefix = "");
+// What the two sides of a comparison are called in a message: "in the folder", "now".
+struct Sides {
+  std::string was, now;
+};
+
+// "spec.seed: 1 in the folder, 2 now; spec.count: ...": every entry that differs, one level
+// into objects, each value followed by its side's name; empty when equal.
+std::string differing_keys(const nlohmann::json& was, const nlohmann::json& now, const Sides& sides,
+                           const std::string& prefix = "");
 
 // The manifest.json of a finished run: its identity, count, classes, each output's size
 // and XXH3-64, and the images folder when there is one. One function, so that a single

@@ -247,9 +247,9 @@ std::vector<Part> read_parts(const std::vector<std::string>& dirs) {
   std::vector<std::string> names;
   for (const json& o : parts[0].manifest["outputs"]) names.push_back(o.at("name").get<std::string>());
   for (const Part& p : parts) {
-    if (const std::string diff = differing_keys(shared_identity(p.manifest), id); !diff.empty())
-      throw InputError(p.dir + ": does not belong with " + parts[0].dir + ": " + diff +
-                       " (\"there\" is this part, \"now\" the first)");
+    if (const std::string diff = differing_keys(shared_identity(p.manifest), id, {"here", "in the first"});
+        !diff.empty())
+      throw InputError("part " + p.dir + " differs from the first part " + parts[0].dir + " in " + diff);
     std::vector<std::string> n;
     for (const json& o : p.manifest["outputs"]) n.push_back(o.at("name").get<std::string>());
     if (n != names) throw InputError(p.dir + ": holds other outputs than " + parts[0].dir);

@@ -141,8 +141,8 @@ bool finished_run_here(const std::string& dir, const json& identity, bool resume
   }
   json was = json::object();
   for (const auto& [k, v] : identity.items()) was[k] = manifest.value(k, json());
-  if (const std::string diff = differing_keys(was, identity); !diff.empty())
-    throw InputError("--resume: " + dir + " holds a finished run with other parameters: " + diff +
+  if (const std::string diff = differing_keys(was, identity, {"in the folder", "now"}); !diff.empty())
+    throw InputError("--resume: " + dir + " holds a finished run that differs in " + diff +
                      "; give the same parameters, or another folder");
   return true;
 }
@@ -164,9 +164,10 @@ FolderStart examine_folder(const std::string& dir, const json& identity, bool re
   }
   if (resume && fs::exists(checkpoint_path, ec)) {
     start.checkpoint = parse_checkpoint(read_state_file(checkpoint_path.string()), checkpoint_path.string());
-    if (const std::string diff = differing_keys(start.checkpoint.value("identity", json::object()), identity);
+    if (const std::string diff =
+            differing_keys(start.checkpoint.value("identity", json::object()), identity, {"in the folder", "now"});
         !diff.empty())
-      throw InputError("--resume: " + dir + " was made by a different run: " + diff +
+      throw InputError("--resume: " + dir + " was made by a run that differs in " + diff +
                        "; give the same parameters, or another folder");
     start.resuming = true;
   } else if (fs::exists(started_path, ec) && !fs::exists(checkpoint_path, ec)) {

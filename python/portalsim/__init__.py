@@ -21,10 +21,11 @@ from . import _core
 __version__ = _core.version
 __all__ = ["Generator", "simulate", "__version__"]
 
-# generate's flags that make no sense in memory: the output folder and its files, and how a
-# run is split or shown. batch(start, count) takes the place of --batch and --shard.
-_NOT_IN_PYTHON = {"out", "format", "compress", "image-format", "resume", "quiet", "shard", "batch", "timing",
-                  "stages"}
+# generate's flags that make no sense in memory: the output folder and its files (their
+# formats and compression: Generator writes none), and how a run is split or shown.
+# batch(start, count) takes the place of --batch and --shard.
+_FILES_ONLY = {"out", "format", "compress", "image-format", "png-level", "stages"}
+_NOT_IN_PYTHON = _FILES_ONLY | {"resume", "quiet", "shard", "batch", "timing"}
 # Keywords whose list values are comma-separated names; other lists and tuples are ranges.
 _LISTS = {"pool", "subjects"}
 
@@ -52,8 +53,12 @@ def _flags(command, keywords):
         flag = key.replace("_", "-")
         if flag not in known or flag in _NOT_IN_PYTHON:
             usable = sorted(k.replace("-", "_") for k in known if k not in _NOT_IN_PYTHON)
-            raise ValueError(f"{key}: not a keyword of portalsim.{'Generator' if command == 'generate' else command}"
-                             f" (`portalsim {command}` has no --{flag} here); the keywords are {', '.join(usable)}")
+            name = "Generator" if command == "generate" else command
+            why = (f"--{flag} only shapes the files `portalsim {command}` writes, and portalsim.{name} writes none"
+                   if flag in _FILES_ONLY and flag in known else
+                   f"`portalsim {command}` has no --{flag} here" if flag in known else
+                   f"`portalsim {command}` has no --{flag}")
+            raise ValueError(f"{key}: not a keyword of portalsim.{name} ({why}); the keywords are {', '.join(usable)}")
         if known[flag]:  # a switch such as --balance or --annotations
             if not isinstance(value, bool):
                 raise ValueError(f"--{flag}: expected True or False, got {value!r}")

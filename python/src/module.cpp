@@ -159,8 +159,13 @@ class Engine {
     plan_ = run_plan(req_.spec, session_.catalogue);
     threads_ = req_.threads ? req_.threads : default_threads();
     ctx_ = plan_sink_context(plan_, session_.catalogue, session_.assets, threads_, req_.spec.image_format);
-    columns_ = tensor_columns(ctx_, h5_tensor_options(req_.spec, plan_, source_->rule()));
-    if (datasets) select(*datasets);
+    const TensorOptions topt = h5_tensor_options(req_.spec, plan_, source_->rule());
+    columns_ = tensor_columns(ctx_, topt);
+    if (datasets) {
+      TensorOptions every = topt;  // every dataset a data.h5 of this catalogue can hold
+      every.images = every.features = every.annotations = true;
+      select(*datasets, tensor_columns(ctx_, every));
+    }
   }
   const std::vector<TensorColumn>& columns() const { return columns_; }
   const ScenarioSource& source() const { return *source_; }
@@ -168,15 +173,27 @@ class Engine {
   // Keeps the columns named in `names` (data.h5's order stays), and narrows the plan to what
   // they read: a view is rendered only for its own datasets (or for features), masks only
   // for mask_*, features and metal zones only when named. Each kept column's bytes are the
-  // same as with every column made: no output depends on another being computed.
-  void select(const std::vector<std::string>& names) {
+  // same as with every column made: no output depends on another being computed. `every`:
+  // the columns of every dataset there is (images, features and annotations on), so that a
+  // name that is no dataset at all is told before one these keywords do not make.
+  void select(const std::vector<std::string>& names, const std::vector<TensorColumn>& every) {
     const auto named = [&](const std::string& n) { return std::find(names.begin(), names.end(), n) != names.end(); };
-    std::string all;
-    for (const TensorColumn& c : columns_) all += (all.empty() ? "" : ", ") + c.ds.name;
+    const auto list = [](const std::vector<TensorColumn>& cs) {
+      std::string all;
+      for (const TensorColumn& c : cs) all += (all.empty() ? "" : ", ") + c.ds.name;
+      return all;
+    };
+    const auto in = [](const std::vector<TensorColumn>& cs, const std::string& n) {
+      return std::any_of(cs.begin(), cs.end(), [&](const TensorColumn& c) { return c.ds.name == n; });
+    };
+    for (const std::string& n : names)
+      if (!in(every, n))
+        throw InputError("datasets: \"" + n + "\" is not a dataset (the datasets are " + list(every) + ")");
     for (const std::string& n : names) {
       if (std::count(names.begin(), names.end(), n) > 1) throw InputError("datasets: \"" + n + "\" is named twice");
-      if (std::none_of(columns_.begin(), columns_.end(), [&](const TensorColumn& c) { return c.ds.name == n; }))
-        throw InputError("datasets: \"" + n + "\" is not a dataset of these keywords (they make " + all + ")");
+      if (!in(columns_, n))
+        throw InputError("datasets: \"" + n + "\" is not a dataset of these keywords (they make " + list(columns_) +
+                         "; what=\"images\" or \"both\" makes the views, annotations=True the masks)");
     }
     if (names.empty()) throw InputError("datasets: name at least one dataset");
     std::erase_if(columns_, [&](const TensorColumn& c) { return !named(c.ds.name); });
@@ -394,7 +411,9 @@ py::dict flags(const std::string& command) {
   else
     cli::add_simulate(app);
   py::dict d;
-  for (const CLI::Option* o : app.get_subcommand(command)->get_options()) {
+  const CLI::App* sub = app.get_subcommand(command);
+  for (const CLI::Option* o : sub->get_options()) {
+    if (o == sub->get_help_ptr() || o == sub->get_help_all_ptr()) continue;  // --help is no keyword
     const std::string name = o->get_name();
     if (name.rfind("--", 0) != 0) continue;
     d[py::str(name.substr(2))] = o->get_expected_min() == 0;

@@ -43,6 +43,26 @@ def test_unknown_keyword_is_named():
         portalsim.Generator(balance="yes")
 
 
+def test_help_is_not_a_keyword():
+    """help=True once raised CLI11's "This should be caught in your main function" (issue 36)."""
+    for make in (lambda: portalsim.Generator(seed=1, help=True), lambda: portalsim.simulate(["gun"], help=True)):
+        with pytest.raises(ValueError) as e:
+            make()
+        message = str(e.value)
+        assert message.startswith("help: not a keyword of portalsim."), message
+        assert "the keywords are" in message and "help" not in message.split("the keywords are ")[1].split(", ")
+
+
+@pytest.mark.parametrize("key, value", [("png_level", 3), ("image_format", "jpg"), ("compress", True)])
+def test_flags_for_files_only_are_refused(key, value):
+    """Generator writes no files: a knob of generate's files is refused, saying so (issue 36)."""
+    flag = key.replace("_", "-")
+    with pytest.raises(ValueError) as e:
+        portalsim.Generator(seed=1, what="images", **{key: value})
+    assert str(e.value).startswith(f"{key}: not a keyword of portalsim.Generator (--{flag} only shapes the files "
+                                   "`portalsim generate` writes, and portalsim.Generator writes none)"), str(e.value)
+
+
 def test_bad_spec_file_names_file_and_line(tmp_path, portalsim_bin):
     spec = tmp_path / "bad.toml"
     spec.write_text('seed = 1\nrule = "gun"\nrotate = "sideways"\n')
@@ -75,7 +95,7 @@ def test_bad_batches_and_the_interpreter_goes_on():
 
 
 @pytest.mark.parametrize("datasets, message", [
-    (["uper"], '"uper" is not a dataset of these keywords (they make upper, lower, ir, ir_index, metal'),
+    (["uper"], '"uper" is not a dataset (the datasets are upper, lower, ir, ir_index, '),
     (["upper", "upper"], '"upper" is named twice'),
     ([], "name at least one dataset"),
     (["mask_upper"], '"mask_upper" is not a dataset'),  # masks need annotations=True
@@ -84,3 +104,15 @@ def test_bad_datasets_name_the_dataset(datasets, message):
     with pytest.raises(ValueError) as e:
         portalsim.Generator(seed=1, what="images", datasets=datasets)
     assert str(e.value).startswith("datasets: ") and message in str(e.value), str(e.value)
+
+
+def test_a_name_that_is_no_dataset_is_told_first():
+    """With what="features", "upper" is a dataset these keywords do not make, "nope" no dataset
+    at all: the typo is the one named (issue 36)."""
+    with pytest.raises(ValueError) as e:
+        portalsim.Generator(seed=1, datasets=("upper", "nope"))
+    assert str(e.value).startswith('datasets: "nope" is not a dataset (the datasets are '), str(e.value)
+    with pytest.raises(ValueError) as e:
+        portalsim.Generator(seed=1, datasets=("upper",))
+    assert str(e.value).startswith('datasets: "upper" is not a dataset of these keywords (they make '), str(e.value)
+    assert 'what="images"' in str(e.value)

@@ -2,8 +2,10 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -51,7 +53,10 @@ std::string cache_problem() {
   while (!dir.empty() && !fs::exists(dir, ec) && dir != dir.parent_path()) dir = dir.parent_path();
   if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
     return "must be a writable folder, and " + (dir == pocl_cache() ? std::string("it") : dir.string()) + " is a file";
-  if (::access(dir.c_str(), W_OK) != 0) return "must be writable";
+  if (::access(dir.c_str(), W_OK) != 0)
+    return dir == pocl_cache()
+               ? "must be writable, and is not (" + std::string(std::strerror(errno)) + ")"
+               : "is missing and cannot be made: " + dir.string() + " is not writable (" + std::strerror(errno) + ")";
   return "";
 }
 
@@ -69,19 +74,23 @@ OpenCLDeviceInfo describe(const std::string& name, const cl::Device& d) {
 }
 
 // Every device of every platform with its "platform / device" name, in platform order.
-std::vector<std::pair<std::string, cl::Device>> all_devices() {
+// `failed` gets the OpenCL call that failed on the way ("" where none did).
+std::vector<std::pair<std::string, cl::Device>> all_devices(std::string& failed) {
+  failed.clear();
   std::vector<cl::Platform> platforms;
   try {
     cl::Platform::get(&platforms);
-  } catch (const cl::Error&) {
+  } catch (const cl::Error& e) {
     platforms.clear();  // no platform at all: the caller says so
+    failed = std::string(e.what()) + " returned " + std::to_string(e.err());
   }
   std::vector<std::pair<std::string, cl::Device>> all;
   for (const cl::Platform& p : platforms) {
     std::vector<cl::Device> devices;
     try {
       p.getDevices(CL_DEVICE_TYPE_ALL, &devices);
-    } catch (const cl::Error&) {
+    } catch (const cl::Error& e) {
+      failed = p.getInfo<CL_PLATFORM_NAME>() + ": " + e.what() + " returned " + std::to_string(e.err());
       continue;
     }
     for (const cl::Device& d : devices)
@@ -89,19 +98,33 @@ std::vector<std::pair<std::string, cl::Device>> all_devices() {
   }
   return all;
 }
+
+// Why OpenCL is not usable, after `what` ("no OpenCL platform found") and `call` (the OpenCL
+// call that failed and its error, or ""): PoCL needs a writable kernel cache, and without
+// one offers no platform, no device or no program, so an unwritable cache is named first;
+// else what to install.
+std::string not_usable(const std::string& what, const std::string& call) {
+  const std::string failed = what + (call.empty() ? "" : ": " + call);
+  if (const std::string problem = cache_problem(); !problem.empty())
+    return "PoCL's kernel cache, " + pocl_cache() + ", " + problem + " (" + failed +
+           "); POCL_CACHE_DIR, or XDG_CACHE_HOME, must name a writable folder; --backend reference works without "
+           "OpenCL";
+  return failed + " (is pocl-opencl-icd installed?); --backend reference works without one";
+}
 }  // namespace
 
 std::vector<OpenCLDeviceInfo> list_opencl_devices() {
+  std::string failed;
   std::vector<OpenCLDeviceInfo> list;
-  for (const auto& [name, d] : all_devices()) list.push_back(describe(name, d));
+  for (const auto& [name, d] : all_devices(failed)) list.push_back(describe(name, d));
+  if (list.empty()) throw EnvironmentError(not_usable("no OpenCL platform found", failed));
   return list;
 }
 
 OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
-  const auto devices = all_devices();
-  if (devices.empty())
-    throw EnvironmentError(
-        "no OpenCL platform found (is pocl-opencl-icd installed?); --backend reference works without one");
+  std::string failed;
+  const auto devices = all_devices(failed);
+  if (devices.empty()) throw EnvironmentError(not_usable("no OpenCL platform found", failed));
   bool found = false;
   for (const auto& [name, d] : devices) {
     const bool wanted = options.device.empty() ? (d.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0
@@ -119,11 +142,7 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
     throw InputError("--device: no OpenCL device matches \"" + options.device + "\"; the devices are: " + names +
                      " (portalsim bench --list-devices)");
   }
-  if (!found)
-    throw EnvironmentError(
-        "no OpenCL CPU device found (is pocl-opencl-icd installed? PoCL also offers none when its "
-        "kernel cache, " +
-        pocl_cache() + ", is not writable); --backend reference works without one");
+  if (!found) throw EnvironmentError(not_usable("no OpenCL CPU device found", failed));
   if (options.compute_units > 0) {
     // Device fission: PoCL runs a sub-device's work on that many threads.
     const cl_uint max_units = device_.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
@@ -157,9 +176,7 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
 void OpenCLRuntime::build_failed(const cl::Program& p, const std::string& options) const {
   const std::string log = p.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
   const std::string what = "OpenCL program build failed" + (options.empty() ? "" : " (" + options + ")");
-  if (const std::string problem = cache_problem(); !problem.empty())
-    throw EnvironmentError(what + ": PoCL's kernel cache, " + pocl_cache() + ", " + problem +
-                           " (or set POCL_CACHE_DIR)\n" + log);
+  if (!cache_problem().empty()) throw EnvironmentError(not_usable(what, "") + "\n" + log);
   throw std::runtime_error(what + ":\n" + log);
 }
 

@@ -24,8 +24,8 @@ struct OpenCLDeviceInfo {
   bool fp64 = false;  // cl_khr_fp64: the exact tier and --model physics's metal zones need it
 };
 
-// Every device of every OpenCL platform, in the order --device searches them; empty
-// when there is no platform.
+// Every device of every OpenCL platform, in the order --device searches them; throws
+// EnvironmentError (saying why: no platform, or PoCL's cache not writable) when there is none.
 std::vector<OpenCLDeviceInfo> list_opencl_devices();
 
 class OpenCLRuntime {
