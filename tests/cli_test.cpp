@@ -284,7 +284,7 @@ TEST(CliSimulate, TimingNamesThePathEachViewTook) {
       << describe(r);
   const Result g = run(t, {"generate", "--count", "8", "--timing", "--out", (t.w() / "set").string()});
   ExpectSuccess(g);
-  EXPECT_TRUE(has(g.out, "\npaths: features: thesis_sparse_features\n")) << describe(g);
+  EXPECT_TRUE(has(g.out, "\npaths: features: thesis_sparse_features (pattern noise)\n")) << describe(g);
 }
 
 TEST(CliSimulate, FeaturesCsvHasHeaderAndOneMatchingRow) {

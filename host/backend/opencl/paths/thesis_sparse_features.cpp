@@ -18,10 +18,15 @@ class ThesisSparseFeatures final : public FeaturePath {
  public:
   explicit ThesisSparseFeatures(Device& d) : d_(d) {}
   const char* name() const override { return "thesis_sparse_features"; }
-  // The chain the tables implement: thesis_images's.
+  enum Variant { kNoPatterns, kPatterns };
+  // The chain the tables implement: thesis_images's; with pattern noise, the tables hold a
+  // footprint's change per noise pattern and each scenario's patterns are drawn first.
   Gate gate(const Plan& plan, const Sensor& sensor) const override {
-    return {.runs = plan.sparse_features() && sensor.camera == Camera::mmw &&
-                    sensor.chain_for(plan.model.model) == thesis_images_path().chain()};
+    if (!plan.sparse_features() || sensor.camera != Camera::mmw ||
+        sensor.chain_for(plan.model.model) != thesis_images_path().chain())
+      return {};
+    if (plan.model.pattern_noise) return {.runs = true, .variant = kPatterns, .variant_name = "pattern noise"};
+    return {.runs = true, .variant = kNoPatterns};
   }
   void features(Kernels& K, const Plan& plan, const Gate& g, const DeviceBatch& b, cl::Buffer& feats) override;
 
@@ -32,7 +37,7 @@ class ThesisSparseFeatures final : public FeaturePath {
     bool noise = false;
     cl::Buffer fps, deltas, region_deltas, base_sums, base_means;
   };
-  Tables& tables(Kernels& K, const Plan& plan);
+  Tables& tables(Kernels& K, const Plan& plan, bool noise);
   // The tables assume every pooled view has the first one's size.
   const Sensor& pooled_view(const FeatureLayout& lay) const { return d_.cat.sensors[lay.pooled.at(0)]; }
 
@@ -41,7 +46,7 @@ class ThesisSparseFeatures final : public FeaturePath {
   Grown patterns_;
 };
 
-ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Plan& plan) {
+ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Plan& plan, bool noise) {
   Tables& t = tables_[&K];
   const std::string key = table_key(plan, "");
   if (t.key == key) return t;
@@ -52,7 +57,6 @@ ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Pla
   const FeatureLayout lay = FeatureLayout::of(cat, plan.model.block);
   const Sensor& view = pooled_view(lay);
   const int block = plan.model.block, W = view.width, H = view.height, N = ic.noise_size;
-  const bool noise = plan.model.pattern_noise;
   const int S = static_cast<int>(cat.subjects.size()), V = static_cast<int>(cat.variant_list.size());
   const int P = noise ? static_cast<int>(cat.noise.size()) : 1;
   // A footprint per (variant, region, subject): the place moves with the subject's height.
@@ -153,9 +157,9 @@ ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Pla
   return t;
 }
 
-void ThesisSparseFeatures::features(Kernels& K, const Plan& plan, const Gate&, const DeviceBatch& b,
+void ThesisSparseFeatures::features(Kernels& K, const Plan& plan, const Gate& g, const DeviceBatch& b,
                                     cl::Buffer& feats) {
-  const Tables& t = tables(K, plan);
+  const Tables& t = tables(K, plan, g.variant == kPatterns);
   const Catalogue& cat = d_.cat;
   const DeviceCatalogue& c = d_.data;
   const ImagesConfig& ic = cat.images;
