@@ -167,10 +167,11 @@ TEST_P(CalibrateTold, RecoversTheHiddenCamera) {
   // line fits it only with --accept-non-camera; the noisy coarser grids pass. The noiseless
   // camera is not asserted: its fitted noise, the kernels' one-level differences from the
   // reference (0.10 gray here), sits on the rule's edge of a tenth of a gray level.
-  if (c.netd > 0)
+  if (c.netd > 0) {
     EXPECT_EQ(portalsim::calibrate::not_camera_like(portalsim::calibrate::read_captures(dir.string()), f).empty(),
               c.raw_w < 200)
         << c.name;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Calibrate, CalibrateTold,
