@@ -14,6 +14,9 @@ src=$(realpath "$1") build=$(realpath "$2") host_bin=$(realpath "$3")
 for tool in debootstrap chroot unshare flock mount; do
   command -v "$tool" >/dev/null || fail "$tool is missing (tools/packages.sh lists debootstrap)"
 done
+for f in /etc/apt/sources.list.d/debian.sources /etc/resolv.conf; do
+  [ -f "$f" ] || fail "$f is missing: the roots take the host's Debian sources and name server"
+done
 
 # A private mount namespace: whatever is mounted below goes away with this process, even if
 # the trap's unmounts are cut short.

@@ -17,7 +17,7 @@
 #   FEATURES_COUNT (2048), IMAGES_COUNT (64), TRADEOFF_COUNT (400), BENCH_SECONDS (150) size it.
 set -euo pipefail
 fail() { echo "device-check: $*" >&2; exit 1; }
-trap 'echo "device-check: stopped by a failing command at line $LINENO" >&2' ERR
+trap '[[ $- != *e* ]] || echo "device-check: stopped by a failing command at line $LINENO" >&2' ERR
 [ $# -ge 1 ] && [ $# -le 2 ] || fail "usage: device-check.sh OUTDIR [DEVICE]"
 out=$(realpath -m "$1")
 want=${2:-}
