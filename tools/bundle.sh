@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Makes portalsim-VERSION-linux-x86_64.tar.gz in the build folder (PORTALSIM_BUILD_DIR, default
 # build): bin/portalsim, the Python package, every shared library they load but glibc's (in
-# lib/, found through RUNPATH $ORIGIN), and the docs. docs/guide/install.md describes it; the
+# lib/, found through the RPATH $ORIGIN/../lib), and the docs. docs/guide/install.md describes it; the
 # ctest bundle.minimal_root runs it in a bare Debian 12 root.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -73,7 +73,7 @@ while read -r soname path; do
   packages[$pkg]=1
 done < <(libs)
 [ -f "$stage/lib/libOpenCL.so.1" ] || { echo "bundle.sh: libOpenCL.so.1 (the ICD loader) is not among the libraries" >&2; exit 1; }
-if ls "$stage/lib" | grep -qi pocl; then echo "bundle.sh: a PoCL library was picked up; the driver must not be bundled" >&2; exit 1; fi
+if compgen -G "$stage/lib/*[pP][oO][cC][lL]*" >/dev/null; then echo "bundle.sh: a PoCL library was picked up; the driver must not be bundled" >&2; exit 1; fi
 
 # Found from wherever the bundle is unpacked: DT_RPATH (not RUNPATH) on the binary and the
 # module, because the loader applies an object's RPATH to its libraries' libraries too, so
