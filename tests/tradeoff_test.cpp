@@ -258,6 +258,19 @@ TEST(TradeoffModelsOption, SelectsOneModel) {
   }
 }
 
+// --no-plot (tools/device-check.sh, on machines without matplotlib): the table, not the plot.
+TEST(TradeoffModelsOption, NoPlotWritesTheTablesWithoutThePlot) {
+  test::TempDir t;
+  const fs::path out = t.w() / "trade";
+  const test::Result r = test::finish(test::start(t.cap(), {"tradeoff", "--count", "10", "--models", "thesis",
+                                                            "--no-classifier", "--no-plot", "--out", out.string()}),
+                                      600);
+  ASSERT_TRUE(r.exited && r.status == 0) << test::describe(r);
+  EXPECT_EQ(json::parse(test::slurp(out / "tradeoff.json"))["rows"].size(), 4u);
+  EXPECT_TRUE(fs::is_regular_file(out / "tradeoff.csv"));
+  EXPECT_FALSE(fs::exists(out / "tradeoff.png"));
+}
+
 TEST(TradeoffModelsOption, BadListsAreRejectedBeforeAnythingIsWritten) {
   test::TempDir t;
   for (const std::string models : {"thesis,bogus", "thesis,thesis", "", "physics,"}) {

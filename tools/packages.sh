@@ -10,7 +10,8 @@ python_packages=(python3 python3-dev pybind11-dev python3-pybind11 python3-numpy
   python3-pytest python3-pil)
 # The rest of the tests and tools: clinfo, oiiotool, MPI and Slurm, WEKA, the figures' and
 # dataset card's Python, cram (the guides' examples run as tests), clang-format, ccache,
-# the sanitizers' and fuzzers' clang, Chromium.
+# the sanitizers' and fuzzers' clang, Chromium, and tools/bundle.sh's patchelf and the
+# minimal root of its test (debootstrap).
 tool_packages=(clinfo openimageio-tools openmpi-bin libopenmpi-dev slurm-wlm munge
   weka default-jdk-headless python3-matplotlib python3-scipy python3-pyld python3-yaml python3-cram
-  clang-format ccache clang libclang-rt-14-dev chromium)
+  clang-format ccache clang libclang-rt-14-dev chromium patchelf debootstrap)

@@ -46,6 +46,7 @@ struct TradeoffOptions {
   ModelSettings model;
   std::string models = "thesis,physics";
   bool classifier = true;
+  bool plot = true;
 };
 
 Plan images_plan(const ModelSettings& m) {
@@ -431,18 +432,21 @@ int tradeoff(TradeoffOptions& o) {
   }
   write_text_atomic(folder.path("tradeoff.csv"), csv);
 
-  // The plot, drawn by the embedded matplotlib script.
-  const std::string script = (std::filesystem::path(staging) / ".plot_tradeoff.py").string();
-  write_text_atomic(script, std::string(embedded::plot_tradeoff));
-  // Debian's matplotlib belongs to the system interpreter, which may not be first on PATH.
-  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string cmd = python + " '" + script + "' '" + staging + "'";
-  const int rc = std::system(cmd.c_str());
-  std::filesystem::remove(script, ec);
-  if (rc != 0) throw OutputError("tradeoff.png: the plot failed (python3 with matplotlib is needed)");
-  folder.path("tradeoff.png");
+  // The plot, drawn by the embedded matplotlib script; --no-plot for machines without it
+  // (tools/device-check.sh on a GPU machine).
+  if (o.plot) {
+    const std::string script = (std::filesystem::path(staging) / ".plot_tradeoff.py").string();
+    write_text_atomic(script, std::string(embedded::plot_tradeoff));
+    // Debian's matplotlib belongs to the system interpreter, which may not be first on PATH.
+    const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+    const std::string cmd = python + " '" + script + "' '" + staging + "'";
+    const int rc = std::system(cmd.c_str());
+    std::filesystem::remove(script, ec);
+    if (rc != 0) throw OutputError("tradeoff.png: the plot failed (python3 with matplotlib is needed; or --no-plot)");
+    folder.path("tradeoff.png");
+  }
   folder.commit();
-  std::printf("%s: tradeoff.json, tradeoff.csv, tradeoff.png%s\n", o.out.c_str(),
+  std::printf("%s: tradeoff.json, tradeoff.csv%s%s\n", o.out.c_str(), o.plot ? ", tradeoff.png" : "",
               o.classifier ? ", two ARFFs (cases 1 and 2) per model and tier" : "");
   return 0;
 }
@@ -462,6 +466,7 @@ std::function<int()> add_tradeoff(CLI::App& app) {
   sub->add_option("--block", o->model.block, "feature block side (default 10)");
   sub->add_option("--models", o->models, "sensor models to measure, comma-separated (default thesis,physics)");
   sub->add_flag("!--no-classifier", o->classifier, "skip WEKA J48 (faster)");
+  sub->add_flag("!--no-plot", o->plot, "skip tradeoff.png (needs no python3 with matplotlib)");
   return [o] { return tradeoff(*o); };
 }
 
