@@ -11,6 +11,7 @@
 #include "assets/assets.h"
 #include "backend/opencl/buffers.h"
 #include "backend/opencl/display_tables.h"
+#include "base/lru_cache.h"
 #include "plan/plan.h"
 #include "scene/catalogue.h"
 
@@ -37,7 +38,8 @@ class PhysicsParams {
   const Catalogue& cat_;
   const AssetSet& assets_;
   cl::Context& ctx_;
-  std::map<std::string, Tables> tables_;
+  // Per (knobs, view, precision); a run uses one per view and precision.
+  LruCache<std::string, Tables> tables_{32};
   Grown none_;
 };
 

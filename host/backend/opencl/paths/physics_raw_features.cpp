@@ -12,6 +12,7 @@
 #include "backend/opencl/paths/paths.h"
 #include "backend/opencl/raw_grid_pooling.h"
 #include "backend/opencl/table_key.h"
+#include "base/lru_cache.h"
 #include "base/sizes.h"
 
 namespace portalsim::opencl {
@@ -68,7 +69,8 @@ class PhysicsRawFeatures final : public FeaturePath {
   }
 
   Device& d_;
-  std::map<std::string, Tables> tables_;  // per (knobs, view, tabulated, program variant)
+  // Per (knobs, view, tabulated, program variant); a run uses one per pooled view.
+  LruCache<std::string, Tables> tables_{8};
   Grown scratch_;
 };
 
