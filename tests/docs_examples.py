@@ -36,6 +36,7 @@ the PATH and its Python package on PYTHONPATH. Uses cram (Debian python3-cram) t
 session and compare its output.
 """
 import argparse
+import functools
 import os
 import re
 import shutil
@@ -164,14 +165,12 @@ def pycon(path, line, body):
     ])
 
 
-def subcommand_help(portalsim, words, cache={}):
-    key = tuple(words)
-    if key not in cache:
-        r = subprocess.run([portalsim, *words, "--help"], capture_output=True, text=True)
-        if r.returncode != 0:
-            raise DocError(f"`portalsim {' '.join(words)} --help` failed: {r.stderr.strip()}")
-        cache[key] = r.stdout
-    return cache[key]
+@functools.lru_cache(maxsize=None)
+def subcommand_help(portalsim, words):
+    r = subprocess.run([portalsim, *words, "--help"], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise DocError(f"`portalsim {' '.join(words)} --help` failed: {r.stderr.strip()}")
+    return r.stdout
 
 
 def check_usage(path, line, body, portalsim):
@@ -180,7 +179,7 @@ def check_usage(path, line, body, portalsim):
     for n, l in enumerate(body):
         m = re.match(r"\s*portalsim(?:\s+([a-z][a-z-]*))?", l)
         if m:
-            words = [m.group(1)] if m.group(1) else []
+            words = (m.group(1),) if m.group(1) else ()
         if words is None:
             raise DocError(f"{path}:{line + n}: a usage block's first line is `portalsim ...`")
         text = subcommand_help(portalsim, words)

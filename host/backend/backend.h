@@ -59,6 +59,8 @@ class Backend {
   // How run() makes `plan`'s outputs, as --timing names it: per rendered view and for the
   // features, the path taken ("upper: physics_raw (fixed window)").
   virtual std::vector<std::string> paths(const Plan& plan) const = 0;
+  // paths()'s name for features made by pooling the rendered views, the way both backends can.
+  static constexpr const char* kPooledFeatures = "pooled from the rendered views";
 
  protected:
   // The annotations `plan` asks for (the same function for every backend), or none.

@@ -53,9 +53,9 @@ void open_catalogue(Session& s, const CommonOptions& o) {
 }
 
 void print_paths(const Backend& backend, const Plan& plan) {
-  std::string line = "paths:";
-  for (const std::string& p : backend.paths(plan)) line += (line.size() > 6 ? ", " : " ") + p;
-  std::printf("%s\n", line.c_str());
+  std::string line;
+  for (const std::string& p : backend.paths(plan)) line += (line.empty() ? "" : ", ") + p;
+  std::printf("paths: %s\n", line.c_str());
 }
 
 void open_backend(Session& s, const CommonOptions& o) {

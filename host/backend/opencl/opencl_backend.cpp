@@ -88,7 +88,7 @@ class OpenCLBackend final : public Backend {
         taken.push_back(cat_.sensors[k].name + ": " + describe(r.views[k].path->name(), r.views[k].gate));
     if (plan.features)
       taken.push_back(r.features ? "features: " + describe(r.features->name(), r.features_gate)
-                                 : std::string("features: pooled from the rendered views"));
+                                 : std::string("features: ") + kPooledFeatures);
     return taken;
   }
 
@@ -103,13 +103,16 @@ class OpenCLBackend final : public Backend {
   Route route(const Plan& plan, const FeatureLayout& lay) const {
     Route r;
     // The first features path whose gate applies to every pooled view.
+    // (the first pooled view's gate gives the variant).
     if (plan.features && !lay.pooled.empty())
       for (const auto& p : features_paths_) {
-        bool all = true;
-        for (int view : lay.pooled) all = all && p->applies(plan, cat_.sensors[view]);
+        const Gate g = p->gate(plan, cat_.sensors[lay.pooled[0]]);
+        bool all = g.runs;
+        for (size_t slot = 1; slot < lay.pooled.size(); ++slot)
+          all = all && p->applies(plan, cat_.sensors[lay.pooled[slot]]);
         if (all) {
           r.features = p.get();
-          r.features_gate = p->gate(plan, cat_.sensors[lay.pooled[0]]);
+          r.features_gate = g;
           break;
         }
       }

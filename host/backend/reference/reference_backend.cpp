@@ -19,7 +19,7 @@ class ReferenceBackend final : public Backend {
     std::vector<std::string> taken;
     for (size_t k = 0; k < cat_.sensors.size(); ++k)
       if (plan.renders(cat_.sensors[k], static_cast<int>(k))) taken.push_back(cat_.sensors[k].name + ": fp64 stages");
-    if (plan.features) taken.push_back("features: pooled from the rendered views");
+    if (plan.features) taken.push_back(std::string("features: ") + kPooledFeatures);
     return taken;
   }
 
