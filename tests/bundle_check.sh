@@ -104,7 +104,8 @@ bundle=$work/bundle/portalsim-$version-linux-x86_64
 
 # The commands, run from an empty folder both outside (the build's binary) and inside.
 simulate=(simulate --seed 7 --out simulate none none none gun)
-simulate_physics=(simulate --seed 7 --model physics --out simulate-physics none Mobile none none none cd)
+# JPEG, so that the OpenImageIO module (lib/portalsim/) is loaded and writes them.
+simulate_physics=(simulate --seed 7 --model physics --image-format jpg --out simulate-physics none Mobile none none none cd)
 generate=(generate --count 120 --seed 5 --what both --format arff,csv,npy,h5 --annotations --out generate)
 python_code='
 import hashlib, sys, portalsim
@@ -134,7 +135,8 @@ run_root() {  # run_root ROOT DIR BACKEND: the bundle inside ROOT, with nothing 
   mnt "$root"
   # Every library but glibc's resolves inside the bundle.
   local ldd_out
-  ldd_out=$(in_root "$root" ldd /opt/portalsim/bin/portalsim /opt/portalsim/python/portalsim/_core.cpython-311-x86_64-linux-gnu.so) ||
+  ldd_out=$(in_root "$root" ldd /opt/portalsim/bin/portalsim /opt/portalsim/python/portalsim/_core.cpython-311-x86_64-linux-gnu.so \
+    /opt/portalsim/lib/portalsim/libportalsim_oiio.so /opt/portalsim/python/portalsim/libportalsim_oiio.so) ||
     fail "ldd failed in the $1 root"
   if grep -q 'not found' <<<"$ldd_out"; then fail "in the $1 root, libraries are missing: $(grep 'not found' <<<"$ldd_out" | tr -s ' \t' ' ')"; fi
   local outside

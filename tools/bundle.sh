@@ -28,20 +28,27 @@ name=portalsim-$version-linux-x86_64
 stage_root=$build_dir/bundle-stage
 stage=$stage_root/$name
 rm -rf "$stage_root"
-mkdir -p "$stage/bin" "$stage/lib" "$stage/python/portalsim" "$stage/share/licenses" "$stage/tools"
+mkdir -p "$stage/bin" "$stage/lib/portalsim" "$stage/python/portalsim" "$stage/share/licenses" "$stage/tools"
 
 install -m 755 "$sub/portalsim" "$stage/bin/portalsim"
 core=$(find "$sub/python/portalsim" -maxdepth 1 -name '_core*.so')
 [ -n "$core" ] || { echo "bundle.sh: the Python module _core*.so was not built in $sub/python/portalsim" >&2; exit 1; }
 install -m 644 "$core" "$stage/python/portalsim/"
 install -m 644 "$src"/python/portalsim/*.py "$stage/python/portalsim/"
+# The OpenImageIO module (host/assets/oiio/codec.h), loaded when an image file is read or a
+# non-PNG one written: where the binary looks for it from bin/ (lib/portalsim/, as
+# `cmake --install` puts it), and beside the Python module, where the Python module looks.
+oiio=$sub/libportalsim_oiio.so
+[ -f "$oiio" ] || { echo "bundle.sh: the OpenImageIO module $oiio was not built" >&2; exit 1; }
+install -m 644 "$oiio" "$stage/lib/portalsim/"
+install -m 644 "$oiio" "$stage/python/portalsim/"
 
 # Every library the binary and the module load, transitively (ldd), but glibc's (package
 # libc6: libc, libm, libpthread, libdl, librt, ld-linux), which must be the system's own.
 # libstdc++ and libgcc_s come along, so an older (>= 2.36) glibc system needs no GCC 12.
 # The OpenCL ICD loader (libOpenCL.so.1) comes along; drivers are dlopened by it, never linked.
 libs() {
-  ldd "$stage/bin/portalsim" "$stage/python/portalsim/"_core*.so | awk '$2 == "=>" {print $1, $3}' | sort -u
+  ldd "$stage/bin/portalsim" "$stage/python/portalsim/"_core*.so "$stage/lib/portalsim/libportalsim_oiio.so" | awk '$2 == "=>" {print $1, $3}' | sort -u
 }
 missing=$(libs | awk '$2 == "not" {print $1}')
 [ -z "$missing" ] || { echo "bundle.sh: ldd finds no $missing" >&2; exit 1; }
@@ -79,10 +86,14 @@ if compgen -G "$stage/lib/*[pP][oO][cC][lL]*" >/dev/null; then echo "bundle.sh: 
 # module, because the loader applies an object's RPATH to its libraries' libraries too, so
 # the Debian libraries need no change. The few that carry their own RUNPATH (Open MPI's)
 # would look there instead: theirs becomes $ORIGIN.
-strip --strip-unneeded "$stage/bin/portalsim" "$stage/python/portalsim/"_core*.so
+strip --strip-unneeded "$stage/bin/portalsim" "$stage/python/portalsim/"_core*.so "$stage/lib/portalsim/libportalsim_oiio.so" \
+  "$stage/python/portalsim/libportalsim_oiio.so"
 patchelf --force-rpath --set-rpath '$ORIGIN/../lib' "$stage/bin/portalsim"
-patchelf --force-rpath --set-rpath '$ORIGIN/../../lib' "$stage/python/portalsim/"_core*.so
+patchelf --force-rpath --set-rpath '$ORIGIN/../../lib' "$stage/python/portalsim/"_core*.so \
+  "$stage/python/portalsim/libportalsim_oiio.so"
+patchelf --force-rpath --set-rpath '$ORIGIN/..' "$stage/lib/portalsim/libportalsim_oiio.so"
 for lib in "$stage"/lib/*; do
+  [ -f "$lib" ] || continue
   [ -z "$(patchelf --print-rpath "$lib")" ] || patchelf --set-rpath '$ORIGIN' "$lib"
 done
 
@@ -100,7 +111,7 @@ stray=$(libs | while read -r soname path; do
   [[ " ${glibc_sonames[*]} " == *" $soname "* ]] || echo "$soname => $path"
 done)
 [ -z "$stray" ] || { printf 'bundle.sh: libraries resolved outside the bundle:\n%s\n' "$stray" >&2; exit 1; }
-glibc=$(objdump -T "$stage/bin/portalsim" "$stage/python/portalsim/"_core*.so "$stage"/lib/* 2>/dev/null |
+glibc=$(objdump -T "$stage/bin/portalsim" "$stage/python/portalsim/"_core*.so "$stage"/lib/*.so* "$stage"/lib/portalsim/*.so 2>/dev/null |
   grep -o 'GLIBC_[0-9][0-9.]*' | sort -u -V | tail -n1)
 
 cp -r "$src/docs" "$stage/docs"
@@ -119,7 +130,8 @@ PYTHONPATH=\$PWD/python python3.11 -c "import portalsim; print(portalsim.__versi
 \`\`\`
 
 - \`bin/portalsim\`: the simulator; its kernels and built-in catalogue are inside it.
-- \`lib/\`: the libraries it and the Python module load, but glibc's; the newest glibc symbol
+- \`lib/\`: the libraries it and the Python module load, but glibc's (\`lib/portalsim/\`: its
+  OpenImageIO module, loaded only to read image files or write other formats than PNG); the newest glibc symbol
   version they need is $glibc. It includes the OpenCL ICD loader (libOpenCL.so.1), not a driver:
   the OpenCL backend (the default) uses the drivers that /etc/OpenCL/vendors/*.icd (or
   OCL_ICD_VENDORS) names. \`--backend reference\` needs none.

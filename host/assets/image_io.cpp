@@ -1,26 +1,20 @@
 #include "assets/image_io.h"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
+#include <dlfcn.h>
 #include <fcntl.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
+#include <vector>
 
+#include "assets/oiio/codec.h"
 #include "assets/png_writer.h"
 #include "base/error.h"
 #include "io/input_file.h"
 
 namespace portalsim {
-
-namespace {
-OIIO::ImageSpec spec_of(const Image& img) {
-  return OIIO::ImageSpec(img.width, img.height, img.channels, OIIO::TypeDesc::UINT8);
-}
-}  // namespace
 
 namespace {
 // libpng prints its complaints to stderr and OpenImageIO's PNG reader echoes them to
@@ -59,6 +53,55 @@ class QuietOutput {
 };
 }  // namespace
 
+namespace {
+// The folders where the OpenImageIO module may be, in order: beside the object that holds
+// this code (a build folder, the Python package), beside the executable, and where
+// `cmake --install` puts it relative to bin/ (PORTALSIM_OIIO_MODULE_RELPATH).
+std::vector<std::filesystem::path> module_folders() {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> folders;
+  Dl_info info{};
+  std::error_code ec;
+  if (dladdr(reinterpret_cast<void*>(&module_folders), &info) && info.dli_fname && *info.dli_fname)
+    folders.push_back(fs::absolute(info.dli_fname, ec).parent_path());
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    folders.push_back(exe.parent_path());
+    folders.push_back((exe.parent_path() / PORTALSIM_OIIO_MODULE_RELPATH).lexically_normal());
+  }
+  return folders;
+}
+
+const oiio::Codec& load_codec() {
+  std::string tried, reason;
+  for (const std::filesystem::path& folder : module_folders()) {
+    const std::string file = (folder / PORTALSIM_OIIO_MODULE).string();
+    tried += (tried.empty() ? "" : ", ") + file;
+    if (!std::filesystem::exists(file)) continue;
+    // Never closed: its functions serve the whole process.
+    void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!handle) {
+      reason = dlerror();
+      continue;
+    }
+    using Entry = const oiio::Codec* (*)();
+    const auto entry = reinterpret_cast<Entry>(dlsym(handle, "portalsim_oiio_codec"));
+    const oiio::Codec* codec = entry ? entry() : nullptr;
+    if (codec && codec->version == oiio::kCodecVersion) return *codec;
+    reason = file + " is from another build of portalsim";
+  }
+  throw EnvironmentError("image files are read and written by portalsim's OpenImageIO module " +
+                         std::string(PORTALSIM_OIIO_MODULE) + ", " + (reason.empty() ? "not found" : reason) +
+                         " (looked in: " + tried + "); reinstall portalsim");
+}
+
+// Loaded on first use, once for the process.
+const oiio::Codec& codec() {
+  static const oiio::Codec& c = load_codec();
+  return c;
+}
+}  // namespace
+
 Image read_image(const std::string& path, const std::string& origin) {
   const std::string where = origin + ": " + path;
   std::error_code ec;
@@ -70,39 +113,10 @@ Image read_image(const std::string& path, const std::string& origin) {
   }
   std::string error;
   Image img;
+  const oiio::Codec& c = codec();
   {
     QuietOutput quiet;
-    // create() then open(), not ImageInput::open(): a failed open() inside the latter
-    // leaves an uncollected error that OpenImageIO prints at exit.
-    auto in = OIIO::ImageInput::create(path);
-    OIIO::ImageSpec opened;
-    if (!in) {
-      error = "cannot read image: " + OIIO::geterror();
-    } else if (!in->open(path, opened)) {
-      error = "cannot read image: " + in->geterror();
-    } else {
-      const OIIO::ImageSpec& spec = in->spec();
-      // Checked from the header, before decoding: a small file must not decode to gigabytes.
-      const OIIO::TypeDesc::BASETYPE depth = static_cast<OIIO::TypeDesc::BASETYPE>(spec.format.basetype);
-      if (spec.width < 1 || spec.height < 1 || spec.width > kMaxImageSide || spec.height > kMaxImageSide ||
-          static_cast<int64_t>(spec.width) * spec.height > kMaxImagePixels || spec.depth != 1) {
-        error = "image is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " pixels; at most " +
-                std::to_string(kMaxImageSide) + " a side and " + std::to_string(kMaxImagePixels) + " pixels in all";
-      } else if (spec.nchannels < 1 || spec.nchannels > 4) {
-        error =
-            "image has " + std::to_string(spec.nchannels) + " channels; expected 1 to 4 (gray, gray+alpha, RGB, RGBA)";
-      } else if (depth != OIIO::TypeDesc::UINT8 && depth != OIIO::TypeDesc::UINT16) {
-        error = std::string("image samples are ") + spec.format.c_str() + "; expected 8- or 16-bit integers";
-      } else {
-        img = Image(spec.width, spec.height, spec.nchannels);
-        const bool ok = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, img.pixels.data());
-        const std::string err = in->geterror();
-        if (!ok || !err.empty()) error = "corrupt or unreadable image" + (err.empty() ? "" : ": " + err);
-      }
-      in->close();
-      in->geterror();
-    }
-    OIIO::geterror();  // nothing left pending to be printed later
+    error = c.read(path, oiio::ImageLimits{kMaxImageSide, kMaxImagePixels}, img);
   }
   if (!error.empty()) {
     // OpenImageIO's messages may span lines; one error, one line.
@@ -115,12 +129,9 @@ Image read_image(const std::string& path, const std::string& origin) {
 
 Image resize_image(const Image& img, int width, int height) {
   if (img.width == width && img.height == height) return img;
-  OIIO::ImageBuf src(spec_of(img), const_cast<uint8_t*>(img.pixels.data()));
-  OIIO::ImageSpec dst_spec(width, height, img.channels, OIIO::TypeDesc::UINT8);
-  OIIO::ImageBuf dst(dst_spec);
-  if (!OIIO::ImageBufAlgo::resize(dst, src)) throw std::runtime_error("resize failed: " + dst.geterror());
-  Image out(width, height, img.channels);
-  dst.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::UINT8, out.pixels.data());
+  Image out;
+  const std::string error = codec().resize(img, width, height, out);
+  if (!error.empty()) throw std::runtime_error(error);
   return out;
 }
 
@@ -133,14 +144,8 @@ void write_image(const std::string& path, const Image& img, int png_level, int j
     return;
   }
   // Failures here are the disk's or the folder's (full, read-only): output errors.
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw OutputError(path + ": cannot write image: " + OIIO::geterror());
-  OIIO::ImageSpec spec = spec_of(img);
-  spec.attribute("CompressionQuality", jpeg_quality);
-  if (!out->open(path, spec)) throw OutputError(path + ": cannot write image: " + out->geterror());
-  const bool ok = out->write_image(OIIO::TypeDesc::UINT8, img.pixels.data());
-  const bool closed = out->close();
-  if (!ok || !closed) throw OutputError(path + ": cannot write image: " + out->geterror());
+  const std::string error = codec().write(path, img, jpeg_quality);
+  if (!error.empty()) throw OutputError(path + ": " + error);
 }
 
 }  // namespace portalsim

@@ -1,4 +1,5 @@
-// Reading and writing image files: OpenImageIO, and png_writer.h for PNG output.
+// Reading and writing image files: OpenImageIO, in a module loaded on first use
+// (assets/oiio/codec.h), and png_writer.h for PNG output.
 #pragma once
 #include <string>
 

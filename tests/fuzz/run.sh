@@ -12,12 +12,20 @@ CC=clang CXX=clang++ cmake -S . -B build-fuzz "${generator[@]}" -DCMAKE_BUILD_TY
   -DPORTALSIM_TESTS=OFF -DPORTALSIM_BENCH=OFF ${PORTALSIM_CMAKE_ARGS:-} >/dev/null
 targets=(catalogue spec scenarios feature_table image arff csv h5 checkpoint manifest request)
 cmake --build build-fuzz -j "$(nproc)" --target "${targets[@]/#/fuzz_}"
-for target in "${targets[@]}"; do
-  work=build-fuzz/corpus/$target crashes=build-fuzz/crashes/$target
+# One target per core at a time; each prints its stats when it ends.
+fuzz_one() {
+  local target=$1 seconds=$2
+  local work=build-fuzz/corpus/$target crashes=build-fuzz/crashes/$target
   rm -rf "$work" && mkdir -p "$work" "$crashes"
-  echo "== fuzz_$target, $seconds s"
-  ASAN_OPTIONS=detect_leaks=0 build-fuzz/fuzz_$target -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  if ! ASAN_OPTIONS=detect_leaks=0 build-fuzz/fuzz_$target -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
     -max_len=65536 -artifact_prefix="$crashes/" -print_final_stats=1 "$work" "tests/fuzz/corpus/$target" \
-    2>build-fuzz/fuzz_$target.log || { tail -40 build-fuzz/fuzz_$target.log; exit 1; }
-  grep -E "^stat::number_of_executed_units|^stat::average_exec_per_sec|^Done" build-fuzz/fuzz_$target.log || true
-done
+    2>build-fuzz/fuzz_$target.log; then
+    echo "== fuzz_$target failed:"
+    tail -40 build-fuzz/fuzz_$target.log
+    return 1
+  fi
+  echo "== fuzz_$target, $seconds s: $(grep -E "^stat::number_of_executed_units|^stat::average_exec_per_sec" \
+    build-fuzz/fuzz_$target.log | tr -s ' ' | tr '\n' ' ')"
+}
+export -f fuzz_one
+printf '%s\n' "${targets[@]}" | xargs -P "$(nproc)" -I{} bash -c 'fuzz_one "$1" "$2"' _ {} "$seconds"
