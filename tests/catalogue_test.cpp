@@ -1,6 +1,8 @@
 // The default catalogue's contents, object names and the threat rules.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "base/error.h"
 #include "scene/rules.h"
 #include "support.h"
@@ -29,6 +31,21 @@ TEST(Catalogue, DefaultHoldsTheThesisInventory) {
     const bool two = o.name == "gun" || o.name == "iron-rod";
     EXPECT_EQ(o.variants.size(), two ? 2u : 1u) << o.name;
   }
+}
+
+// A subject's base image files go to the views whose asset keys name them, and to no
+// other: a key it names no file for, or no view has, is the procedural body.
+TEST(Catalogue, SubjectImagesGoOnlyToTheirOwnViews) {
+  Subject s;
+  s.images.emplace("ir", ImageSource{"/data/ir.png", "catalogue.toml:3: subjects[1].ir"});
+  EXPECT_EQ(s.image("ir").path, "/data/ir.png");
+  EXPECT_EQ(s.image("mmw_upper").path, "");
+  EXPECT_EQ(s.image("mmw_lower").path, "");
+  EXPECT_EQ(s.image("mmw_back").path, "");
+  // Every view of the built-in catalogue has a subject image key.
+  for (const Sensor& view : catalogue().sensors)
+    EXPECT_NE(std::find(kSubjectImageKeys.begin(), kSubjectImageKeys.end(), view.asset_key), kSubjectImageKeys.end())
+        << view.name;
 }
 
 TEST(Catalogue, NamesIgnoreCaseAndPunctuationAndAcceptThesisSpellings) {

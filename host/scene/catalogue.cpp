@@ -2,11 +2,13 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include "base/error.h"
 #include "io/input_file.h"
@@ -202,6 +204,12 @@ void read_metal_physics(const Reader& rd, const toml::node* node, Catalogue& cat
 
 }  // namespace
 
+const ImageSource& Subject::image(std::string_view key) const {
+  static const ImageSource procedural;
+  const auto it = images.find(key);
+  return it == images.end() ? procedural : it->second;
+}
+
 std::array<double, 9> Catalogue::polarizability(int variant_id) const {
   const Object& o = object_of(variant_id);
   const double m = metal_physics.polarizability.empty() ? 0.0 : metal_physics.polarizability[o.metal];
@@ -332,11 +340,12 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     s.ir_limb = rd.integer(t, "ir_limb", f, 0, 255, 175);
     const std::vector<int> z = rd.ints(rd.need(t, "base_zones", f + ".base_zones"), f + ".base_zones", kZones, 1, 200);
     std::copy(z.begin(), z.end(), s.base_zones.begin());
-    s.mmw_upper = rd.image(t, "mmw_upper", f);
-    s.mmw_lower = rd.image(t, "mmw_lower", f);
-    s.ir = rd.image(t, "ir", f);
+    for (std::string_view key : kSubjectImageKeys) {
+      ImageSource src = rd.image(t, std::string(key), f);
+      if (!src.path.empty()) s.images.emplace(key, std::move(src));
+    }
     // Objects move with the stature; an image file's body would not.
-    if (s.height != 1.0 && (!s.mmw_upper.path.empty() || !s.mmw_lower.path.empty() || !s.ir.path.empty()))
+    if (s.height != 1.0 && !s.images.empty())
       rd.fail(t.get("height"), f + ".height",
               "only a procedural body can be drawn at another height; this subject names image files "
               "(mmw_upper, mmw_lower or ir)");
@@ -537,6 +546,10 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     cat.noise.push_back(std::move(p));
   }
   cat.sensors = camera_sensors(cat);
+  for (const Sensor& view : cat.sensors)
+    if (std::find(kSubjectImageKeys.begin(), kSubjectImageKeys.end(), view.asset_key) == kSubjectImageKeys.end())
+      throw std::logic_error("camera view " + view.name + " has asset key " + view.asset_key +
+                             ", which no subject image key names");
   return cat;
 }
 

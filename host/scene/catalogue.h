@@ -2,6 +2,8 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -11,6 +13,9 @@
 namespace portalsim {
 
 constexpr int kUpperRegions = 6;
+
+// The catalogue keys of a subject's base images, one per camera view (Sensor::asset_key).
+inline constexpr std::array<std::string_view, 3> kSubjectImageKeys{"mmw_upper", "mmw_lower", "ir"};
 
 enum class View : int { upper = 0, lower = 1 };
 
@@ -26,11 +31,12 @@ struct Subject {
   double height = 1.0;  // stature scale about the floor (procedural::Body::height)
   int mmw_level = 150, ir_core = 215, ir_limb = 175;
   std::array<int, kZones> base_zones{};
-  ImageSource mmw_upper, mmw_lower, ir;
-  // The base image named by a camera view's asset key (Sensor::asset_key).
-  const ImageSource& image(std::string_view key) const {
-    return key == "ir" ? ir : key == "mmw_upper" ? mmw_upper : mmw_lower;
-  }
+  // The base image files the catalogue names, by camera view asset key (Sensor::asset_key:
+  // kSubjectImageKeys); a view with none draws the procedural body.
+  std::map<std::string, ImageSource, std::less<>> images;
+  // The base image of the view with asset key `key`: its file, or the procedural source
+  // (empty path) where the catalogue names none.
+  const ImageSource& image(std::string_view key) const;
 };
 
 struct Region {
