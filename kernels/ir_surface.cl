@@ -1,15 +1,20 @@
 // The physics model's IR camera, which sees the clothing surface. Stage "contact_shadow":
-// the field is each object's surface dT alone (host: PS_PHYS_VARIANTS, -coupling (skin -
-// object)), laid by its IR sprite's coverage over 0 K; "heat_spread" then blurs it with
-// the optics kernels. Stage "ir_surface": plus the bare body's surface temperature, the
+// the field is each object's surface dT alone, laid by its IR sprite's coverage over 0 K,
+// against the surface it touches: on the body (a base image index of at least the
+// subject's body_from) the skin (host: PS_PHYS_VARIANTS, -coupling (skin - object)), off
+// it the room (phys_off_body); "heat_spread" then blurs it with the optics kernels. Stage "ir_surface": plus the bare body's surface temperature, the
 // base image's index read as kelvin through the subject's (gain, offset).
 kernel void stage_contact_shadow(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;
   global preal* dT = (global preal*)field + row0;
   global const param* shadow = phys + PS_PHYS_VARIANTS(L.subjects);
+  global const param* off_body = phys + L.phys_off_body + L.subjects;
+  global const uchar* restrict base = base_row(atlas, bases, subject, &L, i, y);
+  const int body_from = (int)phys[L.phys_off_body + subject[i]];
   Layers Ly;
   composite_layers(&Ly, rec, &L, y);
-  for (int x = 0; x < L.width; ++x) dT[x] = lay_values(&Ly, atlas, x, shadow, (preal)0);
+  for (int x = 0; x < L.width; ++x)
+    dT[x] = lay_values(&Ly, atlas, x, (int)base[x] >= body_from ? shadow : off_body, (preal)0);
 }
 
 kernel void stage_ir_surface(VIEW_STAGE_ARGS) {

@@ -54,6 +54,8 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
   // contact_shadow over each row's span (into T), zero over the rest the row blur reads;
   // then heat_spread along the row (T -> S) as stage_optics_rows, over the span's reach.
   global const param* shadow = phys + PS_PHYS_VARIANTS(L->subjects);
+  global const param* off_body = phys + L->phys_off_body + L->subjects;
+  const int body_from = (int)phys[L->phys_off_body + s];
   global const param* taps = psf_taps(phys, L);
   for (int y = y_lo; y < y_hi; ++y) {
     Layers Ly;
@@ -70,7 +72,9 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
     }
     global preal* restrict src = T + (size_t)y * W;
     for (int x = max(a - 2 * R, 0); x < a; ++x) src[x] = 0;
-    for (int x = a; x < b; ++x) src[x] = lay_values(&Ly, atlas, x, shadow, (preal)0);
+    global const uchar* restrict base_y = base_row(atlas, bases, subject, L, i, y);
+    for (int x = a; x < b; ++x)
+      src[x] = lay_values(&Ly, atlas, x, (int)base_y[x] >= body_from ? shadow : off_body, (preal)0);
     for (int x = b; x < min(b + 2 * R, W); ++x) src[x] = 0;
     global preal* restrict dst = S + (size_t)y * W;
     const int lo = max(a - R, 0), hi = min(b + R, W);

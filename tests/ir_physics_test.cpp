@@ -4,6 +4,7 @@
 // display is ir_netd; the palette changes the RGB but never the index; bad values refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "assets/image_io.h"
@@ -250,6 +251,82 @@ TEST(IrPhysics, ContrastFadesWithTheTimeWorn) {
   }
 }
 
+// Where an object reaches past the body's outline (the gun's grip, drawn horizontally at the
+// right abdomen), its shadow is taken against the room it touches there, not the skin:
+// -coupling (room - T_object), never colder than the room, where it was 10 K below it
+// (palette index 0 beside the body). On the body it stays against the skin.
+TEST(IrPhysics, AnObjectPastTheBodysOutlineIsShadowedAgainstTheRoom) {
+  const World w;
+  const PhysicsConfig& pc = w.cat.physics;
+  Scenario scene;
+  int region = -1;
+  for (int r = 0; r < kRegions; ++r)
+    if (w.cat.regions[r].name == "right-abdomen") region = r;
+  ASSERT_GE(region, 0);
+  scene.objects[region] = static_cast<int16_t>(variant_of(w.cat, "gun"));
+  Plan plan = physics_plan();
+  plan.model.ir_netd = 0;
+  const int gun = variant_of(w.cat, "gun");
+  const Material& mat = w.cat.materials.at(w.cat.object_of(gun).material_id);
+  const double t_object = pc.skin_temperature - (pc.skin_temperature - pc.room_temperature) *
+                                                    std::exp(-plan.model.worn_minutes / mat.warm_minutes);
+  const double on_body = -pc.ir_coupling * (pc.skin_temperature - t_object);
+  const double off_body = -pc.ir_coupling * (pc.room_temperature - t_object);
+  ASSERT_GE(off_body, 0.0);
+
+  // Reference, before the heat spreads: each covered pixel between 0 and its surface's dT.
+  const reference::Field shadow = ir_field(w, plan.model, scene, {"contact_shadow"});
+  const Image& base = w.assets.bases[0][ir_view(w.cat)];
+  const double per_index = (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0;
+  const auto is_body = [&](int x, int y) {
+    return pc.ir_index_min_k + per_index * base.at(x, y) >= (pc.room_temperature + pc.skin_temperature) / 2;
+  };
+  int off_covered = 0, off_full = 0, on_full = 0;
+  for (int y = 0; y < shadow.height; ++y)
+    for (int x = 0; x < shadow.width; ++x) {
+      const double v = shadow.at(x, y);
+      if (v == 0) continue;
+      if (is_body(x, y)) {
+        EXPECT_LE(v, 0.0);
+        EXPECT_GE(v, on_body - 1e-9);
+        on_full += std::abs(v - on_body) < 1e-9;
+      } else {
+        ++off_covered;
+        EXPECT_GE(v, 0.0) << x << "," << y;
+        EXPECT_LE(v, off_body + 1e-9);
+        off_full += std::abs(v - off_body) < 1e-9;
+      }
+    }
+  EXPECT_GT(off_covered, 20) << "the grip must reach past the outline for this test to mean anything";
+  EXPECT_GT(off_full, 0);
+  EXPECT_GT(on_full, 0);
+
+  // Kernels, as shown: off the body and not touching it (where the skin's shadow spreads
+  // over), the gun never shows below the bare room beside the body; it was index 0 there.
+  auto cl = make_opencl_backend(w.cat, w.assets, test::runtime());
+  BatchOutput with, bare;
+  cl->run(test::batch_of({scene}), plan, with);
+  cl->run(test::batch_of({Scenario{}}), plan, bare);
+  const ViewImages& a = with.view("ir");
+  const ViewImages& b = bare.view("ir");
+  int compared = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      if (shadow.at(x, y) == 0) continue;
+      bool near_body = false;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int u = std::clamp(x + dx, 0, a.width - 1), t = std::clamp(y + dy, 0, a.height - 1);
+          near_body = near_body || is_body(u, t);
+        }
+      if (near_body) continue;
+      const size_t at = static_cast<size_t>(y) * a.width + x;
+      EXPECT_GE(a.pixels[at], b.pixels[at]) << x << "," << y;
+      ++compared;
+    }
+  EXPECT_GT(compared, 0);
+}
+
 // The 10%-90% width of the shadow's left edge along the row through the object's centre,
 // in pixels (linear between pixels).
 double edge_width(const reference::Field& f, int cx, int cy) {
@@ -276,7 +353,11 @@ TEST(IrPhysics, MoreSpreadingWidensTheShadowsEdge) {
   double w0 = 0, last = 0;
   for (double mm : {0.0, 10.0, 25.0, 40.0}) {
     SCOPED_TRACE(mm);
-    const World w(Edits{big, {"ir_spread_mm = 10.0", "ir_spread_mm = " + std::to_string(mm)}});
+    // The plate is wider than the body; a room colder than the IR scale's bottom makes every
+    // pixel body (contact_shadow), so that its whole edge is shadowed against the skin.
+    const World w(Edits{big,
+                        {"ir_spread_mm = 10.0", "ir_spread_mm = " + std::to_string(mm)},
+                        {"room_temperature = 293.0", "room_temperature = 270.0"}});
     const OneObject one(w, "metal-plate");
     const reference::Field f = ir_field(w, plan.model, one.scene, {"contact_shadow", "heat_spread"});
     const double width = edge_width(f, one.cx, one.cy);

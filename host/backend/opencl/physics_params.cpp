@@ -61,6 +61,7 @@ size_t mmw_display_scratch(const Sensor& s, int raw_width, int raw_height) {
 
 cl::Buffer PhysicsParams::operator()(bool fp64, const Plan& plan, int view, PsViewLaunch& L) {
   L.psf_radius = L.phys_wx = L.phys_wy = L.phys_cband = L.phys_rband = L.phys_base = L.phys_gauss = 0;
+  L.phys_off_body = 0;
   L.display_stride = L.phys_dx = L.phys_dxband = L.phys_dy = L.phys_dyband = 0;
   if (plan.model.model != Model::physics) return none_.at_least(ctx_, 16);
   Tables& t = tables_[table_key(plan, "view=" + std::to_string(view) + ";fp64=" + std::to_string(fp64))];
@@ -72,6 +73,7 @@ cl::Buffer PhysicsParams::operator()(bool fp64, const Plan& plan, int view, PsVi
   L.phys_rband = t.rband;
   L.phys_base = t.base;
   L.phys_gauss = t.gauss;
+  L.phys_off_body = t.off_body;
   L.display_stride = t.display.stride;
   L.phys_dx = t.display.dx;
   L.phys_dxband = t.display.dxband;
@@ -127,7 +129,21 @@ PhysicsParams::Tables PhysicsParams::make(const Plan& plan, const Sensor& s, int
     return at;
   };
   t.gauss = append(gauss_table());  // the sensor noise's table Gaussians
-  if (ir) return t;
+  if (ir) {
+    // Where an object reaches past the body's outline, its shadow is taken against the room
+    // it touches there, not the skin (PsViewLaunch::phys_off_body).
+    std::vector<double> off_body;
+    const double per_index = (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0;
+    const double body_from = (pc.room_temperature + pc.skin_temperature) / 2;
+    for (size_t subj = 0; subj < cat_.subjects.size(); ++subj)
+      off_body.push_back(std::ceil((body_from - pc.ir_index_min_k) / per_index));
+    for (size_t v = 0; v < cat_.variant_list.size(); ++v) {
+      const Material& mat = cat_.materials.at(cat_.object_of(static_cast<int>(v)).material_id);
+      off_body.push_back(-pc.ir_coupling * (pc.room_temperature - worn_temperature(pc, mat, m.worn_minutes)));
+    }
+    t.off_body = append(off_body);
+    return t;
+  }
   // The MMW raw-grid path's tables (kernels/physics_raw.cl).
   const int W = s.width, H = s.height, RW = m.raw_width, RH = m.raw_height;
   std::vector<double> wx, wy, cband, rband;

@@ -27,7 +27,7 @@ class PhysicsParams {
 
   struct Tables {
     std::vector<double> values;
-    int32_t radius = 0, wx = 0, wy = 0, cband = 0, rband = 0, base = 0, gauss = 0;
+    int32_t radius = 0, wx = 0, wy = 0, cband = 0, rband = 0, base = 0, gauss = 0, off_body = 0;
     DisplayTables display;  // stage_mmw_display's (MMW views)
     cl::Buffer buffer;
   };

@@ -9,15 +9,35 @@ double contact_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int v
   return -pc.ir_coupling * (pc.skin_temperature - worn_temperature(cat, m, variant));
 }
 
+// Where the object lies off the body, the surface it touches is the room's.
+double off_body_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant) {
+  const PhysicsConfig& pc = cat.physics;
+  return -pc.ir_coupling * (pc.room_temperature - worn_temperature(cat, m, variant));
+}
+
 // The shadow field alone (0 K where no object lies), objects in region order by their IR
-// sprites' coverage, as radiometry lays them: v = c dT + (1 - c) v.
+// sprites' coverage, as radiometry lays them: v = c dT + (1 - c) v; dT against the skin
+// where the base image is body (warmer than halfway from the room to the skin), against the
+// room elsewhere.
 void contact_shadow(const ViewScene& vs, Field& f) {
   f.width = vs.sensor.width;
   f.height = vs.sensor.height;
   f.v.assign(vs.sensor.pixels(), 0.0);
+  Field off = f;
   lay_objects(vs, f, 1.0, [](const ViewScene& s, const Placed& p, int, int) {
     return contact_shadow_kelvin(s.cat, s.model, p.variant);
   });
+  lay_objects(vs, off, 1.0, [](const ViewScene& s, const Placed& p, int, int) {
+    return off_body_shadow_kelvin(s.cat, s.model, p.variant);
+  });
+  const PhysicsConfig& pc = vs.cat.physics;
+  const Image& base = vs.assets.bases[vs.scenario.subject][vs.view];
+  const double per_index = (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0;
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      const double kelvin = pc.ir_index_min_k + per_index * base.at(x, y);
+      if (kelvin < (pc.room_temperature + pc.skin_temperature) / 2) f.at(x, y) = off.at(x, y);
+    }
 }
 
 // The bare body's surface temperature, its base image's index read linearly as kelvin,
