@@ -170,6 +170,12 @@ double alarm_rate(const std::vector<uint8_t>& lowest, int level) {
 
 double rounded(double v, double unit) { return std::round(v / unit) * unit; }
 
+std::string text(double v) {
+  char t[32];
+  std::snprintf(t, sizeof t, "%g", v);
+  return t;
+}
+
 }  // namespace
 
 void check_metal_map(const Catalogue& cat, const MetalMapSettings& s) {
@@ -182,23 +188,23 @@ void check_metal_map(const Catalogue& cat, const MetalMapSettings& s) {
   }
   auto finite_positive = [](double v) { return std::isfinite(v) && v > 0; };
   if (!finite_positive(s.grid_step))
-    throw InputError("--grid-step: must be a number of metres above 0, not " + std::to_string(s.grid_step));
+    throw InputError("--grid-step: must be a number of metres above 0, not " + text(s.grid_step));
   if (grid_of(cat.metal_physics, s.grid_step).cells() == 0) {
     char text[160];
     std::snprintf(text, sizeof text, "--grid-step: %g m leaves no cell across the %g m passage or up its %g m",
                   s.grid_step, cat.metal_physics.panel_separation, cat.metal_physics.body_height);
     throw InputError(text);
   }
-  if (!finite_positive(s.speed)) throw InputError("--speed: must be above 0 m/s, not " + std::to_string(s.speed));
+  if (!finite_positive(s.speed)) throw InputError("--speed: must be above 0 m/s, not " + text(s.speed));
   if (!finite_positive(s.sample_rate))
-    throw InputError("--sample-rate: must be above 0 Hz, not " + std::to_string(s.sample_rate));
+    throw InputError("--sample-rate: must be above 0 Hz, not " + text(s.sample_rate));
   if (!finite_positive(s.walk)) throw InputError("walk: must be above 0 m");
   if (samples_of(s) > kMaxSamples)
     throw InputError("--sample-rate: " + std::to_string(samples_of(s)) + " samples a walk at this --speed; at most " +
                      std::to_string(kMaxSamples));
   if (s.passes < 1 || s.passes > 100000)
     throw InputError("--passes: must be 1 to 100000, not " + std::to_string(s.passes));
-  if (!(s.pfa >= 0 && s.pfa <= 1)) throw InputError("--clean-pfa: must be within 0..1, not " + std::to_string(s.pfa));
+  if (!(s.pfa >= 0 && s.pfa <= 1)) throw InputError("--clean-pfa: must be within 0..1, not " + text(s.pfa));
   if (s.settings.empty()) throw InputError("--sensitivity: give at least one level, 1 to 199");
   for (int v : s.settings)
     if (v < 1 || v > 199) throw InputError("--sensitivity: each level must be 1 to 199, not " + std::to_string(v));
