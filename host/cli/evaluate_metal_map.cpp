@@ -73,7 +73,9 @@ int run_metal_map(MetalMapOptions& o) {
   s.seed = io::parse_u64(given(app, "--seed", "0"), "--seed");
   s.metal_noise = to_int(given(app, "--metal-noise", std::to_string(s.metal_noise)), "--metal-noise");
   const std::string threads = given(app, "--threads", "0");
-  s.threads = static_cast<unsigned>(to_int(threads, "--threads"));
+  const int thread_count = to_int(threads, "--threads");
+  if (thread_count < 0) throw InputError("--threads: must be 0 (every core) or more, not " + threads);
+  s.threads = static_cast<unsigned>(thread_count);
   const std::string out = given(app, "--out", "");
   if (out.empty()) throw InputError("--out: the metal map needs a report folder");
   const std::string backend = given(app, "--backend", "opencl");
