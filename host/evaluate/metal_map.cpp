@@ -168,7 +168,8 @@ double alarm_rate(const std::vector<uint8_t>& lowest, int level) {
   return lowest.empty() ? 0.0 : static_cast<double>(alarms) / static_cast<double>(lowest.size());
 }
 
-double rounded(double v, double unit) { return std::round(v / unit) * unit; }
+// v to `per` parts of a unit (1e9: nanometres), so that 0.35 prints as 0.35.
+double rounded(double v, double per) { return std::round(v * per) / per; }
 
 std::string text(double v) {
   char t[32];
@@ -303,7 +304,7 @@ json metal_map(const Catalogue& cat, const MetalMapSettings& s, OpenCLRuntime* r
   report["metal_category"] = cat.metal_categories[object.metal];
   report["polarizability_cm3"] = mp.polarizability.empty() ? 0.0 : mp.polarizability[object.metal];
   report["anisotropy"] = object.metal_anisotropy;
-  report["length_m"] = rounded(t.length, 1e-6);
+  report["length_m"] = rounded(t.length, 1e6);
   report["standards"] = "NIJ 0601.02, ASTM F1468, ASTM F3566-22 (simplified: docs/model/metal.md)";
   report["carrier"] = cat.subjects[0].name;
   report["grid"] = {{"step_m", s.grid_step},
@@ -316,8 +317,8 @@ json metal_map(const Catalogue& cat, const MetalMapSettings& s, OpenCLRuntime* r
                      {"tx_height_m", mp.tx_height},
                      {"rx_height_m", mp.rx_height},
                      {"transmit_on_a", "zones 1-9 transmit on panel A and receive on B; zones 10-19 the other way"}};
-  for (double x : g.x) report["grid"]["x_m"].push_back(rounded(x, 1e-9));
-  for (double z : g.z) report["grid"]["z_m"].push_back(rounded(z, 1e-9));
+  for (double x : g.x) report["grid"]["x_m"].push_back(rounded(x, 1e9));
+  for (double z : g.z) report["grid"]["z_m"].push_back(rounded(z, 1e9));
   report["walk"] = {{"speed_m_per_s", s.speed},
                     {"sample_rate_hz", s.sample_rate},
                     {"from_y_m", -static_cast<double>(w.samples - 1) / 2.0 * s.speed / s.sample_rate},
@@ -379,8 +380,7 @@ json metal_map(const Catalogue& cat, const MetalMapSettings& s, OpenCLRuntime* r
         if (p < worst_pd || (p == worst_pd && peak_r < worst_peak)) {
           worst_pd = p;
           worst_peak = peak_r;
-          worst = {
-              {"x_m", rounded(g.x[i], 1e-9)}, {"z_m", rounded(g.z[j], 1e-9)}, {"pd", p}, {"peak_response", peak_r}};
+          worst = {{"x_m", rounded(g.x[i], 1e9)}, {"z_m", rounded(g.z[j], 1e9)}, {"pd", p}, {"peak_response", peak_r}};
         }
       }
       pd.push_back(pd_row);
