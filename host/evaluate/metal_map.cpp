@@ -20,7 +20,7 @@ using nlohmann::json;
 constexpr std::array<const char*, 3> kAxisNames{"x", "y", "z"};
 constexpr std::array<std::array<double, 3>, 3> kAxes{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
 // Most samples one walk may take, and most probes (walks x samples) one map may hold.
-constexpr size_t kMaxSamples = 100000, kMaxProbes = size_t{1} << 26;
+constexpr size_t kMaxSamples = 100000, kMaxProbes = size_t{1} << 24;  // about 3 GB of responses
 
 struct Grid {
   std::vector<double> x, z;  // cell centres, metres
