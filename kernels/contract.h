@@ -31,12 +31,21 @@
 #define PS_MR_ROW 1
 #define PS_MR_LEN 2
 /* Each object is PS_METAL_SEGMENTS equal dipoles at the midpoints of equal segments of its
- * drawn long side (docs/model/metal.md). Record of one variant, doubles: its polarizability
- * tensor (row-major 3x3, cm^3), then its long side's x and z (metres). */
+ * drawn long side (docs/model/metal.md). Record of one variant (or one oriented test object
+ * of a metal map), doubles: its polarizability tensor (row-major 3x3, cm^3), then its long
+ * side's x, z and y (metres; y is 0 for a catalogue variant). */
 #define PS_METAL_SEGMENTS 5
 #define PS_MV_LONG_X 9
 #define PS_MV_LONG_Z 10
-#define PS_MV_LEN 11
+#define PS_MV_LONG_Y 11
+#define PS_MV_LEN 12
+/* A metal map's probe (host/evaluate/metal_map.h), doubles: the object's centre x, y, z
+ * (metres) and the index of its record (PS_MV_*) as a double. */
+#define PS_MP_X 0
+#define PS_MP_Y 1
+#define PS_MP_Z 2
+#define PS_MP_OBJECT 3
+#define PS_MP_LEN 4
 
 /* Random streams of the counter generator: each kind of draw has its own, so adding one
  * never shifts another. element = the index within the stream named beside it. */
@@ -50,6 +59,7 @@
 #define PS_STREAM_TRANSFORM 8u         /* randomised objects: rotation, scale, flip; element = region */
 #define PS_STREAM_FEATURE_NOISE 9u     /* physics features-only: NETD noise in feature space; PS_GAUSS_ELEMENT */
 #define PS_STREAM_PIXEL_NOISE_FAST 10u /* per-pixel sensor noise, Irwin-Hall draws; PS_GAUSS_ELEMENT */
+#define PS_STREAM_METAL_MAP 11u        /* metal maps' detector noise (host only); element = zone */
 #define PS_STREAM_GENERATE 16u         /* scenario generators (host only) */
 /* physics: frame k >= 1 of the MMW camera's integration draws its NETD from stream
  * PS_STREAM_FRAME_NOISE + k (frame 0 from PS_STREAM_RAW_NOISE); element: PS_GAUSS_ELEMENT */

@@ -46,8 +46,13 @@ tradeoff() {
   cp "$work/trade/tradeoff.png" docs/tradeoff.png
   cp "$work/trade/tradeoff.csv" docs/tradeoff.csv
 }
+# docs/guide/metal-map.md: the gun's metal detector sensitivity map (seconds).
+metalmap() {
+  "$portalsim" evaluate --metal-map gun --out "$work/metalmap" > /dev/null
+  cp "$work/metalmap/metal_map.png" docs/guide/metal-map.png
+}
 
-all=(models subjects randomised coco calibrate serve sensitivity tradeoff)
+all=(models subjects randomised coco calibrate serve sensitivity tradeoff metalmap)
 for figure in "${@:-${all[@]}}"; do
   case " ${all[*]} " in
     *" $figure "*) ;;

@@ -211,14 +211,22 @@ const ImageSource& Subject::image(std::string_view key) const {
 }
 
 std::array<double, 9> Catalogue::polarizability(int variant_id) const {
+  const bool turned = variant(variant_id).code == "v";
+  return polarizability(variant_id, turned ? std::array<double, 3>{0, 0, 1} : std::array<double, 3>{1, 0, 0});
+}
+
+std::array<double, 9> Catalogue::polarizability(int variant_id, const std::array<double, 3>& u) const {
   const Object& o = object_of(variant_id);
   const double m = metal_physics.polarizability.empty() ? 0.0 : metal_physics.polarizability[o.metal];
   const double a = o.metal_anisotropy;
-  const int axis = variant(variant_id).code == "v" ? 2 : 0;
-  std::array<double, 9> t{};
   const double across = m * 3.0 / (a + 2.0);
-  for (int i = 0; i < 3; ++i) t[i * 3 + i] = across;
-  t[axis * 3 + axis] = across * a;
+  // Diagonal across (1 - u_i^2) + across a u_i^2, off the diagonal across (a - 1) u_i u_j:
+  // along an axis, exactly across and across a.
+  std::array<double, 9> t{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      t[i * 3 + j] =
+          i == j ? across * (1.0 - u[i] * u[i]) + across * a * (u[i] * u[i]) : across * (a - 1.0) * u[i] * u[j];
   return t;
 }
 

@@ -150,6 +150,10 @@ struct Catalogue {
   // across, y along the walk, z up): m (I + (a - 1) u u^T) 3 / (a + 2), mean m of its metal
   // category, anisotropy a along its long axis u (z for a "v" drawing, else x).
   std::array<double, 9> polarizability(int variant_id) const;
+  // The same tensor with its long axis along the unit vector `axis` (portal axes), any
+  // orientation: across (I + (a - 1) u u^T), written so that an axis along x or z gives
+  // polarizability(variant_id)'s numbers to the bit (metal maps, host/evaluate/metal_map.h).
+  std::array<double, 9> polarizability(int variant_id, const std::array<double, 3>& axis) const;
   // A variant's long side as the coils see it, metres (x across, z up): the drawing's
   // longer side (x where it is wider than tall, else z; a "v" drawing turned a quarter) at
   // the metal model's scale, body_height over the two MMW views' height.

@@ -138,6 +138,15 @@ PS_KERNEL_ARGS(MetalZonesArgs, PS_METAL_ZONES_ARGS)
   X(cl::Buffer, out)
 PS_KERNEL_ARGS(MetalPhysicsArgs, PS_METAL_PHYSICS_ARGS)
 
+#define PS_METAL_MAP_ARGS(X) \
+  X(cl::Buffer, zone_rec)    \
+  X(cl::Buffer, objects)     \
+  X(cl::Buffer, probes)      \
+  X(cl_uint, n)              \
+  X(cl::Buffer, response)    \
+  X(cl::Buffer, deduction)
+PS_KERNEL_ARGS(MetalMapArgs, PS_METAL_MAP_ARGS)
+
 // kernels/pool_sparse.cl
 #define PS_BASE_FEATURES_ARGS(X) \
   X(cl::Buffer, atlas)           \

@@ -27,6 +27,13 @@ Vec dipole(Vec m, Vec c, Vec p) {
   return {(k * r.x - m.x) / den, (k * r.y - m.y) / den, (k * r.z - m.z) / den};
 }
 
+// A zone's deduction from its response gain |signal|: rounded half up; anything at or past
+// the cap (or not finite, an object on a coil) is the cap.
+int deduction_of(double t) {
+  constexpr int kMaxDeduction = 199;  // a zone reads at least 1 from its base of 200
+  return t < kMaxDeduction ? static_cast<int>(std::floor(t + 0.5)) : kMaxDeduction;
+}
+
 }  // namespace
 
 std::vector<MetalObject> metal_objects(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m,
@@ -63,7 +70,7 @@ double zone_signal(const MetalPhysics& mp, int zone, const MetalObject& o) {
   double sum = 0;
   for (int k = 0; k < PS_METAL_SEGMENTS; ++k) {
     const double f = (k + 0.5) / PS_METAL_SEGMENTS - 0.5;  // along the long side, -1/2 .. 1/2
-    const Vec p{o.x + f * o.lx, 0.0, o.z + f * o.lz};
+    const Vec p{o.x + f * o.lx, o.y + f * o.ly, o.z + f * o.lz};
     // Both coils' moments point into the portal.
     const Vec ht = dipole({-side * mp.tx_moment, 0.0, 0.0}, tx, p);
     const Vec hr = dipole({side * mp.rx_moment, 0.0, 0.0}, rx, p);
@@ -82,16 +89,20 @@ void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSett
   for (int z = 0; z < kZones; ++z) {
     double signal = 0;
     for (const MetalObject& o : objects) signal += zone_signal(mp, z, o);
-    // Rounded half up; anything at or past the cap (or not finite, an object on a coil) is the cap.
-    const double t = mp.gain[z] * std::fabs(signal);
-    constexpr int kMaxDeduction = 199;  // a zone reads at least 1 from its base of 200
-    const int deduction = t < kMaxDeduction ? static_cast<int>(std::floor(t + 0.5)) : kMaxDeduction;
+    const int deduction = deduction_of(mp.gain[z] * std::fabs(signal));
     int value = cat.subjects[s.subject].base_zones[z] - deduction;
     if (m.metal_noise > 0 && deduction > 0) {
       const Philox4 r = draw(m.seed, index, kStreamMetalNoise, static_cast<uint32_t>(z));
       value += static_cast<int>(below(r[0], m.metal_noise + 1)) - static_cast<int>(below(r[1], m.metal_noise + 1));
     }
     zones[z] = static_cast<uint8_t>(std::clamp(value, 1, 200));
+  }
+}
+
+void metal_response(const MetalPhysics& mp, const MetalObject& o, double* response, uint8_t* deduction) {
+  for (int z = 0; z < kZones; ++z) {
+    response[z] = mp.gain[z] * std::fabs(zone_signal(mp, z, o));
+    deduction[z] = static_cast<uint8_t>(deduction_of(response[z]));
   }
 }
 

@@ -117,19 +117,25 @@ void metal(const Catalogue& cat, const ModelSettings& m, const Scenario& s, uint
 void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m, const Scenario& s,
                    uint64_t index, uint8_t* zones);
 // A metal object as the coils see it: polarizability tensor (cm^3) and position (metres,
-// x across the portal, z up; y = 0), its region's centre in the stacked MMW views, moved
-// with the subject's height as the composite's place (Sensor::place), plus the
-// composite's placement jitter.
+// x across the portal, y along the walk, z up), its region's centre in the stacked MMW
+// views, moved with the subject's height as the composite's place (Sensor::place), plus the
+// composite's placement jitter; a scenario's objects stand at y = 0, a metal map's walk
+// through (host/evaluate/metal_map.h).
 // It is PS_METAL_SEGMENTS dipoles of tensor / PS_METAL_SEGMENTS each, at the midpoints of
-// equal segments of its long side (lx, lz) about (x, z).
+// equal segments of its long side (lx, ly, lz) about (x, y, z). y and ly come last so that
+// {tensor, x, z, lx, lz} still reads as before.
 struct MetalObject {
   std::array<double, 9> tensor;
   double x, z;
   double lx = 0, lz = 0;
+  double y = 0, ly = 0;
 };
 std::vector<MetalObject> metal_objects(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m,
                                        const Scenario& s, uint64_t index);
 // One object's H_R^T M H_T in zone `zone` (0-based), summed over its dipoles, before the gain.
 double zone_signal(const MetalPhysics& mp, int zone, const MetalObject& o);
+// One object alone, every zone: its response gain |H_R^T M H_T| (counts, unrounded) and
+// its deduction, the response rounded half up and capped at 199 (metal maps).
+void metal_response(const MetalPhysics& mp, const MetalObject& o, double* response, uint8_t* deduction);
 
 }  // namespace portalsim::reference

@@ -2,6 +2,7 @@
 // the physics model's coil fields and polarizability tensors (kernels/metal_physics.cl, in
 // fp64).
 #include "backend/opencl/launch.h"
+#include "backend/opencl/metal_map.h"
 #include "backend/opencl/paths/paths.h"
 #include "base/error.h"
 
@@ -14,18 +15,8 @@ MetalPath::MetalPath(Device& d) : d_(d) {
   if (!cat.metal_physics.present) return;
   const MetalPhysics& mp = cat.metal_physics;
   const size_t S = cat.subjects.size();
-  std::vector<cl_double> zones(kZones * PS_MZ_LEN, 0.0), regions(S * kRegions * PS_MR_LEN, 0.0), tensors;
-  for (int z = 0; z < kZones; ++z) {
-    const double side = z < PS_METAL_PANEL_A_ZONES ? -1.0 : 1.0;
-    cl_double* rec = &zones[z * PS_MZ_LEN];
-    rec[PS_MZ_TX_X] = side * mp.panel_separation / 2.0;
-    rec[PS_MZ_TX_Z] = mp.tx_height[z];
-    rec[PS_MZ_TX_M] = -side * mp.tx_moment;
-    rec[PS_MZ_RX_X] = -side * mp.panel_separation / 2.0;
-    rec[PS_MZ_RX_Z] = mp.rx_height[z];
-    rec[PS_MZ_RX_M] = side * mp.rx_moment;
-    rec[PS_MZ_GAIN] = mp.gain[z];
-  }
+  const std::vector<cl_double> zones = metal_zone_records(mp);
+  std::vector<cl_double> regions(S * kRegions * PS_MR_LEN, 0.0), tensors;
   double row_offset = 0;  // the MMW views stacked, the first on top
   for (const Sensor& s : cat.sensors) {
     if (s.camera != Camera::mmw) continue;
@@ -44,8 +35,9 @@ MetalPath::MetalPath(Device& d) : d_(d) {
   for (size_t v = 0; v < cat.variant_list.size(); ++v) {
     for (double e : cat.polarizability(static_cast<int>(v))) tensors.push_back(e);
     for (double e : cat.long_side(static_cast<int>(v))) tensors.push_back(e);
+    tensors.push_back(0.0);  // long side's y: a catalogue variant lies across the walk
   }
-  static_assert(PS_MV_LEN == 11 && PS_MV_LONG_X == 9 && PS_MV_LONG_Z == 10);
+  static_assert(PS_MV_LEN == 12 && PS_MV_LONG_X == 9 && PS_MV_LONG_Z == 10 && PS_MV_LONG_Y == 11);
   zone_rec_ = constant(d.ctx(), zones);
   region_rec_ = constant(d.ctx(), regions);
   tensors_ = constant(d.ctx(), tensors);
