@@ -13,7 +13,7 @@ import re
 import sys
 import tempfile
 
-LAYERS = ["base", "io", "scene", "assets", "plan", "backend", "sink", "calibrate", "schedule", "serve", "cli"]
+LAYERS = ["base", "io", "scene", "assets", "plan", "backend", "sink", "calibrate", "schedule", "evaluate", "serve", "cli"]
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 CONTRACT = "kernels/contract.h"
 REFERENCE = "host/backend/reference"

@@ -18,6 +18,7 @@ std::function<int()> add_validate(CLI::App& app);
 std::function<int()> add_knobs(CLI::App& app);
 std::function<int()> add_merge(CLI::App& app);
 std::function<int()> add_calibrate(CLI::App& app);
+std::function<int()> add_evaluate(CLI::App& app);
 
 // Whether run() prints the error a command fails with (an MPI rank other than 0 does not:
 // rank 0 prints every rank's).

@@ -58,6 +58,7 @@ int run(int argc, char** argv, const std::map<std::string, AddCommand>& more) {
   commands["knobs"] = add_knobs(app);
   commands["merge"] = add_merge(app);
   commands["calibrate"] = add_calibrate(app);
+  commands["evaluate"] = add_evaluate(app);
   for (const auto& [name, add] : more) commands[name] = add(app);
   try {
     app.parse(argc, argv);
