@@ -38,7 +38,7 @@ double since(std::chrono::steady_clock::time_point t0) {
 
 struct EvaluateOptions {
   SpecFlags flags;  // --spec, the data set's flags and knobs, --catalogue, --seed, --timing
-  std::string dir, out, sweep, samples, pfa = "0.01,0.05,0.1", classifier = "trees", eval_seed = "1";
+  std::string dir, out, sweep, samples, part, pfa = "0.01,0.05,0.1", classifier = "trees", eval_seed = "1";
   int folds = 5, bootstrap = 1000;
   unsigned threads = 0;
   bool plot = true;
@@ -90,7 +90,7 @@ int run_evaluate(EvaluateOptions& o) {
   if (!o.dir.empty() && o.flags.app->get_option("--count")->count() + o.flags.app->get_option("--rule")->count() > 0)
     throw InputError("--count, --rule and the knobs make a data set: they go with --spec or --sweep, not DIR");
   const EvaluateSettings settings = settings_from(o);
-  if (sweep) return run_sweep(o.flags, o.sweep, o.samples, o.out, settings);
+  if (sweep) return run_sweep(o.flags, o.sweep, o.samples, o.part, o.out, settings);
   check_new_or_empty(o.out);
   Session s;
   open_catalogue(s, o.flags.common);
@@ -107,7 +107,9 @@ int run_evaluate(EvaluateOptions& o) {
     data = folder.path("data");
     timing.generation = generate_data(spec, s, data, settings.options.threads);
   }
-  const nlohmann::json report = evaluate_folder(data, s, settings, folder.dir(), timing);
+  // The report names the data where it will be, not where it is staged.
+  const std::string source = o.dir.empty() ? (fs::path(o.out) / "data").string() : o.dir;
+  const nlohmann::json report = evaluate_folder(data, s, settings, folder.dir(), timing, source);
   for (const char* name : {"report.md", "report.json", "scores.csv", "roc.csv"}) folder.path(name);
   if (settings.plot)
     for (const auto& p : report["plots"]) folder.path(p.get<std::string>());
@@ -165,9 +167,10 @@ void run_plot_script(std::string_view script, const std::string& dir, const std:
 }
 
 nlohmann::json evaluate_folder(const std::string& data, const Session& s, const EvaluateSettings& settings,
-                               const std::string& report_dir, EvaluateTiming& timing) {
+                               const std::string& report_dir, EvaluateTiming& timing, const std::string& source) {
   auto t0 = std::chrono::steady_clock::now();
-  const EvaluateData in = read_evaluate_data(data, s.catalogue);
+  EvaluateData in = read_evaluate_data(data, s.catalogue);
+  if (!source.empty()) in.about["source"] = source;
   timing.reading += since(t0);
   const evaluate::Evaluation e = evaluate::run_evaluation(in.data, settings.options);
   timing.training += e.timing.training;
@@ -209,6 +212,7 @@ std::function<int()> add_evaluate(CLI::App& app) {
                   "grid of knob values, e.g. \"netd=1,2,3 mmw_raw=16x16,28x28\"; with --samples: "
                   "ranges, e.g. \"netd=1..4 frames=1..10\"");
   sub->add_option("--samples", o->samples, "N settings drawn by Latin hypercube over --sweep's ranges");
+  sub->add_option("--part", o->part, "i/k: run only the sweep's points i, i+k, ... (a Slurm array task's share)");
   sub->add_option("--classifier", o->classifier, "trees (gradient-boosted, default) or logistic");
   sub->add_option("--folds", o->folds, "cross-validation folds (default 5)");
   sub->add_option("--bootstrap", o->bootstrap, "bootstrap draws for the 95% intervals (default 1000)");

@@ -32,9 +32,10 @@ double generate_data(const RunSpec& spec, Session& s, const std::string& dir, un
 
 // Evaluates the generate folder `data` and writes report.md, report.json, scores.csv,
 // roc.csv and (with plots) roc.png and regions.png into `report_dir`, an existing folder
-// (a staging folder: the caller renames it into place). Returns report.json.
+// (a staging folder: the caller renames it into place). `source` names the data in the
+// report (default: the folder). Returns report.json.
 nlohmann::json evaluate_folder(const std::string& data, const Session& s, const EvaluateSettings& settings,
-                               const std::string& report_dir, EvaluateTiming& timing);
+                               const std::string& report_dir, EvaluateTiming& timing, const std::string& source = "");
 
 // Runs the embedded script `script` (text) with python3 on `args`; OutputError naming
 // `what` if it fails.

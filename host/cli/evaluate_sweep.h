@@ -9,7 +9,9 @@
 
 namespace portalsim::cli {
 
-int run_sweep(SpecFlags& flags, const std::string& sweep, const std::string& samples, const std::string& out,
-              const EvaluateSettings& settings);
+// `part` "i/k" (or empty): run only the points whose index is i modulo k (a Slurm array
+// task's share); the table is written by the run that finds every point done.
+int run_sweep(SpecFlags& flags, const std::string& sweep, const std::string& samples, const std::string& part,
+              const std::string& out, const EvaluateSettings& settings);
 
 }  // namespace portalsim::cli

@@ -18,7 +18,7 @@ namespace {
 // The folds' Philox stream (apart from the generator's streams by value).
 constexpr uint32_t kStreamFolds = 0x464f4c44;  // "FOLD"
 
-constexpr int kTreeRounds = 100;
+constexpr int kTreeRounds = 50;
 constexpr int kLinearRounds = 100;
 
 void check(int rc, const char* what) {
@@ -95,8 +95,8 @@ void fit_fold(const CvJob& job, const std::vector<int>& fold, int f, uint64_t se
     b.set("booster", "gbtree");
     b.set("tree_method", "hist");
     b.set("max_depth", "4");
-    b.set("eta", "0.2");
-    b.set("max_bin", "64");
+    b.set("eta", "0.3");
+    b.set("max_bin", "32");
   } else {
     // coord_descent: the linear booster's deterministic updater (shotgun races its threads).
     b.set("booster", "gblinear");
