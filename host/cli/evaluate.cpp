@@ -84,9 +84,10 @@ int run_evaluate(EvaluateOptions& o) {
   const bool sweep = !o.sweep.empty() || !o.samples.empty();
   if (sweep) modes.push_back("--sweep");
   if (!o.flags.spec_file.empty() && !sweep) modes.push_back("--spec");
-  if (modes.size() != 1)
-    throw InputError(std::string(modes.empty() ? "evaluate: nothing to evaluate" : "evaluate: more than one of") +
-                     ": give a generate folder DIR, --spec FILE (generated first), or --sweep/--samples");
+  if (modes.size() != 1)  // "dir:" names the positional argument: a usage error
+    throw InputError(
+        std::string(modes.empty() ? "dir: nothing to evaluate" : "dir: more than one of DIR, --spec, --sweep") +
+        ": give a generate folder DIR, --spec FILE (generated first), or --sweep/--samples");
   if (!o.dir.empty() && o.flags.app->get_option("--count")->count() + o.flags.app->get_option("--rule")->count() > 0)
     throw InputError("--count, --rule and the knobs make a data set: they go with --spec or --sweep, not DIR");
   const EvaluateSettings settings = settings_from(o);
