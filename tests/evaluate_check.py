@@ -103,7 +103,7 @@ for name in report["entry_order"]:
               "%s: Pd at Pfa %g: achieved Pfa or interval wrong" % (name, t))
 
 # Stacking: a logistic regression on the sensors' out-of-fold logits, on the same folds, as
-# scikit-learn's (nearly unregularised) gives it: the AUCs agree to 0.003.
+# scikit-learn's (nearly unregularised) gives it: the AUCs agree to 0.0005 (measured: 3e-5).
 sensors = report["sensors"]
 fold = [int(r["fold"]) for r in rows]
 X = [[math.log(min(max(float(r[s]), 1e-6), 1 - 1e-6) / (1 - min(max(float(r[s]), 1e-6), 1 - 1e-6))) for s in sensors]
@@ -111,7 +111,7 @@ X = [[math.log(min(max(float(r[s]), 1e-6), 1 - 1e-6) / (1 - min(max(float(r[s]),
 stacked = cross_val_predict(LogisticRegression(C=1e4, max_iter=2000), X, labels, cv=PredefinedSplit(fold),
                             method="predict_proba")[:, 1]
 ref = roc_auc_score(labels, stacked)
-check(abs(report["entries"]["fused_stacking"]["auc"] - ref) < 0.003,
+check(abs(report["entries"]["fused_stacking"]["auc"] - ref) < 0.0005,
       "fused_stacking: AUC %r, scikit-learn's logistic regression on the same logits %r" %
       (report["entries"]["fused_stacking"]["auc"], ref))
 
@@ -176,6 +176,10 @@ with open("data/features.csv") as f:
     lines = f.read().splitlines()
 with open("nolabels/features.csv", "w") as f:
     f.write("\n".join([lines[0]] + [line.rsplit(",", 1)[0] + ",negative" for line in lines[1:]]) + "\n")
+for name, value in (("unlabelled", "?"), ("badclass", "maybe")):
+    shutil.copytree("data", name)
+    with open(name + "/features.csv", "w") as f:
+        f.write("\n".join([lines[0]] + [line.rsplit(",", 1)[0] + "," + value for line in lines[1:]]) + "\n")
 shutil.copytree("data", "nomanifest")
 os.remove("nomanifest/manifest.json")
 bad = [
@@ -187,6 +191,8 @@ bad = [
     (["data", "--pfa", "0"], 2, "--pfa"),
     (["data", "--folds", "1"], 2, "--folds"),
     (["nolabels"], 3, "field 'class'"),
+    (["unlabelled"], 3, "field 'class' is missing"),
+    (["badclass"], 3, "field 'class' is \"maybe\""),
     (["nomanifest"], 3, "manifest.json"),
     (["no-such-folder"], 3, "no-such-folder"),
     (["data/features.csv"], 3, "not a folder"),

@@ -111,11 +111,13 @@ TEST(EvaluateBootstrap, IntervalsHoldTheEstimateAndRepeat) {
   const auto c = bootstrap({&o}, label, pfa, {.seed = 4, .draws = 400, .threads = 2});
   EXPECT_NE(a[0].auc.lo, c[0].auc.lo);
   // Stratified: each draw keeps the classes' counts.
-  const std::vector<uint32_t> w = bootstrap_weights(label, 3, 0);
-  uint32_t pos = 0, neg = 0;
-  for (size_t i = 0; i < w.size(); ++i) (label[i] ? pos : neg) += w[i];
-  EXPECT_EQ(pos, 134u);
-  EXPECT_EQ(neg, 266u);
+  for (uint64_t d = 0; d < 10; ++d) {
+    const std::vector<uint32_t> w = bootstrap_weights(label, 3, d);
+    uint32_t pos = 0, neg = 0;
+    for (size_t i = 0; i < w.size(); ++i) (label[i] ? pos : neg) += w[i];
+    EXPECT_EQ(pos, 134u) << "draw " << d;
+    EXPECT_EQ(neg, 266u) << "draw " << d;
+  }
 }
 
 TEST(EvaluateBootstrap, QuantileIsLinearBetweenOrderStatistics) {

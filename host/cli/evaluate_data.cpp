@@ -121,9 +121,6 @@ EvaluateData read_evaluate_data(const std::string& dir, const Catalogue& cat) {
     for (size_t i = 0; i < nf; ++i)
       d.x.x.push_back(row[i] == "?" ? std::nanf("") : std::strtof(row[i].c_str(), nullptr));
   }
-  if (t.classes.size() < 2)
-    throw InputError(t.path + ": field 'class': every row is " + (t.classes.empty() ? "missing" : *t.classes.begin()) +
-                     "; evaluate needs labelled threats and non-threats");
 
   out.about = {{"source", dir}, {"table", fs::path(table_path).filename().string()}};
   const std::string rule = manifest["spec"].value("rule", "");
