@@ -198,6 +198,7 @@ bad = [
     (["data/features.csv"], 3, "not a folder"),
     ([], 2, "nothing to evaluate"),
     (["data", "--spec", spec], 2, "more than one"),
+    (["data", "--netd", "2"], 2, "--netd"),
 ]
 for i, (args, code, text) in enumerate(bad):
     out = "bad%d" % i

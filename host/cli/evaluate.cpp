@@ -18,6 +18,7 @@
 #include "cli/validate_tables.h"
 #include "evaluate/report.h"
 #include "io/input_file.h"
+#include "plan/knobs.h"
 #include "schedule/pipeline.h"
 #include "sink/staging.h"
 
@@ -88,8 +89,15 @@ int run_evaluate(EvaluateOptions& o) {
     throw InputError(
         std::string(modes.empty() ? "dir: nothing to evaluate" : "dir: more than one of DIR, --spec, --sweep") +
         ": give a generate folder DIR, --spec FILE (generated first), or --sweep/--samples");
-  if (!o.dir.empty() && o.flags.app->get_option("--count")->count() + o.flags.app->get_option("--rule")->count() > 0)
-    throw InputError("--count, --rule and the knobs make a data set: they go with --spec or --sweep, not DIR");
+  if (!o.dir.empty()) {  // a folder is evaluated as it was made: flags that make a data set are refused
+    const CLI::App& app = *o.flags.app;
+    for (const char* flag : {"--count", "--rule", "--pool", "--objects", "--subjects", "--balance", "--tier"})
+      if (app.get_option(flag)->count() > 0)
+        throw InputError(std::string(flag) + ": makes a data set; it goes with --spec or --sweep, not with DIR");
+    for (const auto& [key, text] : given_knobs(app, o.flags.knobs))
+      throw InputError(find_knob(key)->flag() +
+                       ": a knob makes a data set; it goes with --spec or --sweep, not with DIR");
+  }
   const EvaluateSettings settings = settings_from(o);
   if (sweep) return run_sweep(o.flags, o.sweep, o.samples, o.part, o.out, settings);
   check_new_or_empty(o.out);

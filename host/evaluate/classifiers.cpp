@@ -129,7 +129,8 @@ std::string classifier_description(ClassifierKind k) {
     return "gradient-boosted trees (XGBoost gbtree, hist, " + std::to_string(kTreeRounds) +
            " rounds, max_depth 4, eta 0.2, max_bin 64, binary:logistic)";
   return "logistic regression (XGBoost gblinear, coord_descent, cyclic, " + std::to_string(kLinearRounds) +
-         " rounds, eta 0.5, lambda 0.0001 (times the rows, as XGBoost scales it), binary:logistic; features standardised on each training fold)";
+         " rounds, eta 0.5, lambda 0.0001 (times the rows, as XGBoost scales it), binary:logistic; features "
+         "standardised on each training fold)";
 }
 
 Matrix select_columns(const Matrix& m, const std::vector<size_t>& cols) {
