@@ -7,7 +7,7 @@
 # Without FIGURE names it makes them all; the names are the functions below. Needs
 # /usr/bin/python3 with matplotlib, and for the page's screenshot node, puppeteer-core
 # (tests/browser/, installed by tools/run-tests.sh) and Chromium. `tradeoff` and
-# `sensitivity` take minutes: they train classifiers on thousands of scenarios.
+# `sensitivity` and `evaluate` take minutes: they train classifiers on thousands of scenarios.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -52,7 +52,20 @@ metalmap() {
   cp "$work/metalmap/metal_map.png" docs/guide/metal-map.png
 }
 
-all=(models subjects randomised coco calibrate serve sensitivity tradeoff metalmap)
+# docs/guide/evaluate.md: the example study, 27 settings of the MMW camera x 5,000
+# scenarios of case 2's objects (about 5 minutes on 2 cores), and one setting's report.
+evaluate() {
+  "$portalsim" evaluate --spec scenarios/study-case2-mmw-metal.toml \
+    --sweep "netd=1,2,3 mmw_raw=16x16,28x28,56x56 frames=1,4,10" --out "$work/study" > /dev/null
+  cp "$work/study/sweep.png" docs/evaluate_study_sweep.png
+  cp "$work/study/sweep.csv" docs/evaluate_study_sweep.csv
+  "$portalsim" evaluate --spec scenarios/study-case2-mmw-metal.toml --netd 1 --mmw-raw 56x56 --frames 10 \
+    --out "$work/one" > /dev/null
+  cp "$work/one/roc.png" docs/evaluate_study_roc.png
+  cp "$work/one/regions.png" docs/evaluate_study_regions.png
+}
+
+all=(models subjects randomised coco calibrate serve sensitivity tradeoff metalmap evaluate)
 for figure in "${@:-${all[@]}}"; do
   case " ${all[*]} " in
     *" $figure "*) ;;

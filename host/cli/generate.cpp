@@ -8,6 +8,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "cli/python_requests.h"
+#include "cli/spec_flags.h"
 #include "io/input_file.h"
 #include "schedule/pipeline.h"
 #include "schedule/ranked_run.h"
@@ -21,82 +22,22 @@ std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop = true; }
 
 struct GenerateOptions {
-  CommonOptions common;
-  RunSpec spec;
-  std::string count, out, spec_file, objects, pool, subjects, formats, shard, png_level;
-  std::map<std::string, std::string> knobs;
+  SpecFlags flags;
+  std::string out, shard;
   long long batch = 0;
   unsigned threads = 0;
   bool resume = false, quiet = false;
-  CLI::App* app = nullptr;
 };
 
-// The run the flags ask for: the --spec file, then the flags given over it.
-RunSpec build_spec(GenerateOptions& o) {
-  CLI::App& app = *o.app;
-  RunSpec spec;
-  if (!o.spec_file.empty()) read_spec_file(o.spec_file, spec);
-  // Flags given on the command line override the spec file.
-  const auto given = [&](const char* name) {
-    const bool g = app.get_option(name)->count() > 0;
-    if (g) {  // the flag overrides the spec file: errors name the flag
-      std::string key = std::string(name).substr(2);
-      for (char& c : key)
-        if (c == '-') c = '_';
-      spec.origin.erase(key);
-    }
-    return g;
-  };
-  if (given("--count")) {
-    spec.count = io::parse_u64(o.count, "--count");
-    if (spec.count < 1 || spec.count > (1ull << 40))
-      throw InputError("--count: \"" + o.count + "\" is not between 1 and 2^40");
-  }
-  if (given("--seed")) spec.seed = io::parse_u64(o.common.seed, "--seed");
-  if (given("--rule")) spec.rule = o.spec.rule;
-  if (given("--pool")) {
-    spec.pool = split_list(o.pool);
-    if (spec.pool.empty()) throw InputError("--pool: no object names given");
-  }
-  if (given("--objects")) parse_object_range(o.objects, "--objects", spec);
-  if (given("--subjects")) {
-    spec.subjects.clear();
-    for (const std::string& s : split_list(o.subjects)) {
-      if (s.empty() || s.size() > 3 || s.find_first_not_of("0123456789") != std::string::npos)
-        throw InputError("--subjects: \"" + s + "\" is not a subject number");
-      spec.subjects.push_back(std::stoi(s));
-    }
-  }
-  if (given("--balance")) spec.balance = o.spec.balance;
-  if (given("--what")) spec.what = o.spec.what;
-  if (given("--format")) spec.formats = split_list(o.formats);
-  if (given("--image-format")) spec.image_format = o.spec.image_format;
-  if (given("--png-level")) {
-    const uint64_t level = io::parse_u64(o.png_level, "--png-level");
-    if (level > kMaxPngLevel)
-      throw InputError("--png-level: \"" + o.png_level + "\" is not between 0 and " + std::to_string(kMaxPngLevel));
-    spec.png_level = static_cast<int>(level);
-  }
-  if (given("--compress")) spec.compress = o.spec.compress;
-  if (given("--annotations")) spec.annotations = o.spec.annotations;
-  if (given("--scenarios")) spec.scenarios = o.spec.scenarios;
-  if (given("--tier")) spec.tier = o.spec.tier;
-  for (const auto& [key, text] : given_knobs(app, o.knobs)) {
-    spec.origin.erase(key);
-    spec.set_knob_text(key, text, spec.where(key));
-  }
-  spec.validate();
-  return spec;
-}
-
 int generate(GenerateOptions& o) {
-  CLI::App& app = *o.app;
+  CLI::App& app = *o.flags.app;
+  const CommonOptions& common = o.flags.common;
   // Under an MPI launcher every rank runs this; rank 0 alone speaks.
   std::unique_ptr<Ranks> alone;
   Ranks* ranks = mpi_ranks();
   if (!ranks) ranks = (alone = single_rank()).get();
   if (ranks->rank() != 0) print_errors(false);
-  const RunSpec spec = build_spec(o);
+  const RunSpec spec = build_spec(o.flags);
   if (o.out.empty()) throw InputError("--out: empty folder name");
 
   PipelineOptions popt;
@@ -119,9 +60,9 @@ int generate(GenerateOptions& o) {
   Session s;
   // Together: a rank that cannot start stops them all, rather than leaving them waiting.
   ranks->together([&] {
-    open_catalogue(s, o.common);
+    open_catalogue(s, common);
     check_generate(spec, s.catalogue);
-    open_backend(s, o.common);
+    open_backend(s, common);
   });
 
   std::signal(SIGINT, on_signal);
@@ -147,11 +88,11 @@ int generate(GenerateOptions& o) {
               ranked ? (", " + std::to_string(ranks->size()) + (ranks->size() == 1 ? " rank" : " ranks")).c_str() : "",
               static_cast<unsigned long long>(r.positive), static_cast<unsigned long long>(r.negative),
               r.interrupted ? " so far; not finished: run the same command with --resume to finish it" : "");
-  if (o.common.timing)
+  if (common.timing)
     std::printf("timing: compute %.3f s (%.0f scenarios/s), waiting for the writer %.3f s%s\n", r.compute_seconds,
                 r.compute_seconds > 0 ? r.done / r.compute_seconds : 0.0, r.write_wait_seconds,
                 s.runtime ? (", kernel build " + std::to_string(s.runtime->build_seconds()) + " s").c_str() : "");
-  if (o.common.timing) print_paths(*s.backend, run_plan(spec, s.catalogue));
+  if (common.timing) print_paths(*s.backend, run_plan(spec, s.catalogue));
   if (r.interrupted) {
     std::fprintf(stderr, "portalsim: interrupted; %s is consistent, run the same command with --resume to finish it\n",
                  o.out.c_str());
@@ -161,28 +102,8 @@ int generate(GenerateOptions& o) {
 }
 
 void add_generate_options(CLI::App* sub, GenerateOptions* o) {
-  o->app = sub;
-  add_common_options(*sub, o->common);
-  sub->add_option("--spec", o->spec_file, "TOML spec file; command-line flags override its keys");
-  sub->add_option("--count", o->count, "number of scenarios (default 1000)");
+  add_spec_flags(sub, &o->flags, true);
   sub->add_option("--out", o->out, "output folder (must be new or empty, unless --resume)")->required();
-  sub->add_option("--rule", o->spec.rule, "threat rule, e.g. gun or 'iron-rod&metal-plate'");
-  sub->add_option("--pool", o->pool, "objects to draw from, comma-separated (default: all)");
-  sub->add_option("--objects", o->objects, "objects per scenario, MIN..MAX (default 0..4)");
-  sub->add_option("--subjects", o->subjects, "subjects to draw from, e.g. 1,2,5 (default: all)");
-  sub->add_flag("--balance", o->spec.balance, "equal classes: even indices threats, odd not");
-  sub->add_option("--what", o->spec.what, "features, images or both (default features)");
-  sub->add_option("--format", o->formats,
-                  "arff,csv,npy feature tables; h5: data.h5 with image tensors and labels; npy with --what images: "
-                  "image tensors as .npy (default arff)");
-  sub->add_flag("--compress", o->spec.compress, "gzip data.h5's datasets (--format h5)");
-  sub->add_flag("--annotations", o->spec.annotations,
-                "per-object boxes and instance masks: annotations.json (COCO), YOLO .txt and mask images");
-  sub->add_option("--image-format", o->spec.image_format, "png or jpg (default png)");
-  sub->add_option("--png-level", o->png_level,
-                  "image folders' PNG compression, 0 (none) to 9 (smallest); default 1, the fastest that compresses");
-  sub->add_option("--scenarios", o->spec.scenarios, "explicit scenario list (CSV: subject, region1..13, label)");
-  add_knob_options(*sub, o->spec.tier, o->knobs);
   sub->add_option("--batch", o->batch, "scenarios per kernel launch (default: about 16 MiB of outputs)");
   sub->add_option("--threads", o->threads, "host threads for generating and writing (default: all cores)");
   sub->add_option("--shard", o->shard, "i/k: make only part i (0-based) of k of the index range");
@@ -210,8 +131,8 @@ GenerateRequest parse_generate(const std::vector<std::string>& args) {
   add_generate_options(&app, &o);
   parse_args(app, args);
   GenerateRequest r;
-  r.spec = build_spec(o);
-  r.common = o.common;
+  r.spec = build_spec(o.flags);
+  r.common = o.flags.common;
   r.threads = o.threads;
   return r;
 }

@@ -60,26 +60,6 @@ Table load(const std::string& path, const std::string& work, const std::string& 
   throw InputError(path + ": a feature table must be .arff, .csv or .h5, or a folder of scenario folders");
 }
 
-// The two feature sets of the thesis (tables 6.1/6.3/6.5 and 6.2/6.4/6.6): region means
-// (regionN) and block means (VIEW_rY_cX). Other columns (the metal zones) are in both.
-// "digits then `tail`" at the end of s, with at least one digit: returns where they start.
-size_t digits_before(std::string_view s, size_t end) {
-  size_t b = end;
-  while (b > 0 && s[b - 1] >= '0' && s[b - 1] <= '9') --b;
-  return b < end ? b : std::string_view::npos;
-}
-
-bool is_block(std::string_view s) {  // .+_r[0-9]+_c[0-9]+
-  const size_t c = digits_before(s, s.size());
-  if (c == std::string_view::npos || c < 2 || s.substr(c - 2, 2) != "_c") return false;
-  const size_t r = digits_before(s, c - 2);
-  return r != std::string_view::npos && r >= 3 && s.substr(r - 2, 2) == "_r";
-}
-
-bool is_region(std::string_view s) {  // region[0-9]+
-  return s.starts_with("region") && s.size() > 6 && digits_before(s, s.size()) == 6;
-}
-
 bool has_column(const Table& t, bool (*kind)(std::string_view)) {
   return std::any_of(t.names.begin(), t.names.end(), [&](const std::string& n) { return kind(n); });
 }

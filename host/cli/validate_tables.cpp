@@ -181,6 +181,32 @@ Table read_csv(const std::string& path) {
   return parse_csv(in, path);
 }
 
+namespace {
+
+// "digits" at the end of s[0..end), at least one: returns where they start, or npos.
+size_t digits_before(std::string_view s, size_t end) {
+  size_t b = end;
+  while (b > 0 && s[b - 1] >= '0' && s[b - 1] <= '9') --b;
+  return b < end ? b : std::string_view::npos;
+}
+
+}  // namespace
+
+bool is_block(std::string_view s) {  // .+_r[0-9]+_c[0-9]+
+  const size_t c = digits_before(s, s.size());
+  if (c == std::string_view::npos || c < 2 || s.substr(c - 2, 2) != "_c") return false;
+  const size_t r = digits_before(s, c - 2);
+  return r != std::string_view::npos && r >= 3 && s.substr(r - 2, 2) == "_r";
+}
+
+bool is_region(std::string_view s) {  // region[0-9]+
+  return s.starts_with("region") && s.size() > 6 && digits_before(s, s.size()) == 6;
+}
+
+bool is_zone(std::string_view s) {  // zone[0-9]+
+  return s.starts_with("zone") && s.size() > 4 && digits_before(s, s.size()) == 4;
+}
+
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;

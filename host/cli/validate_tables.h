@@ -4,6 +4,7 @@
 #include <istream>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace portalsim::cli {
@@ -24,6 +25,13 @@ Table parse_csv(std::istream& in, const std::string& path);
 Table read_arff(const std::string& path);
 Table read_csv(const std::string& path);
 Table read_h5_table(const std::string& path);
+
+// The kinds of feature column portalsim writes (plan's FeatureLayout::names): a camera
+// view's block means (VIEW_rY_cX), the region means (regionN; the thesis's two feature sets,
+// tables 6.1/6.3/6.5 and 6.2/6.4/6.6) and the metal zones (zoneN).
+bool is_block(std::string_view s);
+bool is_region(std::string_view s);
+bool is_zone(std::string_view s);
 
 // Lower case (ASCII), and comma-separated items with blanks trimmed (validate's option
 // lists; the tables' fields go through io/table_fields.h).
