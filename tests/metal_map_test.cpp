@@ -389,6 +389,18 @@ TEST(MetalMapCommand, WritesTheReportAndThePlot) {
   EXPECT_TRUE(test::has(r.out, "critical orientation"));
 }
 
+// The plot's script is run through the shell: a folder named with a quote and a command
+// substitution is one word to it, and nothing in the name runs (cli/common.h, run_plot_script).
+TEST(MetalMapCommand, AnyFolderNameIsOneWordToThePlot) {
+  TempDir t;
+  const fs::path out = t.w() / "it's $(touch pwned) map";
+  const Result r = run(t, map_args(out));
+  ASSERT_EQ(r.status, 0) << test::describe(r);
+  EXPECT_TRUE(fs::exists(out / "metal_map.png"));
+  EXPECT_FALSE(fs::exists(t.w() / "pwned"));
+  EXPECT_FALSE(fs::exists(fs::current_path() / "pwned"));
+}
+
 // Each bad value is refused naming its flag, exit 2 (a bad flag value), no report folder.
 TEST(MetalMapCommand, BadInputNamesTheFlagAndWritesNothing) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases{

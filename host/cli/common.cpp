@@ -1,6 +1,8 @@
 #include "cli/common.h"
 
 #include <chrono>
+#include <cstdlib>
+#include <filesystem>
 
 #include "backend/opencl/opencl_backend.h"
 #include "base/error.h"
@@ -50,6 +52,26 @@ void open_catalogue(Session& s, const CommonOptions& o) {
   t0 = std::chrono::steady_clock::now();
   s.assets = build_assets(s.catalogue);
   s.assets_seconds = since(t0);
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+void run_plot_script(std::string_view script, const std::string& dir, const std::vector<std::string>& args,
+                     const std::string& what) {
+  namespace fs = std::filesystem;
+  const std::string path = (fs::path(dir) / ".plot.py").string();
+  write_text_atomic(path, std::string(script));
+  std::string cmd = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  cmd += " " + shell_quote(path);
+  for (const std::string& a : args) cmd += " " + shell_quote(a);
+  const int rc = std::system(cmd.c_str());
+  std::error_code ec;
+  fs::remove(path, ec);
+  if (rc != 0) throw OutputError(what + ": the plot failed (python3 with matplotlib is needed; or --no-plot)");
 }
 
 void print_paths(const Backend& backend, const Plan& plan) {

@@ -50,6 +50,15 @@ void open_backend(Session& s, const CommonOptions& o);
 // --timing's line of the paths `backend` takes for `plan` ("paths: upper: thesis_images, ...").
 void print_paths(const Backend& backend, const Plan& plan);
 
+// `s` as one word for /bin/sh, whatever it holds ('...' with each ' as '\'').
+std::string shell_quote(const std::string& s);
+
+// Runs an embedded Python script (the plots' matplotlib) with Debian's /usr/bin/python3,
+// whose matplotlib it is, where it exists: written into `dir` as .plot.py, run with `args`
+// (each one word, however named), then removed. Throws OutputError naming `what` if it fails.
+void run_plot_script(std::string_view script, const std::string& dir, const std::vector<std::string>& args,
+                     const std::string& what);
+
 // Every base image, sprite and noise pattern of the session, as `portalsim catalogue
 // --images` writes them; a subject's view is named by subject_image_name.
 void write_catalogue_images(const Session& s, StagedFolder& folder);

@@ -166,18 +166,6 @@ double generate_data(const RunSpec& spec, Session& s, const std::string& dir, un
   return since(t0);
 }
 
-void run_plot_script(std::string_view script, const std::string& dir, const std::string& args,
-                     const std::string& what) {
-  const std::string path = (fs::path(dir) / ".plot.py").string();
-  write_text_atomic(path, std::string(script));
-  // Debian's matplotlib belongs to the system interpreter, which may not be first on PATH.
-  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const int rc = std::system((python + " '" + path + "' " + args).c_str());
-  std::error_code ec;
-  fs::remove(path, ec);
-  if (rc != 0) throw OutputError(what + ": the plot failed (python3 with matplotlib is needed; or --no-plot)");
-}
-
 nlohmann::json evaluate_folder(const std::string& data, const Session& s, const EvaluateSettings& settings,
                                const std::string& report_dir, EvaluateTiming& timing, const std::string& source) {
   auto t0 = std::chrono::steady_clock::now();
@@ -206,7 +194,7 @@ nlohmann::json evaluate_folder(const std::string& data, const Session& s, const 
         bodies.push_back((dir / (".body_" + s.catalogue.sensors[k].name + ".png")).string());
         write_image(bodies.back(), s.assets.bases[0][k]);
       }
-    run_plot_script(embedded::plot_evaluate, report_dir, "'" + report_dir + "'", "roc.png");
+    run_plot_script(embedded::plot_evaluate, report_dir, {report_dir}, "roc.png");
     std::error_code ec;
     for (const std::string& b : bodies) fs::remove(b, ec);
     timing.plots += since(t0);

@@ -8,6 +8,7 @@
 
 #include "backend/opencl/runtime.h"
 #include "base/error.h"
+#include "cli/common.h"
 #include "evaluate/metal_map.h"
 #include "io/input_file.h"
 #include "sink/staging.h"
@@ -95,14 +96,7 @@ int run_metal_map(MetalMapOptions& o) {
   // The plot, drawn by the embedded matplotlib script (tools/plot_metal_map.py).
   const bool plot = o.plot && !(app.get_option_no_throw("--no-plot") && app.get_option_no_throw("--no-plot")->count());
   if (plot) {
-    const std::string script = (std::filesystem::path(folder.dir()) / ".plot_metal_map.py").string();
-    write_text_atomic(script, std::string(embedded::plot_metal_map));
-    // Debian's matplotlib belongs to the system interpreter, which may not be first on PATH.
-    const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-    const int rc = std::system((python + " '" + script + "' '" + folder.dir() + "'").c_str());
-    std::error_code ec;
-    std::filesystem::remove(script, ec);
-    if (rc != 0) throw OutputError("metal_map.png: the plot failed (python3 with matplotlib is needed; or --no-plot)");
+    run_plot_script(embedded::plot_metal_map, folder.dir(), {folder.dir()}, "metal_map.png");
     folder.path("metal_map.png");
   }
   folder.commit();

@@ -37,8 +37,4 @@ double generate_data(const RunSpec& spec, Session& s, const std::string& dir, un
 nlohmann::json evaluate_folder(const std::string& data, const Session& s, const EvaluateSettings& settings,
                                const std::string& report_dir, EvaluateTiming& timing, const std::string& source = "");
 
-// Runs the embedded script `script` (text) with python3 on `args`; OutputError naming
-// `what` if it fails.
-void run_plot_script(std::string_view script, const std::string& dir, const std::string& args, const std::string& what);
-
 }  // namespace portalsim::cli

@@ -314,7 +314,7 @@ int run_sweep(SpecFlags& flags, const std::string& sweep, const std::string& sam
     const auto t0 = std::chrono::steady_clock::now();
     // Drawn in a staging folder, then renamed into place.
     StagedFolder staged(out_text);
-    run_plot_script(embedded::plot_sweep, staged.dir(), "'" + out_text + "' '" + staged.dir() + "'", "sweep.png");
+    run_plot_script(embedded::plot_sweep, staged.dir(), {out_text, staged.dir()}, "sweep.png");
     staged.path("sweep.png");
     staged.commit();
     timing.plots += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

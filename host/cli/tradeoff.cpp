@@ -435,14 +435,7 @@ int tradeoff(TradeoffOptions& o) {
   // The plot, drawn by the embedded matplotlib script; --no-plot for machines without it
   // (tools/device-check.sh on a GPU machine).
   if (o.plot) {
-    const std::string script = (std::filesystem::path(staging) / ".plot_tradeoff.py").string();
-    write_text_atomic(script, std::string(embedded::plot_tradeoff));
-    // Debian's matplotlib belongs to the system interpreter, which may not be first on PATH.
-    const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-    const std::string cmd = python + " '" + script + "' '" + staging + "'";
-    const int rc = std::system(cmd.c_str());
-    std::filesystem::remove(script, ec);
-    if (rc != 0) throw OutputError("tradeoff.png: the plot failed (python3 with matplotlib is needed; or --no-plot)");
+    run_plot_script(embedded::plot_tradeoff, staging, {staging}, "tradeoff.png");
     folder.path("tradeoff.png");
   }
   folder.commit();

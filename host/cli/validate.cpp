@@ -20,6 +20,7 @@
 
 #include "base/error.h"
 #include "cli/commands.h"
+#include "cli/common.h"
 #include "cli/features_table.h"
 #include "cli/validate_demo.h"
 #include "cli/validate_stats.h"
@@ -146,12 +147,6 @@ void write_arff(const Table& t, const std::set<std::string>& classes, const std:
     s += q(r.back()) + "\n";
   }
   write_text_atomic(path, s);
-}
-
-std::string shell_quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
 }
 
 bool on_path(const std::string& program) {
@@ -434,11 +429,7 @@ int run_validate(Options o) {
   write_text_atomic(folder.path("report.json"), report.dump(2) + "\n");
 
   // The plots, drawn by the embedded matplotlib script from report.json in the staging folder.
-  const std::string script = (fs::path(work) / "plot_validate.py").string();
-  write_text_atomic(script, std::string(embedded::plot_validate));
-  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  if (std::system((python + " " + shell_quote(script) + " " + shell_quote(folder.dir())).c_str()) != 0)
-    throw OutputError("accuracy.png: the plot failed (python3 with matplotlib is needed)");
+  run_plot_script(embedded::plot_validate, folder.dir(), {folder.dir()}, "accuracy.png");
   folder.path("accuracy.png");
   folder.path("curve.png");
   folder.commit();
