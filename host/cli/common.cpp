@@ -61,7 +61,7 @@ std::string shell_quote(const std::string& s) {
 }
 
 void run_plot_script(std::string_view script, const std::string& dir, const std::vector<std::string>& args,
-                     const std::string& what) {
+                     const std::string& what, bool offers_no_plot) {
   namespace fs = std::filesystem;
   const std::string path = (fs::path(dir) / ".plot.py").string();
   write_text_atomic(path, std::string(script));
@@ -71,7 +71,9 @@ void run_plot_script(std::string_view script, const std::string& dir, const std:
   const int rc = std::system(cmd.c_str());
   std::error_code ec;
   fs::remove(path, ec);
-  if (rc != 0) throw OutputError(what + ": the plot failed (python3 with matplotlib is needed; or --no-plot)");
+  if (rc != 0)
+    throw OutputError(what + ": the plot failed (python3 with matplotlib is needed" +
+                      (offers_no_plot ? "; or --no-plot)" : ")"));
 }
 
 void print_paths(const Backend& backend, const Plan& plan) {

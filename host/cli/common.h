@@ -55,9 +55,10 @@ std::string shell_quote(const std::string& s);
 
 // Runs an embedded Python script (the plots' matplotlib) with Debian's /usr/bin/python3,
 // whose matplotlib it is, where it exists: written into `dir` as .plot.py, run with `args`
-// (each one word, however named), then removed. Throws OutputError naming `what` if it fails.
+// (each one word, however named), then removed. Throws OutputError naming `what` if it fails,
+// and --no-plot where the command has it.
 void run_plot_script(std::string_view script, const std::string& dir, const std::vector<std::string>& args,
-                     const std::string& what);
+                     const std::string& what, bool offers_no_plot = true);
 
 // Every base image, sprite and noise pattern of the session, as `portalsim catalogue
 // --images` writes them; a subject's view is named by subject_image_name.

@@ -429,7 +429,7 @@ int run_validate(Options o) {
   write_text_atomic(folder.path("report.json"), report.dump(2) + "\n");
 
   // The plots, drawn by the embedded matplotlib script from report.json in the staging folder.
-  run_plot_script(embedded::plot_validate, folder.dir(), {folder.dir()}, "accuracy.png");
+  run_plot_script(embedded::plot_validate, folder.dir(), {folder.dir()}, "accuracy.png", false);
   folder.path("accuracy.png");
   folder.path("curve.png");
   folder.commit();
