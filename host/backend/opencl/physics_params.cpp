@@ -107,11 +107,14 @@ PhysicsParams::Tables PhysicsParams::make(const Plan& plan, const Sensor& s, int
     p.push_back(gain);
     p.push_back(ir ? pc.ir_index_min_k : pc.background_temperature - gain * pc.base_background_gray);
   }
-  // Per variant: the IR surface's contact shadow, or the MMW apparent temperature.
+  // Per variant: the IR surface's contact shadow (and, for phys_off_body, the same against
+  // the room), or the MMW apparent temperature.
+  std::vector<double> off_body_shadow;
   for (size_t v = 0; v < cat_.variant_list.size(); ++v) {
     const Material& mat = cat_.materials.at(cat_.object_of(static_cast<int>(v)).material_id);
     const double worn = worn_temperature(pc, mat, m.worn_minutes);
     p.push_back(ir ? -pc.ir_coupling * (pc.skin_temperature - worn) : seen(mat.emissivity, worn));
+    if (ir) off_body_shadow.push_back(-pc.ir_coupling * (pc.room_temperature - worn));
   }
   // MMW: the Airy core's FWHM, 1.02 lambda / D at the range, in this view's pixels, as a
   // Gaussian of that FWHM. IR: ir_spread_mm over the view's pixel (as wide as an MMW view).
@@ -137,10 +140,7 @@ PhysicsParams::Tables PhysicsParams::make(const Plan& plan, const Sensor& s, int
     const double body_from = (pc.room_temperature + pc.skin_temperature) / 2;
     for (size_t subj = 0; subj < cat_.subjects.size(); ++subj)
       off_body.push_back(std::ceil((body_from - pc.ir_index_min_k) / per_index));
-    for (size_t v = 0; v < cat_.variant_list.size(); ++v) {
-      const Material& mat = cat_.materials.at(cat_.object_of(static_cast<int>(v)).material_id);
-      off_body.push_back(-pc.ir_coupling * (pc.room_temperature - worn_temperature(pc, mat, m.worn_minutes)));
-    }
+    off_body.insert(off_body.end(), off_body_shadow.begin(), off_body_shadow.end());
     t.off_body = append(off_body);
     return t;
   }

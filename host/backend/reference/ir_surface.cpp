@@ -9,11 +9,23 @@ double contact_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int v
   return -pc.ir_coupling * (pc.skin_temperature - worn_temperature(cat, m, variant));
 }
 
+namespace {
+
+// The bare surface's temperature at (x, y): the subject's base image index read linearly
+// as kelvin.
+double base_kelvin(const ViewScene& vs, int x, int y) {
+  const PhysicsConfig& pc = vs.cat.physics;
+  const Image& base = vs.assets.bases[vs.scenario.subject][vs.view];
+  return pc.ir_index_min_k + (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0 * base.at(x, y);
+}
+
 // Where the object lies off the body, the surface it touches is the room's.
 double off_body_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant) {
   const PhysicsConfig& pc = cat.physics;
   return -pc.ir_coupling * (pc.room_temperature - worn_temperature(cat, m, variant));
 }
+
+}  // namespace
 
 // The shadow field alone (0 K where no object lies), objects in region order by their IR
 // sprites' coverage, as radiometry lays them: v = c dT + (1 - c) v; dT against the skin
@@ -31,23 +43,16 @@ void contact_shadow(const ViewScene& vs, Field& f) {
     return off_body_shadow_kelvin(s.cat, s.model, p.variant);
   });
   const PhysicsConfig& pc = vs.cat.physics;
-  const Image& base = vs.assets.bases[vs.scenario.subject][vs.view];
-  const double per_index = (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0;
   for (int y = 0; y < f.height; ++y)
-    for (int x = 0; x < f.width; ++x) {
-      const double kelvin = pc.ir_index_min_k + per_index * base.at(x, y);
-      if (kelvin < (pc.room_temperature + pc.skin_temperature) / 2) f.at(x, y) = off.at(x, y);
-    }
+    for (int x = 0; x < f.width; ++x)
+      if (base_kelvin(vs, x, y) < (pc.room_temperature + pc.skin_temperature) / 2) f.at(x, y) = off.at(x, y);
 }
 
 // The bare body's surface temperature, its base image's index read linearly as kelvin,
 // added to the (spread) shadow.
 void ir_surface(const ViewScene& vs, Field& f) {
-  const PhysicsConfig& pc = vs.cat.physics;
-  const Image& base = vs.assets.bases[vs.scenario.subject][vs.view];
-  const double per_index = (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0;
   for (int y = 0; y < f.height; ++y)
-    for (int x = 0; x < f.width; ++x) f.at(x, y) += pc.ir_index_min_k + per_index * base.at(x, y);
+    for (int x = 0; x < f.width; ++x) f.at(x, y) += base_kelvin(vs, x, y);
 }
 
 }  // namespace portalsim::reference
