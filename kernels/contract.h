@@ -25,11 +25,17 @@
 #define PS_MZ_RX_M 5
 #define PS_MZ_GAIN 6
 #define PS_MZ_LEN 8
-/* Record of one region, doubles: its rectangle's centre in its MMW view (column, and row
- * counted from the top of the upper view: the two views stacked). */
+/* Record of one region, doubles: its rectangle's centre in the portal's field (column, row
+ * from the top; scene/sensor.h, Frame) as the view that places it draws it, then that view's
+ * field units per pixel (across, negative for a back view; down) and its pixels per field
+ * unit (the jitter's scale, across and down). */
 #define PS_MR_COL 0
 #define PS_MR_ROW 1
-#define PS_MR_LEN 2
+#define PS_MR_FIELD_PER_COL 2
+#define PS_MR_FIELD_PER_ROW 3
+#define PS_MR_JITTER_X 4
+#define PS_MR_JITTER_Y 5
+#define PS_MR_LEN 6
 /* Each object is PS_METAL_SEGMENTS equal dipoles at the midpoints of equal segments of its
  * drawn long side (docs/model/metal.md). Record of one variant (or one oriented test object
  * of a metal map), doubles: its polarizability tensor (row-major 3x3, cm^3), then its long
@@ -130,7 +136,7 @@ typedef struct {
   PS_U32 n;           /* scenarios in the batch */
   PS_I32 view;        /* camera view: base image slot, pixel noise element */
   PS_I32 views;       /* camera views per subject (stride of the base table) */
-  PS_I32 sprite_set;  /* 0 MMW, 1 IR: row of the sprite table */
+  PS_I32 sprite_set;  /* the view's sprite set (camera, scale, mirror): row of the sprite table */
   PS_I32 variants;    /* stride of the sprite and place tables */
   PS_U32 region_mask; /* bit r: region r is drawn in this view */
   PS_I32 width, height;

@@ -40,8 +40,8 @@ inline int metal_deduction(double t) {
 
 kernel void metal_physics(global const double* zone_rec, global const double* region_rec,
                           global const double* tensors, global const uchar* base_zones, global const uchar* subject,
-                          global const short* objects, uint n, uint2 seed, uint2 first, int noise, double jitter_x,
-                          double jitter_y, double half_width, double scale, double body_height, global uchar* out) {
+                          global const short* objects, uint n, uint2 seed, uint2 first, int noise, double jitter,
+                          double half_width, double scale, double body_height, global uchar* out) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const ulong index = upsample(first.y, first.x) + i;
@@ -52,17 +52,18 @@ kernel void metal_physics(global const double* zone_rec, global const double* re
   for (int r = 0; r < PS_REGIONS; ++r) {
     const int v = objects[(size_t)i * PS_REGIONS + r];
     if (v < 0) continue;
-    double dx = 0.0, dy = 0.0;
-    if (jitter_x > 0.0 || jitter_y > 0.0) {
-      const uint4 q = draw(seed, index, PS_STREAM_JITTER, (uint)r);
-      dx = jitter_x * (2.0 * ((double)(q.x >> 8) * (1.0 / 16777216.0)) - 1.0);
-      dy = jitter_y * (2.0 * ((double)(q.y >> 8) * (1.0 / 16777216.0)) - 1.0);
-    }
     // The region's centre on this subject (its place moves with the subject's height).
     global const double* rr = region_rec + ((size_t)subject[i] * PS_REGIONS + r) * PS_MR_LEN;
-    const double col = rr[PS_MR_COL], row = rr[PS_MR_ROW];
-    px[count] = (col + dx - half_width) * scale;
-    pz[count] = body_height - (row + dy) * scale;
+    // The jitter of its placing view's composite, in that view's pixels.
+    double dx = 0.0, dy = 0.0;
+    if (jitter > 0.0) {
+      const uint4 q = draw(seed, index, PS_STREAM_JITTER, (uint)r);
+      dx = jitter * rr[PS_MR_JITTER_X] * (2.0 * ((double)(q.x >> 8) * (1.0 / 16777216.0)) - 1.0);
+      dy = jitter * rr[PS_MR_JITTER_Y] * (2.0 * ((double)(q.y >> 8) * (1.0 / 16777216.0)) - 1.0);
+    }
+    const double col = rr[PS_MR_COL] + dx * rr[PS_MR_FIELD_PER_COL], row = rr[PS_MR_ROW] + dy * rr[PS_MR_FIELD_PER_ROW];
+    px[count] = (col - half_width) * scale;
+    pz[count] = body_height - row * scale;
     variant[count] = v;
     ++count;
   }

@@ -330,24 +330,29 @@ kernel void features_sparse(global const uchar* restrict atlas, global const int
 // than drawing sigma * N(0,1) for every pixel, each mean over c pixels gets one draw of
 // N(0, sigma^2 / c), clipped to the pixel range. Rounding and clipping of single pixels
 // are not modelled; tradeoff measures what that costs. One work-item per scenario.
-kernel void analytic_noise(global float* features, global const int4* rects, uint n, int W, int H, int block,
-                           int bx_count, int by_count, int npooled, int row_len, float sigma, uint2 seed, uint2 first) {
+kernel void analytic_noise(global float* features, global const int4* rects, global const int4* grids, uint n,
+                           int block, int npooled, int row_len, float sigma, uint2 seed, uint2 first) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const ulong index = upsample(first.y, first.x) + i;
-  const int per_view = bx_count * by_count;
+  // grids: per pooled view (width, height, blocks across, first column); the regions follow.
+  const int4 last = grids[npooled - 1];
+  const int block_features = last.w + last.z * ((last.y + block - 1) / block);
   global float* row = features + (size_t)i * row_len;
+  int slot = 0;
   for (int f = 0; f < row_len; f += 2) {
     const uint4 r = draw(seed, index, PS_STREAM_BLOCK_NOISE, (uint)f);
     const float2 g = gauss2(r.x, r.y);
     for (int k = 0; k < 2 && f + k < row_len; ++k) {
       const int q = f + k;
       int count;
-      if (q < npooled * per_view) {
-        const int b = q % per_view;
-        count = block_count(b % bx_count, b / bx_count, block, W, H);
+      if (q < block_features) {
+        while (slot + 1 < npooled && q >= grids[slot + 1].w) ++slot;
+        const int4 v = grids[slot];
+        const int b = q - v.w;
+        count = block_count(b % v.z, b / v.z, block, v.x, v.y);
       } else {
-        const int4 rc = rects[q - npooled * per_view];
+        const int4 rc = rects[q - block_features];
         count = rc.z * rc.w;
       }
       row[q] = clamp(row[q] + sigma * rsqrt((float)count) * (k ? g.y : g.x), 0.0f, 255.0f);

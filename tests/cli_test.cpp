@@ -759,18 +759,19 @@ TEST(CliCatalogueFile, SyntaxError) {
 
 TEST(CliCatalogueFile, RegionRectangleWithThreeValues) {
   TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "mmw = [117, 40, 34, 70]", "mmw = [1, 2, 3]");
+  const std::string text = replace_once(default_catalogue_text(), "upper = [117, 40, 34, 70]", "upper = [1, 2, 3]");
   const fs::path cat = write_catalogue(t, text);
   ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "mmw = [1, 2, 3]")), "regions[3].mmw", "3"});
+                 {at_line(cat, line_of(text, "upper = [1, 2, 3]")), "regions[3].rects.upper", "3"});
 }
 
 TEST(CliCatalogueFile, RegionRectangleOutsideTheView) {
   TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "mmw = [117, 40, 34, 70]", "mmw = [180, 40, 34, 70]");
+  const std::string text =
+      replace_once(default_catalogue_text(), "upper = [117, 40, 34, 70]", "upper = [180, 40, 34, 70]");
   const fs::path cat = write_catalogue(t, text);
   ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "mmw = [180, 40, 34, 70]")), "regions[3].mmw", "outside"});
+                 {at_line(cat, line_of(text, "upper = [180, 40, 34, 70]")), "regions[3].rects.upper", "outside"});
 }
 
 TEST(CliCatalogueFile, AlphaNotANumber) {
@@ -974,8 +975,8 @@ TEST(CliCatalogueCmd, ImagesWritesEveryImage) {
   EXPECT_EQ(noise, 5);
   // 12 objects, gun and iron-rod with two drawings: 14 drawings, each an MMW and an IR sprite.
   EXPECT_EQ(sprites, 14 * 2);
-  for (const char* n : {"subject1_mmw_upper.png", "subject5_ir.png", "gun_h_mmw.png", "gun_v_ir.png",
-                        "iron-handle_mmw.png", "mobile-phone_ir.png"})
+  for (const char* n : {"subject1_upper.png", "subject5_ir.png", "gun_h_mmw.png", "gun_v_ir.png", "iron-handle_mmw.png",
+                        "mobile-phone_ir.png"})
     EXPECT_TRUE(std::find(names.begin(), names.end(), n) != names.end()) << n << " missing";
   EXPECT_EQ(names_in(t.w()), (std::vector<std::string>{"images"}));
 }

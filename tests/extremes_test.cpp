@@ -31,6 +31,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -41,6 +42,7 @@
 #include "assets/image_io.h"
 #include "backend/compare.h"
 #include "backend/reference/draws.h"
+#include "backend/reference/stages.h"
 #include "base/error.h"
 #include "plan/plan.h"
 #include "plan/tolerance.h"
@@ -104,36 +106,55 @@ std::vector<int> numbers_in(const std::string& line) {
   return v;
 }
 
-std::string rect_line(const char* key, const Rect& r) {
-  return std::string(key) + " = [" + std::to_string(r.x) + ", " + std::to_string(r.y) + ", " + std::to_string(r.w) +
-         ", " + std::to_string(r.h) + "]";
+std::string rect_text(const Rect& r) {
+  return "[" + std::to_string(r.x) + ", " + std::to_string(r.y) + ", " + std::to_string(r.w) + ", " +
+         std::to_string(r.h) + "]";
 }
 
-// Every region rectangle through `f(region id 1..13, is_mmw, rect)`.
+// Every region rectangle through `f(region id 1..13, is_mmw, rect)`: the built-in catalogue's
+// `rects = { upper|lower = [...], ir = [...] }` lines.
 std::string map_rects(const std::string& text, const std::function<Rect(int, bool, Rect)>& f) {
   int region = 0;
   return edit_lines(text, [&](const std::string& line) -> std::optional<std::string> {
     if (line.rfind("[[", 0) == 0) region = line == "[[regions]]" ? region + 1 : (region > 0 ? 100 : 0);
-    if (region < 1 || region > kRegions) return std::nullopt;
-    for (const char* key : {"mmw", "ir"}) {
-      if (line.rfind(std::string(key) + " = [", 0) != 0) continue;
-      const std::vector<int> v = numbers_in(line);
-      if (v.size() != 4) return std::nullopt;
-      return rect_line(key, f(region, key[0] == 'm', Rect{v[0], v[1], v[2], v[3]}));
-    }
-    return std::nullopt;
+    if (region < 1 || region > kRegions || line.rfind("rects = { ", 0) != 0) return std::nullopt;
+    const size_t ir_at = line.find(", ir = [");
+    const std::string mmw_view = line.substr(10, line.find(" = [") - 10);
+    const std::vector<int> m = numbers_in(line), i = numbers_in(line.substr(ir_at));
+    if (m.size() != 4 || i.size() != 4) return std::nullopt;
+    return "rects = { " + mmw_view + " = " + rect_text(f(region, true, Rect{m[0], m[1], m[2], m[3]})) +
+           ", ir = " + rect_text(f(region, false, Rect{i[0], i[1], i[2], i[3]})) + " }";
   });
 }
 
 // Every object's `size = [w, h]` through `f`.
 std::string map_sizes(const std::string& text, const std::function<std::pair<int, int>(int, int)>& f) {
+  bool object = false;
   return edit_lines(text, [&](const std::string& line) -> std::optional<std::string> {
-    if (line.rfind("size = [", 0) != 0) return std::nullopt;
+    if (line.rfind("[", 0) == 0) object = line == "[[objects]]";
+    if (!object || line.rfind("size = [", 0) != 0) return std::nullopt;
     const std::vector<int> v = numbers_in(line);
     if (v.size() != 2) return std::nullopt;
     const auto [w, h] = f(v[0], v[1]);
     return "size = [" + std::to_string(w) + ", " + std::to_string(h) + "]";
   });
+}
+
+// The built-in portal's view sizes: the two MMW views, then the IR view.
+std::string set_view_sizes(const std::string& text, int mmw_w, int mmw_h, int ir_w, int ir_h) {
+  std::string view;
+  return edit_lines(text, [&](const std::string& line) -> std::optional<std::string> {
+    if (line.rfind("[", 0) == 0) view = line == "[[views]]" ? "?" : "";
+    if (!view.empty() && line.rfind("name = \"", 0) == 0) view = line.substr(8, line.find('"', 8) - 8);
+    if (view.empty() || view == "?" || line.rfind("size = [", 0) != 0) return std::nullopt;
+    const bool ir = view == "ir";
+    return "size = [" + std::to_string(ir ? ir_w : mmw_w) + ", " + std::to_string(ir ? ir_h : mmw_h) + "]";
+  });
+}
+
+// A subject's image files for the built-in portal's three views.
+std::string subject_images(const std::string& upper, const std::string& lower, const std::string& ir) {
+  return "images = { upper = \"" + upper + "\", lower = \"" + lower + "\", ir = \"" + ir + "\" }\n";
 }
 
 // Sets one [images] key (a line "key = value ...").
@@ -287,8 +308,8 @@ void expect_same_shape(const BatchOutput& a, const BatchOutput& ref) {
   EXPECT_EQ(a.metal.size(), ref.metal.size());
   EXPECT_EQ(a.features.size(), ref.features.size());
   EXPECT_EQ(a.layout.block, ref.layout.block);
-  EXPECT_EQ(a.layout.blocks_x, ref.layout.blocks_x);
-  EXPECT_EQ(a.layout.blocks_y, ref.layout.blocks_y);
+  EXPECT_EQ(a.layout.grids[0].blocks_x, ref.layout.grids[0].blocks_x);
+  EXPECT_EQ(a.layout.grids[0].blocks_y, ref.layout.grids[0].blocks_y);
 }
 
 // Features are finite gray levels and metal zones lie in [1, 200]. (compare_outputs would let
@@ -317,12 +338,17 @@ std::vector<double> feature_counts(const Catalogue& cat, const FeatureLayout& la
   std::vector<double> c;
   for (int k : lay.pooled) {
     const Sensor& s = cat.sensors[k];
-    for (int by = 0; by < lay.blocks_y; ++by)
-      for (int bx = 0; bx < lay.blocks_x; ++bx)
+    for (int by = 0; by * lay.block < s.height; ++by)
+      for (int bx = 0; bx * lay.block < s.width; ++bx)
         c.push_back(double(std::min(lay.block, s.width - bx * lay.block)) *
                     std::min(lay.block, s.height - by * lay.block));
   }
-  for (const Region& r : cat.regions) c.push_back(double(r.mmw.w) * r.mmw.h);
+  for (int r = 0; r < kRegions; ++r)  // in the first pooled view that sees it
+    for (int k : lay.pooled)
+      if (cat.sensors[k].sees(r)) {
+        c.push_back(double(cat.sensors[k].rects[r].w) * cat.sensors[k].rects[r].h);
+        break;
+      }
   return c;
 }
 
@@ -487,12 +513,12 @@ size_t count_differing(const uint8_t* a, const uint8_t* b, size_t n) {
 // The features row of a subject with no objects: block and region means of its bases.
 std::vector<double> base_features(const World& w, int subject, int block) {
   const FeatureLayout f = FeatureLayout::of(w.cat, block);
-  const int W = w.cat.images.mmw_width, H = w.cat.images.mmw_height;
+  const int W = w.cat.sensors[0].width, H = w.cat.sensors[0].height;
   std::vector<double> row;
   for (int view = 0; view < 2; ++view) {
     const Image& img = w.assets.bases[subject][view];
-    for (int by = 0; by < f.blocks_y; ++by)
-      for (int bx = 0; bx < f.blocks_x; ++bx) {
+    for (int by = 0; by < f.grids[0].blocks_y; ++by)
+      for (int bx = 0; bx < f.grids[0].blocks_x; ++bx) {
         double sum = 0;
         int count = 0;
         for (int y = by * block; y < std::min(H, (by + 1) * block); ++y)
@@ -500,12 +526,13 @@ std::vector<double> base_features(const World& w, int subject, int block) {
         row.push_back(sum / count);
       }
   }
-  for (const Region& r : w.cat.regions) {
-    const Image& img = w.assets.bases[subject][r.view == View::upper ? 0 : 1];
+  for (int k = 0; k < kRegions; ++k) {
+    const Image& img = w.assets.bases[subject][test::mmw_view_of(w.cat, k)];
+    const Rect& r = test::mmw_rect(w.cat, k);
     double sum = 0;
-    for (int y = r.mmw.y; y < r.mmw.y + r.mmw.h; ++y)
-      for (int x = r.mmw.x; x < r.mmw.x + r.mmw.w; ++x) sum += img.at(x, y);
-    row.push_back(sum / (double(r.mmw.w) * r.mmw.h));
+    for (int y = r.y; y < r.y + r.h; ++y)
+      for (int x = r.x; x < r.x + r.w; ++x) sum += img.at(x, y);
+    row.push_back(sum / (double(r.w) * r.h));
   }
   return row;
 }
@@ -651,11 +678,11 @@ TEST(ExtremeAlpha, OneMakesSpritesOpaque) {
       for (int r = 0; r < kRegions; ++r) {
         const int v = s.objects[r];
         if (v < 0) continue;
-        const Region& reg = w->cat.regions[r];
-        const int view = reg.view == View::upper ? 0 : 1;
-        check_opaque(w->assets.sprite(Camera::mmw, v), reg.mmw,
-                     view == 0 ? o.view("upper").of(i) : o.view("lower").of(i), w->assets.bases[s.subject][view], mmw);
-        check_opaque(w->assets.sprite(Camera::ir, v), reg.ir, o.view("ir").of(i), w->assets.bases[s.subject][2], ir);
+        const int view = test::mmw_view_of(w->cat, r);
+        const Sensor &mv = w->cat.sensors[view], &iv = w->cat.sensors[2];
+        check_opaque(w->assets.sprite(mv, v), mv.rects[r], o.view(mv.name).of(i), w->assets.bases[s.subject][view],
+                     mmw);
+        check_opaque(w->assets.sprite(iv, v), iv.rects[r], o.view("ir").of(i), w->assets.bases[s.subject][2], ir);
       }
     }
     EXPECT_GT(mmw.checked, 10000u) << who;
@@ -707,9 +734,7 @@ void black_and_white(uint8_t base, uint8_t sprite) {
   const std::string ih = write_gray(t.path(), "sprite-ir-h-" + s + ".png", 20, 15, sprite);
   const std::string iv = write_gray(t.path(), "sprite-ir-v-" + s + ".png", 15, 20, sprite);
   std::string text = default_text();
-  for (int k = 1; k <= 5; ++k)
-    text = add_after_name(text, "subject-" + std::to_string(k),
-                          "mmw_upper = \"" + up + "\"\nmmw_lower = \"" + up + "\"\nir = \"" + ir + "\"\n");
+  for (int k = 1; k <= 5; ++k) text = add_after_name(text, "subject-" + std::to_string(k), subject_images(up, up, ir));
   for (const char* o : {"gun", "iron-rod"})
     text = add_after_name(
         text, o, "mmw_h = \"" + sh + "\"\nmmw_v = \"" + sv + "\"\nir_h = \"" + ih + "\"\nir_v = \"" + iv + "\"\n");
@@ -720,7 +745,7 @@ void black_and_white(uint8_t base, uint8_t sprite) {
   for (const auto& views : w->assets.bases)
     for (const Image& img : views)
       ASSERT_TRUE(std::all_of(img.pixels.begin(), img.pixels.end(), [&](uint8_t v) { return v == base; }));
-  for (const Image& sp : w->assets.sprites[static_cast<int>(Camera::mmw)]) ASSERT_EQ(sp.at(0, 0, 0), sprite);
+  for (const Image& sp : w->assets.sprites[w->cat.sensors[0].sprite_set]) ASSERT_EQ(sp.at(0, 0, 0), sprite);
 
   std::vector<Scenario> scenes;
   for (int subject = 0; subject < 5; ++subject) scenes.push_back(crowded(w->cat, subject, subject));
@@ -882,9 +907,9 @@ TEST(ExtremeBlock, SizesFromOnePixelToBeyondTheImage) {
   for (int block : {1, 7, 200, 256, 257, 500, 65536}) {
     SCOPED_TRACE("block " + std::to_string(block));
     const FeatureLayout lay = FeatureLayout::of(w.cat, block);
-    EXPECT_EQ(lay.blocks_x, (200 + block - 1) / block);
-    EXPECT_EQ(lay.blocks_y, (200 + block - 1) / block);
-    EXPECT_EQ(lay.image_features(), 2 * lay.blocks_x * lay.blocks_y + kRegions);
+    EXPECT_EQ(lay.grids[0].blocks_x, (200 + block - 1) / block);
+    EXPECT_EQ(lay.grids[0].blocks_y, (200 + block - 1) / block);
+    EXPECT_EQ(lay.image_features(), 2 * lay.grids[0].blocks_x * lay.grids[0].blocks_y + kRegions);
     EXPECT_EQ(lay.names().size(), static_cast<size_t>(lay.row_features()));
     Plan check = features_plan(model(0, true, 0.0, block), Tier::standard);
     EXPECT_NO_THROW(validate(check, w.cat));
@@ -892,8 +917,8 @@ TEST(ExtremeBlock, SizesFromOnePixelToBeyondTheImage) {
     const auto p = expect_parity(w, batch, model(41, true, 0.0, block), "block");
     if (block >= 200) {
       // One block per view: its mean is the whole view's, in every output with images.
-      EXPECT_EQ(lay.blocks_x, 1);
-      EXPECT_EQ(lay.blocks_y, 1);
+      EXPECT_EQ(lay.grids[0].blocks_x, 1);
+      EXPECT_EQ(lay.grids[0].blocks_y, 1);
       for (const BatchOutput* o : {&p->ref_images, &p->images[0], &p->images[1], &p->images[2]}) {
         ASSERT_EQ(o->features.size(), batch.size() * (2 + kRegions));
         for (size_t i = 0; i < batch.size(); ++i) {
@@ -920,13 +945,13 @@ TEST(ExtremeBlock, SizesFromOnePixelToBeyondTheImage) {
 
 TEST(ExtremeImageSize, OneByOne) {
   std::string text = default_text();
-  for (const char* key : {"mmw_width", "mmw_height", "ir_width", "ir_height"}) text = set_image_key(text, key, "1");
+  text = set_view_sizes(text, 1, 1, 1, 1);
   text = map_rects(text, [](int, bool, Rect) { return Rect{0, 0, 1, 1}; });
   for (const std::string noise : {"40", "1"}) {
     SCOPED_TRACE("noise_size " + noise);
     auto w = make_world(set_image_key(text, "noise_size", noise));
-    ASSERT_EQ(w->cat.images.mmw_width, 1);
-    ASSERT_EQ(w->cat.regions[12].ir.w, 1);
+    ASSERT_EQ(w->cat.sensors[0].width, 1);
+    ASSERT_EQ(w->cat.sensors[2].rects[12].w, 1);
     const SceneBatch batch = test::batch_of(coverage(w->cat, 300, 13), 42);
     for (int block : {1, 10}) expect_parity(*w, batch, model(61, true, 0.0, block), "1x1 images");
     expect_parity(*w, batch, model(62, true, 3.0, 1), "1x1 images with pixel noise", FastNoisy::own_model);
@@ -940,8 +965,7 @@ TEST(ExtremeImageSize, OneByOne) {
 // following the draws within the tier's bounds.
 void odd_views_render_as_the_stages(Tier tier, NoiseDraw draw) {
   std::string text = default_text();
-  for (const char* key : {"mmw_width", "ir_width"}) text = set_image_key(text, key, "37");
-  for (const char* key : {"mmw_height", "ir_height"}) text = set_image_key(text, key, "23");
+  text = set_view_sizes(text, 37, 23, 37, 23);
   text = map_rects(text, [](int, bool, Rect) { return Rect{0, 0, 37, 23}; });
   auto w = make_world(text);
   const SceneBatch batch = test::batch_of(coverage(w->cat, 40, 4), 7);
@@ -971,18 +995,15 @@ TEST(ExtremeImageSize, OddViewsPairTheBoxMullerNoiseAsTheStages) {
   odd_views_render_as_the_stages(Tier::standard, NoiseDraw::box_muller);
 }
 
-// A 4096x4096 catalogue: the default's rectangles, object sizes and noise tile scaled by 20
-// (IR 2048x4096), one subject to keep the procedural images quick.
+// A 4096x4096 catalogue: the default's rectangles and noise tile scaled by 20 (IR 2048x4096;
+// the objects' drawings follow the views' scale, 20.48 pixels per field unit), one subject to
+// keep the procedural images quick.
 World& world_4096() {
   static std::unique_ptr<World> w = [] {
     std::string text = first_subject_only(default_text());
-    text = set_image_key(text, "mmw_width", "4096");
-    text = set_image_key(text, "mmw_height", "4096");
-    text = set_image_key(text, "ir_width", "2048");
-    text = set_image_key(text, "ir_height", "4096");
+    text = set_view_sizes(text, 4096, 4096, 2048, 4096);
     text = set_image_key(text, "noise_size", "800");
     text = map_rects(text, [](int, bool, Rect r) { return Rect{r.x * 20, r.y * 20, r.w * 20, r.h * 20}; });
-    text = map_sizes(text, [](int a, int b) { return std::pair{a * 20, b * 20}; });
     return make_world(text);
   }();
   return *w;
@@ -997,7 +1018,7 @@ std::vector<Scenario> three_scenes_4096(const Catalogue& c) {
 
 TEST(ExtremeImageSize, FourThousandNinetySix) {
   World& w = world_4096();
-  ASSERT_EQ(w.cat.images.mmw_width, 4096);
+  ASSERT_EQ(w.cat.sensors[0].width, 4096);
   ASSERT_EQ(w.assets.bases[0][0].width, 4096);
   ASSERT_EQ(w.assets.bases[0][2].width, 2048);
   const SceneBatch batch = test::batch_of(three_scenes_4096(w.cat), 7);
@@ -1031,7 +1052,7 @@ TEST(ExtremeSprites, PartlyOutsideTheImage) {
         std::pair{"400x400 sprites, 600x600 noise tile, default regions", set_image_key(big, "noise_size", "600")}}) {
     SCOPED_TRACE(name);
     auto w = make_world(text);
-    ASSERT_EQ(w->assets.sprite(Camera::mmw, 0).width, 400);
+    ASSERT_EQ(w->assets.sprite(w->cat.sensors[0], 0).width, 400);
     std::vector<Scenario> scenes = coverage(w->cat, 40, 4, false);
     scenes.push_back(crowded(w->cat, 0, 0));
     scenes.push_back(crowded(w->cat, 0, 7));
@@ -1169,7 +1190,7 @@ TEST(ExtremeLargeSums, BlockOf4096OverA4096Image) {
     World& w = world_4096();
     const SceneBatch batch = test::batch_of({three_scenes_4096(w.cat)[2]}, 3);
     const auto p = expect_parity(w, batch, model(111, true, 0.0, 4096), "4096 image, block 4096");
-    EXPECT_EQ(p->ref_features.layout.blocks_x, 1);
+    EXPECT_EQ(p->ref_features.layout.grids[0].blocks_x, 1);
   }
   // All white, with regions 1 and 7 the whole view: every mean is exactly 255, though the sum
   // (255 * 4096^2) is above 2^31 and far above 2^24. Block 256 takes the sparse path.
@@ -1177,16 +1198,12 @@ TEST(ExtremeLargeSums, BlockOf4096OverA4096Image) {
   const std::string white = write_gray(t.path(), "white.png", 4096, 4096, 255);
   const std::string white_ir = write_gray(t.path(), "white-ir.png", 2048, 4096, 255);
   std::string text = first_subject_only(default_text());
-  text = set_image_key(text, "mmw_width", "4096");
-  text = set_image_key(text, "mmw_height", "4096");
-  text = set_image_key(text, "ir_width", "2048");
-  text = set_image_key(text, "ir_height", "4096");
+  text = set_view_sizes(text, 4096, 4096, 2048, 4096);
   text = map_rects(text, [](int region, bool mmw, Rect r) {
     if (region == 1 || region == 7) return mmw ? Rect{0, 0, 4096, 4096} : Rect{0, 0, 2048, 4096};
     return Rect{r.x * 20, r.y * 20, r.w * 20, r.h * 20};
   });
-  text = add_after_name(text, "subject-1",
-                        "mmw_upper = \"" + white + "\"\nmmw_lower = \"" + white + "\"\nir = \"" + white_ir + "\"\n");
+  text = add_after_name(text, "subject-1", subject_images(white, white, white_ir));
   auto w = make_world(text, t.str());
   std::vector<Scenario> scenes(2);  // empty, then objects over the white
   for (int r : {0, 3, 6, 9, 12}) scenes[1].objects[r] = static_cast<int16_t>(r % w->cat.variant_list.size());
@@ -1200,7 +1217,8 @@ TEST(ExtremeLargeSums, BlockOf4096OverA4096Image) {
       size_t not_white = 0;
       for (int k = 0; k < o->layout.image_features(); ++k) not_white += o->features_of(0)[k] != 255.0f;
       EXPECT_EQ(not_white, 0u) << "means of an all-white scenario that are not exactly 255";
-      EXPECT_LT(o->features_of(1)[2 * o->layout.blocks_x * o->layout.blocks_y], 255.0f) << "objects show";
+      EXPECT_LT(o->features_of(1)[2 * o->layout.grids[0].blocks_x * o->layout.grids[0].blocks_y], 255.0f)
+          << "objects show";
     }
   }
 }
@@ -1229,10 +1247,10 @@ TEST(ExtremeRejection, CatalogueNumbers) {
       {"gain = 1.0", "gain = -1", "noise[1].gain", {"-1"}},
       {"gain = 1.0", "gain = inf", "noise[1].gain", {"infinity"}},
       {"gain = 1.0", "gain = nan", "noise[1].gain", {"NaN"}},
-      {"mmw_width = 200", "mmw_width = -200", "images.mmw_width", {"-200"}},
+      {"size = [200, 200]", "size = [-200, 200]", "views[1].size[0]", {"-200"}},
       {"noise_size = 40", "noise_size = -40", "images.noise_size", {"-40"}},
       {"mmw_level = 238", "mmw_level = -1", "objects[1].mmw_level", {"-1"}},
-      {"mmw = [49, 40, 34, 70]", "mmw = [-1, 40, 34, 70]", "regions[1].mmw", {}},
+      {"upper = [49, 40, 34, 70]", "upper = [-1, 40, 34, 70]", "regions[1].rects.upper", {}},
   };
   for (const Case& c : cases) {
     const std::string text = replace_once(default_text(), c.from, c.to);
@@ -1295,6 +1313,197 @@ TEST(ExtremeRejection, CommandLineNumbers) {
   // The value as typed, not as wrapped to an unsigned 64-bit integer.
   cases.push_back({{"generate", "--count", "-1"}, {"--count", "-1"}});
   expect_all_rejected(cases);
+}
+
+// =============================================================================================
+// 13. Portals other than the thesis's: views, regions and pooling declared in the catalogue.
+
+std::string front_back_text() { return slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "portal-front-back.toml"); }
+
+// Objects in every region, front and back; each scenario's objects from `first` on.
+std::vector<Scenario> front_and_back_scenes(const Catalogue& c) {
+  std::vector<Scenario> v = coverage(c, 60, 5);
+  for (int s = 0; s < 5; ++s) v.push_back(crowded(c, s, static_cast<size_t>(3 * s)));
+  return v;
+}
+
+// The shipped front-and-back portal (scenarios/portal-front-back.toml): four MMW views, two
+// of them the back's, mirrored, through both models and every tier, images and features, as
+// the built-in portal is held.
+TEST(PortalViews, FrontAndBackPortalMatchesTheReferenceInEveryTier) {
+  auto w = make_world(front_back_text());
+  ASSERT_EQ(w->cat.sensors.size(), 5u);
+  EXPECT_EQ(w->cat.sensors[2].side, Side::back);
+  EXPECT_TRUE(FeatureLayout::of(w->cat, 10).uniform) << "four pooled 200x200 views: the sparse paths take them";
+  const SceneBatch batch = test::batch_of(front_and_back_scenes(w->cat), 500);
+  expect_parity(*w, batch, model(131, true), "front and back, pattern noise");
+  expect_parity(*w, batch, model(132, false, 4.0, 7, 3), "front and back, pixel and metal noise");
+  expect_parity(*w, batch, physics_model(133), "front and back, physics");
+  // Any batch split gives the same bytes.
+  BatchOutput whole, part;
+  const Plan plan = features_plan(model(134, true), Tier::standard);
+  w->cl->run(batch, plan, whole);
+  std::vector<float> pieces;
+  for (size_t at = 0; at < batch.size(); at += 7) {
+    SceneBatch b;
+    b.first_index = batch.first_index + at;
+    for (size_t i = at; i < std::min(batch.size(), at + 7); ++i) b.push(batch.at(i));
+    w->cl->run(b, plan, part);
+    pieces.insert(pieces.end(), part.features.begin(), part.features.end());
+  }
+  EXPECT_EQ(pieces, whole.features);
+}
+
+// A back view draws the body and the objects mirrored: the body's outline is the front's
+// mirror image (its texture its own), and each object's drawing the front's, mirrored.
+TEST(PortalViews, BackViewsAreMirrored) {
+  auto w = make_world(front_back_text());
+  const Sensor &front = w->cat.sensors[0], &back = w->cat.sensors[2];
+  ASSERT_EQ(back.name, "back_upper");
+  ASSERT_NE(front.sprite_set, back.sprite_set);
+  for (size_t v = 0; v < w->cat.variant_list.size(); ++v) {
+    const Image &a = w->assets.sprite(front, static_cast<int>(v)), &b = w->assets.sprite(back, static_cast<int>(v));
+    ASSERT_EQ(a.width, b.width);
+    for (int y = 0; y < a.height; ++y)
+      for (int x = 0; x < a.width; ++x)
+        for (int c = 0; c < 2; ++c)
+          ASSERT_EQ(a.at(x, y, c), b.at(a.width - 1 - x, y, c)) << w->cat.variant_name(int(v));
+  }
+  const Image &f = w->assets.bases[0][0], &b = w->assets.bases[0][2];
+  size_t outline_differs = 0, texture_differs = 0;
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      const int a = f.at(x, y), m = b.at(f.width - 1 - x, y);
+      outline_differs += (a > 90) != (m > 90);  // body (about 150) or room (about 25)
+      texture_differs += a != m;
+    }
+  EXPECT_LT(outline_differs, 100u) << "the back's outline is the front's mirrored (edge pixels aside)";
+  EXPECT_GT(texture_differs, 5000u) << "the back has its own texture";
+}
+
+// The metal detector places a back region's object where the body carries it: a back view is
+// mirrored, so the back of the right knee is on the subject's right, where the front's right
+// knee is. The same object there and at the front's right knee reads the same zones.
+TEST(PortalViews, MetalFindsABackObjectOnTheSameSideOfThePortal) {
+  auto back = make_world(front_back_text());
+  // Region 12 (back of the right knee) moved to the front lower view's right knee.
+  std::string text = replace_once(front_back_text(), "rects = { back_lower = [104, 80, 46, 55] }",
+                                  "rects = { lower = [50, 80, 46, 55] }");
+  auto front = make_world(text);
+  Scenario s;
+  s.objects[11] = static_cast<int16_t>(test::variant_of(back->cat, "gun"));
+  const ModelSettings m = physics_model(141);
+  const auto a = reference::metal_objects(back->cat, back->assets, m, s, 0);
+  const auto b = reference::metal_objects(front->cat, front->assets, m, s, 0);
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_EQ(a[0].x, b[0].x);
+  EXPECT_EQ(a[0].z, b[0].z);
+  EXPECT_LT(a[0].x, 0.0) << "the subject's right is the portal's x < 0 (panel A)";
+  BatchOutput oa, ob;
+  Plan plan = features_plan(m, Tier::standard);
+  back->cl->run(test::batch_of({s}), plan, oa);
+  front->cl->run(test::batch_of({s}), plan, ob);
+  EXPECT_EQ(oa.metal, ob.metal);
+  // The gun on the subject's right reads more on panel A's zones than on panel B's.
+  int a_zones = 0, b_zones = 0;
+  for (int z = 0; z < kZones; ++z) (z < PS_METAL_PANEL_A_ZONES ? a_zones : b_zones) += 200 - oa.metal[z];
+  EXPECT_GT(a_zones, 0);
+}
+
+// A pooled IR view (100x200 beside the 200x200 MMW views): each pooled view has its own grid of
+// blocks, the features take the rendered views, and they match the reference in every tier.
+TEST(PortalViews, PooledViewsOfOtherSizesHaveTheirOwnGrids) {
+  const std::string text =
+      replace_once(default_text(), "field = [0, 0, 200, 400]\n", "field = [0, 0, 200, 400]\npooled = true\n");
+  auto w = make_world(text);
+  const FeatureLayout lay = FeatureLayout::of(w->cat, 30);
+  ASSERT_EQ(lay.pooled.size(), 3u);
+  EXPECT_FALSE(lay.uniform);
+  EXPECT_EQ(lay.grids[2].blocks_x, 4);  // 100 = 3 x 30 + 10
+  EXPECT_EQ(lay.grids[2].blocks_y, 7);  // 200 = 6 x 30 + 20
+  EXPECT_EQ(lay.grids[2].offset, 2 * 49);
+  EXPECT_EQ(lay.names()[2 * 49], "ir_r0_c0");
+  EXPECT_EQ(lay.names()[2 * 49 + 27], "ir_r6_c3");
+  const SceneBatch batch = test::batch_of(coverage(w->cat, 40, 4), 900);
+  expect_parity(*w, batch, model(151, true, 0.0, 30), "pooled IR");
+  expect_parity(*w, batch, model(152, false, 3.0, 30), "pooled IR, pixel noise");
+  expect_parity(*w, batch, physics_model(153, 30), "pooled IR, physics");
+}
+
+// A catalogue's views and regions are checked like every other field: file, line and field.
+TEST(PortalViews, BadViewsAndRegionsAreRefusedNamingTheField) {
+  struct Case {
+    std::string from, to, field, says;
+  };
+  const std::vector<Case> cases{
+      {"name = \"back_upper\"", "name = \"upper\"  # again", "views[3].name", "named twice"},
+      {"name = \"back_upper\"", "name = \"Back Upper\"", "views[3].name", "a-z, 0-9 and _"},
+      {"camera = \"ir\"", "camera = \"thermal\"", "views[5].camera", "\"mmw\" or \"ir\""},
+      {"side = \"back\"", "side = \"left\"", "views[3].side", "\"front\" or \"back\""},
+      {"field = [0, 200, 200, 200]", "field = [0, 200, 0, 200]", "views[2].field[2]", "out of range"},
+      {"field = [0, 200, 200, 200]", "field = [0, 200]", "views[2].field", "[x, y, width, height]"},
+      {"pooled = true", "pooled = 1", "views[1].pooled", "true or false"},
+      {"rects = { back_upper = [66, 40, 68, 70] }", "rects = { back = [66, 40, 68, 70] }", "regions[8].rects.back",
+       "not one of the catalogue's [[views]]"},
+      {"rects = { back_upper = [66, 40, 68, 70] }", "rects = {}", "regions[8].rects", "at least one"},
+      {"rects = { back_upper = [66, 40, 68, 70] }", "rects = { back_upper = [166, 40, 68, 70] }",
+       "regions[8].rects.back_upper", "outside the 200x200 view"},
+      {"name = \"subject-2\"", "name = \"subject-2\"\nimages.back = \"b.png\"", "subjects[2].images.back",
+       "not one of the catalogue's [[views]]"},
+      {"alpha = 0.9", "alpha = 0.9\nmmw_width = 200", "images.mmw_width", "[[views]] entries now"},
+      {"name = \"seat\"", "name = \"seat\"\nview = \"lower\"", "regions[11].view", "rects = { VIEW"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.to);
+    const std::string text = replace_once(front_back_text(), c.from, c.to);
+    const int line = line_of(text, c.to.substr(c.to.rfind('\n') == std::string::npos ? 0 : c.to.rfind('\n') + 1));
+    try {
+      parse_catalogue(text, "test.toml", "", "");
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(c.field + ": "), std::string::npos) << what;
+      EXPECT_NE(what.find(c.says), std::string::npos) << what;
+      if (c.field != "regions[8].rects" && c.field != "views[2].field") {
+        EXPECT_NE(what.find("test.toml:" + std::to_string(line) + ":"), std::string::npos) << what;
+      }
+    }
+  }
+}
+
+// A pooled IR view is a sensor of its own to `evaluate`, and a data set is read only through
+// the catalogue it was made with.
+TEST(PortalViews, EvaluateReportsAPooledIrViewAndRefusesAnotherCatalogue) {
+  TempDir t;
+  const fs::path cat = t.path() / "ir-pooled.toml";
+  spit(cat, replace_once(default_text(), "field = [0, 0, 200, 400]\n", "field = [0, 0, 200, 400]\npooled = true\n"));
+  const fs::path data = t.path() / "set", report = t.path() / "report";
+  const Result g = finish(start(t.path(), {"generate",  "--catalogue", cat.string(),
+                                           "--count",   "400",         "--seed",
+                                           "3",         "--pool",      "gun,metal-plate,mobile-phone",
+                                           "--objects", "0..2",        "--rule",
+                                           "gun",       "--balance",   "--what",
+                                           "features",  "--format",    "csv",
+                                           "--block",   "40",          "--quiet",
+                                           "--out",     data.string()}));
+  ASSERT_EQ(g.status, 0) << describe(g);
+  EXPECT_TRUE(has(slurp(data / "features.csv").substr(0, 4096), "ir_r0_c0,")) << "IR blocks are columns";
+  const Result e = finish(start(t.path(), {"evaluate", data.string(), "--catalogue", cat.string(), "--bootstrap", "50",
+                                           "--no-plot", "--out", report.string()}));
+  ASSERT_EQ(e.status, 0) << describe(e);
+  const nlohmann::json json = nlohmann::json::parse(slurp(report / "report.json"));
+  for (const char* sensor : {"upper", "lower", "ir", "metal", "fused_features"})
+    EXPECT_TRUE(json["entries"].contains(sensor)) << sensor << " in report.json";
+  // A carried gun shows in IR (the clothing over it cooler): its features alone tell it apart.
+  EXPECT_GT(json["entries"]["ir"]["auc"].get<double>(), 0.6);
+  // The same folder through the built-in catalogue: refused, nothing written.
+  const fs::path other = t.path() / "other";
+  const Result r = finish(start(t.path(), {"evaluate", data.string(), "--no-plot", "--out", other.string()}));
+  EXPECT_NE(r.status, 0);
+  EXPECT_TRUE(has(r.err, "made with the catalogue " + cat.string())) << r.err;
+  EXPECT_TRUE(has(r.err, "give that catalogue with --catalogue")) << r.err;
+  EXPECT_FALSE(fs::exists(other));
 }
 
 }  // namespace

@@ -232,7 +232,7 @@ TEST(InputFiles, HostileTextIsRefusedNamingFileLineAndField) {
   const std::string after = file("after.csv", kHeader + "\n1,\"gun\"x" + nones + "\n");
   const std::string bad_rule = file("rule.toml", "count = 5\n\nrule = \"gun&\"\n");
   std::string cat = slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "catalogue.toml");
-  cat.insert(cat.find("\n", cat.find("[[subjects]]")) + 1, "mmw_uper = \"u.png\"\n");
+  cat.insert(cat.find("\n", cat.find("[[subjects]]")) + 1, "imagse = { upper = \"u.png\" }\n");
   const std::string typo = file("typo.toml", cat);
   const std::vector<Case> cases{
       {{"generate", "--scenarios", nul}, {nul + ":2:6", "NUL"}},
@@ -250,7 +250,7 @@ TEST(InputFiles, HostileTextIsRefusedNamingFileLineAndField) {
       {{"generate", "--scenarios", open}, {open + ":2", "column 3", "not closed on its line"}},
       {{"generate", "--scenarios", after}, {after + ":2", "column 2", "after the closing quote"}},
       {{"generate", "--spec", bad_rule}, {bad_rule + ":3: rule", "\"gun&\" at character 5"}},
-      {{"catalogue", "--catalogue", typo}, {typo + ":", "subjects[1].mmw_uper", "did you mean mmw_upper?"}},
+      {{"catalogue", "--catalogue", typo}, {typo + ":", "subjects[1].imagse", "did you mean images?"}},
   };
   for (const Case& c : cases) {
     Args a = c.args;

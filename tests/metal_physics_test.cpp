@@ -108,7 +108,7 @@ TEST(MetalPhysics, EachZoneHasItsOwnGain) {
 // 24.5 cm, along x and along z), and the rod's long side is the catalogue's drawing.
 TEST(MetalPhysics, LongObjectsAreDipolesAlongTheirLength) {
   const Catalogue& cat = catalogue();
-  const double scale = cat.metal_physics.body_height / (2.0 * cat.images.mmw_height);
+  const double scale = cat.metal_physics.body_height / 400.0;  // the field: the two 200-pixel MMW views
   const int rod_h = cat.find_object("iron-rod"), rod = cat.objects[rod_h].first_variant;
   EXPECT_NEAR(cat.long_side(rod)[0], 56 * scale, 1e-12);
   EXPECT_EQ(cat.long_side(rod)[1], 0.0);

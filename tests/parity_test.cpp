@@ -186,17 +186,19 @@ TEST(Parity, FeaturesAreMeansOfTheImages) {
   for (size_t i = 0; i < scenes.size(); ++i) {
     const float* f = out.features_of(i);
     // The bottom-right partial block of the lower view: 200 = 28 * 7 + 4.
-    const int bx = out.layout.blocks_x - 1, by = out.layout.blocks_y - 1;
+    const int bx = out.layout.grids[0].blocks_x - 1, by = out.layout.grids[0].blocks_y - 1;
     double sum = 0;
     for (int y = by * 7; y < H; ++y)
       for (int x = bx * 7; x < W; ++x) sum += out.view("lower").of(i)[y * W + x];
-    EXPECT_FLOAT_EQ(f[out.layout.blocks_x * out.layout.blocks_y + by * out.layout.blocks_x + bx], sum / 16.0);
+    EXPECT_FLOAT_EQ(
+        f[out.layout.grids[0].blocks_x * out.layout.grids[0].blocks_y + by * out.layout.grids[0].blocks_x + bx],
+        sum / 16.0);
     // Region 3 (left chest, upper view).
-    const Rect& r = catalogue().regions[2].mmw;
+    const Rect& r = test::mmw_rect(catalogue(), 2);
     sum = 0;
     for (int y = r.y; y < r.y + r.h; ++y)
       for (int x = r.x; x < r.x + r.w; ++x) sum += out.view("upper").of(i)[y * W + x];
-    EXPECT_NEAR(f[2 * out.layout.blocks_x * out.layout.blocks_y + 2], sum / (r.w * r.h), 1e-3);
+    EXPECT_NEAR(f[2 * out.layout.grids[0].blocks_x * out.layout.grids[0].blocks_y + 2], sum / (r.w * r.h), 1e-3);
   }
 }
 
@@ -382,8 +384,8 @@ TEST(SharedHelpers, PlaceHandComputed) {
 TEST(SharedHelpers, FeatureLayoutHandComputed) {
   for (auto [block, side] : {std::pair{10, 20}, std::pair{7, 29}, std::pair{1, 200}, std::pair{300, 1}}) {
     const FeatureLayout f = FeatureLayout::of(catalogue(), block);
-    EXPECT_EQ(f.blocks_x, side);
-    EXPECT_EQ(f.blocks_y, side);
+    EXPECT_EQ(f.grids[0].blocks_x, side);
+    EXPECT_EQ(f.grids[0].blocks_y, side);
     EXPECT_EQ(f.image_features(), 2 * side * side + 13);
   }
 }

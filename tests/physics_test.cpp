@@ -244,10 +244,10 @@ TEST(Physics, RawGridFeatureNoiseMatchesTheReference) {
   for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
     const RawGridPooling pool = raw_grid_pooling(catalogue().sensors[lay.pooled[slot]], lay, static_cast<int>(slot),
                                                  plan.model.raw_width, plan.model.raw_height);
-    for (int f = 0; f < lay.blocks_per_view(); ++f) {
+    for (int f = 0; f < lay.grids[0].blocks(); ++f) {
       const size_t col = static_cast<size_t>(pool.columns[f]);
       const double sd = plan.model.netd * scale * std::sqrt(2 * RawGridNoise::covariance(pool, f, f));
-      const bool spaced = (f % lay.blocks_x) % 3 == 0 && (f / lay.blocks_x) % 3 == 0;
+      const bool spaced = (f % lay.grids[0].blocks_x) % 3 == 0 && (f / lay.grids[0].blocks_x) % 3 == 0;
       for (size_t i = 0; i < batch.size(); ++i) {
         const size_t at = i * row + col;
         const double c0 = k0.features[at];
@@ -337,12 +337,12 @@ TEST(Physics, RawGridNoiseHasThePerPixelCovariance) {
     const size_t row = lay.image_features();
     const auto column = [&](int f) { return static_cast<size_t>(pool.columns[f]); };
     // Some blocks, their right and lower neighbours, and the last region the view sees.
-    const int blocks = lay.blocks_per_view(), region = static_cast<int>(pool.columns.size()) - 1;
+    const int blocks = lay.grids[0].blocks(), region = static_cast<int>(pool.columns.size()) - 1;
     std::vector<std::pair<int, int>> pairs;
     for (int f = 0; f < blocks; f += blocks / 11 + 1) {
       pairs.emplace_back(f, f);
       if (f + 1 < blocks) pairs.emplace_back(f, f + 1);
-      if (f + lay.blocks_x < blocks) pairs.emplace_back(f, f + lay.blocks_x);
+      if (f + lay.grids[0].blocks_x < blocks) pairs.emplace_back(f, f + lay.grids[0].blocks_x);
       pairs.emplace_back(f, region);
     }
     pairs.emplace_back(region, region);
@@ -597,7 +597,7 @@ struct FlatWorld {
       ASSERT_NE(at, std::string::npos) << from;
       text.replace(at, from.size(), to);
     };
-    replace("name = \"subject-1\"\n", "name = \"subject-1\"\nmmw_upper = \"flat.png\"\n");
+    replace("name = \"subject-1\"\n", "name = \"subject-1\"\nimages.upper = \"flat.png\"\n");
     replace("shape = \"plate\"\nsize = [32, 40]", "shape = \"plate\"\nsize = [120, 120]");
     if (!edit_from.empty()) replace(edit_from, edit_to);
     cat = parse_catalogue(text, "flat.toml", dir.w().string(), "");

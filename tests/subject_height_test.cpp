@@ -78,11 +78,11 @@ TEST(SubjectHeight, CatalogueReadsHeightAndRefusesBadValues) {
   }
   // A body from image files cannot be drawn at another height.
   int line = 0;
-  const std::string e = error_of(with_subject_line(0, "height = 1.1\nmmw_upper = \"u.png\"", &line));
+  const std::string e = error_of(with_subject_line(0, "height = 1.1\nimages.upper = \"u.png\"", &line));
   EXPECT_NE(e.find("h.toml:" + std::to_string(line) + ": subjects[1].height: only a procedural body"),
             std::string::npos)
       << e;
-  EXPECT_EQ(error_of(with_subject_line(0, "height = 1.0\nmmw_upper = \"u.png\"")), "") << "height 1 is allowed";
+  EXPECT_EQ(error_of(with_subject_line(0, "height = 1.0\nimages.upper = \"u.png\"")), "") << "height 1 is allowed";
 }
 
 // First and last row with a body pixel (above `threshold`) in columns [x0, x1].
@@ -177,7 +177,7 @@ TEST(SubjectHeight, ObjectsStayOnTheirBodyPart) {
     annotate(hi, ahi, ModelSettings{}, test::batch_of({s}), out);
     ASSERT_EQ(out[low].items.size(), 1u);
     EXPECT_EQ(out[low].items[0].y, 0);
-    EXPECT_LT(out[low].items[0].h, ahi.sprite(Camera::mmw, plate).height);
+    EXPECT_LT(out[low].items[0].h, ahi.sprite(hi.sensors[low], plate).height);
   }
   for (int r : {1, 4, 8, 9, 11}) {
     SCOPED_TRACE("region " + std::to_string(r + 1));

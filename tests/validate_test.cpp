@@ -442,9 +442,9 @@ TEST(Validate, DemoMakesBothSetsAndTheReport) {
 
   // The real set comes through the user-image route: a catalogue naming altered images.
   const std::string catalogue = slurp(out / "demo" / "catalogue.toml");
-  EXPECT_NE(catalogue.find("mmw_upper = \"images/subject1_mmw_upper.png\""), std::string::npos);
-  EXPECT_NE(catalogue.find("mmw_lower = \"images/subject5_mmw_lower.png\""), std::string::npos);
-  EXPECT_GT(fs::file_size(out / "demo" / "images" / "subject5_mmw_lower.png"), 1000u);
+  EXPECT_NE(catalogue.find("images.upper = \"images/subject1_upper.png\""), std::string::npos);
+  EXPECT_NE(catalogue.find("images.lower = \"images/subject5_lower.png\""), std::string::npos);
+  EXPECT_GT(fs::file_size(out / "demo" / "images" / "subject5_lower.png"), 1000u);
   const std::string sim = slurp(out / "demo" / "sim.arff"), real = slurp(out / "demo" / "real.arff");
   // The offset of +20 (gain 0.85) lifts the dark background of the altered views.
   EXPECT_GT(mean_of(real, "upper_r0_c0"), mean_of(sim, "upper_r0_c0") + 5);

@@ -71,16 +71,18 @@ def load(path):
 
 
 def region_positions(cat):
-    """Region r's centre in portal coordinates (x, z), metres."""
-    img = cat["images"]
-    w, h = img["mmw_width"], img["mmw_height"]
-    scale = BODY_HEIGHT / (2.0 * h)
+    """Region r's centre in portal coordinates (x, z), metres: in the portal's 200 x 400 field
+    (host/scene/sensor.h), as the first view that sees it frames it (a back view mirrored)."""
+    scale = BODY_HEIGHT / 400.0
+    views = {v["name"]: v for v in cat["views"]}
     pos = {}
-    for r in cat["regions"]:
-        x0, y0, rw, rh = r["mmw"]
-        cx, cy = x0 + rw / 2.0, y0 + rh / 2.0
-        row = cy + (h if r["view"] == "lower" else 0)
-        pos[r["id"]] = ((cx - w / 2.0) * scale, BODY_HEIGHT - row * scale)
+    for k, r in enumerate(cat["regions"]):
+        v = next(views[name] for name in views if name in r["rects"])
+        fx, fy, fw, fh = v["field"]
+        (w, h), (x0, y0, rw, rh) = v["size"], r["rects"][v["name"]]
+        cx, cy = (x0 + rw / 2.0) * fw / w, (y0 + rh / 2.0) * fh / h
+        col = fx + fw - cx if v.get("side") == "back" else fx + cx
+        pos[k + 1] = ((col - 100.0) * scale, BODY_HEIGHT - (fy + cy) * scale)
     return pos
 
 

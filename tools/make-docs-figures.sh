@@ -20,6 +20,8 @@ py=/usr/bin/python3
 
 # The README's two models side by side, and one row through the physics chain.
 models() { "$py" tools/physics_figures.py "$portalsim" docs/; }
+# README and docs/reference/catalogue.md: the front-and-back portal's views and regions.
+portal() { "$py" tools/plot_portal_views.py "$portalsim" docs/portal_front_back.png; }
 # docs/model/subjects.md: the subjects at three heights.
 subjects() { "$py" tools/plot_subject_heights.py "$portalsim" docs/subject_heights.png; }
 # docs/model/randomised-objects.md: turned, scaled and mirrored objects.
@@ -65,7 +67,7 @@ evaluate() {
   cp "$work/one/regions.png" docs/evaluate_study_regions.png
 }
 
-all=(models subjects randomised coco calibrate serve sensitivity tradeoff metalmap evaluate)
+all=(models portal subjects randomised coco calibrate serve sensitivity tradeoff metalmap evaluate)
 for figure in "${@:-${all[@]}}"; do
   case " ${all[*]} " in
     *" $figure "*) ;;

@@ -24,10 +24,12 @@ SparseFeatures::SparseFeatures(const Catalogue& cat, const AssetSet& assets, con
     : cat_(cat), assets_(assets), model_(model), layout_(FeatureLayout::of(cat, model.block)) {
   if (model.pixel_sigma > 0 || model.moves_sprites())
     throw std::invalid_argument("the features baseline is the sparse path: no pixel noise, no jitter");
+  if (!layout_.uniform) throw std::invalid_argument("the features baseline takes pooled views of one size");
   const Sensor& first = cat.sensors[layout_.pooled.at(0)];
   W_ = first.width;
   H_ = first.height;
-  const int block = layout_.block, bx = layout_.blocks_x, by = layout_.blocks_y, per_view = bx * by;
+  const int block = layout_.block, bx = layout_.grids.at(0).blocks_x, by = layout_.grids.at(0).blocks_y,
+            per_view = bx * by;
   alpha_ = static_cast<float>(cat.images.alpha);
   tile_ = cat.images.noise_size;
   patterns_ = model.pattern_noise ? static_cast<int>(cat.noise.size()) : 1;
@@ -74,8 +76,9 @@ SparseFeatures::SparseFeatures(const Catalogue& cat, const AssetSet& assets, con
   for (int v = 0; v < V; ++v)
     for (int r = 0; r < kRegions; ++r) {
       Footprint& fp = prints_[static_cast<size_t>(v) * kRegions + r];
-      const Image& sp = assets.sprite(Camera::mmw, v);
-      const Rect& rc = cat.sensors[layout_.pooled[slot_[r]]].rects[r];
+      const Sensor& in = cat.sensors[layout_.pooled[slot_[r]]];
+      const Image& sp = assets.sprite(in, v);
+      const Rect& rc = in.rects[r];
       fp.sprite = &sp;
       fp.sx = rc.x + ((rc.w - sp.width) >> 1);
       fp.sy = rc.y + ((rc.h - sp.height) >> 1);
@@ -145,8 +148,8 @@ uint8_t SparseFeatures::pixel(const Footprint* const* fps, int count, uint8_t ba
 
 void SparseFeatures::run(const SceneBatch& batch, BatchOutput& out) const {
   const size_t n = batch.size();
-  const int row_len = layout_.image_features(), bx = layout_.blocks_x, block = layout_.block;
-  const int per_view = layout_.blocks_per_view(), npooled = static_cast<int>(layout_.pooled.size());
+  const int row_len = layout_.image_features(), bx = layout_.grids.at(0).blocks_x, block = layout_.block;
+  const int per_view = layout_.grids.at(0).blocks(), npooled = static_cast<int>(layout_.pooled.size());
 #pragma omp parallel
   {
     std::vector<int32_t> acc(per_view);

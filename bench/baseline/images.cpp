@@ -78,7 +78,7 @@ void render_images(const Catalogue& cat, const AssetSet& assets, const SceneBatc
         layers.clear();
         for (int r = 0; r < kRegions; ++r) {
           if (objects[r] < 0 || !s.sees(r)) continue;
-          const Image& sp = assets.sprite(s.camera, objects[r]);
+          const Image& sp = assets.sprite(s, objects[r]);
           const Rect& rc = s.rects[r];
           const int x0 = rc.x + ((rc.w - sp.width) >> 1), y0 = rc.y + ((rc.h - sp.height) >> 1);
           layers.push_back({&sp, x0, y0, x0 + (sp.width >> 1) - (tile >> 1), y0 + (sp.height >> 1) - (tile >> 1)});

@@ -1,5 +1,6 @@
 #include "assets/assets.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -11,9 +12,6 @@ namespace portalsim {
 
 namespace {
 
-// Whether a view shows the body's upper half: its floor lies below it (Sensor::floor_row).
-bool upper_half(const Sensor& view) { return view.floor_row > view.height; }
-
 bool has_alpha(const Image& img) { return img.channels == 2 || img.channels == 4; }
 
 int luminance(const Image& img, int x, int y) {
@@ -24,6 +22,14 @@ int luminance(const Image& img, int x, int y) {
 Image load(const ImageSource& src) { return read_image(src.path, src.origin); }
 
 Image sized(Image img, int w, int h) { return resize_image(img, w, h); }
+
+Image mirrored(const Image& img) {
+  Image out(img.width, img.height, img.channels);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < img.channels; ++c) out.at(img.width - 1 - x, y, c) = img.at(x, y, c);
+  return out;
+}
 
 }  // namespace
 
@@ -89,31 +95,33 @@ AssetSet build_assets(const Catalogue& cat) {
     std::vector<Image> views;
     for (const Sensor& view : cat.sensors) {
       const bool ir = view.camera == Camera::ir;
-      const ImageSource& src = sub.image(view.asset_key);
+      const ImageSource& src = sub.image(view.name);
       if (!src.path.empty())
         views.push_back(sized(ir ? to_temperature(load(src), a.palette, false) : to_gray(load(src), false), view.width,
                               view.height));
       else
-        views.push_back(ir ? procedural::ir_body(body, view.width, view.height)
-                           : procedural::mmw_body(body, upper_half(view), view.width, view.height));
+        views.push_back(ir ? procedural::ir_view(body, view.field, view.side, view.width, view.height)
+                           : procedural::mmw_view(body, view.field, view.side, view.width, view.height));
     }
     a.bases.push_back(std::move(views));
   }
-  // IR sprites keep the objects' physical size: scale by the IR view's pixels per MMW pixel.
-  const double sx = static_cast<double>(ic.ir_width) / ic.mmw_width;
-  const double sy = static_cast<double>(ic.ir_height) / (2.0 * ic.mmw_height);
-  for (size_t v = 0; v < cat.variant_list.size(); ++v) {
-    const Object& o = cat.object_of(static_cast<int>(v));
-    const Variant& var = cat.variant(static_cast<int>(v));
-    const bool vertical = var.code == "v";
-    const int w = vertical ? o.height : o.width, h = vertical ? o.width : o.height;
-    a.sprites[static_cast<int>(Camera::mmw)].push_back(
-        var.mmw.path.empty() ? procedural::sprite(o.shape, vertical, w, h, o.mmw_level) : to_gray(load(var.mmw), true));
-    const int iw = std::max(1, static_cast<int>(std::lround(w * sx)));
-    const int ih = std::max(1, static_cast<int>(std::lround(h * sy)));
-    a.sprites[static_cast<int>(Camera::ir)].push_back(var.ir.path.empty()
-                                                          ? procedural::sprite(o.shape, vertical, iw, ih, o.ir_level)
-                                                          : to_temperature(load(var.ir), a.palette, true));
+  // Each sprite set's drawings keep the objects' physical size: a catalogue size is in field
+  // units, scaled by the set's view pixels per unit. A file is its camera's drawing as given.
+  for (const SpriteSet& set : cat.sprite_sets) {
+    std::vector<Image>& out = a.sprites.emplace_back();
+    const bool ir = set.camera == Camera::ir;
+    for (size_t v = 0; v < cat.variant_list.size(); ++v) {
+      const Object& o = cat.object_of(static_cast<int>(v));
+      const Variant& var = cat.variant(static_cast<int>(v));
+      const bool vertical = var.code == "v";
+      const int w = vertical ? o.height : o.width, h = vertical ? o.width : o.height;
+      const int sw = std::max(1, static_cast<int>(std::lround(w * set.scale_x)));
+      const int sh = std::max(1, static_cast<int>(std::lround(h * set.scale_y)));
+      const ImageSource& file = ir ? var.ir : var.mmw;
+      Image sp = !file.path.empty() ? (ir ? to_temperature(load(file), a.palette, true) : to_gray(load(file), true))
+                                    : procedural::sprite(o.shape, vertical, sw, sh, ir ? o.ir_level : o.mmw_level);
+      out.push_back(set.mirrored ? mirrored(sp) : std::move(sp));
+    }
   }
   for (size_t k = 0; k < cat.noise.size(); ++k) {
     const NoisePattern& p = cat.noise[k];

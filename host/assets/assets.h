@@ -14,14 +14,14 @@ struct AssetSet {
   // Per subject, per camera view (Catalogue::sensors order): 1 channel at the view's size,
   // gray (MMW) or temperature index (IR).
   std::vector<std::vector<Image>> bases;
-  // Per camera (Camera::mmw, Camera::ir), per variant id: 2 channels (value, alpha).
-  // IR sprites are temperature indices at the IR view's scale.
-  std::array<std::vector<Image>, kCameras> sprites;
+  // Per sprite set (Catalogue::sprite_sets), per variant id: 2 channels (value, alpha);
+  // gray for MMW, temperature indices for IR, at the set's scale, mirrored for back views.
+  std::vector<std::vector<Image>> sprites;
   // Per noise pattern: 1 channel, 128 = no change, noise_size square.
   std::vector<Image> noise;
   Palette palette{};
 
-  const Image& sprite(Camera c, int variant) const { return sprites[static_cast<int>(c)][variant]; }
+  const Image& sprite(const Sensor& view, int variant) const { return sprites[view.sprite_set][variant]; }
 };
 
 // Throws InputError naming the catalogue field and file for a missing or corrupt image.

@@ -18,6 +18,9 @@ namespace {
 // Refuse absurd sizes with an exception rather than an allocation failure deep inside.
 constexpr int64_t kMaxPixels = int64_t{1} << 28;
 
+// Added to a body's texture seeds where it is seen from the back.
+constexpr uint64_t kBackSeed = 0x6261636bull;  // "back"
+
 void check_size(int w, int h, const char* what) {
   if (w < 1 || h < 1) throw std::invalid_argument(std::string(what) + ": width and height must be at least 1");
   if (static_cast<int64_t>(w) * h > kMaxPixels) throw std::invalid_argument(std::string(what) + ": image too large");
@@ -675,21 +678,31 @@ constexpr Stop kRainbow[] = {{0, 0, 0, 128},     {40, 0, 0, 255},   {92, 0, 224,
 }  // namespace
 
 Image mmw_body(const Body& body, bool upper, int width, int height) {
+  return mmw_view(body, upper ? Frame{0, 0, 200, 200} : Frame{0, 200, 200, 200}, Side::front, width, height);
+}
+
+Image ir_body(const Body& body, int width, int height) { return ir_view(body, Frame{}, Side::front, width, height); }
+
+Image mmw_view(const Body& body, const Frame& field, Side side, int width, int height) {
   check_size(width, height, "mmw_body");
   const BodyModel model(body);
   Image img(width, height, 1);
-  const double pu = 200.0 / width, pv = 200.0 / height;
+  const double pu = field.w / width, pv = field.h / height;
   const double e = edge_width(std::max(pu, pv));
   const double level = body.mmw_level, bg = body.mmw_background;
-  const uint64_t seed = model.seed();
+  const bool back = side == Side::back;
+  // The back's own texture (its seeds apart from the front's), and no chin.
+  const uint64_t seed = model.seed() + (back ? kBackSeed : 0);
+  const double chin = back ? 0.0 : 18.0;
   for (int y = 0; y < height; ++y) {
-    const double v = (y + 0.5) * pv + (upper ? 0.0 : 200.0);
+    const double v = (y + 0.5) * pv + field.y;
     const double vb = model.body_row(v);  // the body drawn here; the room stays at v
     int next = 0;                         // pixels before `next` are known to be clear of the body
     for (int x = 0; x < width; ++x) {
-      const double u = (x + 0.5) * pu;
-      const double back = bg + 2.0 * value_noise(u / 9.0, v / 9.0, seed + 2) + 1.5 * hash_signed(x, y, seed + 3);
-      double val = back;
+      // A back view sees the field mirrored: its left edge is the field's right.
+      const double u = back ? field.x + field.w - (x + 0.5) * pu : (x + 0.5) * pu + field.x;
+      const double room = bg + 2.0 * value_noise(u / 9.0, v / 9.0, seed + 2) + 1.5 * hash_signed(x, y, seed + 3);
+      double val = room;
       if (x < next) {
         img.at(x, y) = to_u8(val);
         continue;
@@ -701,8 +714,8 @@ Image mmw_body(const Body& body, bool upper, int width, int height) {
         const double depth = clamp01(-f.d / 26.0);
         const double s = 1.0 - (1.0 - depth) * (1.0 - depth);
         const double skin = level + 34.0 * (s - 0.7) + 4.0 * fbm(u / 22.0, vb / 22.0, seed + 4) +
-                            2.5 * hash_signed(x, y, seed + 5) - 18.0 * f.chin * f.chin;
-        val = lerp(back, skin, c);
+                            2.5 * hash_signed(x, y, seed + 5) - chin * f.chin * f.chin;
+        val = lerp(room, skin, c);
       }
       img.at(x, y) = to_u8(val);
     }
@@ -710,20 +723,21 @@ Image mmw_body(const Body& body, bool upper, int width, int height) {
   return img;
 }
 
-Image ir_body(const Body& body, int width, int height) {
+Image ir_view(const Body& body, const Frame& field, Side side, int width, int height) {
   check_size(width, height, "ir_body");
   const BodyModel model(body);
   Image img(width, height, 1);
-  const double pu = 200.0 / width, pv = 400.0 / height;
+  const double pu = field.w / width, pv = field.h / height;
   const double e = edge_width(std::max(pu, pv));
   const double core = body.ir_core, limb = body.ir_limb, bg = body.ir_background;
-  const uint64_t seed = model.seed();
+  const bool back = side == Side::back;
+  const uint64_t seed = model.seed() + (back ? kBackSeed : 0);
   for (int y = 0; y < height; ++y) {
-    const double v = (y + 0.5) * pv;
+    const double v = (y + 0.5) * pv + field.y;
     const double vb = model.body_row(v);  // the body drawn here; the room stays at v
     int next = 0;
     for (int x = 0; x < width; ++x) {
-      const double u = (x + 0.5) * pu;
+      const double u = back ? field.x + field.w - (x + 0.5) * pu : (x + 0.5) * pu + field.x;
       const double back = bg + 3.0 * v / 400.0 + 1.5 * value_noise(u / 12.0, v / 12.0, seed + 6);
       double val = back;
       if (x < next) {

@@ -8,6 +8,7 @@
 
 #include "assets/image.h"
 #include "scene/builtin_images.h"
+#include "scene/sensor.h"
 
 namespace portalsim::procedural {
 
@@ -30,9 +31,14 @@ struct Body {
   int ir_background = 35;
 };
 
-// 1 channel gray: the upper (shoulders to hips) or lower (hips to feet) MMW view.
+// 1 channel gray: the part `field` of the portal's field (scene/sensor.h, Frame) as the MMW
+// camera sees it from `side` (the back mirrored, with a texture of its own).
+Image mmw_view(const Body& body, const Frame& field, Side side, int width, int height);
+// 1 channel temperature index (0 cold .. 255 hot), the same for the IR camera.
+Image ir_view(const Body& body, const Frame& field, Side side, int width, int height);
+// The thesis's views: the upper (shoulders to hips) or lower (hips to feet) MMW view, and
+// the whole body in IR, from the front.
 Image mmw_body(const Body& body, bool upper, int width, int height);
-// 1 channel temperature index (0 cold .. 255 hot), whole body.
 Image ir_body(const Body& body, int width, int height);
 
 // The object outlines of the thesis (section 4.3.1). width/height are the sprite's

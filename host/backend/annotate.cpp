@@ -399,7 +399,7 @@ Annotator::Annotator(const Catalogue& cat, const AssetSet& assets) : kept_(new K
   kept_->runs.resize(cat.sensors.size());
   for (size_t k = 0; k < cat.sensors.size(); ++k)
     for (size_t v = 0; v < cat.variant_list.size(); ++v)
-      kept_->runs[k].emplace_back(assets.sprite(cat.sensors[k].camera, static_cast<int>(v)));
+      kept_->runs[k].emplace_back(assets.sprite(cat.sensors[k], static_cast<int>(v)));
 }
 
 Annotator::~Annotator() = default;

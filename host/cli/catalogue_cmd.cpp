@@ -21,7 +21,8 @@ int list(CatalogueOptions& o) {
   std::printf("catalogue %s (hash %s)\n", c.source.c_str(), c.hash.c_str());
   std::printf("camera views:");
   for (const Sensor& v : c.sensors)
-    std::printf(" %s %s %dx%d;", v.name.c_str(), camera_name(v.camera), v.width, v.height);
+    std::printf(" %s %s%s %dx%d;", v.name.c_str(), camera_name(v.camera), v.side == Side::back ? " back" : "", v.width,
+                v.height);
   std::printf(" alpha %.3g\n", c.images.alpha);
   std::printf("\nsubjects:\n");
   for (size_t i = 0; i < c.subjects.size(); ++i)  // what the body is drawn as: width and stature scales
@@ -51,6 +52,18 @@ int list(CatalogueOptions& o) {
   }
   return 0;
 }
+
+// A sprite set's file name: its camera, "_back" where mirrored, and its index where another
+// set has the same camera and side at another scale.
+std::string sprite_set_name(const Catalogue& c, size_t set) {
+  const SpriteSet& a = c.sprite_sets[set];
+  std::string name = std::string(camera_name(a.camera)) + (a.mirrored ? "_back" : "");
+  for (size_t k = 0; k < c.sprite_sets.size(); ++k)
+    if (k != set && c.sprite_sets[k].camera == a.camera && c.sprite_sets[k].mirrored == a.mirrored)
+      return name + std::to_string(set + 1);
+  return name;
+}
+
 }  // namespace
 
 void write_catalogue_images(const Session& s, StagedFolder& folder) {
@@ -65,15 +78,15 @@ void write_catalogue_images(const Session& s, StagedFolder& folder) {
     std::string n = c.variant_name(static_cast<int>(v));
     for (char& ch : n)
       if (ch == ':') ch = '_';
-    for (Camera cam : {Camera::mmw, Camera::ir})
-      write_image(folder.path(n + "_" + camera_name(cam) + ".png"), s.assets.sprite(cam, static_cast<int>(v)));
+    for (size_t set = 0; set < c.sprite_sets.size(); ++set)
+      write_image(folder.path(n + "_" + sprite_set_name(c, set) + ".png"), s.assets.sprites[set][v]);
   }
   for (size_t k = 0; k < s.assets.noise.size(); ++k)
     write_image(folder.path("noise" + std::to_string(k + 1) + "_" + c.noise[k].name + ".png"), s.assets.noise[k]);
 }
 
 std::string subject_image_name(size_t subject, const Sensor& view) {
-  return "subject" + std::to_string(subject + 1) + "_" + view.asset_key + ".png";
+  return "subject" + std::to_string(subject + 1) + "_" + view.name + ".png";
 }
 
 std::function<int()> add_catalogue(CLI::App& app) {

@@ -78,6 +78,13 @@ EvaluateData read_evaluate_data(const std::string& dir, const Catalogue& cat) {
     throw InputError(dir + ": no manifest.json: not a finished portalsim generate folder");
   const nlohmann::json manifest =
       parse_manifest(io::read_text_file(manifest_path, "manifest", io::Bom::refuse), manifest_path);
+  // Columns and regions are read through the catalogue the data set was made with.
+  const std::string made_with = manifest.value("catalogue", nlohmann::json::object()).value("hash", "");
+  if (made_with != cat.hash)
+    throw InputError(dir + ": made with the catalogue " +
+                     manifest.value("catalogue", nlohmann::json::object()).value("source", std::string("?")) +
+                     " (hash " + made_with + "), not " + cat.source + " (hash " + cat.hash +
+                     "): give that catalogue with --catalogue");
   const std::string table_path = find_table(dir);
   const Table t = read_table(table_path);
 

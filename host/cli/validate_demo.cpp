@@ -97,7 +97,7 @@ nlohmann::json make_demo_sets(const std::string& dir, uint64_t count, uint64_t s
       const std::string name = subject_image_name(i, view);
       const Image img = read_image((fs::path(dump) / name).string(), "validate --demo");
       write_image((d / "images" / name).string(), alter(img, static_cast<uint32_t>(i * cat.sensors.size() + k)));
-      fields[i] += view.asset_key + " = \"images/" + name + "\"\n";
+      fields[i] += "images." + view.name + " = \"images/" + name + "\"\n";
     }
   fs::remove_all(dump, ec);
   std::string toml =

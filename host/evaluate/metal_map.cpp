@@ -231,8 +231,9 @@ MetalWalks metal_map_walks(const Catalogue& cat, const MetalMapSettings& s) {
       for (double x : g.x) add_walk(w, s, x, z, a);
   }
   // Clean testers: each subject with each benign item in each region, as generate places it
-  // (its region's centre in the stacked MMW views, Sensor::place), drawn as the catalogue has it.
-  const double scale = mp.body_height / (2.0 * cat.images.mmw_height);
+  // (its region's centre where its first view places it, Sensor::place, in the portal's
+  // field), drawn as the catalogue has it.
+  const double scale = cat.metres_per_field_unit();
   for (size_t subject = 0; subject < cat.subjects.size(); ++subject)
     for (int o : benign_present(cat, nullptr)) {
       const int v = cat.objects[o].first_variant;
@@ -240,20 +241,12 @@ MetalWalks metal_map_walks(const Catalogue& cat, const MetalMapSettings& s) {
       const int record = static_cast<int>(w.objects.size() / PS_MV_LEN);
       add_object(w.objects, cat.polarizability(v), side[0], 0.0, side[1]);
       for (int r = 0; r < kRegions; ++r) {
-        // The region's first MMW view: one walk a region.
-        double row_offset = 0;
-        bool placed = false;
-        for (const Sensor& sensor : cat.sensors) {
-          if (sensor.camera != Camera::mmw) continue;
-          if (sensor.sees(r) && !placed) {
-            const Rect rc = sensor.place(static_cast<int>(subject), r);
-            const double col = rc.x + rc.w / 2.0, row = row_offset + rc.y + rc.h / 2.0;
-            add_walk(w, s, (col - sensor.width / 2.0) * scale, mp.body_height - row * scale, record);
-            placed = true;
-          }
-          row_offset += sensor.height;
-        }
-        if (!placed) throw InputError("--metal-map: region " + cat.regions[r].name + " is in no MMW view");
+        const int k = metal_view(cat.sensors, r);
+        if (k < 0) throw InputError("--metal-map: region " + cat.regions[r].name + " is in no view");
+        const Sensor& sensor = cat.sensors[k];
+        const Rect rc = sensor.place(static_cast<int>(subject), r);
+        const double col = sensor.field_col(rc.x + rc.w / 2.0), row = sensor.field_row(rc.y + rc.h / 2.0);
+        add_walk(w, s, (col - kFieldWidth / 2.0) * scale, mp.body_height - row * scale, record);
       }
     }
   return w;

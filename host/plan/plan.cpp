@@ -25,10 +25,13 @@ FeatureLayout FeatureLayout::of(const Catalogue& cat, int block) {
   for (size_t k = 0; k < cat.sensors.size(); ++k) {
     const Sensor& s = cat.sensors[k];
     if (!s.pooled) continue;
+    const Sensor& first = cat.sensors[f.pooled.empty() ? k : f.pooled[0]];
+    f.uniform = f.uniform && s.width == first.width && s.height == first.height;
+    f.grids.push_back({.blocks_x = (s.width + block - 1) / block,
+                       .blocks_y = (s.height + block - 1) / block,
+                       .offset = f.block_features()});
     f.pooled.push_back(static_cast<int>(k));
     f.view_names.push_back(s.name);
-    f.blocks_x = (s.width + block - 1) / block;
-    f.blocks_y = (s.height + block - 1) / block;
   }
   return f;
 }
@@ -48,9 +51,10 @@ int FeatureLayout::block_for_grid(const Catalogue& cat, int w, int h) {
 
 std::vector<std::string> FeatureLayout::names() const {
   std::vector<std::string> n;
-  for (const std::string& view : view_names)
-    for (int by = 0; by < blocks_y; ++by)
-      for (int bx = 0; bx < blocks_x; ++bx) n.push_back(view + "_r" + std::to_string(by) + "_c" + std::to_string(bx));
+  for (size_t slot = 0; slot < pooled.size(); ++slot)
+    for (int by = 0; by < grids[slot].blocks_y; ++by)
+      for (int bx = 0; bx < grids[slot].blocks_x; ++bx)
+        n.push_back(view_names[slot] + "_r" + std::to_string(by) + "_c" + std::to_string(bx));
   for (int r = 1; r <= kRegions; ++r) n.push_back("region" + std::to_string(r));
   for (int z = 1; z <= kZones; ++z) n.push_back("zone" + std::to_string(z));
   return n;

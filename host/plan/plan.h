@@ -148,15 +148,22 @@ struct Plan {
 
 // The layout of a feature row: the blocks of each pooled view in turn (row-major,
 // partial blocks at the right and bottom edges averaged over the pixels they hold), the
-// 13 region means, then the 19 metal zones; sinks append the class. Every pooled view
-// has the same size.
+// 13 region means, then the 19 metal zones; sinks append the class. Each pooled view has
+// its own grid of blocks.
 struct FeatureLayout {
+  struct Grid {
+    int blocks_x = 0, blocks_y = 0;
+    int offset = 0;  // its first column
+    int blocks() const { return blocks_x * blocks_y; }
+  };
   int block = 10;
-  int blocks_x = 0, blocks_y = 0;  // per pooled view
-  std::vector<int> pooled;         // the pooled views (indices into Catalogue::sensors)
+  std::vector<int> pooled;  // the pooled views (indices into Catalogue::sensors)
   std::vector<std::string> view_names;
-  int blocks_per_view() const { return blocks_x * blocks_y; }
-  int block_features() const { return static_cast<int>(pooled.size()) * blocks_per_view(); }
+  std::vector<Grid> grids;  // per pooled view
+  // Every pooled view has one size (so one grid): what the features paths' tables assume
+  // (backend/opencl/paths/); the other layouts take the pooled views rendered.
+  bool uniform = true;
+  int block_features() const { return grids.empty() ? 0 : grids.back().offset + grids.back().blocks(); }
   int image_features() const { return block_features() + kRegions; }
   int row_features() const { return image_features() + kZones; }
   std::vector<std::string> names() const;

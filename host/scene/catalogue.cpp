@@ -121,9 +121,7 @@ struct Reader {
     return out;
   }
 
-  Rect rect(const toml::table& t, const std::string& key, const std::string& field, int view_w, int view_h) const {
-    const std::string f = field + "." + key;
-    const toml::node* n = need(t, key, f);
+  Rect rect(const toml::node* n, const std::string& f, int view_w, int view_h) const {
     const std::vector<int> v = ints(n, f, 4, -100000, 100000);
     const Rect r{v[0], v[1], v[2], v[3]};
     if (r.w < 1 || r.h < 1) fail(n, f, "width and height must be at least 1");
@@ -202,11 +200,57 @@ void read_metal_physics(const Reader& rd, const toml::node* node, Catalogue& cat
     mp.polarizability.push_back(rd.number(*pol, c, f + ".polarizability", 0.0, 1e6));
 }
 
+// [[views]]: the portal's camera views, in output order (scene/sensor.h).
+void read_views(const Reader& rd, const toml::table& root, Catalogue& cat) {
+  const toml::array& views = rd.array_of_tables(root, "views");
+  // Views are counted in the pixel noise stream's element (PS_PIXEL_NOISE_VIEW_SHIFT) and a
+  // subject's base images: 16 is far more than any portal has.
+  if (views.empty() || views.size() > 16) rd.fail(&views, "views", "expected 1 to 16 views");
+  for (size_t i = 0; i < views.size(); ++i) {
+    const toml::table& t = *views.get(i)->as_table();
+    const std::string f = "views[" + std::to_string(i + 1) + "]";
+    io::reject_unknown_keys(t, {"name", "camera", "side", "size", "field", "pooled"}, rd.file, f);
+    Sensor s;
+    s.name = rd.string(t, "name", f);
+    const bool name_ok =
+        !s.name.empty() && s.name.size() <= 32 && std::all_of(s.name.begin(), s.name.end(), [](char c) {
+          return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+        });
+    // It names files, columns, data sets and Python keys.
+    if (!name_ok) rd.fail(t.get("name"), f + ".name", "\"" + s.name + "\": expected 1 to 32 of a-z, 0-9 and _");
+    if (cat.sensor_index(s.name) >= 0) rd.fail(t.get("name"), f + ".name", "\"" + s.name + "\" is named twice");
+    const std::string camera = rd.string(t, "camera", f);
+    if (camera != "mmw" && camera != "ir")
+      rd.fail(t.get("camera"), f + ".camera", "expected \"mmw\" or \"ir\", got \"" + camera + "\"");
+    s.camera = camera == "ir" ? Camera::ir : Camera::mmw;
+    const std::string side = rd.string(t, "side", f, "front");
+    if (side != "front" && side != "back")
+      rd.fail(t.get("side"), f + ".side", "expected \"front\" or \"back\", got \"" + side + "\"");
+    s.side = side == "back" ? Side::back : Side::front;
+    const std::vector<int> size = rd.ints(rd.need(t, "size", f + ".size"), f + ".size", 2, 1, 4096);
+    s.width = size[0];
+    s.height = size[1];
+    const std::string ff = f + ".field";
+    const toml::node* fn = rd.need(t, "field", ff);
+    const toml::array* fa = fn->as_array();
+    if (!fa || fa->size() != 4) rd.fail(fn, ff, "expected [x, y, width, height] in the portal's 200 x 400 field");
+    std::array<double, 4> v{};
+    for (size_t k = 0; k < 4; ++k)
+      v[k] = rd.number(fa->get(k), ff + "[" + std::to_string(k) + "]", k < 2 ? -kFieldHeight : 1.0, kFieldHeight);
+    s.field = {v[0], v[1], v[2], v[3]};
+    if (const toml::node* pn = t.get("pooled")) {
+      if (!pn->is_boolean()) rd.fail(pn, f + ".pooled", "expected true or false");
+      s.pooled = pn->as_boolean()->get();
+    }
+    cat.sensors.push_back(std::move(s));
+  }
+}
+
 }  // namespace
 
-const ImageSource& Subject::image(std::string_view key) const {
+const ImageSource& Subject::image(std::string_view view) const {
   static const ImageSource procedural;
-  const auto it = images.find(key);
+  const auto it = images.find(view);
   return it == images.end() ? procedural : it->second;
 }
 
@@ -232,7 +276,7 @@ std::array<double, 9> Catalogue::polarizability(int variant_id, const std::array
 
 std::array<double, 2> Catalogue::long_side(int variant_id) const {
   const Object& o = object_of(variant_id);
-  const double scale = metal_physics.body_height / (2.0 * images.mmw_height);
+  const double scale = metres_per_field_unit();
   const bool turned = variant(variant_id).code == "v";
   const int w = turned ? o.height : o.width, h = turned ? o.width : o.height;
   return w >= h ? std::array<double, 2>{w * scale, 0.0} : std::array<double, 2>{0.0, h * scale};
@@ -267,7 +311,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   Reader rd{source_name, base_dir, assets_dir};
   const toml::table root = io::parse_toml(text, source_name);
   io::reject_unknown_keys(
-      root, {"format", "images", "metal", "subjects", "regions", "objects", "noise", "physics", "materials"},
+      root, {"format", "images", "views", "metal", "subjects", "regions", "objects", "noise", "physics", "materials"},
       source_name, "");
   Catalogue cat;
   cat.source = source_name;
@@ -279,15 +323,15 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   const toml::node* imgs_node = rd.need(root, "images", "images");
   const toml::table* imgs = imgs_node->as_table();
   if (!imgs) rd.fail(imgs_node, "images", "expected a table");
-  io::reject_unknown_keys(*imgs, {"mmw_width", "mmw_height", "ir_width", "ir_height", "alpha", "noise_size"},
-                          source_name, "images");
+  for (const char* moved : {"mmw_width", "mmw_height", "ir_width", "ir_height"})
+    if (const toml::node* n = imgs->get(moved))
+      rd.fail(n, std::string("images.") + moved, "the views' sizes are [[views]] entries now (size = [WIDTH, HEIGHT])");
+  io::reject_unknown_keys(*imgs, {"alpha", "noise_size"}, source_name, "images");
   ImagesConfig& ic = cat.images;
-  ic.mmw_width = rd.integer(*imgs, "mmw_width", "images", 1, 4096);
-  ic.mmw_height = rd.integer(*imgs, "mmw_height", "images", 1, 4096);
-  ic.ir_width = rd.integer(*imgs, "ir_width", "images", 1, 4096);
-  ic.ir_height = rd.integer(*imgs, "ir_height", "images", 1, 4096);
   ic.alpha = rd.number(*imgs, "alpha", "images", 0.0, 1.0);
   ic.noise_size = rd.integer(*imgs, "noise_size", "images", 1, 4096, 64);
+
+  read_views(rd, root, cat);
 
   // [metal] first: objects refer to its categories.
   const toml::node* metal_node = rd.need(root, "metal", "metal");
@@ -333,9 +377,8 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   for (size_t i = 0; i < subjects.size(); ++i) {
     const toml::table& t = *subjects.get(i)->as_table();
     const std::string f = "subjects[" + std::to_string(i + 1) + "]";
-    io::reject_unknown_keys(
-        t, {"name", "build", "height", "mmw_level", "ir_core", "ir_limb", "base_zones", "mmw_upper", "mmw_lower", "ir"},
-        source_name, f);
+    io::reject_unknown_keys(t, {"name", "build", "height", "mmw_level", "ir_core", "ir_limb", "base_zones", "images"},
+                            source_name, f);
     Subject s;
     s.name = rd.string(t, "name", f);
     s.build = rd.number(t, "build", f, 0.5, 1.5, 1.0);
@@ -348,45 +391,48 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     s.ir_limb = rd.integer(t, "ir_limb", f, 0, 255, 175);
     const std::vector<int> z = rd.ints(rd.need(t, "base_zones", f + ".base_zones"), f + ".base_zones", kZones, 1, 200);
     std::copy(z.begin(), z.end(), s.base_zones.begin());
-    for (std::string_view key : kSubjectImageKeys) {
-      ImageSource src = rd.image(t, std::string(key), f);
-      if (!src.path.empty()) s.images.emplace(key, std::move(src));
+    if (const toml::node* in = t.get("images")) {
+      const toml::table* it = in->as_table();
+      if (!it) rd.fail(in, f + ".images", "expected a table of view = \"file\"");
+      for (const auto& [key, value] : *it) {
+        if (cat.sensor_index(key.str()) < 0)
+          rd.fail(&value, f + ".images." + std::string(key.str()), "not one of the catalogue's [[views]]");
+        s.images.emplace(std::string(key.str()), rd.image(*it, std::string(key.str()), f + ".images"));
+      }
     }
     // Objects move with the stature; an image file's body would not.
     if (s.height != 1.0 && !s.images.empty())
       rd.fail(t.get("height"), f + ".height",
-              "only a procedural body can be drawn at another height; this subject names image files "
-              "(mmw_upper, mmw_lower or ir)");
+              "only a procedural body can be drawn at another height; this subject names image files (images)");
     cat.subjects.push_back(std::move(s));
   }
 
-  // [[regions]]
+  // [[regions]]: each with its rectangle in every view that sees it.
   const toml::array& regions = rd.array_of_tables(root, "regions");
   if (regions.size() != kRegions)
     rd.fail(&regions, "regions", "expected exactly 13 regions, found " + std::to_string(regions.size()));
-  std::array<bool, kRegions> seen{};
   for (size_t i = 0; i < regions.size(); ++i) {
     const toml::table& t = *regions.get(i)->as_table();
     const std::string f = "regions[" + std::to_string(i + 1) + "]";
-    io::reject_unknown_keys(t, {"id", "name", "view", "mmw", "ir"}, source_name, f);
-    const int id = rd.integer(t, "id", f, 1, kRegions);
-    if (seen[id - 1]) rd.fail(t.get("id"), f + ".id", "region " + std::to_string(id) + " is defined twice");
-    seen[id - 1] = true;
-    Region& r = cat.regions[id - 1];
-    r.id = id;
+    for (const char* moved : {"id", "view", "mmw", "ir"})
+      if (const toml::node* n = t.get(moved))
+        rd.fail(n, f + "." + moved,
+                "regions are numbered in their order and placed by rects = { VIEW = [x, y, w, h], ... } now");
+    io::reject_unknown_keys(t, {"name", "rects"}, source_name, f);
+    Region& r = cat.regions[i];
+    r.id = static_cast<int>(i + 1);
     r.name = rd.string(t, "name", f);
-    const std::string view = rd.string(t, "view", f);
-    if (view == "upper")
-      r.view = View::upper;
-    else if (view == "lower")
-      r.view = View::lower;
-    else
-      rd.fail(t.get("view"), f + ".view", "expected \"upper\" or \"lower\", got \"" + view + "\"");
-    const bool must_upper = id <= kUpperRegions;
-    if ((r.view == View::upper) != must_upper)
-      rd.fail(t.get("view"), f + ".view", "regions 1-6 are in the upper view and 7-13 in the lower view (thesis 4.2)");
-    r.mmw = rd.rect(t, "mmw", f, ic.mmw_width, ic.mmw_height);
-    r.ir = rd.rect(t, "ir", f, ic.ir_width, ic.ir_height);
+    const toml::node* rn = rd.need(t, "rects", f + ".rects");
+    const toml::table* rects = rn->as_table();
+    if (!rects || rects->empty()) rd.fail(rn, f + ".rects", "expected a table of view = [x, y, w, h], at least one");
+    for (const auto& [key, value] : *rects) {
+      const std::string rf = f + ".rects." + std::string(key.str());
+      const int k = cat.sensor_index(key.str());
+      if (k < 0) rd.fail(&value, rf, "not one of the catalogue's [[views]]");
+      Sensor& view = cat.sensors[k];
+      view.rects[i] = rd.rect(&value, rf, view.width, view.height);
+      view.region_mask |= 1u << i;
+    }
   }
 
   // [physics] and [[materials]]: optional; the physics model needs them.
@@ -553,11 +599,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
                   " noise patterns have procedural defaults; give an image");
     cat.noise.push_back(std::move(p));
   }
-  cat.sensors = camera_sensors(cat);
-  for (const Sensor& view : cat.sensors)
-    if (std::find(kSubjectImageKeys.begin(), kSubjectImageKeys.end(), view.asset_key) == kSubjectImageKeys.end())
-      throw std::logic_error("camera view " + view.name + " has asset key " + view.asset_key +
-                             ", which no subject image key names");
+  for (Sensor& view : cat.sensors) derive_view(cat, view);
   return cat;
 }
 

@@ -12,13 +12,6 @@
 
 namespace portalsim {
 
-constexpr int kUpperRegions = 6;
-
-// The catalogue keys of a subject's base images, one per camera view (Sensor::asset_key).
-inline constexpr std::array<std::string_view, 3> kSubjectImageKeys{"mmw_upper", "mmw_lower", "ir"};
-
-enum class View : int { upper = 0, lower = 1 };
-
 // Where an image comes from: a file, or (path empty) the procedural default.
 struct ImageSource {
   std::string path;    // resolved path, empty for procedural
@@ -31,19 +24,19 @@ struct Subject {
   double height = 1.0;  // stature scale about the floor (procedural::Body::height)
   int mmw_level = 150, ir_core = 215, ir_limb = 175;
   std::array<int, kZones> base_zones{};
-  // The base image files the catalogue names, by camera view asset key (Sensor::asset_key:
-  // kSubjectImageKeys); a view with none draws the procedural body.
+  // The base image files the catalogue names, by camera view name (images.NAME); a view
+  // with none draws the procedural body.
   std::map<std::string, ImageSource, std::less<>> images;
-  // The base image of the view with asset key `key`: its file, or the procedural source
-  // (empty path) where the catalogue names none.
-  const ImageSource& image(std::string_view key) const;
+  // The base image of the view called `view`: its file, or the procedural source (empty
+  // path) where the catalogue names none.
+  const ImageSource& image(std::string_view view) const;
 };
 
+// A region of the body (thesis 4.1): its rectangle in each view that sees it is the view's
+// (Sensor::rects).
 struct Region {
-  int id = 0;
+  int id = 0;  // 1-based, its place in the catalogue
   std::string name;
-  View view = View::upper;
-  Rect mmw, ir;
 };
 
 struct Variant {
@@ -100,8 +93,6 @@ struct NoisePattern {
 };
 
 struct ImagesConfig {
-  int mmw_width = 200, mmw_height = 200;
-  int ir_width = 100, ir_height = 200;
   double alpha = 0.9;
   int noise_size = 64;
 };
@@ -138,7 +129,8 @@ struct Catalogue {
   // influence[category][region][zone]
   std::vector<std::array<std::array<int, kZones>, kRegions>> influence;
   std::vector<VariantRef> variant_list;
-  std::vector<Sensor> sensors;  // the camera views (scene/sensor.h)
+  std::vector<Sensor> sensors;         // the camera views ([[views]]; scene/sensor.h)
+  std::vector<SpriteSet> sprite_sets;  // the objects' drawings the views need
   MetalPhysics metal_physics;
 
   const Object& object_of(int variant_id) const { return objects[variant_list[variant_id].object]; }
@@ -156,8 +148,10 @@ struct Catalogue {
   std::array<double, 9> polarizability(int variant_id, const std::array<double, 3>& axis) const;
   // A variant's long side as the coils see it, metres (x across, z up): the drawing's
   // longer side (x where it is wider than tall, else z; a "v" drawing turned a quarter) at
-  // the metal model's scale, body_height over the two MMW views' height.
+  // the metal model's scale (metres_per_field_unit).
   std::array<double, 2> long_side(int variant_id) const;
+  // The metal model's scale: the field's height is [metal.physics] body_height.
+  double metres_per_field_unit() const { return metal_physics.body_height / kFieldHeight; }
   // "gun:v" for display; "gun" where the object has one drawing.
   std::string variant_name(int variant_id) const;
   // Finds an object by name or alias, ignoring case and punctuation ("Iron Rod",

@@ -21,25 +21,47 @@ struct Rect {
 
 // Which sprites and palette a view uses: the camera it belongs to.
 enum class Camera : int { mmw = 0, ir = 1 };
+// Which side of the body a view sees: a back view sees the body from behind, mirrored.
+enum class Side : int { front = 0, back = 1 };
+inline const char* side_name(Side s) { return s == Side::back ? "back" : "front"; }
+
+// The portal's field: the frame the procedural body is drawn in, in the thesis's MMW pixels
+// (200 across, the two 200 x 200 MMW views stacked, the floor at its bottom edge). Views,
+// their sprites' scale and the metal detector's object positions are all given in it.
+constexpr double kFieldWidth = 200.0, kFieldHeight = 400.0;
+struct Frame {
+  double x = 0, y = 0, w = kFieldWidth, h = kFieldHeight;
+};
 // Which sensor model renders a scenario: the thesis's composite, or the physically based
 // one (docs/model/physics-mmw.md). Each camera view has a stage chain per model.
 enum class Model { thesis = 0, physics = 1 };
 const char* model_name(Model m);
-constexpr int kCameras = 2;
 inline const char* camera_name(Camera c) { return c == Camera::ir ? "ir" : "mmw"; }
 
-struct Sensor {
-  std::string name;       // "upper", "lower", "ir": file stems, column prefixes, data set names
-  std::string asset_key;  // the subject's catalogue key for its base image: "mmw_upper", "ir"
+// The objects' drawings one or more views share: one camera's sprites at one scale (view
+// pixels per field unit), mirrored for back views.
+struct SpriteSet {
   Camera camera = Camera::mmw;
+  double scale_x = 1.0, scale_y = 1.0;
+  bool mirrored = false;
+  bool operator==(const SpriteSet&) const = default;
+};
+
+struct Sensor {
+  std::string name;  // "upper", "lower", "ir": file stems, column prefixes, data set names,
+                     // and the key of the subjects' base images ([[subjects]] images.NAME)
+  Camera camera = Camera::mmw;
+  Side side = Side::front;
   int width = 0, height = 0;
+  Frame field;         // the part of the portal's field it shows
+  int sprite_set = 0;  // its objects' drawings: index into Catalogue::sprite_sets
   // Region r's rectangle in this view, for the regions it sees (bit r of region_mask).
   std::array<Rect, kRegions> rects{};
   uint32_t region_mask = 0;
   bool pattern_noise = false;  // the thesis's MMW noise patterns are laid over objects
   bool pooled = false;         // its block and region means are features
   bool palette = false;        // stored as a temperature index, written through the palette
-  // Jitter is given in MMW pixels; this view's pixels per MMW pixel.
+  // Jitter is given in MMW pixels (field units); this view's pixels per field unit.
   double jitter_scale_x = 1.0, jitter_scale_y = 1.0;
   // The floor's row in this view's pixel coordinates (the bottom edge of the lower MMW
   // view; for the upper view one view height below its own bottom).
@@ -64,10 +86,25 @@ struct Sensor {
     return r;
   }
   size_t pixels() const { return static_cast<size_t>(width) * height; }
+  // A point of this view (pixel coordinates) in the portal's field: a back view mirrored.
+  double field_col(double col) const {
+    return side == Side::back ? field.x + field.w - col / jitter_scale_x : field.x + col / jitter_scale_x;
+  }
+  double field_row(double row) const { return field.y + row / jitter_scale_y; }
+  // Field units per pixel of this view, across (negative for a back view) and down.
+  double field_per_col() const { return (side == Side::back ? -1.0 : 1.0) / jitter_scale_x; }
+  double field_per_row() const { return 1.0 / jitter_scale_y; }
 };
 
+// The view that places region r's object for the metal detector: the first that sees it,
+// -1 where none does.
+int metal_view(const std::vector<Sensor>& views, int region);
+
 struct Catalogue;
-// The camera views of a catalogue, in output order: MMW upper, MMW lower, IR.
-std::vector<Sensor> camera_sensors(const Catalogue& cat);
+// What a catalogue's [[views]] entry leaves to be derived: the chains and flags of its
+// camera, its scales and floor row, its sprite set (added to cat.sprite_sets when new) and
+// each subject's place offsets. The views' names, cameras, sides, sizes, fields, region
+// rectangles and pooling are read from the catalogue first.
+void derive_view(Catalogue& cat, Sensor& s);
 
 }  // namespace portalsim

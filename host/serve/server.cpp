@@ -373,29 +373,37 @@ struct Server::Impl {
   json catalogue() const {
     const Catalogue& c = cat;
     json j;
-    j["mmw"] = {c.images.mmw_width, c.images.mmw_height};
+    j["views"] = json::array();
+    for (const Sensor& v : c.sensors)
+      j["views"].push_back({{"name", v.name},
+                            {"camera", camera_name(v.camera)},
+                            {"side", side_name(v.side)},
+                            {"size", {v.width, v.height}}});
     j["subjects"] = json::array();
     for (const Subject& sub : c.subjects) j["subjects"].push_back(sub.name);
     j["regions"] = json::array();
     for (size_t k = 0; k < c.regions.size(); ++k) {
       const Region& r = c.regions[k];
-      // The MMW view whose rectangles hold the region, named in the sensor table.
+      // The MMW view whose rectangles hold the region (else its first view), named in the
+      // views table.
       int s = -1;
       for (size_t v = 0; s < 0 && v < c.sensors.size(); ++v)
         if (c.sensors[v].camera == Camera::mmw && c.sensors[v].sees(static_cast<int>(k))) s = static_cast<int>(v);
-      const std::string view = s < 0 ? "" : c.sensors[static_cast<size_t>(s)].name;
+      if (s < 0) s = metal_view(c.sensors, static_cast<int>(k));
+      const Sensor& view = c.sensors[static_cast<size_t>(s)];
       // Where the region holds an object on each subject: the rectangle moved with the
       // subject's stature (Sensor::place), which the page's hit boxes follow.
       json places = json::array();
       for (size_t sub = 0; sub < c.subjects.size(); ++sub) {
-        const Rect p =
-            s < 0 ? r.mmw : c.sensors[static_cast<size_t>(s)].place(static_cast<int>(sub), static_cast<int>(k));
+        const Rect p = view.place(static_cast<int>(sub), static_cast<int>(k));
         places.push_back({p.x, p.y, p.w, p.h});
       }
+      const Rect& rc = view.rects[k];
       j["regions"].push_back({{"id", r.id},
                               {"name", r.name},
-                              {"view", view},
-                              {"rect", {r.mmw.x, r.mmw.y, r.mmw.w, r.mmw.h}},
+                              {"view", view.name},
+                              {"size", {view.width, view.height}},
+                              {"rect", {rc.x, rc.y, rc.w, rc.h}},
                               {"places", places}});
     }
     j["objects"] = json::array();

@@ -26,8 +26,8 @@ void pool_images(const Catalogue& cat, const FeatureLayout& lay, const std::vect
   int k = 0;
   for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
     const Sensor& s = cat.sensors[lay.pooled[slot]];
-    for (int by = 0; by < lay.blocks_y; ++by)
-      for (int bx = 0; bx < lay.blocks_x; ++bx) {
+    for (int by = 0; by < lay.grids[slot].blocks_y; ++by)
+      for (int bx = 0; bx < lay.grids[slot].blocks_x; ++bx) {
         const int x0 = bx * lay.block, y0 = by * lay.block;
         row[k++] =
             rect_mean(images[slot], x0, y0, std::min(x0 + lay.block, s.width), std::min(y0 + lay.block, s.height));

@@ -52,12 +52,11 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
     }
     return off;
   };
-  std::vector<cl_int4> sprite_records(kCameras * V);
-  for (int c = 0; c < kCameras; ++c)
-    for (size_t v = 0; v < V; ++v) {
-      const Image& sp = assets.sprites[c][v];
+  variants = V;
+  for (const std::vector<Image>& set : assets.sprites)
+    for (const Image& sp : set) {
       const int plain = add(sp);
-      sprite_records[c * V + v] = {{plain, sp.width, sp.height, add_padded_sprite(sp)}};
+      sprite_records.push_back({{plain, sp.width, sp.height, add_padded_sprite(sp)}});
     }
   // Each sprite centred in its region's rectangle of each view; then, per subject and
   // view, how far each region's place moves with the subject's height (Sensor::place),
@@ -67,7 +66,7 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
   for (size_t k = 0; k < views; ++k) {
     const Sensor& s = cat.sensors[k];
     for (size_t v = 0; v < V; ++v) {
-      const Image& sp = assets.sprite(s.camera, static_cast<int>(v));
+      const Image& sp = assets.sprite(s, static_cast<int>(v));
       for (int r = 0; r < kRegions; ++r) {
         const Rect box = sprite_box(s.rects[r], sp);
         place_records[(k * V + v) * kRegions + r] = {{box.x, box.y}};
@@ -85,8 +84,6 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
   }
   for (const Image& tile : assets.noise) tile_offsets.push_back(add_padded_tile(tile));
   if (atlas_bytes.size() > 0x7fffffffu) throw std::runtime_error("catalogue images exceed 2 GiB");
-  mmw_sprites.assign(sprite_records.begin() + static_cast<int>(Camera::mmw) * V,
-                     sprite_records.begin() + (static_cast<int>(Camera::mmw) + 1) * V);
 
   // Pooled views: each region's rectangle in the pooled view that sees it.
   const FeatureLayout lay = FeatureLayout::of(cat, 1);

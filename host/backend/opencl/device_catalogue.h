@@ -18,7 +18,12 @@ struct DeviceCatalogue {
   cl::Buffer pooled, region_slot, region_rects;  // per region: its pooled slot and rectangle there
   std::vector<cl::Buffer> view_rects;            // per view: int4 per region
   cl::Buffer influence, categories, base_zones;  // the thesis's metal detector
-  std::vector<cl_int4> mmw_sprites;  // each variant's MMW sprite: atlas offset, width, height, padded offset
+  // Per sprite set, each variant's sprite: atlas offset, width, height, padded offset.
+  std::vector<cl_int4> sprite_records;
+  const cl_int4& sprite(const Sensor& view, size_t variant) const {
+    return sprite_records[view.sprite_set * variants + variant];
+  }
+  size_t variants = 0;
 };
 
 // A sprite centred in a region's rectangle (>> 1 floors negative differences too): where

@@ -130,8 +130,7 @@ PS_KERNEL_ARGS(MetalZonesArgs, PS_METAL_ZONES_ARGS)
   X(cl_uint2, seed)              \
   X(cl_uint2, first)             \
   X(cl_int, noise)               \
-  X(cl_double, jitter_x)         \
-  X(cl_double, jitter_y)         \
+  X(cl_double, jitter)           \
   X(cl_double, half_width)       \
   X(cl_double, scale)            \
   X(cl_double, body_height)      \
@@ -233,12 +232,9 @@ PS_KERNEL_ARGS(FeaturesSparseArgs, PS_FEATURES_SPARSE_ARGS)
 #define PS_ANALYTIC_NOISE_ARGS(X) \
   X(cl::Buffer, features)         \
   X(cl::Buffer, rects)            \
+  X(cl::Buffer, grids)            \
   X(cl_uint, n)                   \
-  X(cl_int, width)                \
-  X(cl_int, height)               \
   X(cl_int, block)                \
-  X(cl_int, blocks_x)             \
-  X(cl_int, blocks_y)             \
   X(cl_int, npooled)              \
   X(cl_int, row_len)              \
   X(cl_float, sigma)              \

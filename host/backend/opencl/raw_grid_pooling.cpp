@@ -174,11 +174,12 @@ RawGridPooling raw_grid_pooling(const Sensor& s, const FeatureLayout& lay, int s
           p.weights.push_back(count > 0 ? sy[j] * sx[i] / count : 0.0);
         }
   };
-  for (int by = 0; by < lay.blocks_y; ++by)
-    for (int bx = 0; bx < lay.blocks_x; ++bx) {
+  const FeatureLayout::Grid& g = lay.grids[slot];
+  for (int by = 0; by < g.blocks_y; ++by)
+    for (int bx = 0; bx < g.blocks_x; ++bx) {
       const int x0 = bx * lay.block, y0 = by * lay.block;
       add(x0, y0, std::min(x0 + lay.block, s.width), std::min(y0 + lay.block, s.height),
-          slot * lay.blocks_per_view() + by * lay.blocks_x + bx);
+          g.offset + by * g.blocks_x + bx);
     }
   for (int r = 0; r < kRegions; ++r)
     if (s.sees(r)) {

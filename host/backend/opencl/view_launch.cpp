@@ -16,7 +16,7 @@ PsViewLaunch settings(const Catalogue& cat, const Plan& plan, int view, const De
   L.n = static_cast<uint32_t>(b.n);
   L.view = view;
   L.views = static_cast<int32_t>(cat.sensors.size());
-  L.sprite_set = static_cast<int32_t>(s.camera);
+  L.sprite_set = s.sprite_set;
   L.variants = static_cast<int32_t>(cat.variant_list.size());
   L.region_mask = s.region_mask;
   L.width = s.width;

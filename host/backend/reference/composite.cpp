@@ -13,7 +13,7 @@ ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSe
   for (int r = 0; r < kRegions; ++r) {
     const int16_t v = s.objects[r];
     if (v == kNoObject || !sensor.sees(r)) continue;
-    const Image& sp = assets.sprite(sensor.camera, v);
+    const Image& sp = assets.sprite(sensor, v);
     const Rect rect = sensor.place(s.subject, r);
     const int x0 = rect.x + static_cast<int>(std::floor((rect.w - sp.width) / 2.0));
     const int y0 = rect.y + static_cast<int>(std::floor((rect.h - sp.height) / 2.0));

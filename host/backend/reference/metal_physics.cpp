@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "backend/reference/stages.h"
 #include "scene/philox.h"
@@ -39,25 +40,26 @@ int deduction_of(double t) {
 std::vector<MetalObject> metal_objects(const Catalogue& cat, const AssetSet& assets, const ModelSettings& m,
                                        const Scenario& s, uint64_t index) {
   const MetalPhysics& mp = cat.metal_physics;
-  const double scale = mp.body_height / (2.0 * cat.images.mmw_height);  // metres per MMW pixel
+  const double scale = cat.metres_per_field_unit();
   std::vector<MetalObject> out;
-  double row_offset = 0;  // the MMW views stacked, the first on top
-  for (int k = 0; k < static_cast<int>(cat.sensors.size()); ++k) {
+  // Each region's object where the first view that sees it places it, with that view's
+  // composite's jitter, in the portal's field; in region order.
+  std::vector<std::optional<ViewScene>> scenes(cat.sensors.size());
+  for (int r = 0; r < kRegions; ++r) {
+    const int k = metal_view(cat.sensors, r);
+    if (s.objects[r] == kNoObject || k < 0) continue;
     const Sensor& sensor = cat.sensors[k];
-    if (sensor.camera != Camera::mmw) continue;
-    // The placement jitter is the composite's: its sprites, in region order.
-    const ViewScene vs = view_scene(cat, assets, m, k, s, index);
+    if (!scenes[k]) scenes[k].emplace(view_scene(cat, assets, m, k, s, index));
+    // Its sprites are in region order: this region's is after those of the regions before.
     size_t next = 0;
-    for (int r = 0; r < kRegions; ++r) {
-      if (s.objects[r] == kNoObject || !sensor.sees(r)) continue;
-      const Placed& p = vs.placed[next++];
-      const Rect rc = sensor.place(s.subject, r);
-      const double col = rc.x + rc.w / 2.0, row = row_offset + rc.y + rc.h / 2.0;
-      const std::array<double, 2> side = cat.long_side(s.objects[r]);
-      out.push_back({cat.polarizability(s.objects[r]), (col + p.dx - sensor.width / 2.0) * scale,
-                     mp.body_height - (row + p.dy) * scale, side[0], side[1]});
-    }
-    row_offset += sensor.height;
+    for (int before = 0; before < r; ++before) next += s.objects[before] != kNoObject && sensor.sees(before);
+    const Placed& p = scenes[k]->placed[next];
+    const Rect rc = sensor.place(s.subject, r);
+    const double col = sensor.field_col(rc.x + rc.w / 2.0) + p.dx * sensor.field_per_col();
+    const double row = sensor.field_row(rc.y + rc.h / 2.0) + p.dy * sensor.field_per_row();
+    const std::array<double, 2> side = cat.long_side(s.objects[r]);
+    out.push_back({cat.polarizability(s.objects[r]), (col - kFieldWidth / 2.0) * scale, mp.body_height - row * scale,
+                   side[0], side[1]});
   }
   return out;
 }

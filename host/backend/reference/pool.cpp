@@ -10,8 +10,9 @@ void pool(const Catalogue& cat, const std::vector<std::vector<uint8_t>>& views, 
   for (int view : f.pooled) {
     const Sensor& s = cat.sensors[view];
     const std::vector<uint8_t>& img = views[view];
-    for (int by = 0; by < f.blocks_y; ++by)
-      for (int bx = 0; bx < f.blocks_x; ++bx) {
+    // The view's own grid: blocks until its edges, the last ones partial.
+    for (int by = 0; by * n < s.height; ++by)
+      for (int bx = 0; bx * n < s.width; ++bx) {
         double sum = 0;
         int count = 0;
         for (int y = by * n; y < std::min(s.height, (by + 1) * n); ++y)

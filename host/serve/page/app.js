@@ -81,7 +81,7 @@ async function render() {
   try {
     const out = await post("/api/render", settings());
     if (ticket !== pending) return;  // a newer change is on its way
-    for (const v of ["upper", "lower", "ir"]) $(v).src = out[v];
+    for (const v of cat.views) $(v.name).src = out[v.name];
     drawZones(out.metal);
     $("label").textContent = "Threat: " + (out.threat ? "yes" : "no");
     $("error").textContent = "";
@@ -97,7 +97,7 @@ async function compare(ticket) {
   for (const model of ["thesis", "physics"]) {
     const out = await post("/api/render", { ...settings(), model });
     if (ticket !== pending) return;
-    for (const v of ["upper", "lower", "ir"]) $(model + "-" + v).src = out[v];
+    for (const v of cat.views) $(model + "-" + v.name).src = out[v.name];
     $(model + "-zones").value = out.metal.join(",");
   }
 }
@@ -117,8 +117,39 @@ function regionChanged(r) {
   render();
 }
 
+// "MMW upper", "MMW back_upper (back)", "IR": what a view shows, for captions and alt text.
+function viewTitle(v) {
+  return v.camera.toUpperCase() + (v.name === v.camera ? "" : " " + v.name) + (v.side === "back" ? " (back)" : "");
+}
+
+// One figure per camera view of the catalogue, 300 pixels high at the view's aspect, and a
+// small copy of each in both side-by-side columns.
+function buildViews() {
+  for (const v of cat.views) {
+    const [w, h] = v.size;
+    const fig = document.createElement("figure");
+    const body = document.createElement("div");
+    body.className = "body"; body.id = "body-" + v.name;
+    body.style.width = 300 * w / h + "px";
+    const img = document.createElement("img");
+    img.id = v.name; img.alt = viewTitle(v) + " image";
+    body.appendChild(img);
+    const cap = document.createElement("figcaption");
+    cap.textContent = viewTitle(v);
+    fig.append(body, cap);
+    $("views").appendChild(fig);
+    for (const model of ["thesis", "physics"]) {
+      const small = document.createElement("img");
+      small.id = model + "-" + v.name; small.alt = viewTitle(v) + ", " + model + " model";
+      small.style.width = 150 * w / h + "px";
+      $(model + "-views").appendChild(small);
+    }
+  }
+}
+
 async function init() {
   cat = await (await fetch("/api/catalogue")).json();
+  buildViews();
   knobs = await (await fetch("/api/knobs")).json();
   knobs.forEach(knobControl);
   cat.subjects.forEach((s, i) => option($("subject"), i + 1, (i + 1) + " " + s));
@@ -173,9 +204,9 @@ async function init() {
 // Each region's hit box where the chosen subject holds its object (it moves with the
 // subject's stature; the catalogue's rectangle for subjects of height 1).
 function placeHits() {
-  const [w, h] = cat.mmw;
   const subject = Number($("subject").value) - 1;
   for (const reg of cat.regions) {
+    const [w, h] = reg.size;
     const [x, y, rw, rh] = reg.places[subject] ?? reg.rect;
     Object.assign($("hit" + reg.id).style, { left: x / w * 100 + "%", top: y / h * 100 + "%",
       width: rw / w * 100 + "%", height: rh / h * 100 + "%" });

@@ -17,20 +17,21 @@ MetalPath::MetalPath(Device& d) : d_(d) {
   const size_t S = cat.subjects.size();
   const std::vector<cl_double> zones = metal_zone_records(mp);
   std::vector<cl_double> regions(S * kRegions * PS_MR_LEN, 0.0), tensors;
-  double row_offset = 0;  // the MMW views stacked, the first on top
-  for (const Sensor& s : cat.sensors) {
-    if (s.camera != Camera::mmw) continue;
-    if (!view_) view_ = &s;
-    // Each subject's region centres: the places, moved with its height.
-    for (size_t j = 0; j < S; ++j)
-      for (int r = 0; r < kRegions; ++r)
-        if (s.sees(r)) {
-          const Rect rc = s.place(static_cast<int>(j), r);
-          cl_double* rec = &regions[(j * kRegions + r) * PS_MR_LEN];
-          rec[PS_MR_COL] = rc.x + rc.w / 2.0;
-          rec[PS_MR_ROW] = row_offset + rc.y + rc.h / 2.0;
-        }
-    row_offset += s.height;
+  // Each subject's region centres: the places, moved with its height, in the field.
+  for (int r = 0; r < kRegions; ++r) {
+    const int k = metal_view(cat.sensors, r);
+    if (k < 0) continue;
+    const Sensor& s = cat.sensors[k];
+    for (size_t j = 0; j < S; ++j) {
+      const Rect rc = s.place(static_cast<int>(j), r);
+      cl_double* rec = &regions[(j * kRegions + r) * PS_MR_LEN];
+      rec[PS_MR_COL] = s.field_col(rc.x + rc.w / 2.0);
+      rec[PS_MR_ROW] = s.field_row(rc.y + rc.h / 2.0);
+      rec[PS_MR_FIELD_PER_COL] = s.field_per_col();
+      rec[PS_MR_FIELD_PER_ROW] = s.field_per_row();
+      rec[PS_MR_JITTER_X] = s.jitter_scale_x;
+      rec[PS_MR_JITTER_Y] = s.jitter_scale_y;
+    }
   }
   for (size_t v = 0; v < cat.variant_list.size(); ++v) {
     for (double e : cat.polarizability(static_cast<int>(v))) tensors.push_back(e);
@@ -51,10 +52,9 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
     if (!d_.rt.has_fp64())
       throw EnvironmentError("--model physics computes metal zones in fp64, and " + d_.rt.device_name() +
                              " has no cl_khr_fp64; --backend reference works without it");
-    if (!cat.metal_physics.present || !view_)
-      throw InputError("--model physics: the catalogue has no [metal.physics] section");
+    if (!cat.metal_physics.present) throw InputError("--model physics: the catalogue has no [metal.physics] section");
     const MetalPhysics& mp = cat.metal_physics;
-    // The reference's jitter, (jitter * scale) * (2u - 1), in the MMW views' pixels.
+    // The reference's jitter, (jitter * scale) * (2u - 1), in each region's placing view.
     enqueue(d_.queue(), K["metal_physics"], K.fp64(),
             MetalPhysicsArgs{.zone_rec = zone_rec_,
                              .region_rec = region_rec_,
@@ -66,10 +66,9 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
                              .seed = b.seed,
                              .first = b.first,
                              .noise = plan.model.metal_noise,
-                             .jitter_x = plan.model.jitter * view_->jitter_scale_x,
-                             .jitter_y = plan.model.jitter * view_->jitter_scale_y,
-                             .half_width = view_->width / 2.0,
-                             .scale = mp.body_height / (2.0 * cat.images.mmw_height),
+                             .jitter = plan.model.jitter,
+                             .half_width = kFieldWidth / 2.0,
+                             .scale = cat.metres_per_field_unit(),
                              .body_height = mp.body_height,
                              .out = metal},
             b.n);

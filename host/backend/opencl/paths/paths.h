@@ -95,7 +95,6 @@ class MetalPath {
  private:
   Device& d_;
   cl::Buffer zone_rec_, region_rec_, tensors_;  // the coil model's tables
-  const Sensor* view_ = nullptr;                // the first MMW view: the coil model's pixel scale
   Grown out_;
 };
 

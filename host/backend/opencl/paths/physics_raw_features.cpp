@@ -165,7 +165,7 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& q
     // pair of those whose boxes meet.
     // A pair counts where its boxes meet on any subject (places move with the height).
     const auto meet = [&](int va, int ra, int vb, int rb) {
-      const Image &a = d_.assets.sprite(sv.camera, va), &b = d_.assets.sprite(sv.camera, vb);
+      const Image &a = d_.assets.sprite(sv, va), &b = d_.assets.sprite(sv, vb);
       for (int s = 0; s < S; ++s)
         if (boxes_meet(sprite_box(sv.place(s, ra), a), sprite_box(sv.place(s, rb), b))) return true;
       return false;

@@ -12,25 +12,29 @@ void pool_view(Device& d, Kernels& K, const FeatureLayout& lay, const DeviceBatc
   const Sensor& s = d.cat.sensors[view];
   const cl_uint n = static_cast<cl_uint>(b.n);
   const int row_len = lay.image_features();
+  // Each region's mean is the first pooled view's that sees it (region_slot).
+  uint32_t regions = 0;
+  for (int r = 0; r < kRegions; ++r)
+    if (region_slot(d.cat, lay, r) == slot) regions |= s.region_mask & (1u << r);
   enqueue(d.queue(), K["pool_blocks"], K.fp64(),
           PoolBlocksArgs{.img = img,
                          .n = n,
                          .width = s.width,
                          .height = s.height,
                          .block = lay.block,
-                         .blocks_x = lay.blocks_x,
-                         .blocks_y = lay.blocks_y,
-                         .offset = slot * lay.blocks_per_view(),
+                         .blocks_x = lay.grids[slot].blocks_x,
+                         .blocks_y = lay.grids[slot].blocks_y,
+                         .offset = lay.grids[slot].offset,
                          .row_len = row_len,
                          .features = features},
-          b.n * lay.blocks_per_view());
+          b.n * lay.grids[slot].blocks());
   enqueue(d.queue(), K["pool_regions"], K.fp64(),
           PoolRegionsArgs{.img = img,
                           .n = n,
                           .width = s.width,
                           .height = s.height,
                           .rects = d.data.view_rects[view],
-                          .region_mask = s.region_mask,
+                          .region_mask = regions,
                           .offset = lay.block_features(),
                           .row_len = row_len,
                           .features = features},
@@ -39,16 +43,17 @@ void pool_view(Device& d, Kernels& K, const FeatureLayout& lay, const DeviceBatc
 
 void block_mean_noise(Device& d, Kernels& K, const Plan& plan, const DeviceBatch& b, const cl::Buffer& features) {
   const FeatureLayout lay = FeatureLayout::of(d.cat, plan.model.block);
-  const Sensor& s = d.cat.sensors[lay.pooled.at(0)];  // every pooled view has its size
+  std::vector<cl_int4> grids;
+  for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
+    const Sensor& s = d.cat.sensors[lay.pooled[slot]];
+    grids.push_back({{s.width, s.height, lay.grids[slot].blocks_x, lay.grids[slot].offset}});
+  }
   enqueue(d.queue(), K["analytic_noise"], K.fp64(),
           AnalyticNoiseArgs{.features = features,
                             .rects = d.data.region_rects,
+                            .grids = constant(d.ctx(), grids),
                             .n = static_cast<cl_uint>(b.n),
-                            .width = s.width,
-                            .height = s.height,
                             .block = lay.block,
-                            .blocks_x = lay.blocks_x,
-                            .blocks_y = lay.blocks_y,
                             .npooled = static_cast<cl_int>(lay.pooled.size()),
                             .row_len = lay.image_features(),
                             .sigma = static_cast<cl_float>(plan.model.pixel_sigma),

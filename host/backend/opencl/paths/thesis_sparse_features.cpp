@@ -23,7 +23,8 @@ class ThesisSparseFeatures final : public FeaturePath {
   // footprint's change per noise pattern and each scenario's patterns are drawn first.
   Gate gate(const Plan& plan, const Sensor& sensor) const override {
     if (!plan.sparse_features() || sensor.camera != Camera::mmw ||
-        sensor.chain_for(plan.model.model) != thesis_images_path().chain())
+        sensor.chain_for(plan.model.model) != thesis_images_path().chain() ||
+        !FeatureLayout::of(d_.cat, plan.model.block).uniform)
       return {};
     if (plan.model.pattern_noise) return {.runs = true, .variant = kPatterns, .variant_name = "pattern noise"};
     return {.runs = true, .variant = kNoPatterns};
@@ -38,7 +39,7 @@ class ThesisSparseFeatures final : public FeaturePath {
     cl::Buffer fps, deltas, region_deltas, base_sums, base_means;
   };
   Tables& tables(Kernels& K, const Plan& plan, bool noise);
-  // The tables assume every pooled view has the first one's size.
+  // The tables assume every pooled view has the first one's size (the gate's uniform).
   const Sensor& pooled_view(const FeatureLayout& lay) const { return d_.cat.sensors[lay.pooled.at(0)]; }
 
   Device& d_;
@@ -65,15 +66,17 @@ ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Pla
   for (int v = 0; v < V; ++v)
     for (int r = 0; r < kRegions; ++r)
       for (int s = 0; s < S; ++s) {
-        const Image& sp = d_.assets.sprite(Camera::mmw, v);
-        const Rect box = sprite_box(cat.sensors[lay.pooled[region_slot(cat, lay, r)]].place(s, r), sp);
+        // The region's pooled view: its place and its sprite set's drawing.
+        const Sensor& in = cat.sensors[lay.pooled[region_slot(cat, lay, r)]];
+        const Image& sp = d_.assets.sprite(in, v);
+        const Rect box = sprite_box(in.place(s, r), sp);
         cl_int* f = &fps[((static_cast<size_t>(v) * kRegions + r) * S + s) * PS_FP_LEN];
         f[PS_FP_SPRITE_X0] = box.x;
         f[PS_FP_SPRITE_Y0] = box.y;
         f[PS_FP_SPRITE_W] = box.w;
         f[PS_FP_SPRITE_H] = box.h;
-        f[PS_FP_SPRITE_OFFSET] = c.mmw_sprites[v].s[0];
-        f[PS_FP_SPRITE_PADDED] = c.mmw_sprites[v].s[3];
+        f[PS_FP_SPRITE_OFFSET] = c.sprite(in, v).s[0];
+        f[PS_FP_SPRITE_PADDED] = c.sprite(in, v).s[3];
         f[PS_FP_TILE_X0] = f[PS_FP_SPRITE_X0] + (sp.width >> 1) - (N >> 1);
         f[PS_FP_TILE_Y0] = f[PS_FP_SPRITE_Y0] + (sp.height >> 1) - (N >> 1);
         int x0 = f[PS_FP_SPRITE_X0], y0 = f[PS_FP_SPRITE_Y0], x1 = f[PS_FP_SPRITE_X0] + f[PS_FP_SPRITE_W],
@@ -123,8 +126,8 @@ ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Pla
                            .width = W,
                            .height = H,
                            .block = block,
-                           .blocks_x = lay.blocks_x,
-                           .blocks_y = lay.blocks_y,
+                           .blocks_x = lay.grids[0].blocks_x,
+                           .blocks_y = lay.grids[0].blocks_y,
                            .row_len = row_len,
                            .sums = t.base_sums,
                            .means = t.base_means},
@@ -195,8 +198,8 @@ void ThesisSparseFeatures::features(Kernels& K, const Plan& plan, const Gate& g,
                              .width = view.width,
                              .height = view.height,
                              .block = lay.block,
-                             .blocks_x = lay.blocks_x,
-                             .blocks_y = lay.blocks_y,
+                             .blocks_x = lay.grids[0].blocks_x,
+                             .blocks_y = lay.grids[0].blocks_y,
                              .alpha = {ic.alpha},
                              .tile = ic.noise_size,
                              .use_noise = t.noise ? 1 : 0,
