@@ -4,6 +4,7 @@
 // files against scikit-learn and its refusals are in tests/evaluate_check.py (evaluate.python).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "cli/evaluate_data.h"
@@ -160,16 +161,25 @@ TEST(EvaluateFolds, StratifiedAndRepeatable) {
   }
 }
 
-TEST(EvaluateClassifiers, ScoresAreTheSameOnAnyThreadCountAndSeparateTheClasses) {
+// rows x cols uniform draws (Philox under seed, stream); every `period`-th row a threat, its
+// column `signal` raised by `shift`.
+Matrix draws(uint32_t rows, uint32_t cols, uint64_t seed, uint32_t stream, uint32_t period, uint32_t signal,
+             double shift, std::vector<uint8_t>& label) {
   Matrix m;
-  m.rows = 300;
-  m.cols = 4;
-  std::vector<uint8_t> label;
-  for (uint32_t r = 0; r < m.rows; ++r) {
-    label.push_back(r % 2);
-    for (uint32_t c = 0; c < m.cols; ++c)
-      m.x.push_back(static_cast<float>(uniform24(draw(5, r, 2, c)[0]) + (c == 0 && label.back() ? 0.5 : 0.0)));
+  m.rows = rows;
+  m.cols = cols;
+  for (uint32_t r = 0; r < rows; ++r) {
+    label.push_back(r % period == period - 1);
+    for (uint32_t c = 0; c < cols; ++c)
+      m.x.push_back(
+          static_cast<float>(uniform24(draw(seed, r, stream, c)[0]) + (c == signal && label.back() ? shift : 0.0)));
   }
+  return m;
+}
+
+TEST(EvaluateClassifiers, ScoresAreTheSameOnAnyThreadCountAndSeparateTheClasses) {
+  std::vector<uint8_t> label;
+  const Matrix m = draws(300, 4, 5, 2, 2, 0, 0.5, label);
   const std::vector<int> fold = stratified_folds(label, 5, 1);
   for (ClassifierKind k : {ClassifierKind::trees, ClassifierKind::logistic}) {
     const std::vector<CvJob> jobs = {{&m, &label, k}, {&m, &label, k}};
@@ -179,6 +189,96 @@ TEST(EvaluateClassifiers, ScoresAreTheSameOnAnyThreadCountAndSeparateTheClasses)
     EXPECT_EQ(one[0], one[1]) << classifier_name(k);
     EXPECT_GT(summarize(order_scores(one[0]), label, nullptr, {}).auc, 0.8) << classifier_name(k);
   }
+}
+
+TEST(EvaluateClassifiers, QuantisationCutsAtTheTrainingRowsOnly) {
+  // Column 0: 200 distinct values (the row number, reversed); column 1: 5 values and a
+  // missing one; column 2: a constant.
+  Matrix m;
+  m.rows = 200;
+  m.cols = 3;
+  std::vector<uint8_t> label;
+  for (uint32_t r = 0; r < m.rows; ++r) {
+    label.push_back(r % 2);
+    m.x.insert(m.x.end(), {static_cast<float>(m.rows - r), r % 7 == 6 ? NAN : static_cast<float>(r % 7), 1.5f});
+  }
+  const std::vector<int> fold = stratified_folds(label, 4, 3);
+  const auto bins = quantise_folds(m, fold, 4, 2);
+  ASSERT_EQ(bins.size(), 4u);
+  EXPECT_EQ(bins, quantise_folds(m, fold, 4, 1));  // any thread count
+  for (int f = 0; f < 4; ++f) {
+    const std::vector<uint8_t>& b = bins[static_cast<size_t>(f)];
+    std::vector<size_t> count(kTreeBins, 0);
+    for (uint32_t r = 0; r < m.rows; ++r) {
+      // Larger values, no smaller bins; kTreeBins bins of about equal counts.
+      for (uint32_t s = 0; s < m.rows; ++s)
+        EXPECT_TRUE(m.at(r, 0) <= m.at(s, 0) || b[r * 3] >= b[s * 3]) << r << " " << s;
+      ASSERT_LT(b[r * 3], kTreeBins);
+      if (fold[r] != f) ++count[b[r * 3]];
+      // Few values: a bin each, in order; a missing value marked.
+      EXPECT_EQ(b[r * 3 + 1], r % 7 == 6 ? kMissingBin : r % 7) << r;
+      EXPECT_EQ(b[r * 3 + 2], 0);
+    }
+    for (size_t k = 0; k < count.size(); ++k) EXPECT_NEAR(count[k], 150.0 / kTreeBins, 1.0) << k;
+  }
+  // Fold 2's values move no cut of fold 2: every other row keeps its bin there; in the
+  // folds that train on them, they do move cuts.
+  Matrix moved = m;
+  for (uint32_t r = 0; r < m.rows; ++r)
+    if (fold[r] == 2) moved.x[r * 3] = static_cast<float>(1000 + r);
+  const auto after = quantise_folds(moved, fold, 4, 1);
+  size_t changed = 0;
+  for (uint32_t r = 0; r < m.rows; ++r) {
+    if (fold[r] == 2) continue;
+    EXPECT_EQ(after[2][r * 3], bins[2][r * 3]) << r;
+    changed += after[0][r * 3] != bins[0][r * 3];
+  }
+  EXPECT_GT(changed, 0u);
+}
+
+TEST(EvaluateClassifiers, AValueManyRowsShareTakesOneBinAndTheRestSplitTheOthers) {
+  // 60% of the rows read 1 (as a metal zone does with nothing near it), the rest 400 values.
+  Matrix m;
+  m.rows = 1000;
+  m.cols = 1;
+  std::vector<uint8_t> label;
+  for (uint32_t r = 0; r < m.rows; ++r) {
+    label.push_back(r % 2);
+    m.x.push_back(r % 5 < 3 ? 1.0f : static_cast<float>(2 + r % 400));
+  }
+  const std::vector<int> fold = stratified_folds(label, 5, 1);
+  const std::vector<uint8_t> b = quantise_folds(m, fold, 5, 1)[0];
+  std::vector<size_t> count(kTreeBins, 0);
+  for (uint32_t r = 0; r < m.rows; ++r) ++count[b[r]];
+  EXPECT_EQ(std::count(count.begin(), count.end(), size_t{0}), 0);  // every bin used
+  EXPECT_EQ(count[0], 600u);                                        // the shared value alone
+}
+
+TEST(EvaluateClassifiers, AJobOnSomeColumnsScoresAsACopyOfThem) {
+  std::vector<uint8_t> label;
+  const Matrix m = draws(300, 6, 7, 3, 3, 4, 0.7, label);
+  const std::vector<int> fold = stratified_folds(label, 5, 2);
+  const std::vector<size_t> cols = {4, 1, 5};
+  const Matrix copy = select_columns(m, cols);
+  for (ClassifierKind k : {ClassifierKind::trees, ClassifierKind::logistic}) {
+    // The columns of the shared matrix beside a job on all of it, as trees share its bins.
+    const auto shared = out_of_fold({{&m, &label, k, &cols}, {&m, &label, k}}, fold, 5, 1, 2);
+    const auto alone = out_of_fold({{&copy, &label, k}}, fold, 5, 1, 1);
+    EXPECT_EQ(shared[0], alone[0]) << classifier_name(k);
+    EXPECT_NE(shared[0], shared[1]) << classifier_name(k);
+    EXPECT_GT(summarize(order_scores(shared[0]), label, nullptr, {}).auc, 0.8) << classifier_name(k);
+  }
+}
+
+TEST(EvaluateClassifiers, TheReportStatesTheParametersTheBoostersGet) {
+  for (ClassifierKind k : {ClassifierKind::trees, ClassifierKind::logistic}) {
+    const std::string d = classifier_description(k);
+    for (const auto& [key, value] : booster_parameters(k))
+      EXPECT_NE(d.find(key + " " + value), std::string::npos) << key << " " << value << ": " << d;
+  }
+  const auto trees = booster_parameters(ClassifierKind::trees);
+  EXPECT_NE(std::find(trees.begin(), trees.end(), std::pair<std::string, std::string>{"max_bin", "32"}), trees.end());
+  EXPECT_EQ(kTreeBins, 32);
 }
 
 TEST(EvaluateRegions, AThreatIsInTheRegionsItsObjectsMake) {

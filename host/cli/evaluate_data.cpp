@@ -1,8 +1,10 @@
 #include "cli/evaluate_data.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -35,10 +37,88 @@ std::string find_table(const std::string& dir) {
                    "portalsim generate --what features");
 }
 
-Table read_table(const std::string& path) {
-  if (path.ends_with(".csv")) return read_csv(path);
-  if (path.ends_with(".arff")) return read_arff(path);
-  return read_h5_table(path);
+// The table as evaluate reads it: the names (the class last), where each is declared, and
+// per row its numbers (NaN for "?") and its label.
+struct Numbers {
+  std::string path;
+  std::vector<std::string> names;
+  std::vector<int> name_lines;
+  std::vector<float> x;  // rows x (names - 1)
+  std::vector<uint8_t> label;
+};
+
+// A CSV as generate writes it (a header row, then per row numbers or "?" and the class,
+// nothing quoted, no blanks, no empty lines), parsed without making a string of each field:
+// the numbers are std::from_chars's, as near as strtof's. Anything else (or a number out of
+// float's range) returns false, and the general reader (cli/validate_tables.h) takes the
+// file, with its messages for bad input.
+bool read_plain_csv(const std::string& path, Numbers& out) {
+  io::check_regular_file(path, "feature table", std::numeric_limits<size_t>::max());
+  const std::string text = io::read_file(path, "feature table", std::numeric_limits<size_t>::max());
+  const size_t header_end = text.find('\n');
+  if (header_end == std::string::npos) return false;
+  const std::string_view header(text.data(), header_end);
+  if (header.empty() || header.find_first_of(" \t\r\"'") != std::string_view::npos) return false;
+  for (size_t at = 0;;) {
+    const size_t comma = std::min(header.find(',', at), header.size());
+    if (comma == at) return false;
+    out.names.emplace_back(header.substr(at, comma - at));
+    if (comma == header.size()) break;
+    at = comma + 1;
+  }
+  if (out.names.size() < 2) return false;
+  out.path = path;
+  out.name_lines.assign(out.names.size(), 1);
+  const size_t nf = out.names.size() - 1;
+  const char* p = text.data() + header_end + 1;
+  const char* const end = text.data() + text.size();
+  while (p < end) {
+    for (size_t i = 0; i < nf; ++i) {
+      if (p + 1 < end && p[0] == '?' && p[1] == ',') {
+        out.x.push_back(std::numeric_limits<float>::quiet_NaN());
+        p += 2;
+        continue;
+      }
+      float v = 0;
+      const auto [q, ec] = std::from_chars(p, end, v);
+      if (ec != std::errc() || q == end || *q != ',') return false;
+      out.x.push_back(v);
+      p = q + 1;
+    }
+    const char* line_end = std::find(p, end, '\n');
+    const std::string_view c(p, static_cast<size_t>(line_end - p));
+    if (c != "positive" && c != "negative") return false;
+    out.label.push_back(c == "positive" ? 1 : 0);
+    p = line_end == end ? end : line_end + 1;
+  }
+  return true;
+}
+
+Numbers read_table(const std::string& path) {
+  Numbers out;
+  if (path.ends_with(".csv") && read_plain_csv(path, out)) return out;
+  out = Numbers();
+  const Table t = path.ends_with(".csv")    ? read_csv(path)
+                  : path.ends_with(".arff") ? read_arff(path)
+                                            : read_h5_table(path);
+  out.path = t.path;
+  out.names = t.names;
+  out.name_lines = t.name_lines;
+  const size_t nf = t.names.size() - 1;  // the class is last
+  out.label.reserve(t.rows.size());
+  out.x.reserve(t.rows.size() * nf);
+  size_t line = 0;
+  for (const auto& row : t.rows) {
+    ++line;
+    const std::string& c = row.back();
+    if (c != "positive" && c != "negative")
+      throw InputError(t.path + ": row " + std::to_string(line) + ": field 'class' is \"" + c +
+                       "\", not positive or negative");
+    out.label.push_back(c == "positive" ? 1 : 0);
+    for (size_t i = 0; i < nf; ++i)
+      out.x.push_back(row[i] == "?" ? std::nanf("") : std::strtof(row[i].c_str(), nullptr));
+  }
+  return out;
 }
 
 // The pooled camera view that sees region r (its means are that view's pixels).
@@ -49,7 +129,7 @@ const Sensor* view_of_region(const Catalogue& cat, int r) {
 }
 
 // Where the table declares column i, for errors.
-std::string where_column(const Table& t, size_t i) {
+std::string where_column(const Numbers& t, size_t i) {
   return t.path + (t.name_lines[i] > 0 ? ":" + std::to_string(t.name_lines[i]) : std::string()) + ": column '" +
          t.names[i] + "'";
 }
@@ -86,13 +166,13 @@ EvaluateData read_evaluate_data(const std::string& dir, const Catalogue& cat) {
                      " (hash " + made_with + "), not " + cat.source + " (hash " + cat.hash +
                      "): give that catalogue with --catalogue");
   const std::string table_path = find_table(dir);
-  const Table t = read_table(table_path);
+  Numbers t = read_table(table_path);
 
   EvaluateData out;
   evaluate::Dataset& d = out.data;
   d.source = dir;
   const size_t nf = t.names.size() - 1;  // the class is last
-  d.x.rows = t.rows.size();
+  d.x.rows = t.label.size();
   d.x.cols = nf;
   d.columns.assign(t.names.begin(), t.names.end() - 1);
   // Each column's sensor: a camera view's blocks by their prefix, a region mean by the
@@ -115,19 +195,8 @@ EvaluateData read_evaluate_data(const std::string& dir, const Catalogue& cat) {
     }
   }
   // The labels: the class column, positive (a threat) or negative.
-  d.label.reserve(t.rows.size());
-  d.x.x.reserve(d.x.rows * nf);
-  size_t line = 0;
-  for (const auto& row : t.rows) {
-    ++line;
-    const std::string& c = row.back();
-    if (c != "positive" && c != "negative")
-      throw InputError(t.path + ": row " + std::to_string(line) + ": field 'class' is \"" + c +
-                       "\", not positive or negative");
-    d.label.push_back(c == "positive" ? 1 : 0);
-    for (size_t i = 0; i < nf; ++i)
-      d.x.x.push_back(row[i] == "?" ? std::nanf("") : std::strtof(row[i].c_str(), nullptr));
-  }
+  d.label = std::move(t.label);
+  d.x.x = std::move(t.x);
 
   out.about = {{"source", dir}, {"table", fs::path(table_path).filename().string()}};
   const std::string rule = manifest["spec"].value("rule", "");

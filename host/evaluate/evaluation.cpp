@@ -59,27 +59,25 @@ Evaluation run_evaluation(const Dataset& d, const Options& o) {
   e.fold = stratified_folds(d.label, o.folds, o.seed);
   const std::vector<std::string> sensors = sensors_of(d);
 
-  // Per sensor, then all features, in one pool of fits.
-  std::vector<Matrix> inputs;
+  // Per sensor, then all features, in one pool of fits, each on its columns of d.x.
+  std::vector<std::vector<size_t>> sensor_columns;
   for (const std::string& s : sensors) {
     std::vector<size_t> cols;
     for (size_t c = 0; c < d.sensor.size(); ++c)
       if (d.sensor[c] == s) cols.push_back(c);
-    inputs.push_back(select_columns(d.x, cols));
+    sensor_columns.push_back(cols);
   }
   std::vector<CvJob> jobs;
-  for (const Matrix& m : inputs) jobs.push_back({&m, &d.label, o.classifier});
+  for (const std::vector<size_t>& cols : sensor_columns) jobs.push_back({&d.x, &d.label, o.classifier, &cols});
   jobs.push_back({&d.x, &d.label, o.classifier});
   // The regions' models, on their own labels.
-  std::vector<Matrix> region_inputs(d.regions.size());
   std::vector<size_t> region_job(d.regions.size(), SIZE_MAX);
   for (size_t r = 0; r < d.regions.size(); ++r) {
     const auto& reg = d.regions[r];
     const size_t pos = static_cast<size_t>(std::count(reg.label.begin(), reg.label.end(), uint8_t{1}));
     if (pos == 0 || pos == reg.label.size()) continue;
-    region_inputs[r] = select_columns(d.x, reg.columns);
     region_job[r] = jobs.size();
-    jobs.push_back({&region_inputs[r], &reg.label, o.classifier});
+    jobs.push_back({&d.x, &reg.label, o.classifier, &reg.columns});
   }
   auto t0 = std::chrono::steady_clock::now();
   std::vector<std::vector<double>> oof = out_of_fold(jobs, e.fold, o.folds, o.seed, o.threads);
