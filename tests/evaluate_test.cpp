@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "cli/evaluate_data.h"
 #include "evaluate/bootstrap.h"
@@ -191,17 +192,27 @@ TEST(EvaluateClassifiers, ScoresAreTheSameOnAnyThreadCountAndSeparateTheClasses)
   }
 }
 
+// A matrix of `rows` rows, row r being `row(r)`, and labels alternating 0, 1 into `label`.
+Matrix rows_of(uint32_t rows, size_t cols, std::vector<uint8_t>& label,
+               const std::function<std::vector<float>(uint32_t)>& row) {
+  Matrix m;
+  m.rows = rows;
+  m.cols = cols;
+  for (uint32_t r = 0; r < rows; ++r) {
+    label.push_back(r % 2);
+    const std::vector<float> v = row(r);
+    m.x.insert(m.x.end(), v.begin(), v.end());
+  }
+  return m;
+}
+
 TEST(EvaluateClassifiers, QuantisationCutsAtTheTrainingRowsOnly) {
   // Column 0: 200 distinct values (the row number, reversed); column 1: 5 values and a
   // missing one; column 2: a constant.
-  Matrix m;
-  m.rows = 200;
-  m.cols = 3;
   std::vector<uint8_t> label;
-  for (uint32_t r = 0; r < m.rows; ++r) {
-    label.push_back(r % 2);
-    m.x.insert(m.x.end(), {static_cast<float>(m.rows - r), r % 7 == 6 ? NAN : static_cast<float>(r % 7), 1.5f});
-  }
+  const Matrix m = rows_of(200, 3, label, [](uint32_t r) {
+    return std::vector<float>{static_cast<float>(200 - r), r % 7 == 6 ? NAN : static_cast<float>(r % 7), 1.5f};
+  });
   const std::vector<int> fold = stratified_folds(label, 4, 3);
   const auto bins = quantise_folds(m, fold, 4, 2);
   ASSERT_EQ(bins.size(), 4u);
@@ -238,14 +249,10 @@ TEST(EvaluateClassifiers, QuantisationCutsAtTheTrainingRowsOnly) {
 
 TEST(EvaluateClassifiers, AValueManyRowsShareTakesOneBinAndTheRestSplitTheOthers) {
   // 60% of the rows read 1 (as a metal zone does with nothing near it), the rest 400 values.
-  Matrix m;
-  m.rows = 1000;
-  m.cols = 1;
   std::vector<uint8_t> label;
-  for (uint32_t r = 0; r < m.rows; ++r) {
-    label.push_back(r % 2);
-    m.x.push_back(r % 5 < 3 ? 1.0f : static_cast<float>(2 + r % 400));
-  }
+  const Matrix m = rows_of(1000, 1, label, [](uint32_t r) {
+    return std::vector<float>{r % 5 < 3 ? 1.0f : static_cast<float>(2 + r % 400)};
+  });
   const std::vector<int> fold = stratified_folds(label, 5, 1);
   const std::vector<uint8_t> b = quantise_folds(m, fold, 5, 1)[0];
   std::vector<size_t> count(kTreeBins, 0);
