@@ -1322,7 +1322,7 @@ std::string front_back_text() { return slurp(fs::path(PORTALSIM_SOURCE_DIR) / "s
 
 // Objects in every region, front and back; each scenario's objects from `first` on.
 std::vector<Scenario> front_and_back_scenes(const Catalogue& c) {
-  std::vector<Scenario> v = coverage(c, 60, 5);
+  std::vector<Scenario> v = coverage(c, 30, 5);
   for (int s = 0; s < 5; ++s) v.push_back(crowded(c, s, static_cast<size_t>(3 * s)));
   return v;
 }
