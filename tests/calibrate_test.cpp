@@ -86,8 +86,9 @@ fs::path make_captures(const TempDir& t, const Camera& cam, int count, uint64_t 
 portalsim::calibrate::CameraFit fit(const fs::path& dir) {
   const portalsim::Catalogue cat = portalsim::default_catalogue();
   const portalsim::AssetSet assets = portalsim::build_assets(cat);
-  return portalsim::calibrate::fit_camera(portalsim::calibrate::read_captures(dir.string()), cat, assets,
-                                          portalsim::ModelSettings{});
+  return portalsim::calibrate::fit_camera(
+      portalsim::calibrate::read_captures(dir.string(), portalsim::default_catalogue()), cat, assets,
+      portalsim::ModelSettings{});
 }
 
 double fwhm_of(double aperture_m) {
@@ -168,7 +169,9 @@ TEST_P(CalibrateTold, RecoversTheHiddenCamera) {
   // camera is not asserted: its fitted noise, the kernels' one-level differences from the
   // reference (0.10 gray here), sits on the rule's edge of a tenth of a gray level.
   if (c.netd > 0) {
-    EXPECT_EQ(portalsim::calibrate::not_camera_like(portalsim::calibrate::read_captures(dir.string()), f).empty(),
+    EXPECT_EQ(portalsim::calibrate::not_camera_like(
+                  portalsim::calibrate::read_captures(dir.string(), portalsim::default_catalogue()), f)
+                  .empty(),
               c.raw_w < 200)
         << c.name;
   }
@@ -247,6 +250,35 @@ TEST(Calibrate, GenerateWithItsOutputMakesTheSameCamera) {
   EXPECT_NEAR(f2.netd, f1.netd, 0.1 * f1.netd);
   EXPECT_NEAR(f2.gain, f1.gain, 0.1 * f1.gain);
   EXPECT_NEAR(f2.display_min, f1.display_min, 0.1 * (f1.display_max - f1.display_min));
+}
+
+// Every MMW view of the catalogue is a capture of the camera: the front-and-back portal's
+// four, fitted together; a scenario folder without one of them is refused naming them all.
+TEST(Calibrate, EveryMmwViewOfTheCatalogueIsFitted) {
+  TempDir t;
+  const std::string cat = (fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "portal-front-back.toml").string();
+  const fs::path real = t.w() / "real";
+  auto r = run(
+      t, {"generate", "--catalogue", cat,           "--count",  "6",       "--seed",           "3",        "--objects",
+          "0..2",     "--what",      "images",      "--model",  "physics", "--netd",           "2",        "--mmw-raw",
+          "28x28",    "--window",    "285..305",    "--frames", "1",       "--display-filter", "bilinear", "--smooth",
+          "0",        "--out",       real.string(), "--quiet"});
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  const fs::path out = t.w() / "cam" / "camera.toml";
+  r = run(t, {"calibrate", "--catalogue", cat, "--real", real.string(), "--out", out.string()});
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  const std::string md = portalsim::test::slurp(t.w() / "cam" / "camera-report" / "report.md");
+  EXPECT_NE(md.find("6 captures (upper, lower, back_upper and back_lower views)"), std::string::npos) << md;
+  EXPECT_NE(portalsim::test::slurp(t.w() / "cam" / "camera-report" / "report.json").find("\"width\": 28"),
+            std::string::npos);
+  ASSERT_TRUE(fs::remove(real / "images" / "00000003" / "back_upper.png"));
+  const fs::path out2 = t.w() / "cam2" / "camera.toml";
+  r = run(t, {"calibrate", "--catalogue", cat, "--real", real.string(), "--out", out2.string()});
+  EXPECT_TRUE(r.exited && r.status == 3) << portalsim::test::describe(r);
+  EXPECT_NE(r.err.find("back_upper.png: missing (each scenario folder needs upper.png, lower.png, back_upper.png and "
+                       "back_lower.png)"),
+            std::string::npos)
+      << r.err;
 }
 
 // The rule for captures that do not look like a raw-grid camera's: a raw grid the view's

@@ -13,7 +13,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char* const kViews[] = {"upper", "lower"};
+// "upper.png and lower.png": the files each scenario folder holds.
+std::string files_of(const std::vector<std::string>& views) {
+  std::string s;
+  for (size_t k = 0; k < views.size(); ++k)
+    s += (k == 0 ? "" : k + 1 == views.size() ? " and " : ", ") + views[k] + ".png";
+  return s;
+}
 
 void add_image(ViewCaptures& v, const Image& img, const std::string& file) {
   if (img.channels != 1)
@@ -31,11 +37,11 @@ void add_image(ViewCaptures& v, const Image& img, const std::string& file) {
   v.files.push_back(file);
 }
 
-Captures read_h5(const std::string& path) {
+Captures read_h5(const std::string& path, const std::vector<std::string>& views) {
   const H5Layout layout = read_h5_layout(path);
   Captures c;
   c.source = path;
-  for (const char* name : kViews) {
+  for (const std::string& name : views) {
     auto it = std::find_if(layout.datasets.begin(), layout.datasets.end(),
                            [&](const H5Dataset& d) { return d.name == name; });
     if (it == layout.datasets.end())
@@ -102,20 +108,29 @@ void check_captures(const Captures& c) {
                            ") where the other captures are not: a blank or saturated frame");
 }
 
-Captures read_captures(const std::string& dir) {
+std::vector<std::string> mmw_views(const Catalogue& cat) {
+  std::vector<std::string> names;
+  for (const Sensor& s : cat.sensors)
+    if (s.camera == Camera::mmw) names.push_back(s.name);
+  return names;
+}
+
+Captures read_captures(const std::string& dir, const Catalogue& cat) {
+  const std::vector<std::string> views = mmw_views(cat);
+  if (views.empty()) throw InputError(cat.source + ": the catalogue has no MMW view to calibrate");
   const fs::path p(dir);
   Captures c;
   if (fs::is_regular_file(p) || fs::is_regular_file(p / "data.h5")) {
-    c = read_h5(fs::is_regular_file(p) ? dir : (p / "data.h5").string());
+    c = read_h5(fs::is_regular_file(p) ? dir : (p / "data.h5").string(), views);
   } else {
     if (!fs::is_directory(p)) throw InputError(dir + ": no such folder (give a folder of captures or a data.h5)");
     c.source = dir;
-    for (const char* name : kViews) c.views.push_back(ViewCaptures{name, 0, 0, {}, {}});
+    for (const std::string& name : views) c.views.push_back(ViewCaptures{name, 0, 0, {}, {}});
     for (const fs::path& f : scenario_folders(p))
       for (ViewCaptures& v : c.views) {
         const std::string file = (f / (v.name + ".png")).string();
         if (!fs::exists(file))
-          throw InputError(file + ": missing (each scenario folder needs upper.png and lower.png)");
+          throw InputError(file + ": missing (each scenario folder needs " + files_of(views) + ")");
         add_image(v, read_image(file, "capture"), file);
       }
   }

@@ -69,11 +69,14 @@ nlohmann::json fit_json(const calibrate::CameraFit& f, size_t captures) {
           {"subject", f.subject}};
 }
 
-std::string markdown(const Options& o, const calibrate::CameraFit& f, size_t captures, bool plotted,
+std::string markdown(const Options& o, const calibrate::CameraFit& f, const calibrate::Captures& captures, bool plotted,
                      const std::string& spec_name, const std::string& catalogue_name) {
+  std::string views;
+  for (size_t k = 0; k < captures.views.size(); ++k)
+    views += (k == 0 ? "" : k + 1 == captures.views.size() ? " and " : ", ") + captures.views[k].name;
   std::ostringstream md;
   md << "# Camera calibrated from " << o.real << "\n\n"
-     << captures << " captures (upper and lower views), matched to the catalogue's subjects.\n\n"
+     << captures.count() << " captures (" << views << " views), matched to the catalogue's subjects.\n\n"
      << "| parameter | fitted | how |\n| --- | --- | --- |\n"
      << "| raw grid | " << f.raw_w << "x" << f.raw_h
      << " | the fewest raw pixels whose bilinear interpolation reproduces every row and column to rounding |\n"
@@ -116,8 +119,8 @@ bool run_plot(const std::string& script, const std::string& folder) {
 
 int run_calibrate(const Options& o) {
   // Everything that can refuse the input comes first: nothing is written before the fit.
-  const calibrate::Captures captures = calibrate::read_captures(o.real);
   const Catalogue cat = o.catalogue.empty() ? default_catalogue(o.assets) : load_catalogue(o.catalogue, o.assets);
+  const calibrate::Captures captures = calibrate::read_captures(o.real, cat);
   const std::string catalogue_text =
       o.catalogue.empty() ? std::string(embedded::default_catalogue) : read_text(o.catalogue);
   const AssetSet assets = build_assets(cat);
@@ -145,7 +148,7 @@ int run_calibrate(const Options& o) {
     const bool plotted = run_plot(script, folder.dir());
     if (plotted) folder.path("calibrate.png");
     const std::string md =
-        markdown(o, fit, captures.count(), plotted, out.filename().string(), catalogue_path.filename().string());
+        markdown(o, fit, captures, plotted, out.filename().string(), catalogue_path.filename().string());
     write_text_atomic(folder.path("report.md"), md);
     write_text_atomic(catalogue_path.string(), calibrate::camera_catalogue(catalogue_text, fit));
     write_text_atomic(out.string(),
@@ -163,7 +166,8 @@ std::function<int()> add_calibrate(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "calibrate", "Fit the physics model's MMW camera (raw grid, blur, window, noise) to a folder of captures");
   cmd->add_option("--real", o->real,
-                  "Folder of scenario folders with upper.png and lower.png (simulate or generate --what images), "
+                  "Folder of scenario folders with a PNG of each MMW view (upper.png and lower.png in the built-in "
+                  "portal; simulate or generate --what images), "
                   "or a data.h5 of generate --format h5")
       ->required();
   cmd->add_option("--out", o->out,
