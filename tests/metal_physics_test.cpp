@@ -13,6 +13,9 @@
 #include "support.h"
 
 namespace portalsim {
+namespace embedded {
+extern const std::string_view default_catalogue;
+}
 namespace {
 
 using test::assets;
@@ -101,6 +104,23 @@ TEST(MetalPhysics, EachZoneHasItsOwnGain) {
       EXPECT_EQ(d1, d0) << "zone " << z + 1;
     }
   }
+}
+
+// An anisotropic object's strong axis is its drawing's long side: along z for a drawing
+// taller than wide (the pendant, 14 x 22), along x once it is drawn wider than tall.
+TEST(MetalPhysics, TheStrongAxisIsTheDrawingsLongSide) {
+  std::string text(embedded::default_catalogue);
+  const std::string pendant = "name = \"pendant\"\n";
+  text.insert(text.find(pendant) + pendant.size(), "metal_anisotropy = 4.0\n");
+  Catalogue cat = parse_catalogue(text, "a.toml", "", "");
+  const int v = cat.objects[cat.find_object("pendant")].first_variant;
+  const auto tall = cat.polarizability(v);
+  EXPECT_EQ(cat.long_side(v)[0], 0.0);
+  EXPECT_NEAR(tall[8], 4.0 * tall[0], 1e-9 * tall[8]) << "zz is a times xx";
+  EXPECT_EQ(tall[4], tall[0]);
+  cat.objects[cat.find_object("pendant")].width = 30;  // now wider than tall
+  const auto wide = cat.polarizability(v);
+  EXPECT_NEAR(wide[0], 4.0 * wide[8], 1e-9 * wide[0]) << "xx is a times zz";
 }
 
 // A long object is PS_METAL_SEGMENTS equal dipoles spread along its long side: its signal

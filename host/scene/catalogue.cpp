@@ -255,8 +255,9 @@ const ImageSource& Subject::image(std::string_view view) const {
 }
 
 std::array<double, 9> Catalogue::polarizability(int variant_id) const {
-  const bool turned = variant(variant_id).code == "v";
-  return polarizability(variant_id, turned ? std::array<double, 3>{0, 0, 1} : std::array<double, 3>{1, 0, 0});
+  // Along the drawing's long side, as long_side lays it: across (x) or up (z).
+  const bool up = long_side(variant_id)[0] == 0.0;
+  return polarizability(variant_id, up ? std::array<double, 3>{0, 0, 1} : std::array<double, 3>{1, 0, 0});
 }
 
 std::array<double, 9> Catalogue::polarizability(int variant_id, const std::array<double, 3>& u) const {

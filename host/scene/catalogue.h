@@ -140,7 +140,8 @@ struct Catalogue {
   }
   // A variant's magnetic polarizability tensor, cm^3, row-major 3x3 in portal axes (x
   // across, y along the walk, z up): m (I + (a - 1) u u^T) 3 / (a + 2), mean m of its metal
-  // category, anisotropy a along its long axis u (z for a "v" drawing, else x).
+  // category, anisotropy a along its long axis u: the drawing's longer side as long_side
+  // lays it (x where it is wider than tall, else z; a "v" drawing turned a quarter).
   std::array<double, 9> polarizability(int variant_id) const;
   // The same tensor with its long axis along the unit vector `axis` (portal axes), any
   // orientation: across (I + (a - 1) u u^T), written so that an axis along x or z gives
