@@ -1453,6 +1453,7 @@ TEST(PortalViews, BadViewsAndRegionsAreRefusedNamingTheField) {
        "not one of the catalogue's [[views]]"},
       {"alpha = 0.9", "alpha = 0.9\nmmw_width = 200", "images.mmw_width", "[[views]] entries now"},
       {"name = \"seat\"", "name = \"seat\"\nview = \"lower\"", "regions[11].view", "rects = { VIEW"},
+      {"field = [0, 200, 200, 200]", "field = [0, 200, 1, 1]", "views[2].field", "more than 4096 pixels long"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.to);

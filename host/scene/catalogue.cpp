@@ -601,6 +601,19 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     cat.noise.push_back(std::move(p));
   }
   for (Sensor& view : cat.sensors) derive_view(cat, view);
+  // Each view draws the objects at its scale: none larger than an image may be (4096 a side,
+  // as a view or an object's catalogue size).
+  const toml::array& views = *root.get("views")->as_array();
+  for (size_t k = 0; k < cat.sensors.size(); ++k) {
+    const Sensor& s = cat.sensors[k];
+    for (const Object& o : cat.objects) {
+      const double longest = std::max(o.width, o.height);
+      if (std::lround(longest * s.jitter_scale_x) > 4096 || std::lround(longest * s.jitter_scale_y) > 4096)
+        rd.fail(views.get(k)->as_table()->get("field"), "views[" + std::to_string(k + 1) + "].field",
+                "the view draws " + o.name + " (" + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                    " field units) more than 4096 pixels long; give the view a larger field or a smaller size");
+    }
+  }
   return cat;
 }
 
