@@ -22,11 +22,7 @@ inline const Catalogue& catalogue() {
   return c;
 }
 // The first MMW view that sees region r (index into Catalogue::sensors), and its rectangle.
-inline int mmw_view_of(const Catalogue& cat, int r) {
-  for (size_t k = 0; k < cat.sensors.size(); ++k)
-    if (cat.sensors[k].camera == Camera::mmw && cat.sensors[k].sees(r)) return static_cast<int>(k);
-  return -1;
-}
+inline int mmw_view_of(const Catalogue& cat, int r) { return first_view(cat.sensors, r, Camera::mmw); }
 inline const Rect& mmw_rect(const Catalogue& cat, int r) { return cat.sensors.at(mmw_view_of(cat, r)).rects[r]; }
 
 inline const AssetSet& assets() {

@@ -21,6 +21,12 @@ constexpr int64_t kMaxPixels = int64_t{1} << 28;
 // Added to a body's texture seeds where it is seen from the back.
 constexpr uint64_t kBackSeed = 0x6261636bull;  // "back"
 
+// Column x's centre in the field, pu field units a pixel: a back view sees the field
+// mirrored, its left edge the field's right.
+double field_u(const Frame& field, bool back, double pu, int x) {
+  return back ? field.x + field.w - (x + 0.5) * pu : (x + 0.5) * pu + field.x;
+}
+
 void check_size(int w, int h, const char* what) {
   if (w < 1 || h < 1) throw std::invalid_argument(std::string(what) + ": width and height must be at least 1");
   if (static_cast<int64_t>(w) * h > kMaxPixels) throw std::invalid_argument(std::string(what) + ": image too large");
@@ -699,8 +705,7 @@ Image mmw_view(const Body& body, const Frame& field, Side side, int width, int h
     const double vb = model.body_row(v);  // the body drawn here; the room stays at v
     int next = 0;                         // pixels before `next` are known to be clear of the body
     for (int x = 0; x < width; ++x) {
-      // A back view sees the field mirrored: its left edge is the field's right.
-      const double u = back ? field.x + field.w - (x + 0.5) * pu : (x + 0.5) * pu + field.x;
+      const double u = field_u(field, back, pu, x);
       const double room = bg + 2.0 * value_noise(u / 9.0, v / 9.0, seed + 2) + 1.5 * hash_signed(x, y, seed + 3);
       double val = room;
       if (x < next) {
@@ -737,7 +742,7 @@ Image ir_view(const Body& body, const Frame& field, Side side, int width, int he
     const double vb = model.body_row(v);  // the body drawn here; the room stays at v
     int next = 0;
     for (int x = 0; x < width; ++x) {
-      const double u = back ? field.x + field.w - (x + 0.5) * pu : (x + 0.5) * pu + field.x;
+      const double u = field_u(field, back, pu, x);
       const double back = bg + 3.0 * v / 400.0 + 1.5 * value_noise(u / 12.0, v / 12.0, seed + 6);
       double val = back;
       if (x < next) {

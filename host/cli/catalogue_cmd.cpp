@@ -30,10 +30,9 @@ int list(CatalogueOptions& o) {
                 c.subjects[i].height);
   std::printf("\nregions:\n");
   for (const Region& r : c.regions) {
-    std::string view;  // the MMW view whose rectangles hold it, named in the sensor table
-    for (const Sensor& s : c.sensors)
-      if (view.empty() && s.camera == Camera::mmw && s.sees(r.id - 1)) view = s.name;
-    std::printf("  %2d  %-15s %s\n", r.id, r.name.c_str(), view.c_str());
+    // The MMW view whose rectangles hold it, named in the views line.
+    const int view = first_view(c.sensors, r.id - 1, Camera::mmw);
+    std::printf("  %2d  %-15s %s\n", r.id, r.name.c_str(), view < 0 ? "" : c.sensors[view].name.c_str());
   }
   std::printf("\nobjects (name [variants] metal category: aliases):\n");
   for (const Object& ob : c.objects) {

@@ -241,7 +241,7 @@ MetalWalks metal_map_walks(const Catalogue& cat, const MetalMapSettings& s) {
       const int record = static_cast<int>(w.objects.size() / PS_MV_LEN);
       add_object(w.objects, cat.polarizability(v), side[0], 0.0, side[1]);
       for (int r = 0; r < kRegions; ++r) {
-        const int k = metal_view(cat.sensors, r);
+        const int k = first_view(cat.sensors, r);
         if (k < 0) throw InputError("--metal-map: region " + cat.regions[r].name + " is in no view");
         const Sensor& sensor = cat.sensors[k];
         const Rect rc = sensor.place(static_cast<int>(subject), r);

@@ -34,9 +34,9 @@ void derive_view(Catalogue& cat, Sensor& s) {
     }
 }
 
-int metal_view(const std::vector<Sensor>& views, int region) {
+int first_view(const std::vector<Sensor>& views, int region, std::optional<Camera> camera) {
   for (size_t k = 0; k < views.size(); ++k)
-    if (views[k].sees(region)) return static_cast<int>(k);
+    if (views[k].sees(region) && (!camera || views[k].camera == *camera)) return static_cast<int>(k);
   return -1;
 }
 

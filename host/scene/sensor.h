@@ -5,6 +5,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -96,9 +97,9 @@ struct Sensor {
   double field_per_row() const { return 1.0 / jitter_scale_y; }
 };
 
-// The view that places region r's object for the metal detector: the first that sees it,
-// -1 where none does.
-int metal_view(const std::vector<Sensor>& views, int region);
+// The first view that sees region r (of camera `camera`, where given), -1 where none does.
+// The metal detector places a region's object where its first view draws it.
+int first_view(const std::vector<Sensor>& views, int region, std::optional<Camera> camera = std::nullopt);
 
 struct Catalogue;
 // What a catalogue's [[views]] entry leaves to be derived: the chains and flags of its

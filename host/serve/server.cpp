@@ -386,10 +386,8 @@ struct Server::Impl {
       const Region& r = c.regions[k];
       // The MMW view whose rectangles hold the region (else its first view), named in the
       // views table.
-      int s = -1;
-      for (size_t v = 0; s < 0 && v < c.sensors.size(); ++v)
-        if (c.sensors[v].camera == Camera::mmw && c.sensors[v].sees(static_cast<int>(k))) s = static_cast<int>(v);
-      if (s < 0) s = metal_view(c.sensors, static_cast<int>(k));
+      int s = first_view(c.sensors, static_cast<int>(k), Camera::mmw);
+      if (s < 0) s = first_view(c.sensors, static_cast<int>(k));
       const Sensor& view = c.sensors[static_cast<size_t>(s)];
       // Where the region holds an object on each subject: the rectangle moved with the
       // subject's stature (Sensor::place), which the page's hit boxes follow.

@@ -46,7 +46,7 @@ std::vector<MetalObject> metal_objects(const Catalogue& cat, const AssetSet& ass
   // composite's jitter, in the portal's field; in region order.
   std::vector<std::optional<ViewScene>> scenes(cat.sensors.size());
   for (int r = 0; r < kRegions; ++r) {
-    const int k = metal_view(cat.sensors, r);
+    const int k = first_view(cat.sensors, r);
     if (s.objects[r] == kNoObject || k < 0) continue;
     const Sensor& sensor = cat.sensors[k];
     if (!scenes[k]) scenes[k].emplace(view_scene(cat, assets, m, k, s, index));

@@ -19,7 +19,7 @@ MetalPath::MetalPath(Device& d) : d_(d) {
   std::vector<cl_double> regions(S * kRegions * PS_MR_LEN, 0.0), tensors;
   // Each subject's region centres: the places, moved with its height, in the field.
   for (int r = 0; r < kRegions; ++r) {
-    const int k = metal_view(cat.sensors, r);
+    const int k = first_view(cat.sensors, r);
     if (k < 0) continue;
     const Sensor& s = cat.sensors[k];
     for (size_t j = 0; j < S; ++j) {
