@@ -6,7 +6,8 @@
 #include <chrono>
 #include <random>
 
-#include "backend/opencl/runtime.h"
+#include "backend/opencl/kernels.h"
+#include "scene/catalogue.h"
 
 namespace portalsim {
 namespace {
@@ -15,12 +16,14 @@ void BM_KernelBuild(benchmark::State& state) {
   const bool cold = state.range(0) == 0;
   static OpenCLRuntime rt;
   std::random_device rd;
-  const std::string warm_options = "-DPORTALSIM_BENCH_WARM=1";
+  // The standard tier's options for the built-in catalogue, as its backend builds them.
+  const std::string counts = " " + opencl::build_options(Fidelity{}, opencl::KernelCounts::of(default_catalogue()));
+  const std::string warm_options = "-DPORTALSIM_BENCH_WARM=1" + counts;
   cl::Program(rt.context(), OpenCLRuntime::source()).build(warm_options.c_str());  // fill the cache once
   for (auto _ : state) {
     // A fresh define changes the cache key: PoCL must compile.
     const std::string options =
-        cold ? "-DPORTALSIM_BENCH_NONCE=" + std::to_string(rd()) + std::to_string(rd()) : warm_options;
+        cold ? "-DPORTALSIM_BENCH_NONCE=" + std::to_string(rd()) + std::to_string(rd()) + counts : warm_options;
     cl::Program p(rt.context(), OpenCLRuntime::source());
     p.build(options.c_str());
     cl::Kernel k(p, "render_view");  // kernels exist: the build really finished

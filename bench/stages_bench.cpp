@@ -92,7 +92,8 @@ void BM_Annotate(benchmark::State& state) {
   const size_t n = 1024;
   GeneratorSpec spec;
   Generator gen(fx().cat, spec, 1);
-  SceneBatch batches[2];
+  const int R = fx().cat.region_count();
+  SceneBatch batches[2] = {SceneBatch(R), SceneBatch(R)};
   for (size_t i = 0; i < 2 * n; ++i) batches[i / n].push(gen(i));
   batches[1].first_index = n;
   std::vector<ViewAnnotations> out;

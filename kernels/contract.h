@@ -7,14 +7,22 @@
 #ifndef PORTALSIM_CONTRACT_H
 #define PORTALSIM_CONTRACT_H
 
-/* The body's regions (thesis 4.1) and the metal detector's zones. */
-#define PS_REGIONS 13
-#define PS_ZONES 19
+/* The most regions of the body (thesis 4.1) and zones of the metal detector a catalogue
+ * may declare: a view's region_mask has a bit per region, and a scenario's zones are bytes
+ * on a row. The kernels are built with the catalogue's own counts, -DPS_REGIONS=N and
+ * -DPS_ZONES=M (backend/opencl/kernels.cpp): the strides of the object and zone rows and
+ * the bounds of the loops over them. */
+#define PS_MAX_REGIONS 32
+#define PS_MAX_ZONES 64
+#ifdef __OPENCL_VERSION__
+#if !defined(PS_REGIONS) || !defined(PS_ZONES)
+#error "the kernels are built with the catalogue's counts, -DPS_REGIONS=N -DPS_ZONES=M"
+#endif
 /* Most sprites one camera view draws: one per region. */
 #define PS_MAX_LAYERS PS_REGIONS
+#endif
 
 /* The metal detector under --model physics (docs/model/metal.md). */
-#define PS_METAL_PANEL_A_ZONES 9 /* zones 1..9 transmit from panel A (x < 0), the rest from B */
 /* Record of one zone's coils, doubles: transmit and receive coil position (x, z, metres;
  * y = 0) and moment (along x, A m^2), then the zone's gain. */
 #define PS_MZ_TX_X 0
@@ -213,7 +221,9 @@ typedef struct {
 #define PS_LAYER_A10 23
 #define PS_LAYER_A11 25
 #define PS_LAYER_LEN 27
+#ifdef __OPENCL_VERSION__
 #define PS_REC_LEN (PS_REC_LAYERS + PS_MAX_LAYERS * PS_LAYER_LEN)
+#endif
 
 /* The vector render path reads 16 pixels of a sprite or noise tile row at a time, so
  * each also lives padded: every row with PS_PAD neutral pixels on both sides (sprites:

@@ -40,7 +40,7 @@ Expected expected_mask(const AssetSet& a, const ModelSettings& m, int view, cons
   Expected e;
   e.mask.assign(static_cast<size_t>(sensor.width) * sensor.height, 0);
   size_t p = 0;
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < kBuiltinRegions; ++r) {
     if (s.objects[r] == kNoObject || !sensor.sees(r)) continue;
     reference::ViewScene alone = vs;
     alone.placed = {vs.placed[p++]};
@@ -110,7 +110,7 @@ TEST(Annotations, MasksAndBoxesAgreeWithTheReferenceComposite) {
             cut_off[transforms] += e.cut_off;
             outside[transforms] += e.outside;
             // Every region with a visible pixel has one annotation whose box and area are its pixels'.
-            std::vector<int> seen(kRegions + 1, 0);
+            std::vector<int> seen(kBuiltinRegions + 1, 0);
             for (size_t p = 0; p < px; ++p) seen[e.mask[p]] = 1;
             int listed = 0;
             for (uint32_t t = va.first[i]; t < va.first[i + 1]; ++t) {
@@ -151,7 +151,7 @@ TEST(Annotations, MasksAndBoxesAgreeWithTheReferenceComposite) {
               }
             }
             int regions_visible = 0;
-            for (int r = 1; r <= kRegions; ++r) regions_visible += seen[r];
+            for (int r = 1; r <= kBuiltinRegions; ++r) regions_visible += seen[r];
             EXPECT_EQ(listed, regions_visible);
             ++checked;
           }

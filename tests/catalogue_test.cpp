@@ -20,12 +20,13 @@ TEST(Catalogue, DefaultHoldsTheThesisInventory) {
   EXPECT_EQ(c.metal_categories.size(), 6u);
   EXPECT_EQ(c.influence.size(), 6u);
   int upper = 0;
-  for (int r = 0; r < kRegions; ++r) upper += c.sensors[0].sees(r);
+  for (int r = 0; r < kBuiltinRegions; ++r) upper += c.sensors[0].sees(r);
   EXPECT_EQ(upper, 6);
   EXPECT_EQ(c.regions[2].name, "left-chest");
   EXPECT_EQ(c.regions[3].name, "right-abdomen");
-  EXPECT_EQ(c.subjects[0].base_zones, (std::array<int, kZones>{200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200,
-                                                               200, 200, 200, 200, 200, 200, 200, 200}));
+  EXPECT_EQ(c.region_count(), kBuiltinRegions);
+  EXPECT_EQ(c.zones, kBuiltinZones);
+  EXPECT_EQ(c.subjects[0].base_zones, std::vector<int>(kBuiltinZones, 200));
   // Gun and rod have horizontal and vertical drawings; the rest one.
   for (const Object& o : c.objects) {
     const bool two = o.name == "gun" || o.name == "iron-rod";
@@ -68,7 +69,7 @@ TEST(Catalogue, ObjectTokens) {
   EXPECT_THROW(parse_object_token(c, "none:v", "t"), InputError);
   const Scenario s = parse_object_list(c, {"none", "none", "gun"});
   EXPECT_EQ(s.objects[2], parse_object_token(c, "gun", "t"));
-  for (int r = 3; r < kRegions; ++r) EXPECT_EQ(s.objects[r], kNoObject);
+  for (int r = 3; r < kBuiltinRegions; ++r) EXPECT_EQ(s.objects[r], kNoObject);
   EXPECT_THROW(parse_object_list(c, std::vector<std::string>(14, "none")), InputError);
   try {
     parse_object_list(c, {"none", "none", "bazooka"});

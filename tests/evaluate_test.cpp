@@ -293,16 +293,16 @@ TEST(EvaluateRegions, AThreatIsInTheRegionsItsObjectsMake) {
   const ThreatRule both(c, "iron-rod & metal-plate");
   // rod in 1, plate in 2, tile in 3: a threat made by regions 1 and 2.
   const Scenario s = parse_object_list(c, {"iron-rod", "metal-plate", "cement-tile"});
-  EXPECT_EQ(cli::region_threats(both, s, true), (std::array<uint8_t, kRegions>{1, 1}));
+  EXPECT_EQ(cli::region_threats(both, s, true), (std::array<uint8_t, kMaxRegions>{1, 1}));
   // The rod alone is no threat anywhere.
-  EXPECT_EQ(cli::region_threats(both, parse_object_list(c, {"iron-rod"}), false), (std::array<uint8_t, kRegions>{}));
+  EXPECT_EQ(cli::region_threats(both, parse_object_list(c, {"iron-rod"}), false), (std::array<uint8_t, kMaxRegions>{}));
   // Two plates and a rod: removing either plate leaves a threat; neither plate is needed, the rod is.
   const Scenario s2 = parse_object_list(c, {"iron-rod", "metal-plate", "metal-plate"});
-  EXPECT_EQ(cli::region_threats(both, s2, true), (std::array<uint8_t, kRegions>{1}));
+  EXPECT_EQ(cli::region_threats(both, s2, true), (std::array<uint8_t, kMaxRegions>{1}));
   // A one-object rule: each gun is a threat on its own.
   const ThreatRule gun(c, "gun");
   EXPECT_EQ(cli::region_threats(gun, parse_object_list(c, {"none", "gun", "gun:v", "cement-tile"}), true),
-            (std::array<uint8_t, kRegions>{0, 1, 1, 0}));
+            (std::array<uint8_t, kMaxRegions>{0, 1, 1, 0}));
 }
 
 }  // namespace

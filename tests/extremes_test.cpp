@@ -117,7 +117,7 @@ std::string map_rects(const std::string& text, const std::function<Rect(int, boo
   int region = 0;
   return edit_lines(text, [&](const std::string& line) -> std::optional<std::string> {
     if (line.rfind("[[", 0) == 0) region = line == "[[regions]]" ? region + 1 : (region > 0 ? 100 : 0);
-    if (region < 1 || region > kRegions || line.rfind("rects = { ", 0) != 0) return std::nullopt;
+    if (region < 1 || region > kBuiltinRegions || line.rfind("rects = { ", 0) != 0) return std::nullopt;
     const size_t ir_at = line.find(", ir = [");
     const std::string mmw_view = line.substr(10, line.find(" = [") - 10);
     const std::vector<int> m = numbers_in(line), i = numbers_in(line.substr(ir_at));
@@ -244,7 +244,7 @@ using test::coverage;
 Scenario crowded(const Catalogue& c, int subject, size_t first = 0) {
   Scenario s;
   s.subject = subject;
-  for (int r = 0; r < kRegions; ++r) s.objects[r] = static_cast<int16_t>((first + r) % c.variant_list.size());
+  for (int r = 0; r < c.region_count(); ++r) s.objects[r] = static_cast<int16_t>((first + r) % c.variant_list.size());
   return s;
 }
 
@@ -343,7 +343,7 @@ std::vector<double> feature_counts(const Catalogue& cat, const FeatureLayout& la
         c.push_back(double(std::min(lay.block, s.width - bx * lay.block)) *
                     std::min(lay.block, s.height - by * lay.block));
   }
-  for (int r = 0; r < kRegions; ++r)  // in the first pooled view that sees it
+  for (int r = 0; r < cat.region_count(); ++r)  // in the first pooled view that sees it
     for (int k : lay.pooled)
       if (cat.sensors[k].sees(r)) {
         c.push_back(double(cat.sensors[k].rects[r].w) * cat.sensors[k].rects[r].h);
@@ -498,7 +498,7 @@ std::unique_ptr<Parity> expect_parity(World& w, const SceneBatch& batch, const M
 
 // The first `n` scenarios of `b` (per-pixel noise is costly on the CPU device).
 SceneBatch first_of(const SceneBatch& b, size_t n) {
-  SceneBatch out;
+  SceneBatch out(b.regions);
   out.first_index = b.first_index;
   for (size_t i = 0; i < std::min(n, b.size()); ++i) out.push(b.at(i));
   return out;
@@ -526,7 +526,7 @@ std::vector<double> base_features(const World& w, int subject, int block) {
         row.push_back(sum / count);
       }
   }
-  for (int k = 0; k < kRegions; ++k) {
+  for (int k = 0; k < kBuiltinRegions; ++k) {
     const Image& img = w.assets.bases[subject][test::mmw_view_of(w.cat, k)];
     const Rect& r = test::mmw_rect(w.cat, k);
     double sum = 0;
@@ -675,7 +675,7 @@ TEST(ExtremeAlpha, OneMakesSpritesOpaque) {
     OpaqueCheck mmw, ir;
     for (size_t i = 0; i < singles.size(); ++i) {
       const Scenario& s = singles[i];
-      for (int r = 0; r < kRegions; ++r) {
+      for (int r = 0; r < kBuiltinRegions; ++r) {
         const int v = s.objects[r];
         if (v < 0) continue;
         const int view = test::mmw_view_of(w->cat, r);
@@ -749,7 +749,7 @@ void black_and_white(uint8_t base, uint8_t sprite) {
 
   std::vector<Scenario> scenes;
   for (int subject = 0; subject < 5; ++subject) scenes.push_back(crowded(w->cat, subject, subject));
-  for (const Scenario& s : coverage(w->cat, 200, 13)) scenes.push_back(s);
+  for (const Scenario& s : test::parity_set(w->cat, 200, 13)) scenes.push_back(s);
   const SceneBatch batch = test::batch_of(scenes, 1000);
 
   // Pattern noise pushes past both ends: the kernels must clamp as the reference does.
@@ -817,15 +817,15 @@ TEST(ExtremeMetal, HeaviestMetalInEveryRegionClampsAtOne) {
     for (int mix = 0; mix < 2; ++mix) {
       Scenario sc;
       sc.subject = s;
-      for (int r = 0; r < kRegions; ++r) sc.objects[r] = static_cast<int16_t>(first + (mix ? r % 2 : 0));
+      for (int r = 0; r < kBuiltinRegions; ++r) sc.objects[r] = static_cast<int16_t>(first + (mix ? r % 2 : 0));
       scenes.push_back(sc);
     }
   // Influence sums per zone (the same for every scenario: all 13 regions hold heavy metal).
-  std::array<int, kZones> sum{};
-  for (int r = 0; r < kRegions; ++r)
-    for (int z = 0; z < kZones; ++z) sum[z] += w.cat.influence[w.cat.objects[gun].metal][r][z];
+  std::array<int, kBuiltinZones> sum{};
+  for (int r = 0; r < kBuiltinRegions; ++r)
+    for (int z = 0; z < kBuiltinZones; ++z) sum[z] += w.cat.influence[w.cat.objects[gun].metal][r][z];
   int clamped = 0;
-  for (int z = 0; z < kZones; ++z) clamped += sum[z] >= 200 + 199;
+  for (int z = 0; z < kBuiltinZones; ++z) clamped += sum[z] >= 200 + 199;
   ASSERT_GT(clamped, 5) << "the test needs zones far below 1";
 
   struct Case {
@@ -843,10 +843,10 @@ TEST(ExtremeMetal, HeaviestMetalInEveryRegionClampsAtOne) {
       EXPECT_EQ(p->features[t].metal, p->ref_images.metal) << tier_name(kTiers[t]);
     }
     const BatchOutput& o = p->ref_images;
-    ASSERT_EQ(o.metal.size(), scenes.size() * kZones);
+    ASSERT_EQ(o.metal.size(), scenes.size() * kBuiltinZones);
     for (size_t i = 0; i < scenes.size(); ++i) {
       const auto& base = w.cat.subjects[scenes[i].subject].base_zones;
-      for (int z = 0; z < kZones; ++z) {
+      for (int z = 0; z < kBuiltinZones; ++z) {
         const int got = o.metal_of(i)[z], exact = base[z] - sum[z];
         EXPECT_GE(got, 1) << "zone " << z + 1;
         EXPECT_LE(got, 200) << "zone " << z + 1;
@@ -889,7 +889,7 @@ TEST(ExtremeEmpty, NoObjectsGiveTheBase) {
       expect_features_are_base_means(w, batch, p->images[t], block, 1e-4, who + " images plan");
       expect_features_are_base_means(w, batch, p->features[t], block, 1e-4, who + " features-only");
       for (const BatchOutput* o : {&p->images[t], &p->features[t]}) {
-        ASSERT_EQ(o->metal.size(), scenes.size() * kZones);
+        ASSERT_EQ(o->metal.size(), scenes.size() * kBuiltinZones);
         for (size_t i = 0; i < scenes.size(); ++i) {
           const auto& base = w.cat.subjects[scenes[i].subject].base_zones;
           EXPECT_TRUE(std::equal(base.begin(), base.end(), o->metal_of(i))) << who << " scenario " << i;
@@ -909,7 +909,7 @@ TEST(ExtremeBlock, SizesFromOnePixelToBeyondTheImage) {
     const FeatureLayout lay = FeatureLayout::of(w.cat, block);
     EXPECT_EQ(lay.grids[0].blocks_x, (200 + block - 1) / block);
     EXPECT_EQ(lay.grids[0].blocks_y, (200 + block - 1) / block);
-    EXPECT_EQ(lay.image_features(), 2 * lay.grids[0].blocks_x * lay.grids[0].blocks_y + kRegions);
+    EXPECT_EQ(lay.image_features(), 2 * lay.grids[0].blocks_x * lay.grids[0].blocks_y + kBuiltinRegions);
     EXPECT_EQ(lay.names().size(), static_cast<size_t>(lay.row_features()));
     Plan check = features_plan(model(0, true, 0.0, block), Tier::standard);
     EXPECT_NO_THROW(validate(check, w.cat));
@@ -920,7 +920,7 @@ TEST(ExtremeBlock, SizesFromOnePixelToBeyondTheImage) {
       EXPECT_EQ(lay.grids[0].blocks_x, 1);
       EXPECT_EQ(lay.grids[0].blocks_y, 1);
       for (const BatchOutput* o : {&p->ref_images, &p->images[0], &p->images[1], &p->images[2]}) {
-        ASSERT_EQ(o->features.size(), batch.size() * (2 + kRegions));
+        ASSERT_EQ(o->features.size(), batch.size() * (2 + kBuiltinRegions));
         for (size_t i = 0; i < batch.size(); ++i) {
           const size_t px = size_t(o->view("upper").width) * o->view("upper").height;
           double up = 0, lo = 0;
@@ -956,7 +956,7 @@ TEST(ExtremeImageSize, OneByOne) {
     for (int block : {1, 10}) expect_parity(*w, batch, model(61, true, 0.0, block), "1x1 images");
     expect_parity(*w, batch, model(62, true, 3.0, 1), "1x1 images with pixel noise", FastNoisy::own_model);
     const FeatureLayout lay = FeatureLayout::of(w->cat, 10);
-    EXPECT_EQ(lay.image_features(), 2 + kRegions);
+    EXPECT_EQ(lay.image_features(), 2 + kBuiltinRegions);
   }
 }
 
@@ -1090,7 +1090,7 @@ TEST(ExtremeNoise, SigmaOfAThousand) {
 
 TEST(ExtremePhysics, CoverageSetInEveryTier) {
   World& w = default_world();
-  const SceneBatch batch = test::batch_of(coverage(w.cat, 200, 13), 77);
+  const SceneBatch batch = test::batch_of(test::parity_set(w.cat, 200, 13), 77);
   expect_parity(w, batch, physics_model(201, 10, 5), "physics model, coverage set");
   ModelSettings jitter = physics_model(202);
   jitter.jitter = 5.5;
@@ -1154,18 +1154,18 @@ TEST(ExtremeBatch, OneAndAMillion) {
   const Plan plan = features_plan(m, Tier::standard);
   ASSERT_TRUE(plan.sparse_features());
   constexpr size_t kMillion = 1000000;
-  SceneBatch big;
+  SceneBatch big(kBuiltinRegions);
   big.first_index = 0;
   big.subject.reserve(kMillion);
-  big.objects.reserve(kMillion * kRegions);
+  big.objects.reserve(kMillion * kBuiltinRegions);
   big.label.reserve(kMillion);
   for (uint64_t k = 0; k < kMillion; ++k) big.push(test::random_scenario(w.cat, k, 4));
   BatchOutput out;
   w.cl->run(big, plan, out);
   const size_t F = out.layout.image_features();
-  ASSERT_EQ(F, size_t(2 * 2 * 2 + kRegions));
+  ASSERT_EQ(F, size_t(2 * 2 * 2 + kBuiltinRegions));
   ASSERT_EQ(out.features.size(), kMillion * F);
-  ASSERT_EQ(out.metal.size(), kMillion * kZones);
+  ASSERT_EQ(out.metal.size(), kMillion * kBuiltinZones);
   expect_in_range(out);
   for (const uint64_t index : {uint64_t{0}, uint64_t{1}, uint64_t{500000}, uint64_t{999999}}) {
     SCOPED_TRACE("index " + std::to_string(index));
@@ -1318,11 +1318,30 @@ TEST(ExtremeRejection, CommandLineNumbers) {
 // =============================================================================================
 // 13. Portals other than the thesis's: views, regions and pooling declared in the catalogue.
 
+// `batch` run whole and in pieces of `step` scenarios give the same bytes: every view's
+// images, the features and the zones.
+void expect_split_invariant(Backend& backend, const SceneBatch& batch, const Plan& plan, size_t step) {
+  BatchOutput whole, pieces, part;
+  backend.run(batch, plan, whole);
+  for (size_t at = 0; at < batch.size(); at += step) {
+    SceneBatch b(batch.regions);
+    b.first_index = batch.first_index + at;
+    for (size_t i = at; i < std::min(batch.size(), at + step); ++i) b.push(batch.at(i));
+    backend.run(b, plan, part);
+    append_output(pieces, part);
+  }
+  ASSERT_EQ(pieces.views.size(), whole.views.size());
+  for (size_t k = 0; k < whole.views.size(); ++k)
+    EXPECT_TRUE(pieces.views[k].pixels == whole.views[k].pixels) << whole.views[k].name;
+  EXPECT_EQ(pieces.features, whole.features);
+  EXPECT_EQ(pieces.metal, whole.metal);
+}
+
 std::string front_back_text() { return slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "portal-front-back.toml"); }
 
 // Objects in every region, front and back; each scenario's objects from `first` on.
 std::vector<Scenario> front_and_back_scenes(const Catalogue& c) {
-  std::vector<Scenario> v = coverage(c, 30, 5);
+  std::vector<Scenario> v = test::parity_set(c, 30, 5);
   for (int s = 0; s < 5; ++s) v.push_back(crowded(c, s, static_cast<size_t>(3 * s)));
   return v;
 }
@@ -1335,23 +1354,100 @@ TEST(PortalViews, FrontAndBackPortalMatchesTheReferenceInEveryTier) {
   ASSERT_EQ(w->cat.sensors.size(), 5u);
   EXPECT_EQ(w->cat.sensors[2].side, Side::back);
   EXPECT_TRUE(FeatureLayout::of(w->cat, 10).uniform) << "four pooled 200x200 views: the sparse paths take them";
-  const SceneBatch batch = test::batch_of(front_and_back_scenes(w->cat), 500);
+  ASSERT_EQ(w->cat.region_count(), 19) << "the built-in 13 on the front and 6 on the back";
+  const SceneBatch batch = test::batch_of(front_and_back_scenes(w->cat), 500, w->cat.region_count());
   expect_parity(*w, batch, model(131, true), "front and back, pattern noise");
   expect_parity(*w, batch, model(132, false, 4.0, 7, 3), "front and back, pixel and metal noise");
   expect_parity(*w, batch, physics_model(133), "front and back, physics");
   // Any batch split gives the same bytes.
-  BatchOutput whole, part;
-  const Plan plan = features_plan(model(134, true), Tier::standard);
-  w->cl->run(batch, plan, whole);
-  std::vector<float> pieces;
-  for (size_t at = 0; at < batch.size(); at += 7) {
-    SceneBatch b;
-    b.first_index = batch.first_index + at;
-    for (size_t i = at; i < std::min(batch.size(), at + 7); ++i) b.push(batch.at(i));
-    w->cl->run(b, plan, part);
-    pieces.insert(pieces.end(), part.features.begin(), part.features.end());
+  expect_split_invariant(*w->cl, batch, features_plan(model(134, true), Tier::standard), 7);
+}
+
+std::string portal_20x33_text() {
+  return slurp(fs::path(PORTALSIM_SOURCE_DIR) / "tests" / "portals" / "portal-20x33.toml");
+}
+
+// The test portal of tests/portals/portal-20x33.toml (tools/portal_catalogues.py): front and
+// back MMW and IR views, 20 regions and a 33-zone metal detector, declared as catalogue
+// entries only. Both models and every tier, images and features, against the reference; any
+// batch split gives the same bytes.
+TEST(PortalCounts, TwentyRegionsAndThirtyThreeZonesMatchTheReference) {
+  auto w = make_world(portal_20x33_text());
+  ASSERT_EQ(w->cat.region_count(), 20);
+  ASSERT_EQ(w->cat.zones, 33);
+  ASSERT_EQ(w->cat.sensors.size(), 6u);
+  EXPECT_EQ(w->cat.sensors[5].name, "back_ir");
+  EXPECT_EQ(w->cat.sensors[5].side, Side::back);
+  // Random crowds, then every region filled on each subject.
+  std::vector<Scenario> scenes = coverage(w->cat, 24, 10, false);
+  for (int s = 0; s < 5; ++s) scenes.push_back(crowded(w->cat, s, static_cast<size_t>(2 * s)));
+  const SceneBatch batch = test::batch_of(scenes, 700, w->cat.region_count());
+  expect_parity(*w, batch, model(161, true), "20 regions, pattern noise");
+  expect_parity(*w, batch, model(162, false, 4.0, 7, 3), "20 regions, pixel and metal noise");
+  const auto physics = expect_parity(*w, batch, physics_model(163), "20 regions, physics");
+  // Region 20 (the back of the neck, seen only from behind) and zones past the 19th count.
+  const BatchOutput& o = physics->images[1];
+  ASSERT_EQ(o.metal.size(), batch.size() * 33);
+  EXPECT_EQ(o.layout.image_features(), o.layout.block_features() + 20);
+  size_t late_zones = 0;
+  for (size_t i = 0; i < batch.size(); ++i)
+    for (int z = 19; z < 33; ++z) late_zones += o.metal_of(i)[z] < 200;
+  EXPECT_GT(late_zones, 0u) << "zones 20-33 never read metal";
+  Scenario neck;
+  neck.objects[19] = static_cast<int16_t>(test::variant_of(w->cat, "gun"));
+  BatchOutput bare, gun;
+  const Plan plan = images_plan(physics_model(164), Tier::standard);
+  w->cl->run(test::batch_of({Scenario{}}, 0, 20), plan, bare);
+  w->cl->run(test::batch_of({neck}, 0, 20), plan, gun);
+  EXPECT_EQ(bare.view("upper").pixels, gun.view("upper").pixels) << "the back of the neck is not seen from the front";
+  EXPECT_NE(bare.view("back_upper").pixels, gun.view("back_upper").pixels);
+  EXPECT_NE(bare.view("back_ir").pixels, gun.view("back_ir").pixels);
+  EXPECT_NE(bare.metal, gun.metal);
+  // Any batch split gives the same bytes: images of every view, features and zones.
+  expect_split_invariant(*w->cl, batch, images_plan(model(165, true, 2.0, 10, 2), Tier::standard), 6);
+}
+
+// Regions and zones past the capacities (kernels/contract.h), and tables that disagree with
+// the counts, are refused naming the file, line and field.
+TEST(PortalCounts, CountsPastTheCapacitiesAreRefusedNamingTheField) {
+  const std::string text = portal_20x33_text();
+  std::string extra;
+  for (int r = 21; r <= kMaxRegions + 1; ++r)
+    extra += "[[regions]]\nname = \"extra-" + std::to_string(r) + "\"\nrects = { upper = [0, 0, 10, 10] }\n\n";
+  struct Case {
+    std::string text, field, says;
+  };
+  const std::vector<Case> cases{
+      {replace_once(text, "# --- Objects", extra + "# --- Objects"), "regions",
+       "expected 1 to " + std::to_string(kMaxRegions) + " regions, found " + std::to_string(kMaxRegions + 1)},
+      {replace_once(text, "zones = 33", "zones = " + std::to_string(kMaxZones + 1)), "metal.zones", "out of range"},
+      {replace_once(text, "zones = 33", "zones = 19"), "metal.influence.none[region 1]",
+       "expected 19 values, found 33"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.field);
+    try {
+      parse_catalogue(c.text, "test.toml", "", "");
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("test.toml:"), std::string::npos) << what;
+      EXPECT_NE(what.find(c.field + ": "), std::string::npos) << what;
+      EXPECT_NE(what.find(c.says), std::string::npos) << what;
+    }
   }
-  EXPECT_EQ(pieces, whole.features);
+  // A [metal.physics] of another zone count: its first per-zone array names it.
+  std::string physics = text;
+  const size_t at = physics.find("tx_panel = [\"a\", ");
+  ASSERT_NE(at, std::string::npos);
+  physics.replace(at, std::string("tx_panel = [\"a\", ").size(), "tx_panel = [");
+  try {
+    parse_catalogue(physics, "test.toml", "", "");
+    ADD_FAILURE() << "accepted 32 panels for 33 zones";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("metal.physics.tx_panel: expected an array of 33 panels"), std::string::npos)
+        << e.what();
+  }
 }
 
 // A back view draws the body and the objects mirrored: the body's outline is the front's
@@ -1386,12 +1482,12 @@ TEST(PortalViews, BackViewsAreMirrored) {
 // knee is. The same object there and at the front's right knee reads the same zones.
 TEST(PortalViews, MetalFindsABackObjectOnTheSameSideOfThePortal) {
   auto back = make_world(front_back_text());
-  // Region 12 (back of the right knee) moved to the front lower view's right knee.
+  // Region 18 (back of the right knee) moved to the front lower view's right knee.
   std::string text = replace_once(front_back_text(), "rects = { back_lower = [104, 80, 46, 55] }",
                                   "rects = { lower = [50, 80, 46, 55] }");
   auto front = make_world(text);
   Scenario s;
-  s.objects[11] = static_cast<int16_t>(test::variant_of(back->cat, "gun"));
+  s.objects[17] = static_cast<int16_t>(test::variant_of(back->cat, "gun"));
   const ModelSettings m = physics_model(141);
   const auto a = reference::metal_objects(back->cat, back->assets, m, s, 0);
   const auto b = reference::metal_objects(front->cat, front->assets, m, s, 0);
@@ -1402,12 +1498,13 @@ TEST(PortalViews, MetalFindsABackObjectOnTheSameSideOfThePortal) {
   EXPECT_LT(a[0].x, 0.0) << "the subject's right is the portal's x < 0 (panel A)";
   BatchOutput oa, ob;
   Plan plan = features_plan(m, Tier::standard);
-  back->cl->run(test::batch_of({s}), plan, oa);
-  front->cl->run(test::batch_of({s}), plan, ob);
+  back->cl->run(test::batch_of({s}, 0, back->cat.region_count()), plan, oa);
+  front->cl->run(test::batch_of({s}, 0, front->cat.region_count()), plan, ob);
   EXPECT_EQ(oa.metal, ob.metal);
   // The gun on the subject's right reads more on panel A's zones than on panel B's.
   int a_zones = 0, b_zones = 0;
-  for (int z = 0; z < kZones; ++z) (z < PS_METAL_PANEL_A_ZONES ? a_zones : b_zones) += 200 - oa.metal[z];
+  for (int z = 0; z < back->cat.zones; ++z)
+    (back->cat.metal_physics.tx_side[z] < 0 ? a_zones : b_zones) += 200 - oa.metal[z];
   EXPECT_GT(a_zones, 0);
 }
 
@@ -1425,7 +1522,7 @@ TEST(PortalViews, PooledViewsOfOtherSizesHaveTheirOwnGrids) {
   EXPECT_EQ(lay.grids[2].offset, 2 * 49);
   EXPECT_EQ(lay.names()[2 * 49], "ir_r0_c0");
   EXPECT_EQ(lay.names()[2 * 49 + 27], "ir_r6_c3");
-  const SceneBatch batch = test::batch_of(coverage(w->cat, 40, 4), 900);
+  const SceneBatch batch = test::batch_of(test::parity_set(w->cat, 40, 4), 900);
   expect_parity(*w, batch, model(151, true, 0.0, 30), "pooled IR");
   expect_parity(*w, batch, model(152, false, 3.0, 30), "pooled IR, pixel noise");
   expect_parity(*w, batch, physics_model(153, 30), "pooled IR, physics");
@@ -1444,15 +1541,15 @@ TEST(PortalViews, BadViewsAndRegionsAreRefusedNamingTheField) {
       {"field = [0, 200, 200, 200]", "field = [0, 200, 0, 200]", "views[2].field[2]", "out of range"},
       {"field = [0, 200, 200, 200]", "field = [0, 200]", "views[2].field", "[x, y, width, height]"},
       {"pooled = true", "pooled = 1", "views[1].pooled", "true or false"},
-      {"rects = { back_upper = [66, 40, 68, 70] }", "rects = { back = [66, 40, 68, 70] }", "regions[8].rects.back",
+      {"rects = { back_upper = [66, 40, 68, 70] }", "rects = { back = [66, 40, 68, 70] }", "regions[14].rects.back",
        "not one of the catalogue's [[views]]"},
-      {"rects = { back_upper = [66, 40, 68, 70] }", "rects = {}", "regions[8].rects", "at least one"},
+      {"rects = { back_upper = [66, 40, 68, 70] }", "rects = {}", "regions[14].rects", "at least one"},
       {"rects = { back_upper = [66, 40, 68, 70] }", "rects = { back_upper = [166, 40, 68, 70] }",
-       "regions[8].rects.back_upper", "outside the 200x200 view"},
+       "regions[14].rects.back_upper", "outside the 200x200 view"},
       {"name = \"subject-2\"", "name = \"subject-2\"\nimages.back = \"b.png\"", "subjects[2].images.back",
        "not one of the catalogue's [[views]]"},
       {"alpha = 0.9", "alpha = 0.9\nmmw_width = 200", "images.mmw_width", "[[views]] entries now"},
-      {"name = \"seat\"", "name = \"seat\"\nview = \"lower\"", "regions[11].view", "rects = { VIEW"},
+      {"name = \"seat\"", "name = \"seat\"\nview = \"lower\"", "regions[17].view", "rects = { VIEW"},
       {"field = [0, 200, 200, 200]", "field = [0, 200, 1, 1]", "views[2].field", "more than 4096 pixels long"},
   };
   for (const Case& c : cases) {
@@ -1466,7 +1563,7 @@ TEST(PortalViews, BadViewsAndRegionsAreRefusedNamingTheField) {
       const std::string what = e.what();
       EXPECT_NE(what.find(c.field + ": "), std::string::npos) << what;
       EXPECT_NE(what.find(c.says), std::string::npos) << what;
-      if (c.field != "regions[8].rects" && c.field != "views[2].field") {
+      if (c.field != "regions[14].rects" && c.field != "views[2].field") {
         EXPECT_NE(what.find("test.toml:" + std::to_string(line) + ":"), std::string::npos) << what;
       }
     }

@@ -82,7 +82,7 @@ std::map<std::string, std::string> hashes(const Example& e, const BatchOutput& o
   for (const ViewImages& v : o.views)
     if (!v.empty()) h[std::string(e.name) + " " + v.name] = hex(XXH3_64bits(v.of(0), v.pixels_per_image()));
   h[std::string(e.name) + " features"] = hex(XXH3_64bits(o.features_of(0), o.layout.image_features() * sizeof(float)));
-  h[std::string(e.name) + " metal"] = hex(XXH3_64bits(o.metal_of(0), kZones));
+  h[std::string(e.name) + " metal"] = hex(XXH3_64bits(o.metal_of(0), kBuiltinZones));
   return h;
 }
 

@@ -260,7 +260,7 @@ TEST(IrPhysics, AnObjectPastTheBodysOutlineIsShadowedAgainstTheRoom) {
   const PhysicsConfig& pc = w.cat.physics;
   Scenario scene;
   int region = -1;
-  for (int r = 0; r < kRegions; ++r)
+  for (int r = 0; r < kBuiltinRegions; ++r)
     if (w.cat.regions[r].name == "right-abdomen") region = r;
   ASSERT_GE(region, 0);
   scene.objects[region] = static_cast<int16_t>(variant_of(w.cat, "gun"));

@@ -91,19 +91,19 @@ TEST(MetalMapParity, KernelMatchesReferenceAlongTheWalkInAnyOrientation) {
       probes.insert(probes.end(), {p[0], p[1], p[2], static_cast<double>(o)});
     }
   const size_t n = probes.size() / PS_MP_LEN;
-  const opencl::MetalResponses got = opencl::metal_responses(*test::runtime(), mp, rec, probes);
-  ASSERT_EQ(got.deduction.size(), n * kZones);
+  const opencl::MetalResponses got = opencl::metal_responses(*test::runtime(), cat, rec, probes);
+  ASSERT_EQ(got.deduction.size(), n * kBuiltinZones);
   size_t differ = 0, capped = 0;
   for (size_t i = 0; i < n; ++i) {
     const double* p = &probes[i * PS_MP_LEN];
-    std::array<double, kZones> response{};
-    std::array<uint8_t, kZones> deduction{};
+    std::array<double, kBuiltinZones> response{};
+    std::array<uint8_t, kBuiltinZones> deduction{};
     reference::metal_response(mp, object_of(rec, static_cast<int>(p[3]), p[0], p[1], p[2]), response.data(),
                               deduction.data());
-    for (int z = 0; z < kZones; ++z) {
-      const double k = got.response[i * kZones + z];
+    for (int z = 0; z < kBuiltinZones; ++z) {
+      const double k = got.response[i * kBuiltinZones + z];
       const bool same = k == response[z] || (std::isnan(k) && std::isnan(response[z]));
-      differ += !same || got.deduction[i * kZones + z] != deduction[z];
+      differ += !same || got.deduction[i * kBuiltinZones + z] != deduction[z];
       capped += deduction[z] == 199;
     }
   }
@@ -142,8 +142,8 @@ TEST(MetalMap, PanelsAreMirrorImages) {
     for (double x : {0.05, 0.15, 0.25})
       for (double y : {0.0, 0.2, -0.4})
         for (double z : {0.3, 1.0, 1.4}) {
-          std::array<double, kZones> a{}, b{};
-          std::array<uint8_t, kZones> da{}, db{};
+          std::array<double, kBuiltinZones> a{}, b{};
+          std::array<uint8_t, kBuiltinZones> da{}, db{};
           reference::metal_response(mp, object_of(rec, o, x, y, z), a.data(), da.data());
           reference::metal_response(mp, object_of(rec, o, -x, y, z), b.data(), db.data());
           for (int k = 0; k < 9; ++k) {
@@ -167,8 +167,8 @@ TEST(MetalMap, ResponseFallsWithDistanceToTheCoils) {
   for (const auto& u : kAxes) add_record(rec, catalogue(), "gun", u);
   const double lmax = *std::max_element(rec.begin(), rec.begin() + 9);  // the tensor's largest eigenvalue
   auto responses = [&](int o, double x, double y, double z) {
-    std::array<double, kZones> r{};
-    std::array<uint8_t, kZones> d{};
+    std::array<double, kBuiltinZones> r{};
+    std::array<uint8_t, kBuiltinZones> d{};
     reference::metal_response(mp, object_of(rec, o, x, y, z), r.data(), d.data());
     return r;
   };
@@ -179,8 +179,8 @@ TEST(MetalMap, ResponseFallsWithDistanceToTheCoils) {
         double peak = 0, far = 0;
         for (double y : {0.0, 0.1, 0.2, 0.4, 0.6, 0.8, 1.0, 1.5, 2.0, 3.0}) {
           const auto r = responses(o, x, y, z), back = responses(o, x, -y, z);
-          for (int zone = 0; zone < kZones; ++zone) {
-            const double side = zone < PS_METAL_PANEL_A_ZONES ? -1.0 : 1.0;
+          for (int zone = 0; zone < kBuiltinZones; ++zone) {
+            const double side = mp.tx_side[zone];
             double bound = 0;
             for (int k = 0; k < PS_METAL_SEGMENTS; ++k) {
               const double f = (k + 0.5) / PS_METAL_SEGMENTS - 0.5;
@@ -210,8 +210,8 @@ TEST(MetalMap, ResponseFallsWithDistanceToTheCoils) {
 TEST(MetalMap, OrientationMattersOnlyForAnAnisotropicObject) {
   const MetalPhysics& mp = catalogue().metal_physics;
   auto response = [&](const std::array<double, 9>& t, double z) {
-    std::array<double, kZones> r{};
-    std::array<uint8_t, kZones> d{};
+    std::array<double, kBuiltinZones> r{};
+    std::array<uint8_t, kBuiltinZones> d{};
     reference::MetalObject o{t, 0.1, z};
     reference::metal_response(mp, o, r.data(), d.data());
     return r;
@@ -319,8 +319,8 @@ TEST(MetalMap, CleanTesterAtTheCoilsPlaneReadsAsTheScenario) {
   const Catalogue& cat = catalogue();
   evaluate::MetalMapSettings s = small("gun");
   const evaluate::MetalWalks w = evaluate::metal_map_walks(cat, s);
-  const opencl::MetalResponses r = opencl::metal_responses(*test::runtime(), cat.metal_physics, w.objects, w.probes);
-  const size_t cells = w.walks - cat.subjects.size() * 4 * kRegions;  // the map's walks; four benign items
+  const opencl::MetalResponses r = opencl::metal_responses(*test::runtime(), cat, w.objects, w.probes);
+  const size_t cells = w.walks - cat.subjects.size() * 4 * kBuiltinRegions;  // the map's walks; four benign items
   const size_t at0 = static_cast<size_t>(std::lround(s.walk * s.sample_rate / s.speed));
   ASSERT_EQ(w.probes[(cells * w.samples + at0) * PS_MP_LEN + PS_MP_Y], 0.0);
   ModelSettings m;
@@ -328,17 +328,18 @@ TEST(MetalMap, CleanTesterAtTheCoilsPlaneReadsAsTheScenario) {
   int checked = 0;
   for (size_t subject = 0; subject < cat.subjects.size(); ++subject)
     for (const char* item : {"belt-buckle", "mobile-phone", "pendant", "compact-disk"})
-      for (int region = 0; region < kRegions; ++region, ++checked) {
+      for (int region = 0; region < kBuiltinRegions; ++region, ++checked) {
         Scenario sc;
         sc.subject = static_cast<int>(subject);
         sc.objects.fill(kNoObject);
         sc.objects[region] = cat.objects[cat.find_object(item)].first_variant;
-        std::array<uint8_t, kZones> zones{};
+        std::array<uint8_t, kBuiltinZones> zones{};
         reference::metal_physics(cat, test::assets(), m, sc, 0, zones.data());
         const size_t walk = cells + static_cast<size_t>(checked);
-        for (int z = 0; z < kZones; ++z)
-          EXPECT_EQ(std::clamp(cat.subjects[subject].base_zones[z] - r.deduction[(walk * w.samples + at0) * kZones + z],
-                               1, 200),
+        for (int z = 0; z < kBuiltinZones; ++z)
+          EXPECT_EQ(std::clamp(
+                        cat.subjects[subject].base_zones[z] - r.deduction[(walk * w.samples + at0) * kBuiltinZones + z],
+                        1, 200),
                     zones[z])
               << item << " region " << region + 1 << " zone " << z + 1;
       }

@@ -47,7 +47,7 @@ TEST(MetalPhysics, ZoneSignalFallsAsTheProductOfTwoDipoleFields) {
   const double h = 1.1;
   for (int zone : {2, 14}) {
     mp.tx_height[zone] = mp.rx_height[zone] = h;
-    const double side = zone < PS_METAL_PANEL_A_ZONES ? -1.0 : 1.0;
+    const double side = mp.tx_side[zone];
     const double tx_x = side * mp.panel_separation / 2, rx_x = -tx_x;
     double last = 0;
     for (double f = 0.05; f <= 0.951; f += 0.05) {
@@ -90,12 +90,12 @@ TEST(MetalPhysics, FieldAlongThePanelIsMinusHalfTheAxialField) {
 TEST(MetalPhysics, EachZoneHasItsOwnGain) {
   Catalogue cat = catalogue();
   const Scenario s = parse_object_list(cat, {"none", "none", "none", "none", "none", "none", "compact-disk"});
-  std::array<uint8_t, kZones> before{}, after{};
+  std::array<uint8_t, kBuiltinZones> before{}, after{};
   reference::metal_physics(cat, assets(), physics(), s, 0, before.data());
   const int zone = 13;
   cat.metal_physics.gain[zone] *= 2;
   reference::metal_physics(cat, assets(), physics(), s, 0, after.data());
-  for (int z = 0; z < kZones; ++z) {
+  for (int z = 0; z < kBuiltinZones; ++z) {
     const int d0 = 200 - before[z], d1 = 200 - after[z];
     if (z == zone) {
       ASSERT_GT(d0, 0);
@@ -136,7 +136,7 @@ TEST(MetalPhysics, LongObjectsAreDipolesAlongTheirLength) {
   EXPECT_NEAR(cat.long_side(rod + 1)[1], 56 * scale, 1e-12);
   for (const auto& side : {cat.long_side(rod), cat.long_side(rod + 1)}) {
     const reference::MetalObject o{cat.polarizability(rod), 0.1, 1.1, side[0], side[1]};
-    for (int z = 0; z < kZones; ++z) {
+    for (int z = 0; z < kBuiltinZones; ++z) {
       double sum = 0, size = 0;
       for (int k = 0; k < 5; ++k) {
         const double f = -0.4 + 0.2 * k;
@@ -172,7 +172,7 @@ TEST_P(MetalPhysicsBothBackends, TwoDistantObjectsAdd) {
   const auto objs_a = reference::metal_objects(cat, assets(), physics(), parse_object_list(cat, a), 0);
   const auto objs_c = reference::metal_objects(cat, assets(), physics(), parse_object_list(cat, c), 0);
   int checked = 0;
-  for (int z = 0; z < kZones; ++z) {
+  for (int z = 0; z < kBuiltinZones; ++z) {
     const double sa = reference::zone_signal(cat.metal_physics, z, objs_a[0]);
     const double sc = reference::zone_signal(cat.metal_physics, z, objs_c[0]);
     const int da = 200 - za[z], dc = 200 - zc[z], db = 200 - zb[z];
@@ -182,8 +182,8 @@ TEST_P(MetalPhysicsBothBackends, TwoDistantObjectsAdd) {
   }
   EXPECT_GE(checked, 10);
   // Each one alone moves some zone: neither is invisible.
-  EXPECT_NE(za, std::vector<int>(kZones, 200));
-  EXPECT_NE(zc, std::vector<int>(kZones, 200));
+  EXPECT_NE(za, std::vector<int>(kBuiltinZones, 200));
+  EXPECT_NE(zc, std::vector<int>(kBuiltinZones, 200));
 }
 
 // The gun's and the rod's horizontal and vertical drawings have different tensors, so the
@@ -204,12 +204,12 @@ TEST_P(MetalPhysicsBothBackends, OrientationMatters) {
 // Any metal anywhere responds, and none leaves the subject's base alone.
 TEST_P(MetalPhysicsBothBackends, EveryRegionRespondsAndNonMetalDoesNot) {
   auto b = backend();
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < kBuiltinRegions; ++r) {
     std::vector<std::string> objs(r + 1, "none");
     objs[r] = "iron-handle";  // medium metal
-    EXPECT_NE(zones(*b, objs), std::vector<int>(kZones, 200)) << "region " << r + 1;
+    EXPECT_NE(zones(*b, objs), std::vector<int>(kBuiltinZones, 200)) << "region " << r + 1;
     objs[r] = "ceramic-plate";
-    EXPECT_EQ(zones(*b, objs), std::vector<int>(kZones, 200)) << "region " << r + 1;
+    EXPECT_EQ(zones(*b, objs), std::vector<int>(kBuiltinZones, 200)) << "region " << r + 1;
   }
 }
 
@@ -241,8 +241,8 @@ TEST_P(MetalPhysicsBothBackends, WorkedExamplesArePinnedAndNearTheThesis) {
     const auto got = zones(*b, e.objects);
     EXPECT_EQ(got, e.physics) << e.objects.back();
     double sum = 0;
-    for (int z = 0; z < kZones; ++z) sum += double(got[z] - e.thesis[z]) * (got[z] - e.thesis[z]);
-    EXPECT_LE(std::sqrt(sum / kZones), e.rms_bound) << e.objects.back();
+    for (int z = 0; z < kBuiltinZones; ++z) sum += double(got[z] - e.thesis[z]) * (got[z] - e.thesis[z]);
+    EXPECT_LE(std::sqrt(sum / kBuiltinZones), e.rms_bound) << e.objects.back();
     // The thesis model still gives the thesis's numbers exactly.
     EXPECT_EQ(zones(*b, e.objects, ModelSettings{}), e.thesis);
   }
@@ -259,12 +259,12 @@ TEST_P(MetalPhysicsBothBackends, JitterMovesTheResponseContinuously) {
   for (int k = 1; k <= 60; ++k) {
     m.jitter = 0.25 * k;  // up to 15 MMW pixels, about 6.6 cm
     const auto z = zones(*b, objs, m);
-    for (int j = 0; j < kZones; ++j)
+    for (int j = 0; j < kBuiltinZones; ++j)
       EXPECT_LE(std::abs(z[j] - prev[j]), 4) << "zone " << j + 1 << " jitter " << m.jitter;
     prev = z;
   }
   int moved = 0;
-  for (int j = 0; j < kZones; ++j) moved += std::abs(prev[j] - first[j]);
+  for (int j = 0; j < kBuiltinZones; ++j) moved += std::abs(prev[j] - first[j]);
   EXPECT_GE(moved, 10);
 }
 

@@ -60,10 +60,10 @@ TEST_P(MetalBothBackends, EmptyScenarioGivesTheSubjectsBase) {
 
 TEST_P(MetalBothBackends, HeaviestMetalEverywhereClampsAtOneNeverWraps) {
   auto b = backend();
-  const std::vector<std::string> guns(kRegions, "gun");
+  const std::vector<std::string> guns(kBuiltinRegions, "gun");
   for (int s = 0; s < static_cast<int>(catalogue().subjects.size()); ++s) {
     const std::vector<int> z = zones(*b, guns, s);
-    for (int k = 0; k < kZones; ++k) {
+    for (int k = 0; k < kBuiltinZones; ++k) {
       EXPECT_GE(z[k], 1);
       EXPECT_LE(z[k], 200);
     }
@@ -84,7 +84,7 @@ TEST_P(MetalBothBackends, HeaviestMetalEverywhereClampsAtOneNeverWraps) {
 TEST_P(MetalBothBackends, NonMetalObjectsLeaveTheDetectorAlone) {
   auto b = backend();
   const auto z = zones(*b, {"ceramic-plate", "cement-tile", "none", "ceramic-plate"});
-  EXPECT_EQ(z, std::vector<int>(kZones, 200));
+  EXPECT_EQ(z, std::vector<int>(kBuiltinZones, 200));
 }
 
 INSTANTIATE_TEST_SUITE_P(, MetalBothBackends, ::testing::Values("reference", "opencl"));
@@ -101,9 +101,9 @@ TEST(MetalTable, ModelCellsFallWithDistanceAndGrowWithMetal) {
   const int none = cat("none"), trace = cat("trace"), medium = cat("medium"), large = cat("large"),
             heavy = cat("heavy");
   ASSERT_GE(std::min({none, trace, medium, large, heavy}), 0);
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < kBuiltinRegions; ++r) {
     int total_trace = 0, total_medium = 0, total_heavy = 0;
-    for (int z = 0; z < kZones; ++z) {
+    for (int z = 0; z < kBuiltinZones; ++z) {
       EXPECT_EQ(c.influence[none][r][z], 0);
       total_trace += c.influence[trace][r][z];
       total_medium += c.influence[medium][r][z];
@@ -121,8 +121,8 @@ TEST(MetalTable, ModelCellsFallWithDistanceAndGrowWithMetal) {
   for (int z : {7, 8, 17, 18}) EXPECT_EQ(c.influence[heavy][0][z], 0);
   // Not copies of each other: every (category, region) row but "none" is distinct.
   for (int a = 1; a < static_cast<int>(c.influence.size()); ++a)
-    for (int r = 0; r < kRegions; ++r)
-      for (int r2 = r + 1; r2 < kRegions; ++r2) EXPECT_NE(c.influence[a][r], c.influence[a][r2]);
+    for (int r = 0; r < kBuiltinRegions; ++r)
+      for (int r2 = r + 1; r2 < kBuiltinRegions; ++r2) EXPECT_NE(c.influence[a][r], c.influence[a][r2]);
 }
 
 }  // namespace

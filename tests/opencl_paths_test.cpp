@@ -175,7 +175,7 @@ TEST(OpenCLPaths, ChangedKnobsGiveFreshTables) {
 
 // A launch struct set on a kernel of another signature is refused, naming both counts.
 TEST(OpenCLPaths, LaunchStructsMatchTheirKernels) {
-  opencl::Kernels K(*test::runtime(), Fidelity{});
+  opencl::Kernels K(*test::runtime(), Fidelity{}, opencl::KernelCounts::of(test::catalogue()));
   EXPECT_NO_THROW(opencl::PoolRegionsArgs{}.set(K["pool_regions"], false));
   try {
     opencl::PoolBlocksArgs{}.set(K["pool_regions"], false);

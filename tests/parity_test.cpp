@@ -218,7 +218,7 @@ TEST(Determinism, ScenarioDependsOnlyOnSeedAndIndexNotOnBatch) {
   const size_t px = size_t(whole.view("upper").width) * whole.view("upper").height;
   EXPECT_TRUE(std::equal(one.view("upper").pixels.begin(), one.view("upper").pixels.end(),
                          whole.view("upper").pixels.begin() + 17 * px));
-  EXPECT_TRUE(std::equal(one.metal.begin(), one.metal.end(), whole.metal.begin() + 17 * kZones));
+  EXPECT_TRUE(std::equal(one.metal.begin(), one.metal.end(), whole.metal.begin() + 17 * kBuiltinZones));
   const size_t F = whole.layout.image_features();
   EXPECT_TRUE(std::equal(one.features.begin(), one.features.end(), whole.features.begin() + 17 * F));
   // Another seed changes the noise.
@@ -240,7 +240,7 @@ TEST(SparseFeatures, EqualDenseToTheBit) {
   std::vector<Scenario> scenes;
   const Catalogue& c = test::catalogue();
   for (size_t var = 0; var < c.variant_list.size(); ++var)
-    for (int r = 0; r < kRegions; ++r) {
+    for (int r = 0; r < kBuiltinRegions; ++r) {
       Scenario s;
       s.subject = static_cast<int>((var * 7 + r) % c.subjects.size());
       s.objects[r] = static_cast<int16_t>(var);
@@ -248,7 +248,7 @@ TEST(SparseFeatures, EqualDenseToTheBit) {
     }
   for (uint64_t k = 0; k < 600; ++k) scenes.push_back(test::random_scenario(c, k, k % 3 == 0 ? 13 : 4));
   Scenario crowded;  // every region full: overlaps of three and more footprints
-  for (int r = 0; r < kRegions; ++r) crowded.objects[r] = static_cast<int16_t>(r % c.variant_list.size());
+  for (int r = 0; r < kBuiltinRegions; ++r) crowded.objects[r] = static_cast<int16_t>(r % c.variant_list.size());
   scenes.push_back(crowded);
   scenes.push_back(Scenario());
   auto cl = make_opencl_backend(c, test::assets(), test::runtime());

@@ -13,10 +13,12 @@
 
 #include "backend/compare.h"
 #include "backend/opencl/gauss_table.h"
+#include "backend/opencl/kernels.h"
 #include "backend/opencl/noise_draws.h"
 #include "backend/opencl/runtime.h"
 #include "backend/reference/draws.h"
 #include "plan/tolerance.h"
+#include "scene/catalogue.h"
 
 namespace portalsim {
 namespace embedded {
@@ -142,7 +144,8 @@ cl::Buffer input(OpenCLRuntime& rt, const std::vector<T>& v) {
 template <class... Args>
 void run(OpenCLRuntime& rt, const char* test_kernels, const char* name, size_t n, const Args&... args) {
   cl::Program prog(rt.context(), std::string(embedded::kernel_program) + test_kernels);
-  prog.build("-cl-std=CL1.2");
+  prog.build(
+      ("-cl-std=CL1.2 " + opencl::build_options(Fidelity{}, opencl::KernelCounts::of(default_catalogue()))).c_str());
   cl::Kernel k(prog, name);
   cl_uint i = 0;
   (k.setArg(i++, args), ...);
@@ -395,7 +398,8 @@ TEST(Philox, TradeoffSamplesEachModelsOwnDraws) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     const std::vector<double> got =
-        opencl::noise_draws(rt, tier_fidelity(c.tier), c.model, kSeed, kFirst, kScenarios, kCells);
+        opencl::noise_draws(rt, tier_fidelity(c.tier), opencl::KernelCounts::of(default_catalogue()), c.model, kSeed,
+                            kFirst, kScenarios, kCells);
     ASSERT_EQ(got.size(), kScenarios * kCells);
     double worst = 0;
     for (size_t k = 0; k < got.size(); ++k)

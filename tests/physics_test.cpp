@@ -50,7 +50,7 @@ double fwhm_formula(const Catalogue& cat, int width) {
 constexpr size_t kCoverage = 240;
 
 // The coverage set (support.h: every variant in every region, then crowds of up to 6).
-std::vector<Scenario> coverage_set(size_t n) { return test::coverage(catalogue(), n, 6); }
+std::vector<Scenario> coverage_set(size_t n) { return test::parity_set(catalogue(), n, 6); }
 
 // The tiers on the coverage set; the placements and raw grids on its first 48 (the first
 // drawings in every region), to keep the fp64 reference's time in bounds.

@@ -86,6 +86,12 @@ TEST_F(Serve, PageAndCatalogueAreServed) {
   const json j = json::parse(cat->body);
   EXPECT_EQ(j["regions"].size(), 13u);
   EXPECT_NE(std::find(j["objects"].begin(), j["objects"].end(), "gun:v"), j["objects"].end());
+  // The zones, each with the panel it transmits from (the page's two columns of bars).
+  ASSERT_EQ(j["zones"].size(), 19u);
+  std::string panels;
+  for (const json& z : j["zones"]) panels += z["panel"].get<std::string>();
+  EXPECT_EQ(panels, "aaaaaaaaabbbbbbbbbb");
+  EXPECT_EQ(j["zones"][18]["id"], 19);
 }
 
 // The default catalogue with its first subject at 0.85 of the height: the page's hit boxes

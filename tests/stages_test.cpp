@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "backend/compare.h"
+#include "backend/opencl/kernels.h"
 #include "plan/tolerance.h"
 #include "support.h"
 
@@ -28,7 +29,8 @@ std::vector<Scenario> scenes(size_t n, int max_objects = 6) {
 
 TEST(Stages, EveryStageHasAReferenceAndAKernel) {
   ASSERT_GE(view_stages().size(), 4u);
-  cl::Program& program = test::runtime()->program();
+  cl::Program& program =
+      test::runtime()->program(opencl::build_options(Fidelity{}, opencl::KernelCounts::of(catalogue())));
   for (const ViewStage& s : view_stages()) {
     SCOPED_TRACE(std::string(s.name));
     EXPECT_NE(s.reference, nullptr);

@@ -206,7 +206,7 @@ TEST(SubjectHeight, ObjectsStayOnTheirBodyPart) {
 TEST(SubjectHeight, BothBackendsAgreeAndMetalFollows) {
   const Catalogue cat = heights_catalogue({0.86, 0.93, 1.0, 1.08, 1.15});
   const AssetSet a = build_assets(cat);
-  const SceneBatch batch = test::batch_of(test::coverage(cat, cat.variant_list.size() * kRegions + 120, 8));
+  const SceneBatch batch = test::batch_of(test::coverage(cat, cat.variant_list.size() * kBuiltinRegions + 120, 8));
   auto ref = make_reference_backend(cat, a);
   auto cl = make_opencl_backend(cat, a, test::runtime());
   for (Model model : {Model::thesis, Model::physics}) {
@@ -273,7 +273,7 @@ TEST(SubjectHeight, UnitHeightPlacesAreTheRectangles) {
   const Catalogue& cat = test::catalogue();
   for (const Sensor& s : cat.sensors)
     for (size_t j = 0; j < cat.subjects.size(); ++j)
-      for (int r = 0; r < kRegions; ++r) {
+      for (int r = 0; r < kBuiltinRegions; ++r) {
         EXPECT_EQ(s.place(static_cast<int>(j), r).y, s.rects[r].y);
         EXPECT_EQ(s.place(static_cast<int>(j), r).x, s.rects[r].x);
       }

@@ -15,6 +15,13 @@
 #include "scene/catalogue.h"
 #include "scene/philox.h"
 
+namespace portalsim {
+// The built-in catalogue's regions and zones, which most tests are written for
+// (Catalogue.DefaultHoldsTheThesisInventory checks them).
+constexpr int kBuiltinRegions = 13;
+constexpr int kBuiltinZones = 19;
+}  // namespace portalsim
+
 namespace portalsim::test {
 
 inline const Catalogue& catalogue() {
@@ -43,7 +50,7 @@ inline Scenario random_scenario(const Catalogue& cat, uint64_t k, int max_object
   const int count = static_cast<int>(below(r[1], static_cast<uint32_t>(max_objects + 1)));
   for (int j = 0; j < count; ++j) {
     const Philox4 q = draw(12345, k, 99, 1 + j);
-    const int region = static_cast<int>(below(q[0], kRegions));
+    const int region = static_cast<int>(below(q[0], static_cast<uint32_t>(cat.region_count())));
     s.objects[region] = static_cast<int16_t>(below(q[1], static_cast<uint32_t>(cat.variant_list.size())));
   }
   s.label = static_cast<int>(r[2] & 1);
@@ -67,7 +74,7 @@ inline std::vector<Scenario> coverage(const Catalogue& c, size_t n, int max_obje
   std::vector<Scenario> v;
   if (singles)
     for (size_t var = 0; var < c.variant_list.size(); ++var)
-      for (int r = 0; r < kRegions; ++r) {
+      for (int r = 0; r < c.region_count(); ++r) {
         Scenario s;
         s.subject = static_cast<int>((var + r) % c.subjects.size());
         s.objects[r] = static_cast<int16_t>(var);
@@ -75,6 +82,22 @@ inline std::vector<Scenario> coverage(const Catalogue& c, size_t n, int max_obje
       }
   for (uint64_t k = 0; v.size() < n; ++k) v.push_back(random_scenario(c, k, max_objects));
   return v;
+}
+
+// .ci/run's second pass builds the tests with AddressSanitizer and UndefinedBehaviorSanitizer
+// (PORTALSIM_SANITIZE), where the fp64 reference's loops run several times slower. The
+// sanitizers check the host C++, which a few scenarios walk through as many do: the parity
+// tests whose time is those loops take a quarter of their random crowds there, and not every
+// variant in every region (the Release pass, .ci/run's first, runs them whole).
+#ifdef PORTALSIM_SANITIZED
+inline constexpr bool kSanitized = true;
+#else
+inline constexpr bool kSanitized = false;
+#endif
+inline size_t sanitized_count(size_t n) { return kSanitized ? std::max<size_t>(n / 4, 8) : n; }
+// coverage(c, n, max_objects), or under the sanitizers sanitized_count(n) crowds.
+inline std::vector<Scenario> parity_set(const Catalogue& c, size_t n, int max_objects) {
+  return kSanitized ? coverage(c, sanitized_count(n), max_objects, false) : coverage(c, n, max_objects);
 }
 
 // The physics model's plan at its defaults but for the camera's frames and window, with a
@@ -98,10 +121,17 @@ inline int variant_of(const Catalogue& cat, const std::string& name) {
   return o < 0 ? -1 : cat.objects[o].first_variant;
 }
 
-inline SceneBatch batch_of(const std::vector<Scenario>& scenes, uint64_t first_index = 0) {
-  SceneBatch b;
+// A batch of scenarios of a catalogue of `regions` regions (the built-in one's by default).
+inline SceneBatch batch_of(const std::vector<Scenario>& scenes, uint64_t first_index = 0,
+                           int regions = kBuiltinRegions) {
+  SceneBatch b(regions);
   b.first_index = first_index;
-  for (const Scenario& s : scenes) b.push(s);
+  for (const Scenario& s : scenes) {
+    for (int r = regions; r < kMaxRegions; ++r)
+      if (s.objects[r] != kNoObject)
+        ADD_FAILURE() << "an object in region " << r + 1 << " of a " << regions << "-region batch";
+    b.push(s);
+  }
   return b;
 }
 

@@ -124,7 +124,7 @@ void errors_are_against_the_same_models_reference(const json& report, const fs::
   gs.rule = "gun";
   gs.balance = true;
   Generator gen(test::catalogue(), gs, 0);
-  SceneBatch batch;
+  SceneBatch batch(test::catalogue().region_count());
   for (int i = 0; i < kCount; ++i) batch.push(gen(i));
   auto ref = make_reference_backend(test::catalogue(), test::assets());
   auto cl = make_opencl_backend(test::catalogue(), test::assets(), test::runtime());

@@ -159,7 +159,7 @@ TEST(RandomisedObjects, FlipIsARealMirror) {
     Scenario s;
     const Philox4 q = draw(99, k, 7, 0);
     s.subject = static_cast<int>(below(q[0], static_cast<uint32_t>(cat.subjects.size())));
-    s.objects[below(q[1], kRegions)] =
+    s.objects[below(q[1], kBuiltinRegions)] =
         static_cast<int16_t>(below(q[2], static_cast<uint32_t>(cat.variant_list.size())));
     sc.push_back(s);
   }
@@ -240,7 +240,7 @@ TEST(RandomisedObjects, FeaturesAreThePooledImages) {
   cl->run(test::batch_of(sc), p, with_images);
   EXPECT_EQ(only.features, with_images.features);
   const FeatureLayout& layout = with_images.layout;
-  std::vector<float> row(layout.image_features() + kZones);
+  std::vector<float> row(layout.image_features() + kBuiltinZones);
   double worst = 0;
   for (size_t i = 0; i < sc.size(); ++i) {
     std::vector<std::vector<uint8_t>> views(cat.sensors.size());
@@ -267,7 +267,7 @@ TEST(RandomisedObjects, DrawsLieInTheirRanges) {
   double rlo = 1e9, rhi = -1e9, slo = 1e9, shi = -1e9;
   int flips = 0;
   for (uint64_t i = 0; i < 500; ++i)
-    for (int r = 0; r < kRegions; ++r) {
+    for (int r = 0; r < kBuiltinRegions; ++r) {
       const ObjectTransform t = object_transform(m, i, r);
       rlo = std::min(rlo, t.rotation), rhi = std::max(rhi, t.rotation);
       slo = std::min(slo, t.scale), shi = std::max(shi, t.scale);
@@ -279,7 +279,7 @@ TEST(RandomisedObjects, DrawsLieInTheirRanges) {
   EXPECT_GT(rhi, 24.5);
   EXPECT_GE(slo, 0.5);
   EXPECT_LT(shi, 2);
-  EXPECT_NEAR(flips, 500 * kRegions / 2, 200);
+  EXPECT_NEAR(flips, 500 * kBuiltinRegions / 2, 200);
   m.flip = false;
   m.rotate_lo = m.rotate_hi = 0;
   m.scale_lo = m.scale_hi = 1;
@@ -331,10 +331,10 @@ TEST(RandomisedObjects, ScenariosCsvRecordsTheDrawsAndRemakesTheImages) {
   const std::vector<std::string> rows = lines(slurp(t.w() / "a" / "scenarios.csv"));
   ASSERT_EQ(rows.size(), 25u);
   const std::vector<std::string> head = fields(rows[0]);
-  ASSERT_EQ(head.size(), 2u + 4 * kRegions + 1);
-  EXPECT_EQ(head[2 + kRegions], "rotation1");
-  EXPECT_EQ(head[2 + 2 * kRegions], "scale1");
-  EXPECT_EQ(head[2 + 3 * kRegions + 12], "flip13");
+  ASSERT_EQ(head.size(), 2u + 4 * kBuiltinRegions + 1);
+  EXPECT_EQ(head[2 + kBuiltinRegions], "rotation1");
+  EXPECT_EQ(head[2 + 2 * kBuiltinRegions], "scale1");
+  EXPECT_EQ(head[2 + 3 * kBuiltinRegions + 12], "flip13");
   Plan plan;
   for (const auto& [k, v] :
        std::vector<std::pair<std::string, std::string>>{{"rotate", "-20..35"}, {"scale", "0.7..1.3"}, {"flip", "on"}})
@@ -344,8 +344,9 @@ TEST(RandomisedObjects, ScenariosCsvRecordsTheDrawsAndRemakesTheImages) {
   for (size_t i = 1; i < rows.size(); ++i) {
     const std::vector<std::string> f = fields(rows[i]);
     ASSERT_EQ(f.size(), head.size());
-    for (int r = 0; r < kRegions; ++r) {
-      const std::string &rot = f[2 + kRegions + r], &sc = f[2 + 2 * kRegions + r], &fl = f[2 + 3 * kRegions + r];
+    for (int r = 0; r < kBuiltinRegions; ++r) {
+      const std::string &rot = f[2 + kBuiltinRegions + r], &sc = f[2 + 2 * kBuiltinRegions + r],
+                        &fl = f[2 + 3 * kBuiltinRegions + r];
       if (f[2 + r] == "none") {
         EXPECT_TRUE(rot.empty() && sc.empty() && fl.empty());
         continue;
@@ -411,7 +412,7 @@ TEST(RandomisedObjects, BadValuesAreRefusedClearly) {
   // A scenario list with part of the transform columns, or a bad value in one.
   const std::string head = [] {
     std::string h = "subject";
-    for (int r = 1; r <= kRegions; ++r) h += ",region" + std::to_string(r);
+    for (int r = 1; r <= kBuiltinRegions; ++r) h += ",region" + std::to_string(r);
     return h;
   }();
   const std::string nones = ",none,none,none,none,none,none,none,none,none,none,none,none";
@@ -429,7 +430,7 @@ TEST(RandomisedObjects, BadValuesAreRefusedClearly) {
       InputError);
   std::string full = head;
   for (const char* w : {",rotation", ",scale", ",flip"})
-    for (int r = 1; r <= kRegions; ++r) full += w + std::to_string(r);
+    for (int r = 1; r <= kBuiltinRegions; ++r) full += w + std::to_string(r);
   const std::string empties(12, ',');
   const auto row = [&](const std::string& rot, const std::string& sc, const std::string& fl) {
     return full + "\n1,gun" + nones + "," + rot + empties + "," + sc + empties + "," + fl + empties + "\n";

@@ -21,10 +21,11 @@ import matplotlib.patches as patches  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 
 CATALOGUE = os.path.join(os.path.dirname(__file__), "..", "scenarios", "portal-front-back.toml")
-# Regions 1..13: a gun at the right chest, a rod at the centre hip, a phone on the upper
-# back, a plate at the seat and the gun's vertical drawing at the back of the left knee.
-OBJECTS = ["gun", "none", "none", "none", "none", "iron-rod", "none", "mobile-phone", "none", "none",
-           "metal-plate", "none", "gun:v"]
+# Regions 1..19: a gun at the right chest (1), a rod at the centre hip (8), a phone on the
+# upper back (14), a plate at the seat (17) and the gun's vertical drawing at the back of the
+# left knee (19).
+OBJECTS = ["gun", "none", "none", "none", "none", "none", "none", "iron-rod", "none", "none", "none", "none", "none",
+           "mobile-phone", "none", "none", "metal-plate", "none", "gun:v"]
 
 
 def main():
@@ -55,7 +56,7 @@ def main():
                 ax.set_xticks([])
                 ax.set_yticks([])
             axes[row][0].set_ylabel(f"--model {model}", fontsize=8)
-    fig.suptitle("scenarios/portal-front-back.toml: regions 1-7 on the front, 8-13 on the back "
+    fig.suptitle("scenarios/portal-front-back.toml: regions 1-13 on the front, 14-19 on the back "
                  "(a back view is mirrored)", fontsize=9)
     fig.tight_layout()
     fig.savefig(out, dpi=110)

@@ -29,7 +29,7 @@ class SparseFeatures {
 
  private:
   // Where one variant in one region changes pixels, and its deltas per (subject, pattern):
-  // block sums (bw x bh) then the 13 region sums.
+  // block sums (bw x bh) then the region sums.
   struct Footprint {
     const Image* sprite = nullptr;
     int sx = 0, sy = 0, tx = 0, ty = 0;  // sprite and noise-tile corners
@@ -38,10 +38,10 @@ class SparseFeatures {
     std::vector<int32_t> deltas;
   };
   int32_t* delta_of(Footprint& f, int s, int p) {
-    return f.deltas.data() + (s * patterns_ + p) * (f.bw * f.bh + kRegions);
+    return f.deltas.data() + (s * patterns_ + p) * (f.bw * f.bh + layout_.regions);
   }
   const int32_t* delta_of(const Footprint& f, int s, int p) const {
-    return f.deltas.data() + (s * patterns_ + p) * (f.bw * f.bh + kRegions);
+    return f.deltas.data() + (s * patterns_ + p) * (f.bw * f.bh + layout_.regions);
   }
   uint8_t pixel(const Footprint* const* fps, int count, uint8_t base, int x, int y, int pattern) const;
   int region_pixels(int r) const;
@@ -53,11 +53,11 @@ class SparseFeatures {
   FeatureLayout layout_;
   int W_ = 0, H_ = 0, tile_ = 0, patterns_ = 1;
   float alpha_ = 0;
-  std::array<int, kRegions> slot_{};  // the pooled view each region lies in
-  std::vector<int> count_;            // pixels per block
-  std::vector<uint32_t> base_sums_;   // per subject, a row of integer sums
-  std::vector<float> base_means_;     // per subject, a features row
-  std::vector<Footprint> prints_;     // per (variant, region)
+  std::array<int, kMaxRegions> slot_{};  // the pooled view each region lies in
+  std::vector<int> count_;               // pixels per block
+  std::vector<uint32_t> base_sums_;      // per subject, a row of integer sums
+  std::vector<float> base_means_;        // per subject, a features row
+  std::vector<Footprint> prints_;        // per (variant, region)
 };
 
 }  // namespace portalsim::baseline

@@ -33,7 +33,7 @@ SparseFeatures::SparseFeatures(const Catalogue& cat, const AssetSet& assets, con
   alpha_ = static_cast<float>(cat.images.alpha);
   tile_ = cat.images.noise_size;
   patterns_ = model.pattern_noise ? static_cast<int>(cat.noise.size()) : 1;
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < layout_.regions; ++r) {
     slot_[r] = 0;
     for (size_t s = 0; s < layout_.pooled.size(); ++s)
       if (cat.sensors[layout_.pooled[s]].sees(r)) {
@@ -58,7 +58,7 @@ SparseFeatures::SparseFeatures(const Catalogue& cat, const AssetSet& assets, con
       for (int y = 0; y < H_; ++y)
         for (int x = 0; x < W_; ++x) sums[slot * per_view + (y / block) * bx + x / block] += img.pixels[y * W_ + x];
     }
-    for (int r = 0; r < kRegions; ++r) {
+    for (int r = 0; r < layout_.regions; ++r) {
       const Image& img = assets.bases[s][layout_.pooled[slot_[r]]];
       const Rect& rc = cat.sensors[layout_.pooled[slot_[r]]].rects[r];
       for (int y = rc.y; y < rc.y + rc.h; ++y)
@@ -72,10 +72,10 @@ SparseFeatures::SparseFeatures(const Catalogue& cat, const AssetSet& assets, con
   // Per (variant, region): where the object changes pixels, and per (subject, pattern)
   // the sums of (pixel - base) over each block and region it touches.
   const int V = static_cast<int>(cat.variant_list.size());
-  prints_.resize(static_cast<size_t>(V) * kRegions);
+  prints_.resize(static_cast<size_t>(V) * layout_.regions);
   for (int v = 0; v < V; ++v)
-    for (int r = 0; r < kRegions; ++r) {
-      Footprint& fp = prints_[static_cast<size_t>(v) * kRegions + r];
+    for (int r = 0; r < layout_.regions; ++r) {
+      Footprint& fp = prints_[static_cast<size_t>(v) * layout_.regions + r];
       const Sensor& in = cat.sensors[layout_.pooled[slot_[r]]];
       const Image& sp = assets.sprite(in, v);
       const Rect& rc = in.rects[r];
@@ -94,7 +94,7 @@ SparseFeatures::SparseFeatures(const Catalogue& cat, const AssetSet& assets, con
       fp.bx0 = fp.x0 / block, fp.by0 = fp.y0 / block;
       fp.bw = fp.x1 > fp.x0 ? (fp.x1 - 1) / block - fp.bx0 + 1 : 0;
       fp.bh = fp.y1 > fp.y0 ? (fp.y1 - 1) / block - fp.by0 + 1 : 0;
-      fp.deltas.assign(static_cast<size_t>(S) * patterns_ * (fp.bw * fp.bh + kRegions), 0);
+      fp.deltas.assign(static_cast<size_t>(S) * patterns_ * (fp.bw * fp.bh + layout_.regions), 0);
       for (int s = 0; s < S; ++s)
         for (int p = 0; p < patterns_; ++p) {
           int32_t* d = delta_of(fp, s, p);
@@ -105,7 +105,7 @@ SparseFeatures::SparseFeatures(const Catalogue& cat, const AssetSet& assets, con
               const int diff = static_cast<int>(pixel(&one, 1, base[y * W_ + x], x, y, p)) - base[y * W_ + x];
               if (diff == 0) continue;
               d[(y / block - fp.by0) * fp.bw + x / block - fp.bx0] += diff;
-              for (int q = 0; q < kRegions; ++q)
+              for (int q = 0; q < layout_.regions; ++q)
                 if (slot_[q] == slot_[r] && in_region(q, x, y)) d[fp.bw * fp.bh + q] += diff;
             }
         }
@@ -158,7 +158,7 @@ void SparseFeatures::run(const SceneBatch& batch, BatchOutput& out) const {
 #pragma omp for schedule(static)
     for (size_t i = 0; i < n; ++i) {
       const int s = batch.subject[i];
-      const int16_t* objects = &batch.objects[i * kRegions];
+      const int16_t* objects = &batch.objects[i * layout_.regions];
       float* row = out.features.data() + i * row_len;
       std::memcpy(row, &base_means_[static_cast<size_t>(s) * row_len], row_len * sizeof(float));
       int pattern = 0;
@@ -168,15 +168,15 @@ void SparseFeatures::run(const SceneBatch& batch, BatchOutput& out) const {
         pattern = static_cast<int>((static_cast<uint64_t>(r0) * static_cast<uint32_t>(patterns_)) >> 32);
       }
       const uint32_t* bsum = &base_sums_[static_cast<size_t>(s) * row_len];
-      int32_t reg[kRegions];
-      for (int r = 0; r < kRegions; ++r) reg[r] = static_cast<int32_t>(bsum[layout_.block_features() + r]);
+      int32_t reg[kMaxRegions];
+      for (int r = 0; r < layout_.regions; ++r) reg[r] = static_cast<int32_t>(bsum[layout_.block_features() + r]);
       bool touched = false;
       for (int slot = 0; slot < npooled; ++slot) {
-        const Footprint* fps[kRegions];
+        const Footprint* fps[kMaxRegions];
         int cnt = 0;
-        for (int r = 0; r < kRegions; ++r)
+        for (int r = 0; r < layout_.regions; ++r)
           if (objects[r] >= 0 && slot_[r] == slot)
-            fps[cnt++] = &prints_[static_cast<size_t>(objects[r]) * kRegions + r];
+            fps[cnt++] = &prints_[static_cast<size_t>(objects[r]) * layout_.regions + r];
         if (cnt == 0) continue;
         touched = true;
         ++stamp;
@@ -192,7 +192,7 @@ void SparseFeatures::run(const SceneBatch& batch, BatchOutput& out) const {
               }
               acc[b] += d[y * f.bw + x];
             }
-          for (int r = 0; r < kRegions; ++r) reg[r] += d[f.bw * f.bh + r];
+          for (int r = 0; r < layout_.regions; ++r) reg[r] += d[f.bw * f.bh + r];
         }
         // Where footprints overlap the single-object deltas are wrong: replace their sum
         // by the pixel rendered with every object, once per pixel.
@@ -217,7 +217,7 @@ void SparseFeatures::run(const SceneBatch& batch, BatchOutput& out) const {
                 const int corr = static_cast<int>(pixel(fps, cnt, bp, x, y, pattern)) - bp - singles;
                 if (corr == 0) continue;
                 acc[(y / block) * bx + x / block] += corr;
-                for (int r = 0; r < kRegions; ++r)
+                for (int r = 0; r < layout_.regions; ++r)
                   if (slot_[r] == slot && in_region(r, x, y)) reg[r] += corr;
               }
           }
@@ -225,7 +225,7 @@ void SparseFeatures::run(const SceneBatch& batch, BatchOutput& out) const {
           if (block_stamp[b] == stamp) row[slot * per_view + b] = mean_of(static_cast<uint32_t>(acc[b]), count_[b]);
       }
       if (touched)
-        for (int r = 0; r < kRegions; ++r)
+        for (int r = 0; r < layout_.regions; ++r)
           row[layout_.block_features() + r] = mean_of(static_cast<uint32_t>(reg[r]), region_pixels(r));
     }
   }

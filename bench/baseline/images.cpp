@@ -66,7 +66,7 @@ void render_images(const Catalogue& cat, const AssetSet& assets, const SceneBatc
 #pragma omp for schedule(dynamic, 16)
     for (size_t i = 0; i < n; ++i) {
       const uint64_t index = batch.first_index + i;
-      const int16_t* objects = &batch.objects[i * kRegions];
+      const int16_t* objects = &batch.objects[i * batch.regions];
       uint32_t r0, r1;
       philox_words(0, PS_STREAM_NOISE_PATTERN, index, m.seed, r0, r1);
       const int pattern = static_cast<int>((static_cast<uint64_t>(r0) * static_cast<uint32_t>(patterns)) >> 32);
@@ -76,7 +76,7 @@ void render_images(const Catalogue& cat, const AssetSet& assets, const SceneBatc
         const Image& base = assets.bases[batch.subject[i]][k];
         uint8_t* img = out.views[k].pixels.data() + i * s.pixels();
         layers.clear();
-        for (int r = 0; r < kRegions; ++r) {
+        for (int r = 0; r < batch.regions; ++r) {
           if (objects[r] < 0 || !s.sees(r)) continue;
           const Image& sp = assets.sprite(s, objects[r]);
           const Rect& rc = s.rects[r];

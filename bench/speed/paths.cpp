@@ -79,7 +79,7 @@ SceneBatch make_batch(const Catalogue& cat, size_t n, int max_objects) {
   GeneratorSpec spec;
   spec.max_objects = max_objects;
   Generator gen(cat, spec, 1);
-  SceneBatch b;
+  SceneBatch b(cat.region_count());
   for (size_t i = 0; i < n; ++i) b.push(gen(i));
   return b;
 }

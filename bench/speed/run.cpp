@@ -144,7 +144,7 @@ BenchReport run_bench(const BenchOptions& o, std::shared_ptr<OpenCLRuntime> rt, 
 
   // Per path, made once: the batches, the outputs and the loop's tables.
   struct Work {
-    SceneBatch batch, mid, small;
+    SceneBatch batch{0}, mid{0}, small{0};  // make_batch's
     BatchOutput kernel, exact, loop, reference;
     std::unique_ptr<Loop> loop_impl;
     Plan exact_plan;

@@ -380,7 +380,7 @@ struct Annotator::Kept {
   // Subjects whose places are the same (Sensor::subject_dy in every view) share a body:
   // body[subject] indexes `shape`, which names one such subject.
   std::vector<int> body, shape;
-  std::vector<std::vector<Fixed>> fixed;  // per view, (body * variants + variant) * kRegions + region
+  std::vector<std::vector<Fixed>> fixed;  // per view, (body * variants + variant) * regions + region
   std::vector<Work> spare;
 };
 
@@ -442,12 +442,13 @@ void Annotator::operator()(const ModelSettings& model, const SceneBatch& batch, 
   std::vector<std::vector<Fixed>>& fixed = kept_->fixed;
   const std::vector<int>& body = kept_->body;
   const size_t V = cat.variant_list.size();
+  const int R = cat.region_count();
   const bool moves = model.moves_sprites();
   if (!moves && fixed.empty()) {
     fixed.resize(views);
     for (size_t k = 0; k < views; ++k) {
       const Sensor& sensor = cat.sensors[k];
-      fixed[k].resize(kept_->shape.size() * V * kRegions);
+      fixed[k].resize(kept_->shape.size() * V * R);
       for (size_t b = 0; b < kept_->shape.size(); ++b)
         for (size_t v = 0; v < V; ++v) {
           Scenario every;
@@ -455,9 +456,9 @@ void Annotator::operator()(const ModelSettings& model, const SceneBatch& batch, 
           every.objects.fill(static_cast<int16_t>(v));
           const reference::ViewScene vs = reference::view_scene(cat, assets, model, static_cast<int>(k), every, 0);
           size_t p = 0;
-          for (int r = 0; r < kRegions; ++r) {
+          for (int r = 0; r < R; ++r) {
             if (!sensor.sees(r)) continue;
-            Fixed& f = fixed[k][(b * V + v) * kRegions + r];
+            Fixed& f = fixed[k][(b * V + v) * R + r];
             f.placed = vs.placed[p++];
             f.at.emplace(f.placed, runs[k][v], model, sensor.width, sensor.height);
           }
@@ -489,10 +490,10 @@ void Annotator::operator()(const ModelSettings& model, const SceneBatch& batch, 
       if (scratch[k].size() != cat.sensors[k].pixels()) scratch[k].assign(cat.sensors[k].pixels(), 0);
     std::vector<reference::Placed> moved;  // this view's objects, where sprites move
     std::vector<Placement> moved_at;
-    std::array<const reference::Placed*, kRegions> placed;
-    std::array<const Placement*, kRegions> at;
-    std::array<int, kRegions> regions;
-    std::array<Painted, kRegions> kept;
+    std::array<const reference::Placed*, kMaxRegions> placed;
+    std::array<const Placement*, kMaxRegions> at;
+    std::array<int, kMaxRegions> regions;
+    std::array<Painted, kMaxRegions> kept;
     for (size_t i = lo; i < hi; ++i) {
       const Scenario s = batch.at(i);
       for (size_t k = 0; k < views; ++k) {
@@ -506,14 +507,14 @@ void Annotator::operator()(const ModelSettings& model, const SceneBatch& batch, 
           for (const reference::Placed& pl : moved)
             moved_at.emplace_back(pl, runs[k][pl.variant], model, W, sensor.height);
         }
-        for (int r = 0; r < kRegions; ++r) {
+        for (int r = 0; r < R; ++r) {
           const int16_t v = s.objects[r];
           if (v == kNoObject || !sensor.sees(r)) continue;
           if (moves) {
             placed[m] = &moved[m];
             at[m] = &moved_at[m];
           } else {
-            const Fixed& f = fixed[k][(static_cast<size_t>(body[s.subject]) * V + v) * kRegions + r];
+            const Fixed& f = fixed[k][(static_cast<size_t>(body[s.subject]) * V + v) * R + r];
             placed[m] = &f.placed;
             at[m] = &*f.at;
           }

@@ -45,7 +45,7 @@ struct ViewAnnotations {
   // rather than whole; a size that differs from the masks' count means "clear all".
   struct Painted {
     int count = 0;
-    std::array<std::array<int16_t, 4>, kRegions> box{};  // x0, y0, x1, y1 inclusive
+    std::array<std::array<int16_t, 4>, kMaxRegions> box{};  // x0, y0, x1, y1 inclusive
   };
   std::vector<Painted> painted;
 };

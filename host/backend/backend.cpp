@@ -20,7 +20,7 @@ void prepare_output(BatchOutput& out, const Catalogue& cat, const Plan& plan, si
     v.pixels.resize(plan.image(static_cast<int>(k)) ? n * s.pixels() : 0);
   }
   out.layout = FeatureLayout::of(cat, plan.model.block);
-  out.metal.resize(plan.metal ? n * kZones : 0);
+  out.metal.resize(plan.metal ? n * cat.zones : 0);
   out.features.resize(plan.features ? n * out.layout.image_features() : 0);
 }
 

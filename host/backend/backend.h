@@ -30,7 +30,7 @@ struct ViewImages {
 struct BatchOutput {
   size_t n = 0;
   std::vector<ViewImages> views;  // one per camera view, in Catalogue::sensors order
-  std::vector<uint8_t> metal;     // n * 19
+  std::vector<uint8_t> metal;     // n * layout.zones
   FeatureLayout layout;
   std::vector<float> features;  // n * layout.image_features()
   // Per camera view, boxes and instance masks (backend/annotate.h); empty unless the plan
@@ -39,7 +39,7 @@ struct BatchOutput {
 
   // The view called `name` (a Catalogue::sensors name); throws std::out_of_range if none is.
   const ViewImages& view(std::string_view name) const;
-  const uint8_t* metal_of(size_t i) const { return metal.data() + i * kZones; }
+  const uint8_t* metal_of(size_t i) const { return metal.data() + i * layout.zones; }
   const float* features_of(size_t i) const { return features.data() + i * layout.image_features(); }
 };
 

@@ -23,7 +23,7 @@ struct ImageDiff {
 struct OutputDiff {
   ImageDiff mmw, ir;
   double feature_max_abs = 0, feature_mean_abs = 0;
-  double metal_exact = 1;      // share of scenarios whose 19 zones all match
+  double metal_exact = 1;      // share of scenarios whose zones all match
   bool features_only = false;  // the test run rendered no images: its features came from a features-only path
 };
 

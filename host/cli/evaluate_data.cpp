@@ -136,9 +136,9 @@ std::string where_column(const Numbers& t, size_t i) {
 
 }  // namespace
 
-std::array<uint8_t, kRegions> region_threats(const ThreatRule& rule, const Scenario& s, bool threat) {
-  std::array<uint8_t, kRegions> out{};
-  for (int r = 0; r < kRegions; ++r) {
+std::array<uint8_t, kMaxRegions> region_threats(const ThreatRule& rule, const Scenario& s, bool threat) {
+  std::array<uint8_t, kMaxRegions> out{};
+  for (int r = 0; r < kMaxRegions; ++r) {
     if (s.objects[r] == kNoObject) continue;
     Scenario alone, without = s;
     alone.subject = s.subject;
@@ -183,7 +183,7 @@ EvaluateData read_evaluate_data(const std::string& dir, const Catalogue& cat) {
       d.sensor.push_back(n.substr(0, n.rfind("_r")));
     } else if (is_region(n)) {
       const int r = std::atoi(n.c_str() + 6) - 1;
-      const Sensor* v = r >= 0 && r < kRegions ? view_of_region(cat, r) : nullptr;
+      const Sensor* v = r >= 0 && r < cat.region_count() ? view_of_region(cat, r) : nullptr;
       if (!v) throw InputError(where_column(t, i) + ": no camera view of the catalogue sees this region");
       d.sensor.push_back(v->name);
     } else if (is_zone(n)) {
@@ -220,9 +220,9 @@ EvaluateData read_evaluate_data(const std::string& dir, const Catalogue& cat) {
     if (is_block(t.names[j]))
       blocks_x[d.sensor[j]] =
           std::max(blocks_x[d.sensor[j]], 1 + std::atoi(t.names[j].c_str() + t.names[j].rfind("_c") + 2));
-  d.regions.resize(kRegions);
+  d.regions.resize(cat.regions.size());
   nlohmann::json places = nlohmann::json::array();
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < cat.region_count(); ++r) {
     auto& reg = d.regions[r];
     const Region& region = cat.regions[r];
     reg.name = "region" + std::to_string(r + 1);
@@ -250,7 +250,7 @@ EvaluateData read_evaluate_data(const std::string& dir, const Catalogue& cat) {
   }
   for (size_t i = 0; i < scenes.size(); ++i) {
     const auto threats = region_threats(threat, scenes[i], d.label[i] != 0);
-    for (int r = 0; r < kRegions; ++r) d.regions[r].label[i] = threats[r];
+    for (int r = 0; r < cat.region_count(); ++r) d.regions[r].label[i] = threats[r];
   }
   out.about["region_labels"] = "from scenarios.csv and the rule `" + rule +
                                "`: a region holds a threat when the rule holds for its object alone, or the scenario "

@@ -23,6 +23,6 @@ EvaluateData read_evaluate_data(const std::string& dir, const Catalogue& cat);
 
 // Per region of `s`: whether its object takes part in a threat under `rule`: the rule holds
 // for that object alone, or the scenario is a threat (`threat`) and no longer is without it.
-std::array<uint8_t, kRegions> region_threats(const ThreatRule& rule, const Scenario& s, bool threat);
+std::array<uint8_t, kMaxRegions> region_threats(const ThreatRule& rule, const Scenario& s, bool threat);
 
 }  // namespace portalsim::cli

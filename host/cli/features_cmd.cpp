@@ -53,7 +53,7 @@ FeaturesCount write_features(const std::vector<std::string>& folder_args, const 
 
   BatchOutput rows;
   rows.layout = FeatureLayout::of(s.catalogue, block);
-  SceneBatch labels;
+  SceneBatch labels(s.catalogue.region_count());
   const size_t chunk = 1024;
   SinkContext ctx;
   ctx.dir = out.parent_path().empty() ? "." : out.parent_path().string();
@@ -72,7 +72,7 @@ FeaturesCount write_features(const std::vector<std::string>& folder_args, const 
       const size_t n = std::min(chunk, folders.size() - first);
       rows.n = n;
       rows.features.assign(n * rows.layout.image_features(), 0.0f);
-      rows.metal.assign(n * kZones, 0);
+      rows.metal.assign(n * s.catalogue.zones, 0);
       labels.clear();
       labels.first_index = first;
       for (size_t i = 0; i < n; ++i) {

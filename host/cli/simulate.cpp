@@ -50,12 +50,13 @@ int simulate(SimulateOptions& o) {
   open_backend(s, o.common);
   BatchOutput out;
   const StageFieldsRequest fields{cat, s.assets};
-  const OneScenarioTimes t = write_one_scenario(o.out, *s.backend, scene, plan, procedural::ir_palette(plan.palette),
-                                                FolderOptions{o.image_format}, out, o.stages ? &fields : nullptr);
+  const OneScenarioTimes t =
+      write_one_scenario(o.out, cat, *s.backend, scene, plan, procedural::ir_palette(plan.palette),
+                         FolderOptions{o.image_format}, out, o.stages ? &fields : nullptr);
   const double run_seconds = t.run_seconds, write_seconds = t.write_seconds;
 
   std::printf("%s: subject %d, threat %s, metal", o.out.c_str(), o.subject, scene.label ? "yes" : "no");
-  for (int z = 0; z < kZones; ++z) std::printf("%s%d", z ? "," : " ", out.metal_of(0)[z]);
+  for (int z = 0; z < cat.zones; ++z) std::printf("%s%d", z ? "," : " ", out.metal_of(0)[z]);
   std::printf("\n");
   if (o.common.timing) {
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -72,7 +73,8 @@ int simulate(SimulateOptions& o) {
 void add_simulate_options(CLI::App* sub, SimulateOptions* o) {
   add_common_options(*sub, o->common);
   sub->add_option("objects", o->objects,
-                  "objects for regions 1..13 in order (none = empty region; gun:v = vertical variant)");
+                  "objects for the catalogue's regions in order, 1..13 in the built-in one (none = empty region; gun:v "
+                  "= vertical variant)");
   sub->add_option("--subject", o->subject, "subject 1..5 (base images and base metal values)");
   sub->add_option("--rule", o->rule, "threat rule, e.g. gun or 'iron-rod&metal-plate'");
   sub->add_option("--threat", o->threat, "label the scenario yes or no")->check(CLI::IsMember({"yes", "no"}));

@@ -26,7 +26,7 @@ void add_spec_flags(CLI::App* sub, SpecFlags* o, bool outputs) {
     sub->add_option("--image-format", o->spec.image_format, "png or jpg (default png)");
     sub->add_option("--png-level", o->png_level,
                     "image folders' PNG compression, 0 (none) to 9 (smallest); default 1, the fastest that compresses");
-    sub->add_option("--scenarios", o->spec.scenarios, "explicit scenario list (CSV: subject, region1..13, label)");
+    sub->add_option("--scenarios", o->spec.scenarios, "explicit scenario list (CSV: subject, region1..regionR, label)");
   }
   add_knob_options(*sub, o->spec.tier, o->knobs);
 }

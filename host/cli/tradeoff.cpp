@@ -69,10 +69,10 @@ struct Timed {
 };
 
 SceneBatch slice(const SceneBatch& b, size_t first, size_t n) {
-  SceneBatch s;
+  SceneBatch s(b.regions);
   s.first_index = b.first_index + first;
   s.subject.assign(b.subject.begin() + first, b.subject.begin() + first + n);
-  s.objects.assign(b.objects.begin() + first * kRegions, b.objects.begin() + (first + n) * kRegions);
+  s.objects.assign(b.objects.begin() + first * b.regions, b.objects.begin() + (first + n) * b.regions);
   s.label.assign(b.label.begin() + first, b.label.begin() + first + n);
   return s;
 }
@@ -151,7 +151,7 @@ SceneBatch thesis_case(const Catalogue& cat, int which, uint64_t seed, uint64_t 
     }
   }
   Generator gen(cat, gs, seed);
-  SceneBatch batch;
+  SceneBatch batch(cat.region_count());
   for (uint64_t i = 0; i < count; ++i) batch.push(gen(i));
   return batch;
 }
@@ -204,7 +204,7 @@ int tradeoff(TradeoffOptions& o) {
   if (std::filesystem::exists(o.out, ec) && !std::filesystem::is_empty(o.out, ec))
     throw OutputError(o.out + ": is not empty; choose a new folder");
   // Case 2 is drawn first: it checks the catalogue before anything is written.
-  const SceneBatch case2 = o.classifier ? thesis_case(cat, 2, base.seed, o.count) : SceneBatch{};
+  const SceneBatch case2 = o.classifier ? thesis_case(cat, 2, base.seed, o.count) : SceneBatch(cat.region_count());
   const SceneBatch batch = thesis_case(cat, 1, base.seed, o.count);
   StagedFolder folder(o.out);
 
@@ -376,7 +376,8 @@ int tradeoff(TradeoffOptions& o) {
       ip.fidelity = fp.fidelity = f;
       const Timed img = run_timed(*cl, batch, ip, 1024, 0.3);
       const Timed feat = run_timed(*cl, batch, fp, 16384, 0.3);
-      put_distribution(rows.emplace_back(), opencl::noise_draws(*rt, f, m, model.seed, 0, draw_scenarios, kDrawCells));
+      put_distribution(rows.emplace_back(), opencl::noise_draws(*rt, f, opencl::KernelCounts::of(cat), m, model.seed, 0,
+                                                                draw_scenarios, kDrawCells));
       const bool images_own_features = o.classifier && img.out.features != feat.out.features;
       BatchOutput img2;
       if (images_own_features) cl->run(case2, ip, img2);

@@ -96,11 +96,12 @@ void add_walk(MetalWalks& w, const MetalMapSettings& s, double x, double z, int 
 
 // Each zone's response and deduction at every probe, from the kernels or the reference.
 opencl::MetalResponses responses(const Catalogue& cat, const MetalWalks& w, OpenCLRuntime* rt) {
-  if (rt) return opencl::metal_responses(*rt, cat.metal_physics, w.objects, w.probes);
+  if (rt) return opencl::metal_responses(*rt, cat, w.objects, w.probes);
   const size_t n = w.probes.size() / PS_MP_LEN;
   opencl::MetalResponses out;
-  out.response.resize(n * kZones);
-  out.deduction.resize(n * kZones);
+  const size_t Z = static_cast<size_t>(cat.zones);
+  out.response.resize(n * Z);
+  out.deduction.resize(n * Z);
   parallel_for(n, default_threads(), [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
       const double* p = &w.probes[i * PS_MP_LEN];
@@ -113,7 +114,7 @@ opencl::MetalResponses responses(const Catalogue& cat, const MetalWalks& w, Open
       o.lx = r[PS_MV_LONG_X];
       o.ly = r[PS_MV_LONG_Y];
       o.lz = r[PS_MV_LONG_Z];
-      reference::metal_response(cat.metal_physics, o, &out.response[i * kZones], &out.deduction[i * kZones]);
+      reference::metal_response(cat.metal_physics, o, &out.response[i * Z], &out.deduction[i * Z]);
     }
   });
   return out;
@@ -123,13 +124,13 @@ opencl::MetalResponses responses(const Catalogue& cat, const MetalWalks& w, Open
 // detector's triangular noise where the deduction is not 0 (the physics model's rule), clamped
 // to 1..200. Only readings that can be the lowest draw their noise: one whose noise-free value
 // less the noise's half-width is above the lowest noise-free value plus it cannot be.
-std::vector<uint8_t> lowest_readings(const uint8_t* deduction, size_t samples, const std::array<int, kZones>& base,
+std::vector<uint8_t> lowest_readings(const uint8_t* deduction, size_t samples, const std::vector<int>& base,
                                      const MetalMapSettings& s, uint64_t walk) {
-  const int n = s.metal_noise;
+  const int n = s.metal_noise, Z = static_cast<int>(base.size());
   int bound = std::numeric_limits<int>::max();
   for (size_t t = 0; t < samples; ++t)
-    for (int z = 0; z < kZones; ++z) {
-      const int d = deduction[t * kZones + z];
+    for (int z = 0; z < Z; ++z) {
+      const int d = deduction[t * Z + z];
       bound = std::min(bound, base[z] - d + (d > 0 ? n : 0));
     }
   struct Candidate {
@@ -139,8 +140,8 @@ std::vector<uint8_t> lowest_readings(const uint8_t* deduction, size_t samples, c
   };
   std::vector<Candidate> candidates;
   for (size_t t = 0; t < samples; ++t)
-    for (int z = 0; z < kZones; ++z) {
-      const int d = deduction[t * kZones + z];
+    for (int z = 0; z < Z; ++z) {
+      const int d = deduction[t * Z + z];
       const bool noisy = n > 0 && d > 0;
       if (base[z] - d - (noisy ? n : 0) <= bound)
         candidates.push_back({static_cast<uint32_t>(t), static_cast<uint32_t>(z), base[z] - d, noisy});
@@ -212,7 +213,7 @@ void check_metal_map(const Catalogue& cat, const MetalMapSettings& s) {
   if (s.metal_noise < 0 || s.metal_noise > 199)
     throw InputError("--metal-noise: must be 0 to 199 counts, not " + std::to_string(s.metal_noise));
   const size_t walks = 3 * grid_of(cat.metal_physics, s.grid_step).cells() +
-                       cat.subjects.size() * benign_present(cat, nullptr).size() * kRegions;
+                       cat.subjects.size() * benign_present(cat, nullptr).size() * cat.regions.size();
   if (walks * samples_of(s) > kMaxProbes)
     throw InputError("--grid-step: " + std::to_string(walks) + " walks of " + std::to_string(samples_of(s)) +
                      " samples exceed the map's " + std::to_string(kMaxProbes) + " places; a coarser grid or rate");
@@ -240,7 +241,7 @@ MetalWalks metal_map_walks(const Catalogue& cat, const MetalMapSettings& s) {
       const std::array<double, 2> side = cat.long_side(v);
       const int record = static_cast<int>(w.objects.size() / PS_MV_LEN);
       add_object(w.objects, cat.polarizability(v), side[0], 0.0, side[1]);
-      for (int r = 0; r < kRegions; ++r) {
+      for (int r = 0; r < cat.region_count(); ++r) {
         const int k = first_view(cat.sensors, r);
         if (k < 0) throw InputError("--metal-map: region " + cat.regions[r].name + " is in no view");
         const Sensor& sensor = cat.sensors[k];
@@ -259,20 +260,21 @@ json metal_map(const Catalogue& cat, const MetalMapSettings& s, OpenCLRuntime* r
   const TestObject t = test_object(cat, s.object);
   const MetalWalks w = metal_map_walks(cat, s);
   const opencl::MetalResponses r = responses(cat, w, rt);
+  const int Z = cat.zones, R = cat.region_count();
 
   // Each walk's lowest reading per pass: the test object carried by the first subject, each
   // clean tester on its own body.
   std::vector<std::string> missing;
   const std::vector<int> benign = benign_present(cat, &missing);
   const size_t map_walks = 3 * g.cells();
-  auto base_of = [&](size_t walk) {
-    const size_t subject = walk < map_walks ? 0 : (walk - map_walks) / (benign.size() * kRegions);
+  auto base_of = [&](size_t walk) -> const std::vector<int>& {
+    const size_t subject = walk < map_walks ? 0 : (walk - map_walks) / (benign.size() * R);
     return cat.subjects[subject].base_zones;
   };
   std::vector<std::vector<uint8_t>> lowest(w.walks);
   parallel_for(w.walks, s.threads ? s.threads : default_threads(), [&](size_t begin, size_t end) {
     for (size_t k = begin; k < end; ++k)
-      lowest[k] = lowest_readings(&r.deduction[k * w.samples * kZones], w.samples, base_of(k), s, k);
+      lowest[k] = lowest_readings(&r.deduction[k * w.samples * Z], w.samples, base_of(k), s, k);
   });
   // Clean testers without metal read their bases on every pass (no deduction, so no noise);
   // with benign_clean, the benign items' carriers count as clean too.
@@ -351,16 +353,16 @@ json metal_map(const Catalogue& cat, const MetalMapSettings& s, OpenCLRuntime* r
           for (json* row : {&pd_row, &peak_row, &ded_row, &zones_row}) row->push_back(nullptr);
           continue;
         }
-        std::array<int, kZones> peak_d{};
+        std::vector<int> peak_d(Z, 0);
         double peak_r = 0;
         for (size_t k = 0; k < w.samples; ++k)
-          for (int z = 0; z < kZones; ++z) {
-            const size_t at = (walk * w.samples + k) * kZones + z;
+          for (int z = 0; z < Z; ++z) {
+            const size_t at = (walk * w.samples + k) * Z + z;
             peak_d[z] = std::max<int>(peak_d[z], r.deduction[at]);
             peak_r = std::max(peak_r, r.response[at]);
           }
         int alarming = 0;
-        for (int z = 0; z < kZones; ++z) alarming += level > 0 && 200 - peak_d[z] <= level;
+        for (int z = 0; z < Z; ++z) alarming += level > 0 && 200 - peak_d[z] <= level;
         const double p = alarm_rate(lowest[walk], level);
         pd_row.push_back(p);
         peak_row.push_back(peak_r);
@@ -422,8 +424,8 @@ json metal_map(const Catalogue& cat, const MetalMapSettings& s, OpenCLRuntime* r
       double sum = 0;
       size_t count = 0;
       for (size_t subject = 0; subject < cat.subjects.size(); ++subject)
-        for (int region = 0; region < kRegions; ++region, ++count)
-          sum += alarm_rate(lowest[map_walks + (subject * benign.size() + b) * kRegions + region], v);
+        for (int region = 0; region < R; ++region, ++count)
+          sum += alarm_rate(lowest[map_walks + (subject * benign.size() + b) * R + region], v);
       nuisance[cat.objects[benign[b]].name] = count ? sum / static_cast<double>(count) : 0.0;
     }
     double pd_sum = 0, pd_min = 1;

@@ -22,6 +22,8 @@ ObjectTransform object_transform(const ModelSettings& m, uint64_t index, int reg
 FeatureLayout FeatureLayout::of(const Catalogue& cat, int block) {
   FeatureLayout f;
   f.block = block;
+  f.regions = cat.region_count();
+  f.zones = cat.zones;
   for (size_t k = 0; k < cat.sensors.size(); ++k) {
     const Sensor& s = cat.sensors[k];
     if (!s.pooled) continue;
@@ -55,8 +57,8 @@ std::vector<std::string> FeatureLayout::names() const {
     for (int by = 0; by < grids[slot].blocks_y; ++by)
       for (int bx = 0; bx < grids[slot].blocks_x; ++bx)
         n.push_back(view_names[slot] + "_r" + std::to_string(by) + "_c" + std::to_string(bx));
-  for (int r = 1; r <= kRegions; ++r) n.push_back("region" + std::to_string(r));
-  for (int z = 1; z <= kZones; ++z) n.push_back("zone" + std::to_string(z));
+  for (int r = 1; r <= regions; ++r) n.push_back("region" + std::to_string(r));
+  for (int z = 1; z <= zones; ++z) n.push_back("zone" + std::to_string(z));
   return n;
 }
 

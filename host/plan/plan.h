@@ -148,8 +148,8 @@ struct Plan {
 
 // The layout of a feature row: the blocks of each pooled view in turn (row-major,
 // partial blocks at the right and bottom edges averaged over the pixels they hold), the
-// 13 region means, then the 19 metal zones; sinks append the class. Each pooled view has
-// its own grid of blocks.
+// catalogue's region means (13 in the built-in one), then its metal zones (19); sinks
+// append the class. Each pooled view has its own grid of blocks.
 struct FeatureLayout {
   struct Grid {
     int blocks_x = 0, blocks_y = 0;
@@ -157,15 +157,16 @@ struct FeatureLayout {
     int blocks() const { return blocks_x * blocks_y; }
   };
   int block = 10;
-  std::vector<int> pooled;  // the pooled views (indices into Catalogue::sensors)
+  int regions = 0, zones = 0;  // the catalogue's
+  std::vector<int> pooled;     // the pooled views (indices into Catalogue::sensors)
   std::vector<std::string> view_names;
   std::vector<Grid> grids;  // per pooled view
   // Every pooled view has one size (so one grid): what the features paths' tables assume
   // (backend/opencl/paths/); the other layouts take the pooled views rendered.
   bool uniform = true;
   int block_features() const { return grids.empty() ? 0 : grids.back().offset + grids.back().blocks(); }
-  int image_features() const { return block_features() + kRegions; }
-  int row_features() const { return image_features() + kZones; }
+  int image_features() const { return block_features() + regions; }
+  int row_features() const { return image_features() + zones; }
   std::vector<std::string> names() const;
   static FeatureLayout of(const Catalogue& cat, int block);
   // The smallest square block side that cuts every pooled view into w x h blocks (5x5 on

@@ -109,15 +109,15 @@ struct Reader {
     return out;
   }
 
-  template <size_t N>
-  std::array<double, N> numbers(const toml::table& t, const std::string& key, const std::string& field, double lo,
-                                double hi) const {
+  std::vector<double> numbers(const toml::table& t, const std::string& key, const std::string& field, int count,
+                              double lo, double hi) const {
     const std::string f = field + "." + key;
     const toml::node* n = need(t, key, f);
     const toml::array* a = n->as_array();
-    if (!a || a->size() != N) fail(n, f, "expected an array of " + std::to_string(N) + " numbers");
-    std::array<double, N> out{};
-    for (size_t i = 0; i < N; ++i) out[i] = number(a->get(i), f + "[" + std::to_string(i) + "]", lo, hi);
+    if (!a || a->size() != static_cast<size_t>(count))
+      fail(n, f, "expected an array of " + std::to_string(count) + " numbers");
+    std::vector<double> out;
+    for (int i = 0; i < count; ++i) out.push_back(number(a->get(i), f + "[" + std::to_string(i) + "]", lo, hi));
     return out;
   }
 
@@ -175,19 +175,32 @@ void read_metal_physics(const Reader& rd, const toml::node* node, Catalogue& cat
   const std::string f = "metal.physics";
   const toml::table* t = node->as_table();
   if (!t) rd.fail(node, f, "expected a table");
-  io::reject_unknown_keys(
-      *t,
-      {"body_height", "panel_separation", "tx_moment", "rx_moment", "tx_height", "rx_height", "gain", "polarizability"},
-      rd.file, f);
+  io::reject_unknown_keys(*t,
+                          {"body_height", "panel_separation", "tx_moment", "rx_moment", "tx_panel", "tx_height",
+                           "rx_height", "gain", "polarizability"},
+                          rd.file, f);
   MetalPhysics& mp = cat.metal_physics;
   mp.present = true;
   mp.body_height = rd.number(*t, "body_height", f, 0.5, 3.0);
   mp.panel_separation = rd.number(*t, "panel_separation", f, 0.2, 5.0);
   mp.tx_moment = rd.number(*t, "tx_moment", f, 1e-6, 1e6);
   mp.rx_moment = rd.number(*t, "rx_moment", f, 1e-6, 1e6);
-  mp.tx_height = rd.numbers<kZones>(*t, "tx_height", f, 0.0, 5.0);
-  mp.rx_height = rd.numbers<kZones>(*t, "rx_height", f, 0.0, 5.0);
-  mp.gain = rd.numbers<kZones>(*t, "gain", f, 0.0, 1e12);
+  {
+    const toml::node* n = rd.need(*t, "tx_panel", f + ".tx_panel");
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != static_cast<size_t>(cat.zones))
+      rd.fail(n, f + ".tx_panel", "expected an array of " + std::to_string(cat.zones) + " panels, \"a\" or \"b\"");
+    for (size_t z = 0; z < a->size(); ++z) {
+      const toml::node* e = a->get(z);
+      const std::string ez = f + ".tx_panel[" + std::to_string(z) + "]";
+      if (!e->is_string() || (e->as_string()->get() != "a" && e->as_string()->get() != "b"))
+        rd.fail(e, ez, "expected \"a\" (x < 0, the subject's right) or \"b\"");
+      mp.tx_side.push_back(e->as_string()->get() == "a" ? -1 : 1);
+    }
+  }
+  mp.tx_height = rd.numbers(*t, "tx_height", f, cat.zones, 0.0, 5.0);
+  mp.rx_height = rd.numbers(*t, "rx_height", f, cat.zones, 0.0, 5.0);
+  mp.gain = rd.numbers(*t, "gain", f, cat.zones, 0.0, 1e12);
   const toml::node* pn = rd.need(*t, "polarizability", f + ".polarizability");
   const toml::table* pol = pn->as_table();
   if (!pol) rd.fail(pn, f + ".polarizability", "expected a table of category = cm^3");
@@ -334,84 +347,12 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
 
   read_views(rd, root, cat);
 
-  // [metal] first: objects refer to its categories.
-  const toml::node* metal_node = rd.need(root, "metal", "metal");
-  const toml::table* metal = metal_node->as_table();
-  if (!metal) rd.fail(metal_node, "metal", "expected a table");
-  io::reject_unknown_keys(*metal, {"categories", "influence", "physics"}, source_name, "metal");
-  {
-    const toml::node* cn = rd.need(*metal, "categories", "metal.categories");
-    const toml::array* ca = cn->as_array();
-    if (!ca || ca->empty()) rd.fail(cn, "metal.categories", "expected a non-empty array of names");
-    for (size_t i = 0; i < ca->size(); ++i) {
-      const toml::node* e = ca->get(i);
-      if (!e->is_string()) rd.fail(e, "metal.categories[" + std::to_string(i) + "]", "expected a string");
-      cat.metal_categories.push_back(e->as_string()->get());
-    }
-    const toml::node* inf_node = rd.need(*metal, "influence", "metal.influence");
-    const toml::table* inf = inf_node->as_table();
-    if (!inf) rd.fail(inf_node, "metal.influence", "expected a table");
-    for (const auto& [key, node] : *inf) {
-      bool known = false;
-      for (const std::string& c : cat.metal_categories) known |= (c == key.str());
-      if (!known) rd.fail(&node, "metal.influence." + std::string(key.str()), "not one of metal.categories");
-    }
-    for (const std::string& c : cat.metal_categories) {
-      const std::string f = "metal.influence." + c;
-      const toml::node* rows_node = rd.need(*inf, c, f);
-      const toml::array* rows = rows_node->as_array();
-      if (!rows || rows->size() != kRegions)
-        rd.fail(rows_node, f, "expected " + std::to_string(kRegions) + " rows, one per region");
-      std::array<std::array<int, kZones>, kRegions> table{};
-      for (int r = 0; r < kRegions; ++r) {
-        const std::vector<int> v = rd.ints(rows->get(r), f + "[region " + std::to_string(r + 1) + "]", kZones, 0, 199);
-        std::copy(v.begin(), v.end(), table[r].begin());
-      }
-      cat.influence.push_back(table);
-    }
-    if (const toml::node* pn = metal->get("physics")) read_metal_physics(rd, pn, cat);
-  }
-
-  // [[subjects]]
-  const toml::array& subjects = rd.array_of_tables(root, "subjects");
-  if (subjects.empty() || subjects.size() > 255) rd.fail(&subjects, "subjects", "expected 1 to 255 subjects");
-  for (size_t i = 0; i < subjects.size(); ++i) {
-    const toml::table& t = *subjects.get(i)->as_table();
-    const std::string f = "subjects[" + std::to_string(i + 1) + "]";
-    io::reject_unknown_keys(t, {"name", "build", "height", "mmw_level", "ir_core", "ir_limb", "base_zones", "images"},
-                            source_name, f);
-    Subject s;
-    s.name = rd.string(t, "name", f);
-    s.build = rd.number(t, "build", f, 0.5, 1.5, 1.0);
-    // Stature about the 1.75 m body of [metal.physics]: 0.85..1.15 is about 1.49 m to
-    // 2.01 m, most adults. Within it the drawn head stays below the upper view's top edge
-    // and every region's place stays in its own view (docs/model/subjects.md).
-    s.height = rd.number(t, "height", f, 0.85, 1.15, 1.0);
-    s.mmw_level = rd.integer(t, "mmw_level", f, 0, 255, 150);
-    s.ir_core = rd.integer(t, "ir_core", f, 0, 255, 215);
-    s.ir_limb = rd.integer(t, "ir_limb", f, 0, 255, 175);
-    const std::vector<int> z = rd.ints(rd.need(t, "base_zones", f + ".base_zones"), f + ".base_zones", kZones, 1, 200);
-    std::copy(z.begin(), z.end(), s.base_zones.begin());
-    if (const toml::node* in = t.get("images")) {
-      const toml::table* it = in->as_table();
-      if (!it) rd.fail(in, f + ".images", "expected a table of view = \"file\"");
-      for (const auto& [key, value] : *it) {
-        if (cat.sensor_index(key.str()) < 0)
-          rd.fail(&value, f + ".images." + std::string(key.str()), "not one of the catalogue's [[views]]");
-        s.images.emplace(std::string(key.str()), rd.image(*it, std::string(key.str()), f + ".images"));
-      }
-    }
-    // Objects move with the stature; an image file's body would not.
-    if (s.height != 1.0 && !s.images.empty())
-      rd.fail(t.get("height"), f + ".height",
-              "only a procedural body can be drawn at another height; this subject names image files (images)");
-    cat.subjects.push_back(std::move(s));
-  }
-
   // [[regions]]: each with its rectangle in every view that sees it.
   const toml::array& regions = rd.array_of_tables(root, "regions");
-  if (regions.size() != kRegions)
-    rd.fail(&regions, "regions", "expected exactly 13 regions, found " + std::to_string(regions.size()));
+  if (regions.empty() || regions.size() > static_cast<size_t>(kMaxRegions))
+    rd.fail(&regions, "regions",
+            "expected 1 to " + std::to_string(kMaxRegions) + " regions, found " + std::to_string(regions.size()));
+  cat.regions.resize(regions.size());
   for (size_t i = 0; i < regions.size(); ++i) {
     const toml::table& t = *regions.get(i)->as_table();
     const std::string f = "regions[" + std::to_string(i + 1) + "]";
@@ -434,6 +375,79 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
       view.rects[i] = rd.rect(&value, rf, view.width, view.height);
       view.region_mask |= 1u << i;
     }
+  }
+
+  // [metal] before the objects (they refer to its categories) and the subjects (their
+  // base_zones are one per zone); after the regions (an influence row per region).
+  const toml::node* metal_node = rd.need(root, "metal", "metal");
+  const toml::table* metal = metal_node->as_table();
+  if (!metal) rd.fail(metal_node, "metal", "expected a table");
+  io::reject_unknown_keys(*metal, {"zones", "categories", "influence", "physics"}, source_name, "metal");
+  {
+    cat.zones = static_cast<int>(rd.integer(rd.need(*metal, "zones", "metal.zones"), "metal.zones", 1, kMaxZones));
+    const toml::node* cn = rd.need(*metal, "categories", "metal.categories");
+    const toml::array* ca = cn->as_array();
+    if (!ca || ca->empty()) rd.fail(cn, "metal.categories", "expected a non-empty array of names");
+    for (size_t i = 0; i < ca->size(); ++i) {
+      const toml::node* e = ca->get(i);
+      if (!e->is_string()) rd.fail(e, "metal.categories[" + std::to_string(i) + "]", "expected a string");
+      cat.metal_categories.push_back(e->as_string()->get());
+    }
+    const toml::node* inf_node = rd.need(*metal, "influence", "metal.influence");
+    const toml::table* inf = inf_node->as_table();
+    if (!inf) rd.fail(inf_node, "metal.influence", "expected a table");
+    for (const auto& [key, node] : *inf) {
+      bool known = false;
+      for (const std::string& c : cat.metal_categories) known |= (c == key.str());
+      if (!known) rd.fail(&node, "metal.influence." + std::string(key.str()), "not one of metal.categories");
+    }
+    for (const std::string& c : cat.metal_categories) {
+      const std::string f = "metal.influence." + c;
+      const toml::node* rows_node = rd.need(*inf, c, f);
+      const toml::array* rows = rows_node->as_array();
+      if (!rows || rows->size() != cat.regions.size())
+        rd.fail(rows_node, f, "expected " + std::to_string(cat.regions.size()) + " rows, one per region");
+      std::vector<std::vector<int>> table;
+      for (int r = 0; r < cat.region_count(); ++r)
+        table.push_back(rd.ints(rows->get(r), f + "[region " + std::to_string(r + 1) + "]", cat.zones, 0, 199));
+      cat.influence.push_back(std::move(table));
+    }
+    if (const toml::node* pn = metal->get("physics")) read_metal_physics(rd, pn, cat);
+  }
+
+  // [[subjects]]
+  const toml::array& subjects = rd.array_of_tables(root, "subjects");
+  if (subjects.empty() || subjects.size() > 255) rd.fail(&subjects, "subjects", "expected 1 to 255 subjects");
+  for (size_t i = 0; i < subjects.size(); ++i) {
+    const toml::table& t = *subjects.get(i)->as_table();
+    const std::string f = "subjects[" + std::to_string(i + 1) + "]";
+    io::reject_unknown_keys(t, {"name", "build", "height", "mmw_level", "ir_core", "ir_limb", "base_zones", "images"},
+                            source_name, f);
+    Subject s;
+    s.name = rd.string(t, "name", f);
+    s.build = rd.number(t, "build", f, 0.5, 1.5, 1.0);
+    // Stature about the 1.75 m body of [metal.physics]: 0.85..1.15 is about 1.49 m to
+    // 2.01 m, most adults. Within it the drawn head stays below the upper view's top edge
+    // and every region's place stays in its own view (docs/model/subjects.md).
+    s.height = rd.number(t, "height", f, 0.85, 1.15, 1.0);
+    s.mmw_level = rd.integer(t, "mmw_level", f, 0, 255, 150);
+    s.ir_core = rd.integer(t, "ir_core", f, 0, 255, 215);
+    s.ir_limb = rd.integer(t, "ir_limb", f, 0, 255, 175);
+    s.base_zones = rd.ints(rd.need(t, "base_zones", f + ".base_zones"), f + ".base_zones", cat.zones, 1, 200);
+    if (const toml::node* in = t.get("images")) {
+      const toml::table* it = in->as_table();
+      if (!it) rd.fail(in, f + ".images", "expected a table of view = \"file\"");
+      for (const auto& [key, value] : *it) {
+        if (cat.sensor_index(key.str()) < 0)
+          rd.fail(&value, f + ".images." + std::string(key.str()), "not one of the catalogue's [[views]]");
+        s.images.emplace(std::string(key.str()), rd.image(*it, std::string(key.str()), f + ".images"));
+      }
+    }
+    // Objects move with the stature; an image file's body would not.
+    if (s.height != 1.0 && !s.images.empty())
+      rd.fail(t.get("height"), f + ".height",
+              "only a procedural body can be drawn at another height; this subject names image files (images)");
+    cat.subjects.push_back(std::move(s));
   }
 
   // [physics] and [[materials]]: optional; the physics model needs them.

@@ -23,7 +23,7 @@ struct Subject {
   double build = 1.0;   // body width scale (procedural::Body::build)
   double height = 1.0;  // stature scale about the floor (procedural::Body::height)
   int mmw_level = 150, ir_core = 215, ir_limb = 175;
-  std::array<int, kZones> base_zones{};
+  std::vector<int> base_zones;  // one per zone of the metal detector
   // The base image files the catalogue names, by camera view name (images.NAME); a view
   // with none draws the procedural body.
   std::map<std::string, ImageSource, std::less<>> images;
@@ -98,15 +98,16 @@ struct ImagesConfig {
 };
 
 // The walk-through metal detector under --model physics ([metal.physics];
-// docs/model/metal.md). Zones 1..PS_METAL_PANEL_A_ZONES transmit from panel A (x < 0, the
-// subject's right), the others from panel B; each receives on the other panel.
+// docs/model/metal.md): per zone, the panel its coil transmits from (A at x < 0, the
+// subject's right, or B); it receives on the other panel.
 struct MetalPhysics {
-  bool present = false;                                 // the catalogue has [metal.physics]
-  double body_height = 1.75, panel_separation = 0.76;   // m
-  double tx_moment = 1.0, rx_moment = 1.0;              // A m^2
-  std::array<double, kZones> tx_height{}, rx_height{};  // m above the floor
-  std::array<double, kZones> gain{};                    // counts per unit signal, per zone
-  std::vector<double> polarizability;                   // cm^3 per metal category
+  bool present = false;                                // the catalogue has [metal.physics]
+  double body_height = 1.75, panel_separation = 0.76;  // m
+  double tx_moment = 1.0, rx_moment = 1.0;             // A m^2
+  std::vector<int> tx_side;                            // per zone: -1 panel A (x < 0), +1 panel B
+  std::vector<double> tx_height, rx_height;            // per zone, m above the floor
+  std::vector<double> gain;                            // per zone, counts per unit signal
+  std::vector<double> polarizability;                  // cm^3 per metal category
 };
 
 // A drawable thing: one variant of one object. Scenes refer to these by index.
@@ -120,19 +121,21 @@ struct Catalogue {
   std::string hash;    // FNV-1a 64 of the text, hex
   ImagesConfig images;
   std::vector<Subject> subjects;
-  std::array<Region, kRegions> regions;
+  std::vector<Region> regions;  // [[regions]], at most kMaxRegions
+  int zones = 0;                // the metal detector's zones ([metal] zones), at most kMaxZones
   std::vector<Object> objects;
   std::vector<NoisePattern> noise;
   std::vector<Material> materials;
   PhysicsConfig physics;
   std::vector<std::string> metal_categories;
   // influence[category][region][zone]
-  std::vector<std::array<std::array<int, kZones>, kRegions>> influence;
+  std::vector<std::vector<std::vector<int>>> influence;
   std::vector<VariantRef> variant_list;
   std::vector<Sensor> sensors;         // the camera views ([[views]]; scene/sensor.h)
   std::vector<SpriteSet> sprite_sets;  // the objects' drawings the views need
   MetalPhysics metal_physics;
 
+  int region_count() const { return static_cast<int>(regions.size()); }
   const Object& object_of(int variant_id) const { return objects[variant_list[variant_id].object]; }
   const Variant& variant(int variant_id) const {
     const VariantRef& r = variant_list[variant_id];

@@ -21,9 +21,9 @@ Generator::Generator(const Catalogue& cat, GeneratorSpec spec, uint64_t seed)
     if (s < 0 || s >= static_cast<int>(cat.subjects.size()))
       throw InputError("subjects: " + std::to_string(s + 1) + " is out of range (1 to " +
                        std::to_string(cat.subjects.size()) + ")");
-  if (spec_.min_objects < 0 || spec_.max_objects > kRegions || spec_.min_objects > spec_.max_objects)
+  if (spec_.min_objects < 0 || spec_.max_objects > cat.region_count() || spec_.min_objects > spec_.max_objects)
     throw InputError("objects: " + std::to_string(spec_.min_objects) + ".." + std::to_string(spec_.max_objects) +
-                     " must satisfy 0 <= MIN <= MAX <= 13");
+                     " must satisfy 0 <= MIN <= MAX <= " + std::to_string(cat.region_count()) + " (the regions)");
   if (!spec_.rule.empty()) rule_.emplace(cat, spec_.rule, "rule");
   if (spec_.balance) {
     if (!rule_) throw InputError("balance: needs a threat rule (--rule) to know the classes");
@@ -49,11 +49,12 @@ Scenario Generator::draw_scene(uint64_t index, uint32_t attempt) const {
                     static_cast<int>(below(r[1], static_cast<uint32_t>(spec_.max_objects - spec_.min_objects + 1)));
   // Distinct regions by a partial Fisher-Yates shuffle; objects uniform over the pool,
   // variants uniform over the object's drawings.
-  std::array<int, kRegions> regions;
-  for (int k = 0; k < kRegions; ++k) regions[k] = k;
+  const int R = cat_.region_count();
+  std::array<int, kMaxRegions> regions;
+  for (int k = 0; k < R; ++k) regions[k] = k;
   for (int k = 0; k < count; ++k) {
     const Philox4 q = draw(seed_, index, kStreamGenerate, e0 + 1 + static_cast<uint32_t>(k));
-    const int j = k + static_cast<int>(below(q[0], static_cast<uint32_t>(kRegions - k)));
+    const int j = k + static_cast<int>(below(q[0], static_cast<uint32_t>(R - k)));
     std::swap(regions[k], regions[j]);
     const Object& o = cat_.objects[spec_.pool[below(q[1], static_cast<uint32_t>(spec_.pool.size()))]];
     const int v = o.first_variant + static_cast<int>(below(q[2], static_cast<uint32_t>(o.variants.size())));

@@ -11,7 +11,7 @@ namespace portalsim {
 
 struct ScenarioInputs {
   int subject = 1;                   // 1-based, as typed
-  std::vector<std::string> objects;  // tokens for regions 1..13 ("none", "gun:v")
+  std::vector<std::string> objects;  // tokens for the catalogue's regions in order ("none", "gun:v")
   std::string rule;                  // threat rule, or empty
   std::string threat;                // "yes" / "no" / empty; not together with rule
 };

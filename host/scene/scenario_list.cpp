@@ -46,14 +46,16 @@ ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, c
   col_region_.fill(-1);
   for (auto& c : col_transform_) c.fill(-1);
   const std::string at = path + ":" + std::to_string(lineno);
-  // "region", "rotation", ... followed by 1..13: the region (1-based), 0 for another name,
+  const int R = cat.region_count();
+  const std::string regions = "regions 1 to " + std::to_string(R);
+  // "region", "rotation", ... followed by 1..R: the region (1-based), 0 for another name,
   // -1 for a number out of range.
-  const auto numbered = [](const std::string& h, const std::string& stem) {
+  const auto numbered = [R](const std::string& h, const std::string& stem) {
     if (h.rfind(stem, 0) != 0 || h.size() <= stem.size() || h.size() > stem.size() + 2 ||
         h.find_first_not_of("0123456789", stem.size()) != std::string::npos)
       return 0;
     const int r = std::stoi(h.substr(stem.size()));
-    return r >= 1 && r <= kRegions ? r : -1;
+    return r >= 1 && r <= R ? r : -1;
   };
   for (size_t c = 0; c < header.size(); ++c) {
     const std::string h = normalise_name(header[c]);
@@ -65,7 +67,7 @@ ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, c
     else if (h == "label" || h == "class" || h == "threat")
       col_label_ = static_cast<int>(c);
     else if (int r = numbered(h, "region"); r != 0) {
-      if (r < 0) throw InputError(column + "there are regions 1 to 13 only");
+      if (r < 0) throw InputError(column + "there are " + regions + " only");
       col_region_[r - 1] = static_cast<int>(c);
     } else if (h == "index") {
     } else if (
@@ -74,20 +76,20 @@ ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, c
             if ((tr = numbered(h, kTransformColumns[t])) != 0) return true;
           return false;
         }()) {
-      if (tr < 0) throw InputError(column + "there are regions 1 to 13 only");
+      if (tr < 0) throw InputError(column + "there are " + regions + " only");
       col_transform_[t][tr - 1] = static_cast<int>(c);
       ++transform_columns_;
     } else {
-      throw InputError(column + "unknown column (expected subject, region1..region13, label)");
+      throw InputError(column + "unknown column (expected subject, region1..region" + std::to_string(R) + ", label)");
     }
   }
-  if (transform_columns_ != 0 && transform_columns_ != 3 * kRegions)
-    throw InputError(at +
-                     ": header: the randomised objects' columns come together: rotation1..13, scale1..13 and "
-                     "flip1..13 (found " +
-                     std::to_string(transform_columns_) + " of 39)");
+  const std::string rn = "1.." + std::to_string(R);
+  if (transform_columns_ != 0 && transform_columns_ != 3 * R)
+    throw InputError(at + ": header: the randomised objects' columns come together: rotation" + rn + ", scale" + rn +
+                     " and flip" + rn + " (found " + std::to_string(transform_columns_) + " of " +
+                     std::to_string(3 * R) + ")");
   if (col_subject_ < 0) throw InputError(at + ": header: no \"subject\" column");
-  for (int r = 0; r < kRegions; ++r)
+  for (int r = 0; r < R; ++r)
     if (col_region_[r] < 0) throw InputError(at + ": header: no \"region" + std::to_string(r + 1) + "\" column");
 }
 
@@ -106,7 +108,7 @@ Scenario ScenarioRows::parse(std::string_view row, size_t lineno, ListedTransfor
     throw InputError(at() + ": subject: \"" + subj + "\" is not a subject number (1 to " +
                      std::to_string(cat_.subjects.size()) + ")");
   s.subject = sv - 1;
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < cat_.region_count(); ++r) {
     static const std::string kNone = "none";
     const std::string& token = f[col_region_[r]].empty() ? kNone : f[col_region_[r]];
     if (auto it = tokens.find(token); it != tokens.end()) {
@@ -129,7 +131,7 @@ Scenario ScenarioRows::parse(std::string_view row, size_t lineno, ListedTransfor
   }
   if (transform_columns_) {
     ListedTransforms got{lineno, {}};
-    for (int r = 0; r < kRegions; ++r) {
+    for (int r = 0; r < cat_.region_count(); ++r) {
       const std::array<const std::string*, 3> v = {&f[col_transform_[0][r]], &f[col_transform_[1][r]],
                                                    &f[col_transform_[2][r]]};
       const std::string name = ": region" + std::to_string(r + 1) + " ";

@@ -1,8 +1,8 @@
-// Scenario lists (generate --scenarios FILE): CSV with a header naming subject,
-// region1..region13 and optionally label (yes/no/positive/negative/1/0), index (ignored:
-// scenario i of the list is index i) and the randomised objects' columns (rotation1..13,
-// scale1..13, flip1..13: all 39 or none). Subjects are 1-based. Errors name file, line and
-// column or field.
+// Scenario lists (generate --scenarios FILE): CSV with a header naming subject, region1..
+// regionR (R the catalogue's regions, 13 in the built-in one) and optionally label
+// (yes/no/positive/negative/1/0), index (ignored: scenario i of the list is index i) and the
+// randomised objects' columns (rotation1..R, scale1..R, flip1..R: all 3 R or none). Subjects are 1-based. Errors name
+// file, line and column or field.
 //
 // Fields are read as RFC 4180 does: a field may be quoted, with "" for a quote inside; spaces
 // round an unquoted field are dropped. No field of a scenario list can hold a line break (a
@@ -26,7 +26,7 @@ namespace portalsim {
 // the draws of the run that re-makes it; `line` is the row's line in the file.
 struct ListedTransforms {
   size_t line = 0;
-  std::array<ObjectTransform, kRegions> t;  // identity where the region has no object
+  std::array<ObjectTransform, kMaxRegions> t;  // identity where the region has no object
 };
 
 inline constexpr size_t kMaxFieldBytes = 256;
@@ -54,8 +54,8 @@ class ScenarioRows {
   std::string path_;
   size_t fields_ = 0;
   int col_subject_ = -1, col_label_ = -1;
-  std::array<int, kRegions> col_region_{};
-  std::array<std::array<int, kRegions>, 3> col_transform_{};
+  std::array<int, kMaxRegions> col_region_{};
+  std::array<std::array<int, kMaxRegions>, 3> col_transform_{};
   int transform_columns_ = 0;
 };
 

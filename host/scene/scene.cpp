@@ -35,9 +35,9 @@ int16_t parse_object_token(const Catalogue& cat, const std::string& token, const
 }
 
 Scenario parse_object_list(const Catalogue& cat, const std::vector<std::string>& tokens) {
-  if (tokens.size() > static_cast<size_t>(kRegions))
+  if (tokens.size() > cat.regions.size())
     throw InputError("objects: " + std::to_string(tokens.size()) + " objects given, but there are only " +
-                     std::to_string(kRegions) + " regions (one object per region, \"none\" for empty)");
+                     std::to_string(cat.regions.size()) + " regions (one object per region, \"none\" for empty)");
   Scenario s;
   for (size_t i = 0; i < tokens.size(); ++i)
     s.objects[i] = parse_object_token(cat, tokens[i], "objects: region " + std::to_string(i + 1));

@@ -12,9 +12,9 @@ namespace portalsim {
 constexpr int16_t kNoObject = -1;
 
 struct Scenario {
-  int subject = 0;                        // 0-based
-  std::array<int16_t, kRegions> objects;  // variant id per region, kNoObject for none
-  int label = 0;                          // 1 threat, 0 not
+  int subject = 0;                           // 0-based
+  std::array<int16_t, kMaxRegions> objects;  // variant id per region, kNoObject for none and past the catalogue's
+  int label = 0;                             // 1 threat, 0 not
   Scenario() { objects.fill(kNoObject); }
 };
 
@@ -29,9 +29,11 @@ struct ObjectTransform {
 // n scenarios with global indices first_index .. first_index + n - 1. The index, not the
 // position in the batch, feeds the random generator, so results never depend on batching.
 struct SceneBatch {
+  explicit SceneBatch(int regions) : regions(regions) {}
+  int regions;  // the catalogue's regions: the stride of `objects`
   uint64_t first_index = 0;
   std::vector<uint8_t> subject;  // n
-  std::vector<int16_t> objects;  // n * 13, region-major within a scenario
+  std::vector<int16_t> objects;  // n * regions, region-major within a scenario
   std::vector<uint8_t> label;    // n
 
   size_t size() const { return subject.size(); }
@@ -42,21 +44,21 @@ struct SceneBatch {
   }
   void push(const Scenario& s) {
     subject.push_back(static_cast<uint8_t>(s.subject));
-    objects.insert(objects.end(), s.objects.begin(), s.objects.end());
+    objects.insert(objects.end(), s.objects.begin(), s.objects.begin() + regions);
     label.push_back(static_cast<uint8_t>(s.label));
   }
   Scenario at(size_t i) const {
     Scenario s;
     s.subject = subject[i];
-    for (int r = 0; r < kRegions; ++r) s.objects[r] = objects[i * kRegions + r];
+    for (int r = 0; r < regions; ++r) s.objects[r] = objects[i * regions + r];
     s.label = label[i];
     return s;
   }
 };
 
-// Parses the thesis's command line: up to 13 object tokens for regions 1..13 in order,
-// "none" for an empty region, "name:v" / "name:h" for a variant. `where` prefixes errors
-// (e.g. "argument 3" or "scenes.csv:12: region3").
+// Parses the thesis's command line: an object token per region in order (at most the
+// catalogue's regions), "none" for an empty region, "name:v" / "name:h" for a variant.
+// `where` prefixes errors (e.g. "argument 3" or "scenes.csv:12: region3").
 int16_t parse_object_token(const Catalogue& cat, const std::string& token, const std::string& where);
 // The tokens of simulate's positional argument `objects`: errors start "objects: region N"
 // (the command line names the argument, so that an unknown object there is a usage error).

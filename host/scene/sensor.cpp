@@ -28,7 +28,7 @@ void derive_view(Catalogue& cat, Sensor& s) {
   // integer placement stays integer and height 1 moves nothing.
   s.subject_dy.assign(cat.subjects.size(), {});
   for (size_t k = 0; k < cat.subjects.size(); ++k)
-    for (int r = 0; r < kRegions; ++r) {
+    for (int r = 0; r < cat.region_count(); ++r) {
       const double c = s.rects[r].y + s.rects[r].h / 2.0;
       s.subject_dy[k][r] = static_cast<int>(std::lround((1.0 - cat.subjects[k].height) * (s.floor_row - c)));
     }

@@ -13,8 +13,10 @@
 
 namespace portalsim {
 
-constexpr int kRegions = PS_REGIONS;
-constexpr int kZones = PS_ZONES;
+// The most regions and detector zones a catalogue may declare (kernels/contract.h); the
+// catalogue's own counts are Catalogue::regions.size() and Catalogue::zones.
+constexpr int kMaxRegions = PS_MAX_REGIONS;
+constexpr int kMaxZones = PS_MAX_ZONES;
 
 struct Rect {
   int x = 0, y = 0, w = 0, h = 0;
@@ -57,7 +59,7 @@ struct Sensor {
   Frame field;         // the part of the portal's field it shows
   int sprite_set = 0;  // its objects' drawings: index into Catalogue::sprite_sets
   // Region r's rectangle in this view, for the regions it sees (bit r of region_mask).
-  std::array<Rect, kRegions> rects{};
+  std::array<Rect, kMaxRegions> rects{};
   uint32_t region_mask = 0;
   bool pattern_noise = false;  // the thesis's MMW noise patterns are laid over objects
   bool pooled = false;         // its block and region means are features
@@ -70,7 +72,7 @@ struct Sensor {
   // Per subject, how many whole pixels down each region's place moves with the subject's
   // stature (Subject::height, scaled about the floor): round((1 - height) (floor_row - c)),
   // c the region's centre row. Zero for height 1.
-  std::vector<std::array<int, kRegions>> subject_dy;
+  std::vector<std::array<int, kMaxRegions>> subject_dy;
   // The stages of its chain under each model, in order (names registered in
   // backend/stages.cpp).
   std::vector<std::string> chain{"composite", "pattern_noise", "sensor_noise", "display"};

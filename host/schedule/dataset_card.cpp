@@ -23,49 +23,105 @@ using nlohmann::json;
 
 namespace {
 
+// The portal a data set was made with, as its manifest records the catalogue
+// (pipeline.cpp, run_identity: catalogue.portal).
+struct Portal {
+  struct View {
+    std::string name, camera, side;
+    bool pooled = false;
+  };
+  std::vector<View> views;
+  int regions = 0, zones = 0;
+
+  static Portal of(const json& manifest) {
+    const json& p = manifest.at("catalogue").at("portal");
+    Portal out;
+    for (const json& v : p.at("views"))
+      out.views.push_back({v.at("name"), v.at("camera"), v.at("side"), v.at("pooled").get<bool>()});
+    out.regions = p.at("regions").get<int>();
+    out.zones = p.at("zones").get<int>();
+    return out;
+  }
+  const View* view(const std::string& name) const {
+    for (const View& v : views)
+      if (v.name == name) return &v;
+    return nullptr;
+  }
+  // The names of the views of one camera (or the pooled ones), comma-separated.
+  std::string names(const std::string& camera, bool pooled_only = false) const {
+    std::string out;
+    for (const View& v : views)
+      if ((camera.empty() || v.camera == camera) && (!pooled_only || v.pooled))
+        out += (out.empty() ? "" : ", ") + v.name;
+    return out;
+  }
+  // "passive millimetre-wave camera views (upper, back_upper), infrared camera views (ir)".
+  std::string camera_views() const {
+    std::string out;
+    for (const auto& [camera, what] : {std::pair{"mmw", "passive millimetre-wave"}, std::pair{"ir", "infrared"}})
+      if (const std::string n = names(camera); !n.empty())
+        out += (out.empty() ? "" : ", ") + std::string(what) + " camera views (" + n + ")";
+    return out;
+  }
+  // The thesis's portal: front MMW views upper and lower (pooled), a front IR view ir.
+  bool thesis_cameras() const {
+    return names("mmw") == "upper, lower" && names("ir") == "ir" && names("", true) == "upper, lower" &&
+           view("upper")->side == "front" && view("lower")->side == "front" && view("ir")->side == "front";
+  }
+};
+
 // What each tensor holds (data.h5's datasets and the .npy tensors share names).
-const std::map<std::string, std::string>& tensor_meanings() {
+std::string tensor_meaning(const std::string& name, const Portal& portal) {
+  const std::string R = std::to_string(portal.regions);
+  if (name == "metal")
+    return "metal detector: " + std::to_string(portal.zones) + " zone values, 200 nothing, lower more metal";
+  if (name == "features")
+    return portal.thesis_cameras()
+               ? "image features: block means of the upper then lower MMW view, then region means (names in its "
+                 "columns attribute)"
+               : "image features: block means of each pooled view in turn (" + portal.names("", true) +
+                     "), then region means (names in its columns attribute)";
   static const std::map<std::string, std::string> m{
-      {"upper", "MMW camera, upper body: 8-bit gray"},
-      {"lower", "MMW camera, lower body: 8-bit gray"},
-      {"ir", "IR camera: RGB through the palette"},
-      {"ir_index", "IR camera: the temperature index (0-255) before the palette"},
-      {"metal", "metal detector: 19 zone values, 200 nothing, lower more metal"},
-      {"features",
-       "image features: block means of the upper then lower MMW view, then region means (names in "
-       "its columns attribute)"},
       {"label", "1 = threat, 0 = not"},
       {"subject", "the subject, 1-based"},
-      {"region_object", "per region 1-13: the object's index in the catalogue (object_names), -1 none"},
       {"region_orientation", "per region: the drawing's index (object_drawings: h, v), -1 none"},
       {"region_label", "per region: the rule applied to that region's object alone"},
       {"region_rotation", "per region: the object's angle in degrees, counter-clockwise (0 where empty)"},
       {"region_scale", "per region: the object's scale factor (1 where empty)"},
       {"region_flip", "per region: 1 where the object is mirrored left to right"},
-      {"mask_upper", "instance mask of the upper MMW view: each pixel the region (1-13) whose object owns it, 0 none"},
-      {"mask_lower", "instance mask of the lower MMW view: each pixel the region (1-13) whose object owns it, 0 none"},
-      {"mask_ir", "instance mask of the IR view: each pixel the region (1-13) whose object owns it, 0 none"},
   };
-  return m;
-}
-
-std::string tensor_meaning(const std::string& name) {
-  const auto it = tensor_meanings().find(name);
-  return it != tensor_meanings().end() ? it->second : "per-scenario tensor " + name;
+  if (const auto it = m.find(name); it != m.end()) return it->second;
+  if (name == "region_object")
+    return "per region 1-" + R + ": the object's index in the catalogue (object_names), -1 none";
+  const bool mask = name.starts_with("mask_"), index = name.ends_with("_index");
+  const std::string stem = mask ? name.substr(5) : index ? name.substr(0, name.size() - 6) : name;
+  const Portal::View* v = portal.view(stem);
+  if (!v) return "per-scenario tensor " + name;
+  const bool mmw = v->camera == "mmw", back = v->side == "back";
+  if (mask)
+    return "instance mask of the " + (mmw || stem != "ir" ? stem + " " : std::string()) + (mmw ? "MMW" : "IR") +
+           " view: each pixel the region (1-" + R + ") whose object owns it, 0 none";
+  const std::string camera = std::string(mmw ? "MMW" : "IR") + " camera";
+  const std::string which = (stem == "upper" || stem == "lower") && mmw && !back ? ", " + stem + " body"
+                            : stem == "ir" && !mmw && !back                      ? ""
+                                                            : ", view " + stem + (back ? " (the back)" : "");
+  if (index) return camera + which + ": the temperature index (0-255) before the palette";
+  return camera + which + (mmw ? ": 8-bit gray" : ": RGB through the palette");
 }
 
 // What each file of a data set holds.
-std::string file_meaning(const std::string& name) {
-  static const std::map<std::string, std::string> m{
-      {"features.arff", "WEKA ARFF: one row per scenario: the image features, the 19 metal zones and the class"},
-      {"features.csv", "the same rows as CSV with a header: the image features, the 19 metal zones and the class"},
+std::string file_meaning(const std::string& name, const Portal& portal) {
+  const std::string rows = "the image features, the " + std::to_string(portal.zones) + " metal zones and the class";
+  const std::map<std::string, std::string> m{
+      {"features.arff", "WEKA ARFF: one row per scenario: " + rows},
+      {"features.csv", "the same rows as CSV with a header: " + rows},
       {"features.npy",
-       "float32 matrix, one row per scenario: the image features, the 19 metal zones and the class "
-       "(1/0) last; column names in features.columns.txt"},
+       "float32 matrix, one row per scenario: " + rows + " (1/0) last; column names in features.columns.txt"},
       {"features.columns.txt", "the names of features.npy's columns, one a line"},
       {"scenarios.csv",
-       "the scenario list: subject, the object in each of the 13 regions, the label (and each "
-       "object's random transform); generate --scenarios makes the data set again from it"},
+       "the scenario list: subject, the object in each of the " + std::to_string(portal.regions) +
+           " regions, the label (and each object's random transform); generate --scenarios makes the data set "
+           "again from it"},
       {"data.h5", "HDF5: every tensor, one row per scenario (the datasets are described in croissant.json)"},
       {"annotations.json",
        "COCO: categories, one image per scenario and camera view, and each object's box, "
@@ -77,7 +133,7 @@ std::string file_meaning(const std::string& name) {
       {"croissant.json", "the MLCommons Croissant description of these files and their fields"},
   };
   if (const auto it = m.find(name); it != m.end()) return it->second;
-  if (name.ends_with(".npy")) return "tensor: " + tensor_meaning(name.substr(0, name.size() - 4));
+  if (name.ends_with(".npy")) return "tensor: " + tensor_meaning(name.substr(0, name.size() - 4), portal);
   return "an output of portalsim generate";
 }
 
@@ -334,6 +390,7 @@ json model_parameters(const json& spec) {
 }
 
 struct Description {
+  Portal portal;
   json distribution = json::array();
   json record_sets = json::array();
   json files = json::array();  // for the card: name, bytes, xxh3_64, holds
@@ -345,8 +402,8 @@ void add_file(Description& d, const std::string& name, const json& recorded) {
           {"name", name},
           {"contentUrl", name},
           {"encodingFormat", encoding_of(name)},
-          {"description", file_meaning(name)}};
-  json card{{"name", name}, {"holds", file_meaning(name)}};
+          {"description", file_meaning(name, d.portal)}};
+  json card{{"name", name}, {"holds", file_meaning(name, d.portal)}};
   if (recorded.is_object()) {
     fo["contentSize"] = std::to_string(recorded.at("bytes").get<uint64_t>()) + " B";
     card["bytes"] = recorded.at("bytes");
@@ -371,14 +428,15 @@ void describe_table(Description& d, const fs::path& dir, const std::string& name
     const std::string names = fs::path(name).stem().string() + ".columns.txt";
     for (const std::string& c : lines_of(dir / names)) fields.push_back(column_field(set, c, name, c, "sc:Float"));
   }
-  d.record_sets.push_back(record_set(set, file_meaning(name), std::move(fields)));
+  d.record_sets.push_back(record_set(set, file_meaning(name, d.portal), std::move(fields)));
 }
 
 void describe_h5(Description& d, const fs::path& dir) {
   const H5Layout h5 = read_h5_layout((dir / "data.h5").string());
   json fields = json::array();
   for (const H5Dataset& ds : h5.datasets) {
-    json f = column_field("data_h5", ds.name, "data.h5", ds.name, data_type_of(ds.type), tensor_meaning(ds.name));
+    json f =
+        column_field("data_h5", ds.name, "data.h5", ds.name, data_type_of(ds.type), tensor_meaning(ds.name, d.portal));
     mark_array(f, ds.dims);
     fields.push_back(std::move(f));
   }
@@ -393,7 +451,7 @@ void describe_npy_tensors(Description& d, const fs::path& dir, const std::vector
   for (const std::string& n : names) {
     const std::string stem = n.substr(0, n.size() - 4);
     const NpyHeader h = npy_header_of(dir / n);
-    json f = column_field("tensors", stem, n, stem, data_type_of_descr(h.descr), tensor_meaning(stem));
+    json f = column_field("tensors", stem, n, stem, data_type_of_descr(h.descr), tensor_meaning(stem, d.portal));
     mark_array(f, std::vector<uint64_t>(h.shape.begin() + (h.shape.empty() ? 0 : 1), h.shape.end()));
     fields.push_back(std::move(f));
   }
@@ -444,6 +502,7 @@ void describe_image_folders(Description& d, const fs::path& dir, uint64_t first)
 
 Description describe(const fs::path& dir, const json& manifest) {
   Description d;
+  d.portal = Portal::of(manifest);
   std::vector<std::string> npy_tensors;
   for (const json& o : manifest.at("outputs")) {
     const std::string n = o.at("name").get<std::string>();
@@ -489,14 +548,16 @@ std::string card_text(const json& m, const Description& d) {
   y += "sensor_model: " + yaml(model) + "\n";
   y += "files:\n";
   for (const json& f : d.files) y += "  - " + yaml(f) + "\n";
-  y += "  - " + yaml(json{{"name", "README.md"}, {"holds", file_meaning("README.md")}}) + "\n";
-  y += "  - " + yaml(json{{"name", "croissant.json"}, {"holds", file_meaning("croissant.json")}}) + "\n";
+  y += "  - " + yaml(json{{"name", "README.md"}, {"holds", file_meaning("README.md", d.portal)}}) + "\n";
+  y += "  - " + yaml(json{{"name", "croissant.json"}, {"holds", file_meaning("croissant.json", d.portal)}}) + "\n";
   y += "---\n\n";
   y += "# " + data_set_name(m) + "\n\n";
+  const Portal& p = d.portal;
   y += "Simulated security-portal scenarios made by portalsim " + m.value("portalsim", "") +
-       ": for each scenario a person carrying 0 or more objects walks through a portal with a passive "
-       "millimetre-wave camera (upper and lower body), an infrared camera and a walk-through metal detector (19 "
-       "zones).\n\n";
+       ": for each scenario a person carrying 0 or more objects walks through a portal with " +
+       (p.thesis_cameras() ? std::string("a passive millimetre-wave camera (upper and lower body), an infrared camera")
+                           : p.camera_views()) +
+       " and a walk-through metal detector (" + std::to_string(p.zones) + " zones).\n\n";
   y += "- **Scenarios:** " + std::to_string(count) + " (" + std::to_string(pos) + " threats, " + std::to_string(neg) +
        " not), indices " + std::to_string(m["shard"].value("begin", uint64_t{0})) + " to " +
        std::to_string(m["shard"].value("end", uint64_t{0})) + " of seed " + s.value("seed", "0") + ".\n";

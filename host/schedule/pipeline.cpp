@@ -37,7 +37,7 @@ namespace {
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 struct Job {
-  SceneBatch scenes;
+  SceneBatch scenes{0};  // ScenarioSource::fill gives it the catalogue's stride
   BatchOutput out;
 };
 
@@ -110,7 +110,14 @@ json run_identity(const RunSpec& spec, const Catalogue& cat, uint64_t total, con
                   const PipelineResult& res) {
   json identity;
   identity["portalsim"] = PORTALSIM_VERSION;
-  identity["catalogue"] = {{"source", cat.source}, {"hash", cat.hash}};
+  // The portal it describes, so that the dataset card can say what the data hold.
+  json views = json::array();
+  for (const Sensor& v : cat.sensors)
+    views.push_back(
+        {{"name", v.name}, {"camera", camera_name(v.camera)}, {"side", side_name(v.side)}, {"pooled", v.pooled}});
+  identity["catalogue"] = {{"source", cat.source},
+                           {"hash", cat.hash},
+                           {"portal", {{"views", views}, {"regions", cat.region_count()}, {"zones", cat.zones}}}};
   identity["spec"] = spec.to_json();
   if (!spec.scenarios.empty()) identity["spec"]["scenarios_count"] = total;
   identity["shard"] = {{"index", opt.shard}, {"count", opt.shards}, {"begin", res.begin}, {"end", res.end}};
@@ -308,10 +315,10 @@ void write_manifest(const std::string& dir, std::vector<std::unique_ptr<Sink>>& 
 // 32 MiB last-level cache together, so the writer mostly reads the kernels' output from the
 // cache rather than from memory (docs/guide/deep-learning.md).
 size_t default_batch(const Plan& plan, const Catalogue& cat) {
-  size_t bytes = 64 + kZones;
+  size_t bytes = 64 + static_cast<size_t>(cat.zones);
   for (size_t k = 0; k < cat.sensors.size(); ++k)
     if (plan.renders(cat.sensors[k], static_cast<int>(k))) bytes += cat.sensors[k].pixels();
-  if (plan.sparse_features()) bytes = 64 + kZones;  // no images, on the device either
+  if (plan.sparse_features()) bytes = 64 + static_cast<size_t>(cat.zones);  // no images, on the device either
   if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
   // A multiple of data.h5's chunk rows: a batch ends where a chunk does, so no piece of it
   // waits in memory for the next batch before the file's hash can take it (file_order_hash.h).

@@ -8,7 +8,8 @@
 
 namespace portalsim {
 
-ScenarioSource::ScenarioSource(const RunSpec& spec, const Catalogue& cat) : model_(spec.settings().model) {
+ScenarioSource::ScenarioSource(const RunSpec& spec, const Catalogue& cat)
+    : model_(spec.settings().model), regions_(cat.region_count()) {
   if (!spec.rule.empty()) rule_.emplace(cat, spec.rule, spec.where("rule"));
   if (!spec.scenarios.empty()) {
     list_ = std::make_shared<ScenarioListFile>(cat, spec.scenarios);
@@ -22,8 +23,9 @@ ScenarioSource::ScenarioSource(const RunSpec& spec, const Catalogue& cat) : mode
 
 void ScenarioSource::fill(uint64_t at, size_t n, unsigned threads, SceneBatch& b) const {
   b.first_index = at;
+  b.regions = regions_;
   b.subject.resize(n);
-  b.objects.resize(n * kRegions);
+  b.objects.resize(n * regions_);
   b.label.resize(n);
   std::vector<Scenario> listed;
   std::vector<ListedTransforms> recorded;
@@ -47,7 +49,7 @@ void ScenarioSource::fill(uint64_t at, size_t n, unsigned threads, SceneBatch& b
         // Randomised objects are re-made from (seed, index, knobs), like every draw: a list
         // that records them must be re-made with the seed and knobs that drew them.
         if (!recorded.empty())
-          for (int r = 0; r < kRegions; ++r)
+          for (int r = 0; r < regions_; ++r)
             if (s.objects[r] != kNoObject && object_transform(model_, at + i, r) != recorded[i].t[r]) {
               std::lock_guard<std::mutex> lock(m);
               if (i < bad_row)
@@ -60,7 +62,7 @@ void ScenarioSource::fill(uint64_t at, size_t n, unsigned threads, SceneBatch& b
             }
       }
       b.subject[i] = static_cast<uint8_t>(s.subject);
-      std::copy(s.objects.begin(), s.objects.end(), b.objects.begin() + i * kRegions);
+      std::copy(s.objects.begin(), s.objects.begin() + regions_, b.objects.begin() + i * regions_);
       b.label[i] = static_cast<uint8_t>(s.label);
     }
   });
@@ -69,7 +71,7 @@ void ScenarioSource::fill(uint64_t at, size_t n, unsigned threads, SceneBatch& b
 
 void ScenarioSource::check(uint64_t begin, uint64_t end, unsigned threads) const {
   if (!list_) return;
-  SceneBatch b;
+  SceneBatch b(regions_);
   constexpr uint64_t kRows = 1u << 16;
   for (uint64_t at = begin; at < end; at += kRows) fill(at, static_cast<size_t>(std::min(kRows, end - at)), threads, b);
 }

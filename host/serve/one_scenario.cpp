@@ -10,9 +10,9 @@
 
 namespace portalsim {
 
-OneScenarioTimes write_one_scenario(const std::string& dir, Backend& backend, const Scenario& scene, const Plan& plan,
-                                    const Palette& palette, const FolderOptions& opt, BatchOutput& out,
-                                    const StageFieldsRequest* stages) {
+OneScenarioTimes write_one_scenario(const std::string& dir, const Catalogue& cat, Backend& backend,
+                                    const Scenario& scene, const Plan& plan, const Palette& palette,
+                                    const FolderOptions& opt, BatchOutput& out, const StageFieldsRequest* stages) {
   using clock = std::chrono::steady_clock;
   // The output-folder rules of generate: new or empty, locked while written.
   if (output_folder_state(dir) == FolderState::has_files)
@@ -21,7 +21,7 @@ OneScenarioTimes write_one_scenario(const std::string& dir, Backend& backend, co
   const FolderLock lock(dir);
   if (output_folder_state(dir) == FolderState::has_files)  // filled while this run waited for the lock
     throw OutputError(dir + ": is not empty; choose a new folder");
-  SceneBatch batch;
+  SceneBatch batch(cat.region_count());
   batch.push(scene);
   OneScenarioTimes t;
   const auto t_run = clock::now();

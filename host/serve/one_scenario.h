@@ -24,10 +24,11 @@ struct StageFieldsRequest {
   const AssetSet& assets;
 };
 
-// Runs `scene` on `backend` and writes its folder to `dir` all or nothing. `out` keeps
-// the backend's outputs (metal zones etc.) for the caller.
-OneScenarioTimes write_one_scenario(const std::string& dir, Backend& backend, const Scenario& scene, const Plan& plan,
-                                    const Palette& palette, const FolderOptions& opt, BatchOutput& out,
+// Runs `scene` on `backend` (made for `cat`) and writes its folder to `dir` all or nothing.
+// `out` keeps the backend's outputs (metal zones etc.) for the caller.
+OneScenarioTimes write_one_scenario(const std::string& dir, const Catalogue& cat, Backend& backend,
+                                    const Scenario& scene, const Plan& plan, const Palette& palette,
+                                    const FolderOptions& opt, BatchOutput& out,
                                     const StageFieldsRequest* stages = nullptr);
 
 }  // namespace portalsim

@@ -47,8 +47,9 @@ Request parse_request(const Catalogue& cat, std::string_view body) {
   r.in.threat = field<std::string>(j, "threat", "");
   r.seed = field<std::string>(j, "seed", "0");
   r.tier = field<std::string>(j, "tier", "standard");
-  if (r.in.objects.size() > static_cast<size_t>(kRegions))
-    throw InputError("objects: " + std::to_string(r.in.objects.size()) + " given, at most 13 regions");
+  if (r.in.objects.size() > cat.regions.size())
+    throw InputError("objects: " + std::to_string(r.in.objects.size()) + " given, at most " +
+                     std::to_string(cat.regions.size()) + " regions");
   r.plan.model.seed = io::parse_u64(r.seed, "--seed");
   // The command line's own check (CLI11's IsMember) and its words.
   if (r.tier != "fast" && r.tier != "standard" && r.tier != "exact")

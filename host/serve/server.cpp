@@ -116,8 +116,8 @@ struct Server::Impl {
   std::vector<int> run(const Request& r, const Scenario& scene, const std::string& dir) {
     BatchOutput out;
     std::lock_guard<std::mutex> lock(backend_mutex);
-    write_one_scenario(dir, backend, scene, r.plan, procedural::ir_palette(r.plan.palette), FolderOptions{}, out);
-    return std::vector<int>(out.metal_of(0), out.metal_of(0) + kZones);
+    write_one_scenario(dir, cat, backend, scene, r.plan, procedural::ir_palette(r.plan.palette), FolderOptions{}, out);
+    return std::vector<int>(out.metal_of(0), out.metal_of(0) + cat.zones);
   }
 
   json render(const std::string& body) {
@@ -165,13 +165,13 @@ struct Server::Impl {
     json res;
     res["metal"] = run(r, scene, dir.string());
     std::string line = std::to_string(scene.subject + 1);
-    for (int i = 0; i < kRegions; ++i)
+    for (int i = 0; i < cat.region_count(); ++i)
       line.append(",").append(scene.objects[i] == kNoObject ? std::string("none") : cat.variant_name(scene.objects[i]));
     line += scene.label == 1 ? ",yes\n" : ",no\n";
     std::string text = fs::exists(csv) ? read_file(csv) : std::string();
     if (text.empty()) {
       text = "subject";
-      for (int i = 1; i <= kRegions; ++i) text += ",region" + std::to_string(i);
+      for (int i = 1; i <= cat.region_count(); ++i) text += ",region" + std::to_string(i);
       text += ",label\n";
     }
     write_text_atomic(csv.string(), text + line);
@@ -403,6 +403,14 @@ struct Server::Impl {
                               {"size", {view.width, view.height}},
                               {"rect", {rc.x, rc.y, rc.w, rc.h}},
                               {"places", places}});
+    }
+    // The metal detector's zones and the panel each transmits from ([metal.physics]
+    // tx_panel; null without it), which the page's two columns of bars follow.
+    j["zones"] = json::array();
+    for (int z = 0; z < c.zones; ++z) {
+      json panel = nullptr;
+      if (c.metal_physics.present) panel = c.metal_physics.tx_side[z] < 0 ? "a" : "b";
+      j["zones"].push_back({{"id", z + 1}, {"panel", panel}});
     }
     j["objects"] = json::array();
     for (size_t v = 0; v < c.variant_list.size(); ++v) j["objects"].push_back(c.variant_name(static_cast<int>(v)));

@@ -34,7 +34,7 @@ void append_feature_row(std::string& out, const BatchOutput& b, size_t i, bool t
     out.push_back(',');
   }
   const uint8_t* m = b.metal_of(i);
-  for (int z = 0; z < kZones; ++z) {
+  for (int z = 0; z < b.layout.zones; ++z) {
     out += std::to_string(m[z]);
     out.push_back(',');
   }

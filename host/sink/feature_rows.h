@@ -1,4 +1,4 @@
-// Feature rows as text: the block and region means, the 19 metal zones and the class,
+// Feature rows as text: the block and region means, the metal zones and the class,
 // formatted the same way by every table sink (CSV, ARFF) and by `simulate`.
 #pragma once
 #include <string>

@@ -79,15 +79,16 @@ bool read_scenario_folder(const std::string& dir, const Catalogue& cat, BatchOut
   }
   pool_images(cat, f, views, out.features.data() + i * f.image_features());
   const fs::path metal = d / "metal.txt";
-  const std::array<uint8_t, kZones> zones =
-      parse_metal_text(io::read_file(metal.string(), "metal file", io::kMaxTextBytes), metal.string());
-  std::copy(zones.begin(), zones.end(), out.metal.begin() + static_cast<std::ptrdiff_t>(i * kZones));
+  const std::vector<uint8_t> zones =
+      parse_metal_text(io::read_file(metal.string(), "metal file", io::kMaxTextBytes), metal.string(), cat.zones);
+  std::copy(zones.begin(), zones.end(), out.metal.begin() + static_cast<std::ptrdiff_t>(i * zones.size()));
   const fs::path threat = d / "threat.txt";
   return parse_threat_text(io::read_file(threat.string(), "label file", io::kMaxTextBytes), threat.string());
 }
 
-std::array<uint8_t, kZones> parse_metal_text(std::string_view text, const std::string& source) {
-  // 19 integers 0..200, separated by commas and/or spaces.
+std::vector<uint8_t> parse_metal_text(std::string_view text, const std::string& source, int count) {
+  // `count` integers 0..200, separated by commas and/or spaces.
+  const size_t Z = static_cast<size_t>(count);
   const std::string line = one_line(text, source);
   std::vector<int> zones;
   std::string cur;
@@ -100,18 +101,16 @@ std::array<uint8_t, kZones> parse_metal_text(std::string_view text, const std::s
       zones.push_back(std::stoi(cur));
       if (zones.back() > 200)
         throw InputError(source + ":1: zone " + std::to_string(zones.size()) + ": " + cur + " is above 200");
-      if (zones.size() > kZones) break;
+      if (zones.size() > Z) break;
       cur.clear();
     } else {
       cur.push_back(c);
     }
   }
-  if (zones.size() != kZones)
-    throw InputError(source + ":1: expected 19 zone values, found " +
-                     (zones.size() > kZones ? "more" : std::to_string(zones.size())));
-  std::array<uint8_t, kZones> out;
-  for (int z = 0; z < kZones; ++z) out[z] = static_cast<uint8_t>(zones[z]);
-  return out;
+  if (zones.size() != Z)
+    throw InputError(source + ":1: expected " + std::to_string(Z) + " zone values, found " +
+                     (zones.size() > Z ? "more" : std::to_string(zones.size())));
+  return std::vector<uint8_t>(zones.begin(), zones.end());
 }
 
 bool parse_threat_text(std::string_view text, const std::string& source) {

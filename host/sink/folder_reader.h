@@ -20,8 +20,9 @@ std::vector<std::string> find_scenario_folders(const std::vector<std::string>& p
 // Images of another size are rejected. Throws InputError naming the file and line.
 bool read_scenario_folder(const std::string& dir, const Catalogue& cat, BatchOutput& out, size_t i);
 
-// metal.txt's text: one line of 19 zone values 0..200. `source` names it in errors.
-std::array<uint8_t, kZones> parse_metal_text(std::string_view text, const std::string& source);
+// metal.txt's text: one line of `zones` zone values 0..200 (the catalogue's zones). `source`
+// names it in errors.
+std::vector<uint8_t> parse_metal_text(std::string_view text, const std::string& source, int zones);
 // threat.txt's text: yes or no (also positive/negative, threat, 1/0).
 bool parse_threat_text(std::string_view text, const std::string& source);
 

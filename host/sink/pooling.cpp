@@ -33,7 +33,7 @@ void pool_images(const Catalogue& cat, const FeatureLayout& lay, const std::vect
             rect_mean(images[slot], x0, y0, std::min(x0 + lay.block, s.width), std::min(y0 + lay.block, s.height));
       }
   }
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < lay.regions; ++r) {
     float mean = 0;
     for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
       const Sensor& s = cat.sensors[lay.pooled[slot]];

@@ -47,7 +47,7 @@ void write_scenario_folder(const PathOf& path_of, const BatchOutput& b, size_t i
   }
   if (!b.metal.empty()) {
     std::string m;
-    for (int z = 0; z < kZones; ++z) {
+    for (int z = 0; z < b.layout.zones; ++z) {
       if (z) m.push_back(',');
       m += std::to_string(b.metal_of(i)[z]);
     }

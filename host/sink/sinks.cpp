@@ -87,10 +87,11 @@ class NpySink final : public Sink {
       const std::span<char> room = file_.room();
       char* row = room.size() >= row_bytes ? room.data() : reinterpret_cast<char*>(buf_.data());
       std::memcpy(row, out.features_of(i), F * sizeof(float));
-      std::array<float, kZones + 1> tail;  // the metal zones, then the class
-      for (int z = 0; z < kZones; ++z) tail[z] = out.metal_of(i)[z];
-      tail[kZones] = scenes.label[i] == 1 ? 1.0f : 0.0f;
-      std::memcpy(row + F * sizeof(float), tail.data(), sizeof tail);
+      const int Z = out.layout.zones;
+      std::array<float, kMaxZones + 1> tail;  // the metal zones, then the class
+      for (int z = 0; z < Z; ++z) tail[z] = out.metal_of(i)[z];
+      tail[Z] = scenes.label[i] == 1 ? 1.0f : 0.0f;
+      std::memcpy(row + F * sizeof(float), tail.data(), (Z + 1) * sizeof(float));
       if (row == room.data())
         file_.commit(row_bytes);
       else
@@ -113,10 +114,11 @@ class ScenarioListSink final : public Sink {
       : ctx_(ctx), file_(ctx.dir, "scenarios.csv", resume) {
     if (!resume) {
       std::string h = "index,subject";
-      for (int r = 1; r <= kRegions; ++r) h += ",region" + std::to_string(r);
+      const int R = ctx.cat->region_count();
+      for (int r = 1; r <= R; ++r) h += ",region" + std::to_string(r);
       if (ctx.model.transforms())
         for (const char* what : {",rotation", ",scale", ",flip"})
-          for (int r = 1; r <= kRegions; ++r) h += what + std::to_string(r);
+          for (int r = 1; r <= R; ++r) h += what + std::to_string(r);
       file_.append(h + ",label\n");
     }
     for (size_t v = 0; v < ctx.cat->variant_list.size(); ++v)
@@ -124,27 +126,27 @@ class ScenarioListSink final : public Sink {
   }
   void write(const SceneBatch& scenes, const BatchOutput&) override {
     std::string s;
+    const int R = scenes.regions;
     s.reserve(scenes.size() * 96);
     for (size_t i = 0; i < scenes.size(); ++i) {
       s += std::to_string(scenes.first_index + i);
       s += ',';
       s += std::to_string(scenes.subject[i] + 1);
-      for (int r = 0; r < kRegions; ++r) {
+      for (int r = 0; r < R; ++r) {
         s += ',';
-        const int16_t v = scenes.objects[i * kRegions + r];
+        const int16_t v = scenes.objects[i * R + r];
         s += v == kNoObject ? std::string("none") : names_[v];
       }
       if (ctx_.model.transforms()) {
         // Each object's draw (plan.h, object_transform), exactly: the shortest text that
         // reads back as the same double. Empty where a region has no object.
-        std::array<ObjectTransform, kRegions> t;
-        for (int r = 0; r < kRegions; ++r)
-          if (scenes.objects[i * kRegions + r] != kNoObject)
-            t[r] = object_transform(ctx_.model, scenes.first_index + i, r);
+        std::array<ObjectTransform, kMaxRegions> t;
+        for (int r = 0; r < R; ++r)
+          if (scenes.objects[i * R + r] != kNoObject) t[r] = object_transform(ctx_.model, scenes.first_index + i, r);
         for (int what = 0; what < 3; ++what)
-          for (int r = 0; r < kRegions; ++r) {
+          for (int r = 0; r < R; ++r) {
             s += ',';
-            if (scenes.objects[i * kRegions + r] == kNoObject) continue;
+            if (scenes.objects[i * R + r] == kNoObject) continue;
             if (what == 2) {
               s += t[r].flip ? '1' : '0';
               continue;

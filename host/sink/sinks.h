@@ -1,7 +1,7 @@
 // Data-set sinks: each takes batches in index order and appends them to its outputs.
 //   features.arff  WEKA's format (thesis 5.3, appendix D.4)
 //   features.csv   the same rows with a header
-//   features.npy   float32 matrix (features, 19 zones, class 1/0), names in features.columns.txt
+//   features.npy   float32 matrix (features, the metal zones, class 1/0), names in features.columns.txt
 //   scenarios.csv  index, subject, region1..region13, label: re-runnable with --scenarios;
 //                  with randomised objects also rotation1..13, scale1..13, flip1..13
 //   images/<index>/ the folder `simulate` writes, per scenario

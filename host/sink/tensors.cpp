@@ -60,23 +60,25 @@ struct Tensor {
 // Rows of an int16 per-region tensor: `f` of each region's variant.
 template <class F>
 std::string_view per_region(const SceneBatch& b, size_t lo, size_t hi, char* dst, F f) {
-  for (size_t i = lo * kRegions; i < hi * kRegions; ++i) {
+  const size_t R = static_cast<size_t>(b.regions);
+  for (size_t i = lo * R; i < hi * R; ++i) {
     const int16_t v = f(b.objects[i]);
-    std::memcpy(dst + (i - lo * kRegions) * sizeof(int16_t), &v, sizeof v);
+    std::memcpy(dst + (i - lo * R) * sizeof(int16_t), &v, sizeof v);
   }
-  return {dst, (hi - lo) * kRegions * sizeof(int16_t)};
+  return {dst, (hi - lo) * R * sizeof(int16_t)};
 }
 
 // Scenario i's region r: `of(object_transform(...))`, or `none` where the region is empty.
 template <class T, class F>
 std::string_view per_transform(const ModelSettings& model, const SceneBatch& b, size_t lo, size_t hi, char* dst, T none,
                                F of) {
+  const int R = b.regions;
   for (size_t i = lo; i < hi; ++i)
-    for (int r = 0; r < kRegions; ++r) {
-      const T v = b.objects[i * kRegions + r] == kNoObject ? none : of(object_transform(model, b.first_index + i, r));
-      std::memcpy(dst + ((i - lo) * kRegions + r) * sizeof(T), &v, sizeof v);
+    for (int r = 0; r < R; ++r) {
+      const T v = b.objects[i * R + r] == kNoObject ? none : of(object_transform(model, b.first_index + i, r));
+      std::memcpy(dst + ((i - lo) * R + r) * sizeof(T), &v, sizeof v);
     }
-  return {dst, (hi - lo) * kRegions * sizeof(T)};
+  return {dst, (hi - lo) * R * sizeof(T)};
 }
 
 }  // namespace
@@ -150,10 +152,11 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
         },
         true);
   if (opt.scenario) {
+    const uint64_t regions = static_cast<uint64_t>(ctx.cat->region_count());
     add(
-        "metal", TensorType::u8, {kZones},
+        "metal", TensorType::u8, {static_cast<uint64_t>(ctx.cat->zones)},
         [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, char*) {
-          return rows_of(o.metal, kZones, lo, hi);
+          return rows_of(o.metal, static_cast<size_t>(o.layout.zones), lo, hi);
         },
         true);
     add(
@@ -166,47 +169,48 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
       for (size_t i = lo; i < hi; ++i) dst[i - lo] = static_cast<char>(b.subject[i] + 1);
       return std::string_view(dst, hi - lo);
     });
-    add("region_object", TensorType::i16, {kRegions},
+    add("region_object", TensorType::i16, {regions},
         [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
           return per_region(b, lo, hi, dst, [&](int16_t v) {
             return v == kNoObject ? int16_t(-1) : int16_t(cat->variant_list[v].object);
           });
         });
-    add("region_orientation", TensorType::i16, {kRegions},
+    add("region_orientation", TensorType::i16, {regions},
         [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
           return per_region(b, lo, hi, dst, [&](int16_t v) {
             return v == kNoObject ? int16_t(-1) : int16_t(cat->variant_list[v].variant);
           });
         });
-    add("region_label", TensorType::u8, {kRegions},
+    add("region_label", TensorType::u8, {regions},
         [rule](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
-          const std::string_view rows(dst, (hi - lo) * kRegions);
+          const int R = b.regions;
+          const std::string_view rows(dst, (hi - lo) * R);
           std::memset(dst, 0, rows.size());
           if (!rule) return rows;
           for (size_t i = lo; i < hi; ++i)
-            for (int r = 0; r < kRegions; ++r) {
-              const int16_t v = b.objects[i * kRegions + r];
+            for (int r = 0; r < R; ++r) {
+              const int16_t v = b.objects[i * R + r];
               if (v == kNoObject) continue;
               Scenario alone;
               alone.subject = b.subject[i];
               alone.objects[r] = v;
-              dst[(i - lo) * kRegions + r] = (*rule)(alone) ? 1 : 0;
+              dst[(i - lo) * R + r] = (*rule)(alone) ? 1 : 0;
             }
           return rows;
         });
     if (ctx.model.transforms()) {
       // Each object's randomised draw (plan.h, object_transform), the numbers scenarios.csv
       // records: float64 so they are the same doubles; identity where a region is empty.
-      add("region_rotation", TensorType::f64, {kRegions},
+      add("region_rotation", TensorType::f64, {regions},
           [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
             return per_transform<double>(model, b, lo, hi, dst, 0.0,
                                          [](const ObjectTransform& x) { return x.rotation; });
           });
-      add("region_scale", TensorType::f64, {kRegions},
+      add("region_scale", TensorType::f64, {regions},
           [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
             return per_transform<double>(model, b, lo, hi, dst, 1.0, [](const ObjectTransform& x) { return x.scale; });
           });
-      add("region_flip", TensorType::u8, {kRegions},
+      add("region_flip", TensorType::u8, {regions},
           [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
             return per_transform<uint8_t>(model, b, lo, hi, dst, 0,
                                           [](const ObjectTransform& x) { return uint8_t(x.flip); });

@@ -119,11 +119,12 @@ class Generator:
 
 
 def simulate(objects, **keywords):
-    """One scenario, as `portalsim simulate OBJECTS...` makes it: objects for regions 1..13
-    ("none" for an empty region, "gun:v" a drawing), and simulate's flags as keywords
-    (subject, rule, threat, seed, tier, model and every knob). Returns a dict of NumPy arrays
-    without the scenario axis: upper, lower (gray), ir (RGB), ir_index, features, metal
-    (19 zones), label, subject and region_*."""
+    """One scenario, as `portalsim simulate OBJECTS...` makes it: objects for the catalogue's
+    regions in order (1..13 in the built-in one; "none" for an empty region, "gun:v" a
+    drawing), and simulate's flags as keywords (subject, rule, threat, seed, tier, model,
+    catalogue and every knob). Returns a dict of NumPy arrays without the scenario axis: one
+    per camera view (upper, lower gray; ir RGB, ir_index), features, metal (the catalogue's
+    zones, 19 in the built-in one), label, subject and region_*."""
     if isinstance(objects, str):
         objects = objects.split()
     return _core.simulate([str(o) for o in objects] + _flags("simulate", keywords))

@@ -24,9 +24,9 @@ writes.
 
 In both, `views` picks the image datasets stacked as channels (views of one size: upper and
 lower are 200x200; ir is 200x100x3 and comes alone, channels first). `target` is "label" (one
-class per scenario), "region_label" (13 per-region threat labels, float32) or "mask" (the
-instance masks of the chosen views, int64 (V, H, W): each pixel the region 1-13 whose object
-covers it, 0 none; an H5Dataset needs a set made with --annotations). For detection,
+class per scenario), "region_label" (a threat label per region of the catalogue, 13 in the
+built-in one, float32) or "mask" (the instance masks of the chosen views, int64 (V, H, W):
+each pixel the region 1..R whose object covers it, 0 none; an H5Dataset needs a set made with --annotations). For detection,
 `H5Dataset.boxes()` gives an item's boxes from its masks. With randomised objects (--rotate,
 --scale, --flip), `H5Dataset.transforms(i)` gives item i's per-region rotation, scale and flip,
 as scenarios.csv records them (`has_transforms` says whether the file has them). The file is
@@ -70,11 +70,11 @@ class H5Dataset(Dataset):
             with h5py.File(self.path, "r") as f:
                 self._cache = {k: f[k][:][self.indices] for k in (*self.views, *self._targets)}
 
-    # transforms() keys and the datasets they come from (each N x 13).
+    # transforms() keys and the datasets they come from (each N x the regions).
     TRANSFORMS = {"rotation": "region_rotation", "scale": "region_scale", "flip": "region_flip"}
 
     def transforms(self, i):
-        """Item i's randomised-object transforms, one value per region (13): "rotation"
+        """Item i's randomised-object transforms, one value per region: "rotation"
         (float64 degrees, counter-clockwise in the image), "scale" (float64 factor), "flip"
         (uint8, 1 = mirrored left to right), and "object" (int16, -1 where the region is
         empty, which has rotation 0, scale 1, flip 0)."""

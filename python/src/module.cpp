@@ -34,7 +34,7 @@ double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::d
 // One batch: the backend's outputs and the rows made from them. NumPy arrays hold it
 // through capsules; the last one freed hands it back to its generator's pool.
 struct Rows {
-  SceneBatch scenes;
+  SceneBatch scenes{0};  // filled by ScenarioSource::fill, or with the catalogue's stride below
   BatchOutput out;
   std::vector<std::unique_ptr<char[]>> made;  // per column: the rows made here (not views)
   std::vector<size_t> made_bytes;
@@ -387,8 +387,9 @@ py::dict simulate(const std::vector<std::string>& args) {
     plan.features = plan.metal = true;
     auto r = std::make_shared<Rows>();
     r->scenes.first_index = 0;
+    r->scenes.regions = s.catalogue.region_count();
     r->scenes.subject = {static_cast<uint8_t>(req.scene.subject)};
-    r->scenes.objects.assign(req.scene.objects.begin(), req.scene.objects.end());
+    r->scenes.objects.assign(req.scene.objects.begin(), req.scene.objects.begin() + r->scenes.regions);
     r->scenes.label = {static_cast<uint8_t>(req.scene.label)};
     s.backend->run(r->scenes, plan, r->out);
     const SinkContext ctx = plan_sink_context(plan, s.catalogue, s.assets, 1, "png");

@@ -43,7 +43,7 @@ void scenarios(std::string_view text) {
 void feature_table(std::string_view text) {
   bool parsed = false;
   try {
-    (void)parse_metal_text(text, "<fuzz>");
+    (void)parse_metal_text(text, "<fuzz>", 19);
     parsed = true;
   } catch (const InputError&) {
   }

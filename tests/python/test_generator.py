@@ -15,6 +15,9 @@ CASES = {
     "thesis-annotations": dict(what="images", annotations=True, objects="1..4", rotate=20, rule="gun"),
     "physics-annotations": dict(what="images", model="physics", annotations=True, objects="2..3"),
     "spec-file": dict(spec="scenarios/case1-gun.toml", what="both", seed=5),
+    # 20 regions, 33 zones, front and back MMW and IR views (tools/portal_catalogues.py).
+    "portal-20x33": dict(catalogue="tests/portals/portal-20x33.toml", what="images", annotations=True,
+                         model="physics", objects="4..10", rule="gun"),
 }
 
 
@@ -57,6 +60,18 @@ def test_batch_is_generate_rows(case, tmp_path, portalsim_bin, root, monkeypatch
             w = want[k][start:start + count]
             assert a.dtype == w.dtype and a.shape == w.shape, f"{case} {k}: {a.dtype} {a.shape}, file {w.dtype} {w.shape}"
             assert a.tobytes() == w.tobytes(), f"{case} {k}: rows {start}..{start + count} (batches of {step}) differ"
+
+
+def test_portal_counts_shape_the_batch(root):
+    """A catalogue of 20 regions and 33 zones gives its batch keys its own shapes: a zone
+    column each, a region column each, an image and a mask per camera view."""
+    gen = portalsim.Generator(catalogue=str(root / "tests/portals/portal-20x33.toml"), what="both",
+                              annotations=True, seed=3)
+    b = gen.batch(0, 5)
+    assert b["metal"].shape == (5, 33)
+    assert b["region_object"].shape == (5, 20) and b["region_label"].shape == (5, 20)
+    assert b["back_ir"].shape == (5, 200, 100, 3) and b["mask_back_ir"].shape == (5, 200, 100)
+    assert b["features"].shape == (5, 4 * 20 * 20 + 20)
 
 
 def test_arrays_own_the_buffers():

@@ -28,6 +28,7 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
     return off;
   };
   const size_t V = cat.variant_list.size(), views = cat.sensors.size();
+  const int R = cat.region_count();
   std::vector<cl_int> base_offsets;
   for (const auto& subject_views : assets.bases)
     for (const Image& img : subject_views) base_offsets.push_back(add(img));
@@ -62,19 +63,18 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
   // view, how far each region's place moves with the subject's height (Sensor::place),
   // which place_view adds.
   const size_t S = cat.subjects.size();
-  std::vector<cl_int2> place_records((views * V + S * views) * kRegions);
+  std::vector<cl_int2> place_records((views * V + S * views) * R);
   for (size_t k = 0; k < views; ++k) {
     const Sensor& s = cat.sensors[k];
     for (size_t v = 0; v < V; ++v) {
       const Image& sp = assets.sprite(s, static_cast<int>(v));
-      for (int r = 0; r < kRegions; ++r) {
+      for (int r = 0; r < R; ++r) {
         const Rect box = sprite_box(s.rects[r], sp);
-        place_records[(k * V + v) * kRegions + r] = {{box.x, box.y}};
+        place_records[(k * V + v) * R + r] = {{box.x, box.y}};
       }
     }
     for (size_t j = 0; j < S; ++j)
-      for (int r = 0; r < kRegions; ++r)
-        place_records[(views * V + j * views + k) * kRegions + r] = {{0, s.subject_dy[j][r]}};
+      for (int r = 0; r < R; ++r) place_records[(views * V + j * views + k) * R + r] = {{0, s.subject_dy[j][r]}};
   }
   std::vector<cl_int> tile_offsets;
   std::vector<cl_float> tile_gains;
@@ -87,9 +87,9 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
 
   // Pooled views: each region's rectangle in the pooled view that sees it.
   const FeatureLayout lay = FeatureLayout::of(cat, 1);
-  std::vector<cl_int> pooled_views(lay.pooled.begin(), lay.pooled.end()), slots(kRegions, 0);
-  std::vector<cl_int4> rects(kRegions);
-  for (int r = 0; r < kRegions; ++r)
+  std::vector<cl_int> pooled_views(lay.pooled.begin(), lay.pooled.end()), slots(R, 0);
+  std::vector<cl_int4> rects(R);
+  for (int r = 0; r < R; ++r)
     for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
       const Sensor& s = cat.sensors[lay.pooled[slot]];
       if (!s.sees(r)) continue;
@@ -99,7 +99,7 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
     }
   std::vector<cl_int4> all_view_rects;
   for (const Sensor& s : cat.sensors)
-    for (const Rect& rc : s.rects) all_view_rects.push_back(rect4(rc));
+    for (int r = 0; r < R; ++r) all_view_rects.push_back(rect4(s.rects[r]));
 
   std::vector<uint8_t> influence_bytes, category_bytes, base_zone_bytes;
   for (const auto& table : cat.influence)
@@ -120,8 +120,8 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
   region_slot = constant(ctx, slots);
   region_rects = constant(ctx, rects);
   for (size_t k = 0; k < views; ++k)
-    view_rects.push_back(constant(
-        ctx, std::vector<cl_int4>(all_view_rects.begin() + k * kRegions, all_view_rects.begin() + (k + 1) * kRegions)));
+    view_rects.push_back(
+        constant(ctx, std::vector<cl_int4>(all_view_rects.begin() + k * R, all_view_rects.begin() + (k + 1) * R)));
   influence = constant(ctx, influence_bytes);
   categories = constant(ctx, category_bytes);
   base_zones = constant(ctx, base_zone_bytes);

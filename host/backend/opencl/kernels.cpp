@@ -2,17 +2,17 @@
 
 namespace portalsim::opencl {
 
-std::string build_options(const Fidelity& f) {
+std::string build_options(const Fidelity& f, KernelCounts counts) {
   std::string o = f.precision == Precision::fp64      ? "-DPRECISION_FP64"
                   : f.precision == Precision::fixed16 ? "-DPRECISION_FIXED"
                                                       : "";
   if (f.fast_math) o += " -cl-fast-relaxed-math";
   if (f.draw == NoiseDraw::irwin_hall) o += " -DNOISE_DRAW_IH";
-  return o;
+  return o + " -DPS_REGIONS=" + std::to_string(counts.regions) + " -DPS_ZONES=" + std::to_string(counts.zones);
 }
 
-Kernels::Kernels(OpenCLRuntime& rt, const Fidelity& f)
-    : program_(rt.program(build_options(f))), fp64_(f.precision == Precision::fp64) {}
+Kernels::Kernels(OpenCLRuntime& rt, const Fidelity& f, KernelCounts counts)
+    : program_(rt.program(build_options(f, counts))), fp64_(f.precision == Precision::fp64) {}
 
 cl::Kernel& Kernels::operator[](std::string_view name) {
   auto it = kernels_.find(name);
@@ -24,8 +24,8 @@ cl::Kernel& Kernels::operator[](std::string_view name) {
 }
 
 Kernels& KernelVariants::operator()(const Fidelity& f) {
-  std::unique_ptr<Kernels>& k = variants_[build_options(f)];
-  if (!k) k = std::make_unique<Kernels>(rt_, f);
+  std::unique_ptr<Kernels>& k = variants_[build_options(f, counts_)];
+  if (!k) k = std::make_unique<Kernels>(rt_, f, counts_);
   return *k;
 }
 

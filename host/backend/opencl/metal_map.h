@@ -21,7 +21,7 @@ struct MetalResponses {
 
 // `objects`: records of PS_MV_LEN doubles (tensor, long side x, z, y); `probes`: records of
 // PS_MP_LEN doubles (centre x, y, z, object record). Throws EnvironmentError without fp64.
-MetalResponses metal_responses(OpenCLRuntime& rt, const MetalPhysics& mp, const std::vector<double>& objects,
+MetalResponses metal_responses(OpenCLRuntime& rt, const Catalogue& cat, const std::vector<double>& objects,
                                const std::vector<double>& probes);
 
 }  // namespace portalsim::opencl

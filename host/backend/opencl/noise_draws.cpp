@@ -7,9 +7,9 @@
 
 namespace portalsim::opencl {
 
-std::vector<double> noise_draws(OpenCLRuntime& rt, const Fidelity& f, Model model, uint64_t seed, uint64_t first,
-                                size_t scenarios, int cells) {
-  Kernels K(rt, f);
+std::vector<double> noise_draws(OpenCLRuntime& rt, const Fidelity& f, KernelCounts counts, Model model, uint64_t seed,
+                                uint64_t first, size_t scenarios, int cells) {
+  Kernels K(rt, f, counts);
   const size_t n = scenarios * static_cast<size_t>(cells);
   cl::Buffer out(rt.context(), CL_MEM_WRITE_ONLY, n * sizeof(float));
   cl::Kernel& k = K["noise_draws"];

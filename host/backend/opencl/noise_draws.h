@@ -6,13 +6,13 @@
 #include <cstdint>
 #include <vector>
 
-#include "backend/opencl/runtime.h"
-#include "plan/plan.h"
+#include "backend/opencl/kernels.h"
 
 namespace portalsim::opencl {
 
-// Pixels [0, cells) of view 0 of scenarios first .. first + scenarios - 1, scenario by scenario.
-std::vector<double> noise_draws(OpenCLRuntime& rt, const Fidelity& f, Model model, uint64_t seed, uint64_t first,
-                                size_t scenarios, int cells);
+// Pixels [0, cells) of view 0 of scenarios first .. first + scenarios - 1, scenario by
+// scenario; `counts` are the catalogue's (the program is the one its backend builds).
+std::vector<double> noise_draws(OpenCLRuntime& rt, const Fidelity& f, KernelCounts counts, Model model, uint64_t seed,
+                                uint64_t first, size_t scenarios, int cells);
 
 }  // namespace portalsim::opencl

@@ -16,7 +16,12 @@ using namespace opencl;
 class OpenCLBackend final : public Backend {
  public:
   OpenCLBackend(const Catalogue& cat, const AssetSet& assets, std::shared_ptr<OpenCLRuntime> rt)
-      : cat_(cat), assets_(assets), rt_(std::move(rt)), device_(cat, assets, *rt_), kernels_(*rt_), metal_(device_) {
+      : cat_(cat),
+        assets_(assets),
+        rt_(std::move(rt)),
+        device_(cat, assets, *rt_),
+        kernels_(*rt_, KernelCounts::of(cat)),
+        metal_(device_) {
     for (const Sensor& s : cat.sensors) check_chain(s);
     features_paths_.push_back(thesis_sparse_features_path(device_));
     features_paths_.push_back(physics_raw_features_path(device_));
@@ -37,11 +42,11 @@ class OpenCLBackend final : public Backend {
     Kernels& K = kernels_(plan.fidelity);
     DeviceBatch b{.n = n,
                   .subject = subject_.at_least(ctx, n),
-                  .objects = objects_.at_least(ctx, n * kRegions * sizeof(int16_t)),
+                  .objects = objects_.at_least(ctx, n * cat_.regions.size() * sizeof(int16_t)),
                   .seed = split(plan.model.seed),
                   .first = split(batch.first_index)};
     q.enqueueWriteBuffer(b.subject, CL_FALSE, 0, n, batch.subject.data());
-    q.enqueueWriteBuffer(b.objects, CL_FALSE, 0, n * kRegions * sizeof(int16_t), batch.objects.data());
+    q.enqueueWriteBuffer(b.objects, CL_FALSE, 0, n * cat_.regions.size() * sizeof(int16_t), batch.objects.data());
 
     // Features are written straight into the caller's rows, as kept images are.
     const Route r = route(plan, lay);

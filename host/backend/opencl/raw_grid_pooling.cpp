@@ -130,7 +130,7 @@ RawGridNoise raw_grid_noise(const Sensor& s, const FeatureLayout& lay, int raw_w
   // Regions: qx, qy their mean weights; cov(r, block) = (qy . sy[by]) (qx . sx[bx]), so
   // B's row is (Ly^-1 cy) (x) (Lx^-1 cx).
   std::vector<std::vector<double>> qx, qy, bx_of, by_of;
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < kMaxRegions; ++r) {
     if (!s.sees(r)) continue;
     const Rect& rc = s.rects[r];
     std::vector<double> ax = span(wx, rc.x, rc.x + rc.w), ay = span(wy, rc.y, rc.y + rc.h);
@@ -181,7 +181,7 @@ RawGridPooling raw_grid_pooling(const Sensor& s, const FeatureLayout& lay, int s
       add(x0, y0, std::min(x0 + lay.block, s.width), std::min(y0 + lay.block, s.height),
           g.offset + by * g.blocks_x + bx);
     }
-  for (int r = 0; r < kRegions; ++r)
+  for (int r = 0; r < lay.regions; ++r)
     if (s.sees(r)) {
       const Rect& rc = s.rects[r];
       add(rc.x, rc.y, rc.x + rc.w, rc.y + rc.h, lay.block_features() + r);

@@ -159,15 +159,6 @@ OpenCLRuntime::OpenCLRuntime(const OpenCLOptions& options) {
   }
   context_ = cl::Context(device_);
   queue_ = cl::CommandQueue(context_, device_);
-  program_ = cl::Program(context_, source());
-  const auto t0 = std::chrono::steady_clock::now();
-  try {
-    program_.build({device_}, ("-cl-std=CL1.2 " + options.build_options).c_str());
-  } catch (const cl::Error&) {
-    build_failed(program_, "");
-  }
-  build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  variants_[""] = program_;
   base_options_ = options.build_options;
 }
 
@@ -192,11 +183,13 @@ cl::Program& OpenCLRuntime::program(const std::string& options) {
   if (options.find("PRECISION_FP64") != std::string::npos && !has_fp64())
     throw EnvironmentError("the exact tier needs fp64, and " + device_name_ + " has no cl_khr_fp64");
   cl::Program p(context_, source());
+  const auto t0 = std::chrono::steady_clock::now();
   try {
     p.build({device_}, ("-cl-std=CL1.2 " + base_options_ + " " + options).c_str());
   } catch (const cl::Error&) {
     build_failed(p, options);
   }
+  build_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return variants_.emplace(options, p).first->second;
 }
 

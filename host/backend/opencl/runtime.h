@@ -1,4 +1,4 @@
-// The OpenCL runtime: one device, context, queue and the built portalsim program.
+// The OpenCL runtime: one device, context and queue, and the portalsim program built per set of options.
 #pragma once
 #include <CL/opencl.hpp>
 #include <map>
@@ -33,14 +33,13 @@ class OpenCLRuntime {
   explicit OpenCLRuntime(const OpenCLOptions& options = {});
   cl::Context& context() { return context_; }
   cl::CommandQueue& queue() { return queue_; }
-  cl::Program& program() { return program_; }
-  // The program built with extra options (e.g. "-DPRECISION_FP64 -cl-fast-relaxed-math"),
-  // built once and kept.
+  // The program built with extra options (backend/opencl/kernels.h: build_options; the
+  // catalogue's counts among them), built on first use and kept.
   cl::Program& program(const std::string& options);
   const std::string& device_name() const { return device_name_; }
   bool has_fp64() const;  // the device offers cl_khr_fp64
   OpenCLDeviceInfo info() const;
-  double build_seconds() const { return build_seconds_; }
+  double build_seconds() const { return build_seconds_; }  // every program built so far
   // kernels/shared.h and the kernels/ files, in CMakeLists.txt's order; or the file
   // PORTALSIM_KERNEL_PROGRAM names (tools/mutate.sh). Throws EnvironmentError where that
   // cannot be read.
@@ -52,7 +51,6 @@ class OpenCLRuntime {
   cl::Context context_;
   cl::Device device_;
   cl::CommandQueue queue_;
-  cl::Program program_;
   std::map<std::string, cl::Program> variants_;
   std::string device_name_, base_options_;
   double build_seconds_ = 0;

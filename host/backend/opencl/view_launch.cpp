@@ -58,7 +58,9 @@ ViewLaunch::ViewLaunch(Device& d, Kernels& K, const Plan& p, int view, const Dev
   const DeviceCatalogue& c = d.data;
   PsViewLaunch L = settings(d.cat, p, view, b, tabulated);
   cl::Buffer field = uses_field ? d.field.at_least(ctx, n * s.pixels() * K.real_bytes()) : out;
-  cl::Buffer& records = d.records.at_least(ctx, n * PS_REC_LEN * sizeof(cl_int));
+  // A record per scenario (kernels/contract.h, PS_REC_LEN): a layer per region at most.
+  const size_t rec_len = PS_REC_LAYERS + d.cat.regions.size() * PS_LAYER_LEN;
+  cl::Buffer& records = d.records.at_least(ctx, n * rec_len * sizeof(cl_int));
   cl::Buffer phys = d.physics(K.fp64(), p, view, L);
   const bool physics = p.model.model == Model::physics;
   const ModelSettings& m = p.model;

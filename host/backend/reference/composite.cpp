@@ -10,7 +10,7 @@ ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSe
                      uint64_t index) {
   const Sensor& sensor = cat.sensors[view];
   ViewScene vs{cat, assets, m, sensor, view, s, index, {}};
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < cat.region_count(); ++r) {
     const int16_t v = s.objects[r];
     if (v == kNoObject || !sensor.sees(r)) continue;
     const Image& sp = assets.sprite(sensor, v);

@@ -6,9 +6,9 @@
 namespace portalsim::reference {
 
 void metal(const Catalogue& cat, const ModelSettings& m, const Scenario& s, uint64_t index, uint8_t* zones) {
-  for (int z = 0; z < kZones; ++z) {
+  for (int z = 0; z < cat.zones; ++z) {
     int sum = 0;
-    for (int r = 0; r < kRegions; ++r)
+    for (int r = 0; r < cat.region_count(); ++r)
       if (s.objects[r] != kNoObject) sum += cat.influence[cat.object_of(s.objects[r]).metal][r][z];
     int value = cat.subjects[s.subject].base_zones[z] - sum;
     if (m.metal_noise > 0 && sum > 0) {

@@ -45,7 +45,7 @@ std::vector<MetalObject> metal_objects(const Catalogue& cat, const AssetSet& ass
   // Each region's object where the first view that sees it places it, with that view's
   // composite's jitter, in the portal's field; in region order.
   std::vector<std::optional<ViewScene>> scenes(cat.sensors.size());
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < cat.region_count(); ++r) {
     const int k = first_view(cat.sensors, r);
     if (s.objects[r] == kNoObject || k < 0) continue;
     const Sensor& sensor = cat.sensors[k];
@@ -65,7 +65,7 @@ std::vector<MetalObject> metal_objects(const Catalogue& cat, const AssetSet& ass
 }
 
 double zone_signal(const MetalPhysics& mp, int zone, const MetalObject& o) {
-  const double side = zone < PS_METAL_PANEL_A_ZONES ? -1.0 : 1.0;
+  const double side = mp.tx_side[zone];
   const Vec tx{side * mp.panel_separation / 2.0, 0.0, mp.tx_height[zone]};
   const Vec rx{-side * mp.panel_separation / 2.0, 0.0, mp.rx_height[zone]};
   const std::array<double, 9>& M = o.tensor;
@@ -88,7 +88,7 @@ void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSett
                    uint64_t index, uint8_t* zones) {
   const MetalPhysics& mp = cat.metal_physics;
   const std::vector<MetalObject> objects = metal_objects(cat, assets, m, s, index);
-  for (int z = 0; z < kZones; ++z) {
+  for (int z = 0; z < cat.zones; ++z) {
     double signal = 0;
     for (const MetalObject& o : objects) signal += zone_signal(mp, z, o);
     const int deduction = deduction_of(mp.gain[z] * std::fabs(signal));
@@ -102,8 +102,8 @@ void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSett
 }
 
 void metal_response(const MetalPhysics& mp, const MetalObject& o, double* response, uint8_t* deduction) {
-  for (int z = 0; z < kZones; ++z) {
-    response[z] = mp.gain[z] * std::fabs(zone_signal(mp, z, o));
+  for (size_t z = 0; z < mp.gain.size(); ++z) {
+    response[z] = mp.gain[z] * std::fabs(zone_signal(mp, static_cast<int>(z), o));
     deduction[z] = static_cast<uint8_t>(deduction_of(response[z]));
   }
 }

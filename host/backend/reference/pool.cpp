@@ -24,7 +24,7 @@ void pool(const Catalogue& cat, const std::vector<std::vector<uint8_t>>& views, 
       }
   }
   // Each region's mean, in the pooled view that sees it.
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < f.regions; ++r) {
     double mean = 0;
     for (int view : f.pooled) {
       const Sensor& s = cat.sensors[view];

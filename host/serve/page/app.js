@@ -182,11 +182,12 @@ async function init() {
     b.setAttribute("aria-label", "region " + r + " " + reg.name + ": none");
   }
   placeHits();
-  for (let z = 1; z <= 19; ++z) {
+  // The catalogue's zones, in the column of the panel each transmits from (A where unknown).
+  for (const { id, panel } of cat.zones) {
     const row = document.createElement("div");
-    row.className = "zone"; row.id = "zone" + z; row.setAttribute("role", "img");
-    row.innerHTML = '<span class="name">' + z + '</span><div class="bar"><div></div></div><span class="value"></span>';
-    $(z <= 9 ? "panel-a" : "panel-b").appendChild(row);
+    row.className = "zone"; row.id = "zone" + id; row.setAttribute("role", "img");
+    row.innerHTML = '<span class="name">' + id + '</span><div class="bar"><div></div></div><span class="value"></span>';
+    $(panel === "b" ? "panel-b" : "panel-a").appendChild(row);
   }
   for (const id of ["subject", "seed", "tier", "rule", "threat"])
     $(id).addEventListener("change", render);

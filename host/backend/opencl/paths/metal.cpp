@@ -14,17 +14,17 @@ MetalPath::MetalPath(Device& d) : d_(d) {
   const Catalogue& cat = d.cat;
   if (!cat.metal_physics.present) return;
   const MetalPhysics& mp = cat.metal_physics;
-  const size_t S = cat.subjects.size();
+  const size_t S = cat.subjects.size(), R = cat.regions.size();
   const std::vector<cl_double> zones = metal_zone_records(mp);
-  std::vector<cl_double> regions(S * kRegions * PS_MR_LEN, 0.0), tensors;
+  std::vector<cl_double> regions(S * R * PS_MR_LEN, 0.0), tensors;
   // Each subject's region centres: the places, moved with its height, in the field.
-  for (int r = 0; r < kRegions; ++r) {
+  for (int r = 0; r < cat.region_count(); ++r) {
     const int k = first_view(cat.sensors, r);
     if (k < 0) continue;
     const Sensor& s = cat.sensors[k];
     for (size_t j = 0; j < S; ++j) {
       const Rect rc = s.place(static_cast<int>(j), r);
-      cl_double* rec = &regions[(j * kRegions + r) * PS_MR_LEN];
+      cl_double* rec = &regions[(j * R + r) * PS_MR_LEN];
       rec[PS_MR_COL] = s.field_col(rc.x + rc.w / 2.0);
       rec[PS_MR_ROW] = s.field_row(rc.y + rc.h / 2.0);
       rec[PS_MR_FIELD_PER_COL] = s.field_per_col();
@@ -46,7 +46,7 @@ MetalPath::MetalPath(Device& d) : d_(d) {
 
 void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOutput& out) {
   const Catalogue& cat = d_.cat;
-  cl::Buffer& metal = out_.at_least(d_.ctx(), b.n * kZones);
+  cl::Buffer& metal = out_.at_least(d_.ctx(), b.n * cat.zones);
   const cl_uint n = static_cast<cl_uint>(b.n);
   if (plan.model.model == Model::physics) {
     if (!d_.rt.has_fp64())
@@ -86,7 +86,7 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
                            .out = metal},
             b.n);
   }
-  d_.queue().enqueueReadBuffer(metal, CL_FALSE, 0, b.n * kZones, out.metal.data());
+  d_.queue().enqueueReadBuffer(metal, CL_FALSE, 0, b.n * cat.zones, out.metal.data());
 }
 
 }  // namespace portalsim::opencl

@@ -46,7 +46,7 @@ class PhysicsRawFeatures final : public FeaturePath {
     if (!plan.physics_sparse_features() || !physics_raw_path().applies(quiet(plan), sensor)) return {};
     // Tables where objects stand at their places, and while the pairs' index (subjects x
     // (variants x regions)^2) stays small.
-    const size_t combos = d_.cat.variant_list.size() * kRegions;
+    const size_t combos = d_.cat.variant_list.size() * d_.cat.regions.size();
     if (plan.model.jitter <= 0 && !plan.model.transforms() &&
         d_.cat.subjects.size() * combos * combos <= kMaxTabulatedPairs)
       return {.runs = true, .variant = kTabulated, .variant_name = "tabulated"};
@@ -156,8 +156,9 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& q
     noise.insert(noise.end(), v->begin(), v->end());
   t.noise = params(ctx, fp64, noise);
   const int S = static_cast<int>(cat.subjects.size()), V = static_cast<int>(cat.variant_list.size());
+  const int R = cat.region_count();
   std::vector<double> bare(static_cast<size_t>(S) * t.count, 0.0), values;
-  const size_t combos = static_cast<size_t>(V) * kRegions;
+  const size_t combos = static_cast<size_t>(V) * R;
   std::vector<cl_int2> object_range(S * combos + S * combos * combos, cl_int2{{0, 0}});  // [begin, end)
   std::vector<cl_int> features;
   if (tabulated) {
@@ -170,10 +171,10 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& q
         if (boxes_meet(sprite_box(sv.place(s, ra), a), sprite_box(sv.place(s, rb), b))) return true;
       return false;
     };
-    SceneBatch b;
+    SceneBatch b(R);
     std::vector<std::array<int, 4>> pairs;  // va, ra, vb, rb with ra < rb
-    for (int ra = 0; ra < kRegions; ++ra)
-      for (int rb = ra + 1; rb < kRegions; ++rb)
+    for (int ra = 0; ra < R; ++ra)
+      for (int rb = ra + 1; rb < R; ++rb)
         if (sv.sees(ra) && sv.sees(rb))
           for (int va = 0; va < V; ++va)
             for (int vb = 0; vb < V; ++vb)
@@ -183,7 +184,7 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& q
       sc.subject = s;
       b.push(sc);
       for (int v = 0; v < V; ++v)
-        for (int r = 0; r < kRegions; ++r)
+        for (int r = 0; r < R; ++r)
           if (sv.sees(r)) {
             sc.objects.fill(kNoObject);
             sc.objects[r] = static_cast<int16_t>(v);
@@ -240,8 +241,8 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& q
       const size_t bare_at = at++;
       for (int f = 0; f < t.count; ++f) bare[static_cast<size_t>(s) * t.count + f] = pooled(&raw[bare_at * cells], f);
       for (int v = 0; v < V; ++v)
-        for (int r = 0; r < kRegions; ++r) {
-          const size_t c = static_cast<size_t>(v) * kRegions + r;
+        for (int r = 0; r < R; ++r) {
+          const size_t c = static_cast<size_t>(v) * R + r;
           if (sv.sees(r)) {
             alone[c] = at++;
             entries(s * combos + c, {{alone[c], 1.0}, {bare_at, -1.0}});
@@ -249,7 +250,7 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& q
         }
       // Pairs: both together less each alone, plus the bare grid counted twice over.
       for (const auto& [va, ra, vb, rb] : pairs) {
-        const size_t a = static_cast<size_t>(va) * kRegions + ra, c = static_cast<size_t>(vb) * kRegions + rb;
+        const size_t a = static_cast<size_t>(va) * R + ra, c = static_cast<size_t>(vb) * R + rb;
         entries(S * combos + (s * combos + a) * combos + c,
                 {{at++, 1.0}, {alone[a], -1.0}, {alone[c], -1.0}, {bare_at, 1.0}});
       }

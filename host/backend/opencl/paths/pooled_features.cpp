@@ -14,7 +14,7 @@ void pool_view(Device& d, Kernels& K, const FeatureLayout& lay, const DeviceBatc
   const int row_len = lay.image_features();
   // Each region's mean is the first pooled view's that sees it (region_slot).
   uint32_t regions = 0;
-  for (int r = 0; r < kRegions; ++r)
+  for (int r = 0; r < lay.regions; ++r)
     if (region_slot(d.cat, lay, r) == slot) regions |= s.region_mask & (1u << r);
   enqueue(d.queue(), K["pool_blocks"], K.fp64(),
           PoolBlocksArgs{.img = img,
@@ -38,7 +38,7 @@ void pool_view(Device& d, Kernels& K, const FeatureLayout& lay, const DeviceBatc
                           .offset = lay.block_features(),
                           .row_len = row_len,
                           .features = features},
-          b.n * kRegions);
+          b.n * lay.regions);
 }
 
 void block_mean_noise(Device& d, Kernels& K, const Plan& plan, const DeviceBatch& b, const cl::Buffer& features) {

@@ -61,16 +61,16 @@ ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Pla
   const int S = static_cast<int>(cat.subjects.size()), V = static_cast<int>(cat.variant_list.size());
   const int P = noise ? static_cast<int>(cat.noise.size()) : 1;
   // A footprint per (variant, region, subject): the place moves with the subject's height.
-  std::vector<cl_int> fps(static_cast<size_t>(V) * kRegions * S * PS_FP_LEN, 0);
+  std::vector<cl_int> fps(static_cast<size_t>(V) * lay.regions * S * PS_FP_LEN, 0);
   cl_int offset = 0;
   for (int v = 0; v < V; ++v)
-    for (int r = 0; r < kRegions; ++r)
+    for (int r = 0; r < lay.regions; ++r)
       for (int s = 0; s < S; ++s) {
         // The region's pooled view: its place and its sprite set's drawing.
         const Sensor& in = cat.sensors[lay.pooled[region_slot(cat, lay, r)]];
         const Image& sp = d_.assets.sprite(in, v);
         const Rect box = sprite_box(in.place(s, r), sp);
-        cl_int* f = &fps[((static_cast<size_t>(v) * kRegions + r) * S + s) * PS_FP_LEN];
+        cl_int* f = &fps[((static_cast<size_t>(v) * lay.regions + r) * S + s) * PS_FP_LEN];
         f[PS_FP_SPRITE_X0] = box.x;
         f[PS_FP_SPRITE_Y0] = box.y;
         f[PS_FP_SPRITE_W] = box.w;
@@ -107,10 +107,10 @@ ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Pla
       }
   cl::Context& ctx = d_.ctx();
   cl::CommandQueue& q = d_.queue();
-  const int row_len = lay.image_features(), combos = V * kRegions * S * P;
+  const int row_len = lay.image_features(), combos = V * lay.regions * S * P;
   t.fps = constant(ctx, fps);
   t.deltas = cl::Buffer(ctx, CL_MEM_READ_WRITE, std::max<size_t>(1, offset) * sizeof(cl_int));
-  t.region_deltas = cl::Buffer(ctx, CL_MEM_READ_WRITE, static_cast<size_t>(combos) * kRegions * sizeof(cl_int));
+  t.region_deltas = cl::Buffer(ctx, CL_MEM_READ_WRITE, static_cast<size_t>(combos) * lay.regions * sizeof(cl_int));
   t.base_sums = cl::Buffer(ctx, CL_MEM_READ_WRITE, static_cast<size_t>(S) * row_len * sizeof(cl_int));
   t.base_means = cl::Buffer(ctx, CL_MEM_READ_WRITE, static_cast<size_t>(S) * row_len * sizeof(cl_float));
   const cl_int npooled = static_cast<cl_int>(lay.pooled.size()), views = static_cast<cl_int>(cat.sensors.size());
