@@ -17,7 +17,8 @@ void BM_KernelBuild(benchmark::State& state) {
   static OpenCLRuntime rt;
   std::random_device rd;
   // The standard tier's options for the built-in catalogue, as its backend builds them.
-  const std::string counts = " " + opencl::build_options(Fidelity{}, opencl::KernelCounts::of(default_catalogue()));
+  const std::string counts =
+      std::string(" ").append(opencl::build_options(Fidelity{}, opencl::KernelCounts::of(default_catalogue())));
   const std::string warm_options = "-DPORTALSIM_BENCH_WARM=1" + counts;
   cl::Program(rt.context(), OpenCLRuntime::source()).build(warm_options.c_str());  // fill the cache once
   for (auto _ : state) {

@@ -130,8 +130,10 @@ const Sensor* view_of_region(const Catalogue& cat, int r) {
 
 // Where the table declares column i, for errors.
 std::string where_column(const Numbers& t, size_t i) {
-  return t.path + (t.name_lines[i] > 0 ? ":" + std::to_string(t.name_lines[i]) : std::string()) + ": column '" +
-         t.names[i] + "'";
+  // Appended piece by piece: g++ 12 warns falsely (-Wrestrict) on "literal" + a temporary here.
+  std::string w = t.path;
+  if (t.name_lines[i] > 0) w.append(":").append(std::to_string(t.name_lines[i]));
+  return w.append(": column '").append(t.names[i]).append("'");
 }
 
 }  // namespace
