@@ -6,8 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -21,15 +19,8 @@ namespace fs = std::filesystem;
 
 const std::string kPortal = (fs::path(PORTALSIM_SOURCE_DIR) / "tests" / "portals" / "portal-20x33.toml").string();
 
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 std::string first_line(const fs::path& p) {
-  const std::string t = read_all(p);
+  const std::string t = test::slurp(p);
   return t.substr(0, t.find('\n'));
 }
 
@@ -67,7 +58,8 @@ TEST(PortalCounts, GenerateWritesTheCataloguesCountsAndShardsMergeToTheWholeRun)
   const test::Result m = run(t, {"merge", s0.string(), s1.string(), "--out", merged.string()});
   ASSERT_TRUE(m.exited && m.status == 0) << test::describe(m);
   for (const char* f : {"data.h5", "features.csv", "features.arff", "scenarios.csv", "manifest.json", "README.md"})
-    EXPECT_TRUE(read_all(whole / f) == read_all(merged / f)) << f << ": the merged shards differ from the whole run";
+    EXPECT_TRUE(test::slurp(whole / f) == test::slurp(merged / f))
+        << f << ": the merged shards differ from the whole run";
 
   // Every table and tensor has the catalogue's regions and zones.
   const std::string scen = first_line(whole / "scenarios.csv"), feat = first_line(whole / "features.csv");
@@ -75,7 +67,7 @@ TEST(PortalCounts, GenerateWritesTheCataloguesCountsAndShardsMergeToTheWholeRun)
   EXPECT_EQ(scen.find("region21"), std::string::npos) << scen;
   EXPECT_NE(feat.find(",region20,zone1,"), std::string::npos) << feat;
   EXPECT_TRUE(feat.ends_with(",zone32,zone33,class")) << feat;
-  EXPECT_NE(read_all(whole / "features.arff").find("@attribute zone33 "), std::string::npos);
+  EXPECT_NE(test::slurp(whole / "features.arff").find("@attribute zone33 "), std::string::npos);
   const H5Layout h5 = read_h5_layout((whole / "data.h5").string());
   const H5Dataset *metal = dataset(h5, "metal"), *objects = dataset(h5, "region_object"),
                   *labels = dataset(h5, "region_label"), *back_ir = dataset(h5, "back_ir"),
@@ -91,11 +83,11 @@ TEST(PortalCounts, GenerateWritesTheCataloguesCountsAndShardsMergeToTheWholeRun)
   for (const char* view : {"upper", "lower", "back_upper", "back_lower", "ir", "back_ir"}) dataset(h5, view);
 
   // The dataset card says what the data hold.
-  const std::string card = read_all(whole / "README.md");
+  const std::string card = test::slurp(whole / "README.md");
   for (const char* says : {"metal detector (33 zones)", "the object in each of the 20 regions",
                            "the image features, the 33 metal zones", "infrared camera views (ir, back_ir)"})
     EXPECT_NE(card.find(says), std::string::npos) << says;
-  const std::string croissant = read_all(whole / "croissant.json");
+  const std::string croissant = test::slurp(whole / "croissant.json");
   EXPECT_NE(croissant.find("metal detector: 33 zone values"), std::string::npos);
   EXPECT_NE(croissant.find("per region 1-20:"), std::string::npos);
   EXPECT_NE(croissant.find("IR camera, view back_ir (the back)"), std::string::npos);
@@ -109,7 +101,7 @@ TEST(PortalCounts, CocoHasEveryViewAndTheBackRegions) {
   const test::Result r = run(t, {"generate", "--catalogue", kPortal, "--count", "12", "--seed", "2", "--objects",
                                  "8..12", "--what", "images", "--annotations", "--quiet", "--out", out.string()});
   ASSERT_TRUE(r.exited && r.status == 0) << test::describe(r);
-  const std::string coco = read_all(out / "annotations.json");
+  const std::string coco = test::slurp(out / "annotations.json");
   for (const char* view : {"back_upper", "back_lower", "back_ir"})
     EXPECT_NE(coco.find(std::string("\"view\":\"") + view + "\""), std::string::npos) << view;
   size_t back_regions = 0;

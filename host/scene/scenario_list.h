@@ -1,8 +1,8 @@
 // Scenario lists (generate --scenarios FILE): CSV with a header naming subject, region1..
 // regionR (R the catalogue's regions, 13 in the built-in one) and optionally label
 // (yes/no/positive/negative/1/0), index (ignored: scenario i of the list is index i) and the
-// randomised objects' columns (rotation1..R, scale1..R, flip1..R: all 3 R or none). Subjects are 1-based. Errors name
-// file, line and column or field.
+// randomised objects' columns (rotation1..R, scale1..R, flip1..R: all 3 R or none).
+// Subjects are 1-based. Errors name file, line and column or field.
 //
 // Fields are read as RFC 4180 does: a field may be quoted, with "" for a quote inside; spaces
 // round an unquoted field are dropped. No field of a scenario list can hold a line break (a

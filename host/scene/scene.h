@@ -12,9 +12,10 @@ namespace portalsim {
 constexpr int16_t kNoObject = -1;
 
 struct Scenario {
-  int subject = 0;                           // 0-based
-  std::array<int16_t, kMaxRegions> objects;  // variant id per region, kNoObject for none and past the catalogue's
-  int label = 0;                             // 1 threat, 0 not
+  int subject = 0;  // 0-based
+  // Variant id per region, kNoObject for none and past the catalogue's regions.
+  std::array<int16_t, kMaxRegions> objects;
+  int label = 0;  // 1 threat, 0 not
   Scenario() { objects.fill(kNoObject); }
 };
 

@@ -22,8 +22,9 @@ class ScenarioSource {
   uint64_t total() const { return total_; }
   bool listed() const { return !generator_; }
   const ThreatRule* rule() const { return rule_ ? &*rule_ : nullptr; }
-  // Scenarios [at, at + n) into `b` (on `threads` threads; its stride becomes the catalogue's). A listed source reads
-  // them from its file, and a bad row throws InputError naming its line.
+  // Scenarios [at, at + n) into `b` (on `threads` threads; its stride becomes the
+  // catalogue's). A listed source reads them from its file, and a bad row throws InputError
+  // naming its line.
   void fill(uint64_t at, size_t n, unsigned threads, SceneBatch& b) const;
   // Reads and checks scenarios [begin, end) of a list, keeping none (a generator has nothing
   // to check): a run checks its range before it writes anything, so a bad row far down a

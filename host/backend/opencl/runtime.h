@@ -1,4 +1,5 @@
-// The OpenCL runtime: one device, context and queue, and the portalsim program built per set of options.
+// The OpenCL runtime: one device, context and queue, and the portalsim program built for
+// each set of options.
 #pragma once
 #include <CL/opencl.hpp>
 #include <map>
