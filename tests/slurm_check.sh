@@ -9,12 +9,18 @@ work=$(realpath -m "${2:?usage: slurm_check.sh PORTALSIM WORKDIR}")
 here=$(cd "$(dirname "$0")/.." && pwd)
 slurm="$here/tools/slurm"
 
-"$slurm/local_slurm.sh" stop "$work/state" 2>/dev/null || true
+# The daemons' state lives in a folder of its own under /tmp: munged runs as the munge user,
+# which cannot reach it under a build folder inside a folder only root may enter (a clone
+# in a mktemp -d folder). $work.slurm-state names it, so that a run cut short is stopped.
+marker=$work.slurm-state
+if [ -f "$marker" ]; then "$slurm/local_slurm.sh" stop "$(cat "$marker")" 2>/dev/null || true; fi
 rm -rf "$work"
 mkdir -p "$work"
-trap '"$slurm/local_slurm.sh" stop "$work/state"' EXIT
-"$slurm/local_slurm.sh" start "$work/state" >/dev/null
-export SLURM_CONF=$work/state/slurm.conf PORTALSIM=$portalsim
+state=$(mktemp -d /tmp/portalsim-slurm.XXXXXX)
+echo "$state" >"$marker"
+trap '"$slurm/local_slurm.sh" stop "$state"; rm -rf "$state" "$marker"' EXIT
+"$slurm/local_slurm.sh" start "$state" >/dev/null
+export SLURM_CONF=$state/slurm.conf PORTALSIM=$portalsim
 cd "$work"
 
 spec=(--count 900 --seed 11 --rule gun --what both --format arff,csv,npy,h5 --batch 64)
