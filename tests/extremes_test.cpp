@@ -233,6 +233,22 @@ std::unique_ptr<World> make_world(const std::string& text, const std::string& di
   return w;
 }
 
+// Reading `text` as test.toml is refused naming the file, `field` and `says`: the message
+// ("" where it was accepted).
+std::string expect_refused(const std::string& text, const std::string& field, const std::string& says) {
+  try {
+    parse_catalogue(text, "test.toml", "", "");
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("test.toml:"), std::string::npos) << what;
+    EXPECT_NE(what.find(field + ": "), std::string::npos) << what;
+    EXPECT_NE(what.find(says), std::string::npos) << what;
+    return what;
+  }
+  ADD_FAILURE() << "accepted";
+  return "";
+}
+
 World& default_world() {
   static std::unique_ptr<World> w = make_world(default_text());
   return *w;
@@ -485,10 +501,9 @@ std::unique_ptr<Parity> expect_parity(World& w, const SceneBatch& batch, const M
           size_t differ = 0, first = 0;
           for (size_t k = 0; k < dense.size(); ++k)
             if (o.features[k] != dense[k] && differ++ == 0) first = k;
-          EXPECT_EQ(differ, 0u) << "features differ between the features-only run ("
-                                << (plan.sparse_features() ? "sparse" : "dense") << ") and the images run, e.g. #"
-                                << first << ": " << (differ ? o.features[first] : 0.0f) << " against "
-                                << (differ ? dense[first] : 0.0f);
+          EXPECT_EQ(differ, 0u) << "features differ between the features-only run (" << test::features_path(*w.cl, plan)
+                                << ") and the images run, e.g. #" << first << ": "
+                                << (differ ? o.features[first] : 0.0f) << " against " << (differ ? dense[first] : 0.0f);
         }
       }
     }
@@ -1152,7 +1167,7 @@ TEST(ExtremeBatch, OneAndAMillion) {
   World& w = default_world();
   const ModelSettings m = model(1234, true, 0.0, 100, 5);
   const Plan plan = features_plan(m, Tier::standard);
-  ASSERT_TRUE(plan.sparse_features());
+  ASSERT_EQ(test::features_path(*w.cl, plan), "thesis_sparse_features");
   constexpr size_t kMillion = 1000000;
   SceneBatch big(kBuiltinRegions);
   big.first_index = 0;
@@ -1378,6 +1393,7 @@ TEST(PortalCounts, TwentyRegionsAndThirtyThreeZonesMatchTheReference) {
   ASSERT_EQ(w->cat.sensors.size(), 6u);
   EXPECT_EQ(w->cat.sensors[5].name, "back_ir");
   EXPECT_EQ(w->cat.sensors[5].side, Side::back);
+  EXPECT_EQ(w->cat.sensors[2].raw, (std::array<int, 2>{24, 24})) << "the back MMW camera's own raw grid";
   // Random crowds, then every region filled on each subject.
   std::vector<Scenario> scenes = coverage(w->cat, 24, 10, false);
   for (int s = 0; s < 5; ++s) scenes.push_back(crowded(w->cat, s, static_cast<size_t>(2 * s)));
@@ -1426,15 +1442,7 @@ TEST(PortalCounts, CountsPastTheCapacitiesAreRefusedNamingTheField) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.field);
-    try {
-      parse_catalogue(c.text, "test.toml", "", "");
-      ADD_FAILURE() << "accepted";
-    } catch (const InputError& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find("test.toml:"), std::string::npos) << what;
-      EXPECT_NE(what.find(c.field + ": "), std::string::npos) << what;
-      EXPECT_NE(what.find(c.says), std::string::npos) << what;
-    }
+    expect_refused(c.text, c.field, c.says);
   }
   // A [metal.physics] of another zone count: its first per-zone array names it.
   std::string physics = text;
@@ -1447,6 +1455,84 @@ TEST(PortalCounts, CountsPastTheCapacitiesAreRefusedNamingTheField) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("metal.physics.tx_panel: expected an array of 33 panels"), std::string::npos)
         << e.what();
+  }
+}
+
+// A view's own camera ([[views]] netd, raw): the catalogue's upper view keeps its raw grid
+// and NETD whatever the run's --mmw-raw and --netd, the IR view its NETD over --ir-netd; the
+// other views follow the run. Each view's image is the one a run with its numbers as the
+// knobs gives, on both backends.
+std::string own_cameras_text(const std::string& upper, const std::string& ir) {
+  std::string text = replace_once(default_text(), "field = [0, 0, 200, 200]\n", "field = [0, 0, 200, 200]\n" + upper);
+  return replace_once(text, "field = [0, 0, 200, 400]\n", "field = [0, 0, 200, 400]\n" + ir);
+}
+
+TEST(PortalCameras, AViewsOwnRawGridAndNetdHoldOverTheRunsKnobs) {
+  auto own = make_world(own_cameras_text("raw = [20, 24]\nnetd = 1.5\n", "netd = 0.0\n"));
+  ASSERT_EQ(own->cat.sensors[0].raw, (std::array<int, 2>{20, 24}));
+  ASSERT_EQ(own->cat.sensors[0].netd, 1.5);
+  ASSERT_FALSE(own->cat.sensors[1].netd.has_value());
+  World& plain = default_world();
+  const SceneBatch batch = test::batch_of(coverage(own->cat, 12, 4, false), 300);
+  ModelSettings run = physics_model(171);
+  run.netd = 4.0;
+  run.ir_netd = 0.3;
+  // The upper view as a run of --mmw-raw 20x24 --netd 1.5 gives it; the IR view as one
+  // of --ir-netd 0; the lower view as the run's knobs give it.
+  ModelSettings upper_knobs = run, ir_knobs = run;
+  upper_knobs.raw_width = 20;
+  upper_knobs.raw_height = 24;
+  upper_knobs.netd = 1.5;
+  ir_knobs.ir_netd = 0;
+  for (Tier tier : {Tier::standard, Tier::exact}) {
+    SCOPED_TRACE(tier_name(tier));
+    for (const bool reference : {false, true}) {
+      SCOPED_TRACE(reference ? "reference" : "opencl");
+      const auto run_on = [&](World& w, const ModelSettings& m) {
+        BatchOutput o;
+        (reference ? *w.ref : *w.cl).run(batch, images_plan(m, tier), o);
+        return o;
+      };
+      const BatchOutput o = run_on(*own, run), as_upper = run_on(plain, upper_knobs), as_run = run_on(plain, run),
+                        as_ir = run_on(plain, ir_knobs);
+      EXPECT_TRUE(o.view("upper").pixels == as_upper.view("upper").pixels);
+      EXPECT_TRUE(o.view("lower").pixels == as_run.view("lower").pixels);
+      EXPECT_TRUE(o.view("ir").pixels == as_ir.view("ir").pixels);
+      EXPECT_TRUE(o.view("upper").pixels != as_run.view("upper").pixels) << "the case cannot tell";
+      EXPECT_TRUE(o.view("ir").pixels != as_run.view("ir").pixels) << "the case cannot tell";
+    }
+  }
+  // Every tier against the reference, features-only paths included (the fast tier's
+  // raw-grid tables are made per view), with the upper view's own raw grid: 20x24 where the
+  // run's is 32x32.
+  auto raw_only = make_world(own_cameras_text("raw = [20, 24]\n", ""));
+  ModelSettings m = physics_model(172);
+  m.raw_width = m.raw_height = 32;
+  const SceneBatch singles = test::batch_of(coverage(raw_only->cat, 12, 4, true), 310);
+  ASSERT_EQ(test::features_path(*raw_only->cl, features_plan(m, Tier::fast)), "physics_raw_features");
+  const auto p = expect_parity(*raw_only, singles, m, "the upper view's own raw grid");
+  BatchOutput at_run;
+  plain.cl->run(singles, features_plan(m, Tier::fast), at_run);
+  EXPECT_TRUE(at_run.features != p->features[2].features) << "the fast tier's features ignore the view's raw grid";
+}
+
+// A view's camera numbers out of range, or a raw grid where there is none, are refused
+// naming the file, line and field.
+TEST(PortalCameras, BadOwnCamerasAreRefusedNamingTheField) {
+  struct Case {
+    std::string upper, ir, field, says;
+  };
+  const std::vector<Case> cases{
+      {"", "raw = [20, 20]\n", "views[3].raw", "a raw grid is an MMW camera's"},
+      {"raw = [201, 20]\n", "", "views[1].raw", "201x20 is finer than the view (200x200)"},
+      {"raw = [20]\n", "", "views[1].raw", "expected"},
+      {"netd = -1\n", "", "views[1].netd", "out of range"},
+      {"", "netd = 11\n", "views[3].netd", "out of range"},
+      {"netd = \"3\"\n", "", "views[1].netd", "expected a number"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.field + " " + c.upper + c.ir);
+    expect_refused(own_cameras_text(c.upper, c.ir), c.field, c.says);
   }
 }
 
@@ -1556,16 +1642,9 @@ TEST(PortalViews, BadViewsAndRegionsAreRefusedNamingTheField) {
     SCOPED_TRACE(c.to);
     const std::string text = replace_once(front_back_text(), c.from, c.to);
     const int line = line_of(text, c.to.substr(c.to.rfind('\n') == std::string::npos ? 0 : c.to.rfind('\n') + 1));
-    try {
-      parse_catalogue(text, "test.toml", "", "");
-      ADD_FAILURE() << "accepted";
-    } catch (const InputError& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find(c.field + ": "), std::string::npos) << what;
-      EXPECT_NE(what.find(c.says), std::string::npos) << what;
-      if (c.field != "regions[14].rects" && c.field != "views[2].field") {
-        EXPECT_NE(what.find("test.toml:" + std::to_string(line) + ":"), std::string::npos) << what;
-      }
+    const std::string what = expect_refused(text, c.field, c.says);
+    if (c.field != "regions[14].rects" && c.field != "views[2].field") {
+      EXPECT_NE(what.find("test.toml:" + std::to_string(line) + ":"), std::string::npos) << what;
     }
   }
 }

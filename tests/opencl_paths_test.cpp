@@ -4,6 +4,7 @@
 // against the kernels' own argument counts.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <set>
 #include <string>
 
@@ -11,6 +12,7 @@
 #include "backend/opencl/launch.h"
 #include "backend/opencl/paths/paths.h"
 #include "backend/opencl/table_key.h"
+#include "backend/opencl/view_derive.h"
 #include "plan/knobs.h"
 #include "run_binary.h"
 #include "support.h"
@@ -83,13 +85,16 @@ TEST(OpenCLPaths, AFailedGateFallsBackToTheStageChainAndMatchesTheReference) {
   const SceneBatch batch = test::batch_of(test::coverage(cat, 200, 4));
   auto cl = make_opencl_backend(cat, assets(), test::runtime());
   auto ref = make_reference_backend(cat, assets());
+  auto usual = make_opencl_backend(catalogue(), assets(), test::runtime());
   for (Tier tier : {Tier::fast, Tier::standard}) {
     SCOPED_TRACE(tier_name(tier));
     Plan plan = test::physics_plan();
     plan.images = 0;
     plan.fidelity = tier_fidelity(tier);
     plan.fidelity.noise = NoiseModel::block_mean;
-    ASSERT_TRUE(plan.physics_sparse_features()) << "the plan alone would ask for the raw-grid features path";
+    // The plan would take the raw-grid features path on the usual chains; not on these.
+    ASSERT_EQ(test::features_path(*usual, plan), "physics_raw_features");
+    ASSERT_EQ(test::features_path(*cl, plan), Backend::kPooledFeatures);
     BatchOutput a, b;
     ASSERT_NO_THROW(cl->run(batch, plan, a));
     ref->run(batch, plan, b);
@@ -170,6 +175,57 @@ TEST(OpenCLPaths, ChangedKnobsGiveFreshTables) {
       EXPECT_TRUE(again.views[v].pixels == fresh.views[v].pixels) << "view " << v << " from stale tables";
     EXPECT_TRUE(again.features != first.features || again.views[0].pixels != first.views[0].pixels)
         << "the knob changed nothing: the case cannot tell";
+  }
+}
+
+// One cache holds every view's derivation (view_derive.h): trying knob after knob, as a
+// long-lived serve does, keeps at most its capacity; a derivation in use stays whole when
+// the cache drops it; one made again after it was dropped is the same.
+TEST(OpenCLPaths, ViewDerivationsAreBoundedAndKeepWhatIsInUse) {
+  const Catalogue& cat = catalogue();
+  opencl::ViewDerivations derived(cat, assets(), test::runtime()->context());
+  Plan plan = test::physics_plan();
+  const std::shared_ptr<opencl::ViewDerived> first = derived(plan, 0);
+  const PsViewLaunch first_launch = first->L;
+  ASSERT_GE(derived.capacity(), 2 * cat.sensors.size()) << "a run's own derivations must fit";
+  for (int k = 0; k < static_cast<int>(3 * derived.capacity()); ++k) {
+    plan.model.illumination = 250 + k;
+    for (int view = 0; view < static_cast<int>(cat.sensors.size()); ++view) derived(plan, view);
+    ASSERT_LE(derived.size(), derived.capacity());
+  }
+  EXPECT_EQ(first->model.illumination, 293.0) << "the derivation in use was changed";
+  plan.model.illumination = 293;
+  const std::shared_ptr<opencl::ViewDerived> again = derived(plan, 0);
+  EXPECT_NE(again.get(), first.get()) << "the first derivation was never dropped: the case cannot tell";
+  EXPECT_EQ(std::memcmp(&again->L, &first_launch, sizeof first_launch), 0);
+  EXPECT_EQ(derived(plan, 0).get(), again.get()) << "a derivation is made once per key";
+  // The noise-free derivation (the physics features path's raw grid) is another entry.
+  EXPECT_EQ(derived(plan, 0, true)->model.netd, 0.0);
+  EXPECT_EQ(derived(plan, 0)->model.netd, plan.model.netd);
+}
+
+// After more knob settings than the cache holds, a backend gives the first setting's bytes
+// again: images (the physics parameter tables) and features-only runs (the sparse tables).
+TEST(OpenCLPaths, ARunAfterTheCacheDroppedItsTablesGivesTheSameBytes) {
+  const SceneBatch batch = test::batch_of(test::coverage(catalogue(), 32, 3, false));
+  auto cl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  for (const bool physics : {true, false}) {
+    SCOPED_TRACE(physics ? "physics images" : "thesis features");
+    Plan plan = physics ? test::physics_plan() : Plan{};
+    if (!physics) plan.images = 0;
+    const Knob& k = *find_knob(physics ? "illumination" : "block");
+    BatchOutput first, again;
+    cl->run(batch, plan, first);
+    const size_t settings = 4 * catalogue().sensors.size() + 2;
+    for (size_t i = 1; i <= settings; ++i) {
+      Plan other = plan;
+      k.set(other, physics ? 250.0 + double(i) : double(10 + i));
+      BatchOutput o;
+      cl->run(batch, other, o);
+    }
+    cl->run(batch, plan, again);
+    EXPECT_TRUE(again.features == first.features);
+    for (size_t v = 0; v < first.views.size(); ++v) EXPECT_TRUE(again.views[v].pixels == first.views[v].pixels);
   }
 }
 

@@ -260,10 +260,10 @@ TEST(SparseFeatures, EqualDenseToTheBit) {
       p.model.pattern_noise = noise;
       p.model.seed = 4242;
       BatchOutput sparse, dense;
-      ASSERT_TRUE(p.sparse_features());
+      ASSERT_EQ(test::features_path(*cl, p), "thesis_sparse_features");
       cl->run(test::batch_of(scenes, 3), p, sparse);
       p.fidelity.pooling = Pooling::dense;
-      ASSERT_FALSE(p.sparse_features());
+      ASSERT_EQ(test::features_path(*cl, p), Backend::kPooledFeatures);
       cl->run(test::batch_of(scenes, 3), p, dense);
       ASSERT_EQ(sparse.features.size(), dense.features.size());
       size_t mismatches = 0;
@@ -294,7 +294,7 @@ TEST(Parity, PlacementJitterIntegerAndBilinear) {
   for (bool bilinear : {false, true}) {
     p.model.bilinear = bilinear;
     p.model.jitter = 4.5;
-    ASSERT_FALSE(p.sparse_features());
+    ASSERT_NE(test::features_path(*cl, p), "thesis_sparse_features");
     BatchOutput a, b;
     cl->run(test::batch_of(scenes), p, a);
     ref->run(test::batch_of(scenes), p, b);

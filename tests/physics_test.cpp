@@ -164,7 +164,7 @@ TEST(Physics, FeaturesOnlyRunsMatchTheReferenceAtNetdZero) {
       Plan features = plan;
       features.images = 0;
       features.fidelity = tier_fidelity(tier);
-      ASSERT_EQ(features.physics_sparse_features(), tier == Tier::fast);
+      ASSERT_EQ(test::features_path(*cl, features) == "physics_raw_features", tier == Tier::fast);
       BatchOutput k;
       cl->run(batch, features, k);
       const OutputDiff d = compare_outputs(k, r);
@@ -190,7 +190,7 @@ TEST(Physics, RawGridFeaturesHaveNoBiasColumnByColumn) {
   Plan features = plan;
   features.images = 0;
   features.fidelity = tier_fidelity(Tier::fast);
-  ASSERT_TRUE(features.physics_sparse_features());
+  ASSERT_EQ(test::features_path(*cl, features), "physics_raw_features");
   cl->run(batch, features, k);
   ASSERT_EQ(k.features.size(), r.features.size());
   const size_t n = r.n, columns = static_cast<size_t>(r.layout.image_features());
@@ -230,7 +230,7 @@ TEST(Physics, RawGridFeatureNoiseMatchesTheReference) {
   ref->run(batch, plan, r);
   ref->run(batch, quiet, r0);
   plan.images = quiet.images = 0;
-  ASSERT_TRUE(plan.physics_sparse_features());
+  ASSERT_EQ(test::features_path(*cl, plan), "physics_raw_features");
   cl->run(batch, plan, k);
   cl->run(batch, quiet, k0);
   const FeatureLayout& lay = k.layout;
@@ -288,10 +288,10 @@ TEST(Physics, RawGridFeaturesMatchTheDensePath) {
     plan.model.netd = 0;
     plan.model.jitter = jitter;
     plan.fidelity = tier_fidelity(Tier::fast);
-    ASSERT_TRUE(plan.physics_sparse_features());
+    ASSERT_EQ(test::features_path(*cl, plan), "physics_raw_features");
     Plan dense = plan;
     dense.fidelity.pooling = Pooling::dense;
-    ASSERT_FALSE(dense.physics_sparse_features());
+    ASSERT_EQ(test::features_path(*cl, dense), Backend::kPooledFeatures);
     BatchOutput a, b;
     cl->run(batch, plan, a);
     cl->run(batch, dense, b);

@@ -85,7 +85,8 @@ TEST(PortalCounts, GenerateWritesTheCataloguesCountsAndShardsMergeToTheWholeRun)
   // The dataset card says what the data hold.
   const std::string card = test::slurp(whole / "README.md");
   for (const char* says : {"metal detector (33 zones)", "the object in each of the 20 regions",
-                           "the image features, the 33 metal zones", "infrared camera views (ir, back_ir)"})
+                           "the image features, the 33 metal zones", "infrared camera views (ir, back_ir)",
+                           "**View back_upper** has a camera of its own, over the run's parameters: raw grid 24x24."})
     EXPECT_NE(card.find(says), std::string::npos) << says;
   const std::string croissant = test::slurp(whole / "croissant.json");
   EXPECT_NE(croissant.find("metal detector: 33 zone values"), std::string::npos);

@@ -251,7 +251,7 @@ TEST(SubjectHeight, BothBackendsAgreeAndMetalFollows) {
     p.images = 0;
     p.model.pattern_noise = noise;
     p.model.seed = 4242;
-    ASSERT_TRUE(p.sparse_features());
+    ASSERT_EQ(test::features_path(*cl, p), "thesis_sparse_features");
     const auto [s, dn] = sparse_and_dense(p);
     EXPECT_EQ(s.features, dn.features) << "pattern noise " << noise;
   }
@@ -262,7 +262,7 @@ TEST(SubjectHeight, BothBackendsAgreeAndMetalFollows) {
   p.metal = false;
   p.model.netd = 0;
   p.fidelity = tier_fidelity(Tier::fast);
-  ASSERT_TRUE(p.physics_sparse_features());
+  ASSERT_EQ(test::features_path(*cl, p), "physics_raw_features");
   const auto [s, dn] = sparse_and_dense(p);
   ASSERT_EQ(s.features.size(), dn.features.size());
   EXPECT_LE(compare_outputs(s, dn).feature_max_abs, 0.5);

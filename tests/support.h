@@ -118,6 +118,15 @@ inline Plan physics_plan(uint64_t seed = 7) {
   return p;
 }
 
+// The features path `b` takes for `plan`, as --timing names it, without its variant:
+// "physics_raw_features", "thesis_sparse_features" or Backend::kPooledFeatures.
+inline std::string features_path(const Backend& b, const Plan& plan) {
+  for (const std::string& p : b.paths(plan))
+    if (p.rfind("features: ", 0) == 0)
+      return p.substr(10, p.find(" (") == std::string::npos ? std::string::npos : p.find(" (") - 10);
+  return "";
+}
+
 // The first drawing of the object called `name`; -1 (and a test failure) when none is.
 inline int variant_of(const Catalogue& cat, const std::string& name) {
   const int o = cat.find_object(name);

@@ -498,13 +498,14 @@ TEST(TensorsH5, ResumeRefusesRowsChangedSinceTheCheckpoint) {
 // the other datasets' part of it in memory until the next batch).
 TEST(TensorsH5, DefaultBatchEndsWhereAChunkDoes) {
   const portalsim::Catalogue& cat = portalsim::test::catalogue();
+  const auto backend = portalsim::make_opencl_backend(cat, portalsim::test::assets(), portalsim::test::runtime());
   for (const bool features : {false, true})
     for (const uint32_t images : {0u, portalsim::kAllViews}) {
       portalsim::Plan plan;
       plan.features = features;
       plan.images = images;
       plan.metal = true;
-      const size_t b = portalsim::default_batch(plan, cat);
+      const size_t b = portalsim::default_batch(plan, cat, *backend);
       EXPECT_EQ(b % portalsim::kH5ChunkRows, 0u) << "features " << features << ", images " << images;
       EXPECT_GE(b, portalsim::kH5ChunkRows);
       EXPECT_LE(b, 16384u);

@@ -52,7 +52,8 @@ TEST(RandomisedObjects, KernelsMatchTheReferenceInEveryTier) {
       BatchOutput still;
       cl->run(test::batch_of(sc), p, still);
       randomise(p);
-      ASSERT_FALSE(p.sparse_features()) << "the sparse path cannot follow random transforms";
+      ASSERT_NE(test::features_path(*cl, p), "thesis_sparse_features")
+          << "the sparse path cannot follow random transforms";
       BatchOutput a, b;
       cl->run(test::batch_of(sc), p, a);
       ref->run(test::batch_of(sc), p, b);
@@ -233,7 +234,7 @@ TEST(RandomisedObjects, FeaturesAreThePooledImages) {
   p.model.seed = 21;
   randomise(p, 30, 0.8, 1.4);
   p.images = 0;
-  ASSERT_FALSE(p.sparse_features());
+  ASSERT_EQ(test::features_path(*cl, p), Backend::kPooledFeatures);
   BatchOutput only, with_images;
   cl->run(test::batch_of(sc), p, only);
   p.images = kAllViews;

@@ -27,16 +27,22 @@ import metal_table  # noqa: E402  (the influence model: S, SIGMA)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
-def view_entry(name, camera, size, field, pooled, note=""):
-    """A back [[views]] entry."""
+def view_entry(name, camera, size, field, pooled, note="", extra=()):
+    """A back [[views]] entry; `extra`: lines of its own camera's numbers."""
     lines = ["[[views]]", 'name = "%s"' % name + ("   # " + note if note else ""), 'camera = "%s"' % camera,
              'side = "back"', "size = [%d, %d]" % size, "field = [%s]" % ", ".join(str(v) for v in field)]
-    return "\n" + "\n".join(lines + (["pooled = true"] if pooled else [])) + "\n"
+    return "\n" + "\n".join(lines + (["pooled = true"] if pooled else []) + list(extra)) + "\n"
 
 
 TWIN = "a second %s camera behind the subject: assumed the front one's twin"
 BACK_VIEWS = (view_entry("back_upper", "mmw", (200, 200), (0, 0, 200, 200), True, TWIN % "MMW") +
               view_entry("back_lower", "mmw", (200, 200), (0, 200, 200, 200), True))
+# The test portal's back MMW camera is another make, with a coarser raw grid of its own
+# ([[views]] raw, over the run's --mmw-raw): assumed, for the test.
+OWN_RAW = ["raw = [24, 24]      # its own raw grid (assumed: another make than the front's)"]
+BACK_VIEWS_OWN_RAW = (view_entry("back_upper", "mmw", (200, 200), (0, 0, 200, 200), True,
+                                 "a second MMW camera behind the subject", OWN_RAW) +
+                      view_entry("back_lower", "mmw", (200, 200), (0, 200, 200, 200), True, "", OWN_RAW))
 BACK_IR_VIEW = view_entry("back_ir", "ir", (100, 200), (0, 0, 200, 400), False, TWIN % "IR")
 
 # name, rects (a back view is mirrored: the subject's right on its right), and the built-in
@@ -229,7 +235,7 @@ def portal_20x33(text):
         "detector's.",
     ])
     body = text[text.index("format = 1"):]
-    body = views_with(body, BACK_VIEWS, BACK_IR_VIEW)
+    body = views_with(body, BACK_VIEWS_OWN_RAW, BACK_IR_VIEW)
     body = replace_span(body, "# --- Regions", "# --- Objects", regions_section(regions, back, views, "\n".join([
         "# --- Regions: the built-in 13 on the front, then 7 on the back; each back region is",
         "# seen by a back MMW view and the back IR view."])))

@@ -62,6 +62,16 @@ std::vector<std::string> FeatureLayout::names() const {
   return n;
 }
 
+ModelSettings ModelSettings::for_view(const Sensor& s) const {
+  ModelSettings m = *this;
+  if (s.netd) (s.camera == Camera::ir ? m.ir_netd : m.netd) = *s.netd;
+  if (s.raw) {
+    m.raw_width = (*s.raw)[0];
+    m.raw_height = (*s.raw)[1];
+  }
+  return m;
+}
+
 Fidelity tier_fidelity(Tier t) {
   Fidelity f;
   switch (t) {
@@ -106,8 +116,9 @@ void validate(const Plan& plan, const Catalogue& cat) {
     if (s.mmw_level == cat.physics.base_background_gray)
       throw InputError("--model physics: subject " + s.name + "'s mmw_level equals physics.base_background_gray (" +
                        std::to_string(s.mmw_level) + "), so its base image cannot be read as kelvin");
+  // A view with a raw grid of its own was checked against its size when the catalogue was read.
   for (const Sensor& s : cat.sensors)
-    if (s.camera == Camera::mmw && (plan.model.raw_width > s.width || plan.model.raw_height > s.height))
+    if (s.camera == Camera::mmw && !s.raw && (plan.model.raw_width > s.width || plan.model.raw_height > s.height))
       throw InputError("--mmw-raw: " + std::to_string(plan.model.raw_width) + "x" +
                        std::to_string(plan.model.raw_height) + " is finer than the " + s.name + " view (" +
                        std::to_string(s.width) + "x" + std::to_string(s.height) + ")");

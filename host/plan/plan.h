@@ -54,6 +54,9 @@ struct ModelSettings {
   double window_lo = 290.0, window_hi = 302.0;
   DisplayFilter display_filter = DisplayFilter::bilinear;
   double smooth = 0.0;
+  // The knobs as view `s` takes them: its own camera parameters (Sensor::netd, raw) over
+  // the run's. Both backends read a view's knobs through this, and nothing else.
+  ModelSettings for_view(const Sensor& s) const;
   bool transforms() const { return rotate_lo != 0 || rotate_hi != 0 || scale_lo != 1 || scale_hi != 1 || flip; }
   bool moves_sprites() const { return bilinear || jitter > 0 || transforms(); }
 };
@@ -120,22 +123,6 @@ struct Plan {
   // Per-pixel noise drawn pixel by pixel (otherwise none, or the block-mean model).
   bool pixel_noise_per_pixel() const {
     return model.pixel_sigma > 0 && (images != 0 || fidelity.noise == NoiseModel::per_pixel);
-  }
-  // The plan's half of thesis_sparse_features's gate (backend/opencl/paths/), which also checks
-  // the views' chains and alone decides. Block sums stay exact in fp32 (255 * 256^2 < 2^24).
-  bool sparse_features() const {
-    return features && images == 0 && model.model == Model::thesis && fidelity.pooling == Pooling::sparse &&
-           !pixel_noise_per_pixel() && model.block <= 256 && !model.moves_sprites();
-  }
-  // The plan's half of physics_raw_features's gate (backend/opencl/paths/), which also needs
-  // physics_raw's chain on every pooled view and alone decides: features only, block-mean
-  // noise model (the raw grid leaves single pixels' rounding and clipping out), fused.
-  // The camera's knobs: its tables fold the bilinear interpolation and a fixed window into
-  // each feature, so the automatic window, the bicubic filter and smoothing take the dense path.
-  bool physics_sparse_features() const {
-    return features && images == 0 && model.model == Model::physics && fidelity.pooling == Pooling::sparse &&
-           fidelity.noise == NoiseModel::block_mean && fidelity.fused && !model.window_auto &&
-           model.display_filter == DisplayFilter::bilinear && model.smooth == 0;
   }
   // The MMW camera's frames as the kernels draw them: one each, or (block-mean noise model,
   // the fast tier) one draw of NETD / sqrt(frames).

@@ -222,7 +222,7 @@ void read_views(const Reader& rd, const toml::table& root, Catalogue& cat) {
   for (size_t i = 0; i < views.size(); ++i) {
     const toml::table& t = *views.get(i)->as_table();
     const std::string f = "views[" + std::to_string(i + 1) + "]";
-    io::reject_unknown_keys(t, {"name", "camera", "side", "size", "field", "pooled"}, rd.file, f);
+    io::reject_unknown_keys(t, {"name", "camera", "side", "size", "field", "pooled", "netd", "raw"}, rd.file, f);
     Sensor s;
     s.name = rd.string(t, "name", f);
     const bool name_ok =
@@ -254,6 +254,17 @@ void read_views(const Reader& rd, const toml::table& root, Catalogue& cat) {
     if (const toml::node* pn = t.get("pooled")) {
       if (!pn->is_boolean()) rd.fail(pn, f + ".pooled", "expected true or false");
       s.pooled = pn->as_boolean()->get();
+    }
+    // The camera's own numbers where they differ from the run's knobs (the knobs' ranges).
+    if (t.get("netd")) s.netd = rd.number(t, "netd", f, 0.0, s.camera == Camera::ir ? 10.0 : 100.0);
+    if (const toml::node* rn = t.get("raw")) {
+      if (s.camera != Camera::mmw) rd.fail(rn, f + ".raw", "a raw grid is an MMW camera's; this view's camera is ir");
+      const std::vector<int> raw = rd.ints(rn, f + ".raw", 2, 1, 4096);
+      if (raw[0] > s.width || raw[1] > s.height)
+        rd.fail(rn, f + ".raw",
+                std::to_string(raw[0]) + "x" + std::to_string(raw[1]) + " is finer than the view (" +
+                    std::to_string(s.width) + "x" + std::to_string(s.height) + ")");
+      s.raw = std::array<int, 2>{raw[0], raw[1]};
     }
     cat.sensors.push_back(std::move(s));
   }

@@ -63,7 +63,12 @@ struct Sensor {
   uint32_t region_mask = 0;
   bool pattern_noise = false;  // the thesis's MMW noise patterns are laid over objects
   bool pooled = false;         // its block and region means are features
-  bool palette = false;        // stored as a temperature index, written through the palette
+  // The physics model's camera, where this view's differs from the run's knobs
+  // (ModelSettings::for_view): its NETD, K rms (an MMW view's per raw pixel, over --netd;
+  // an IR view's per pixel, over --ir-netd), and an MMW view's raw grid (over --mmw-raw).
+  std::optional<double> netd;
+  std::optional<std::array<int, 2>> raw;
+  bool palette = false;  // stored as a temperature index, written through the palette
   // Jitter is given in MMW pixels (field units); this view's pixels per field unit.
   double jitter_scale_x = 1.0, jitter_scale_y = 1.0;
   // The floor's row in this view's pixel coordinates (the bottom edge of the lower MMW

@@ -29,6 +29,7 @@ struct Portal {
   struct View {
     std::string name, camera, side;
     bool pooled = false;
+    std::string own_camera;  // "NETD 4 K, raw grid 24x24": its own camera's numbers, if any
   };
   std::vector<View> views;
   int regions = 0, zones = 0;
@@ -36,8 +37,14 @@ struct Portal {
   static Portal of(const json& manifest) {
     const json& p = manifest.at("catalogue").at("portal");
     Portal out;
-    for (const json& v : p.at("views"))
-      out.views.push_back({v.at("name"), v.at("camera"), v.at("side"), v.at("pooled").get<bool>()});
+    for (const json& v : p.at("views")) {
+      View view{v.at("name"), v.at("camera"), v.at("side"), v.at("pooled").get<bool>(), ""};
+      if (v.contains("netd")) view.own_camera = "NETD " + json(v.at("netd").get<double>()).dump() + " K";
+      if (v.contains("raw"))
+        view.own_camera +=
+            (view.own_camera.empty() ? "" : ", ") + std::string("raw grid ") + v.at("raw").get<std::string>();
+      out.views.push_back(std::move(view));
+    }
     out.regions = p.at("regions").get<int>();
     out.zones = p.at("zones").get<int>();
     return out;
@@ -567,6 +574,9 @@ std::string card_text(const json& m, const Description& d) {
        ".\n";
   y += "- **Sensor model:** `" + s.value("model", "thesis") + "`, tier `" + s.value("tier", "standard") +
        "`; every parameter is in the front matter's `sensor_model`.\n";
+  for (const Portal::View& v : p.views)
+    if (!v.own_camera.empty())
+      y += "- **View " + v.name + "** has a camera of its own, over the run's parameters: " + v.own_camera + ".\n";
   y += "- **Make it again** (the same bytes; `--batch`, `--threads` and MPI ranks never change them):\n\n";
   y += "  ```sh\n  " + regenerate_command(m) + "\n  ```\n\n";
   y += "## Files\n\n| file | what it holds |\n| --- | --- |\n";

@@ -112,9 +112,13 @@ json run_identity(const RunSpec& spec, const Catalogue& cat, uint64_t total, con
   identity["portalsim"] = PORTALSIM_VERSION;
   // The portal it describes, so that the dataset card can say what the data hold.
   json views = json::array();
-  for (const Sensor& v : cat.sensors)
-    views.push_back(
-        {{"name", v.name}, {"camera", camera_name(v.camera)}, {"side", side_name(v.side)}, {"pooled", v.pooled}});
+  for (const Sensor& v : cat.sensors) {
+    json view{{"name", v.name}, {"camera", camera_name(v.camera)}, {"side", side_name(v.side)}, {"pooled", v.pooled}};
+    // A camera of its own (the physics model's knobs it keeps whatever the run's).
+    if (v.netd) view["netd"] = *v.netd;
+    if (v.raw) view["raw"] = std::to_string((*v.raw)[0]) + "x" + std::to_string((*v.raw)[1]);
+    views.push_back(std::move(view));
+  }
   identity["catalogue"] = {{"source", cat.source},
                            {"hash", cat.hash},
                            {"portal", {{"views", views}, {"regions", cat.region_count()}, {"zones", cat.zones}}}};
@@ -314,11 +318,11 @@ void write_manifest(const std::string& dir, std::vector<std::unique_ptr<Sink>>& 
 // About 16 MiB of outputs: the batch being written and the next being computed fit in a
 // 32 MiB last-level cache together, so the writer mostly reads the kernels' output from the
 // cache rather than from memory (docs/guide/deep-learning.md).
-size_t default_batch(const Plan& plan, const Catalogue& cat) {
+size_t default_batch(const Plan& plan, const Catalogue& cat, const Backend& backend) {
   size_t bytes = 64 + static_cast<size_t>(cat.zones);
-  for (size_t k = 0; k < cat.sensors.size(); ++k)
-    if (plan.renders(cat.sensors[k], static_cast<int>(k))) bytes += cat.sensors[k].pixels();
-  if (plan.sparse_features()) bytes = 64 + static_cast<size_t>(cat.zones);  // no images, on the device either
+  // The views its paths render ("upper: thesis_images"); a features path renders none.
+  for (const std::string& taken : backend.paths(plan))
+    if (const int k = cat.sensor_index(taken.substr(0, taken.find(':'))); k >= 0) bytes += cat.sensors[k].pixels();
   if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
   // A multiple of data.h5's chunk rows: a batch ends where a chunk does, so no piece of it
   // waits in memory for the next batch before the file's hash can take it (file_order_hash.h).
@@ -344,7 +348,7 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   res.end = source.total() * (opt.shard + 1) / opt.shards;
 
   const Plan plan = run_plan(spec, cat);
-  res.batch = opt.batch ? opt.batch : default_batch(plan, cat);
+  res.batch = opt.batch ? opt.batch : default_batch(plan, cat, backend);
   const unsigned threads = opt.threads ? opt.threads : default_threads();
   const json identity = run_identity(spec, cat, source.total(), opt, res);
 

@@ -39,7 +39,8 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
 // parameters differ (naming every key that does).
 bool holds_finished_run(const RunSpec& spec, const Catalogue& cat, const std::string& dir, bool resume);
 
-// Scenarios per batch for a plan: about 16 MiB of outputs, between 64 and 16384.
-size_t default_batch(const Plan& plan, const Catalogue& cat);
+// Scenarios per batch for a plan on `backend`: about 16 MiB of outputs and rendered views
+// (those its paths render), between 64 and 16384.
+size_t default_batch(const Plan& plan, const Catalogue& cat, const Backend& backend);
 
 }  // namespace portalsim

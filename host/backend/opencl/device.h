@@ -1,5 +1,5 @@
 // What every path of the OpenCL backend works with: the catalogue on the device, the
-// physics parameters, the scratch buffers that grow with the batch, and the batch itself.
+// derivations of each view's launch, the scratch buffers that grow with the batch, and the batch itself.
 #pragma once
 #include <CL/opencl.hpp>
 #include <vector>
@@ -7,15 +7,15 @@
 #include "assets/assets.h"
 #include "backend/opencl/buffers.h"
 #include "backend/opencl/device_catalogue.h"
-#include "backend/opencl/physics_params.h"
 #include "backend/opencl/runtime.h"
+#include "backend/opencl/view_derive.h"
 #include "scene/catalogue.h"
 
 namespace portalsim::opencl {
 
 struct Device {
   Device(const Catalogue& c, const AssetSet& a, OpenCLRuntime& r)
-      : cat(c), assets(a), rt(r), data(c, a, r.context()), physics(c, a, r.context()), pooled_only(c.sensors.size()) {}
+      : cat(c), assets(a), rt(r), data(c, a, r.context()), derived(c, a, r.context()), pooled_only(c.sensors.size()) {}
   cl::Context& ctx() { return rt.context(); }
   cl::CommandQueue& queue() { return rt.queue(); }
 
@@ -23,7 +23,7 @@ struct Device {
   const AssetSet& assets;
   OpenCLRuntime& rt;
   DeviceCatalogue data;
-  PhysicsParams physics;
+  ViewDerivations derived;  // what each (plan, view) launch reads
   // A view launch's placement records, field between stages, MMW raw grid and per-scenario
   // scratch (kernels/composite.cl, VIEW_STAGE_ARGS).
   Grown records, field, raw, view_scratch;

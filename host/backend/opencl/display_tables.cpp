@@ -84,10 +84,10 @@ DisplayTables append_display_tables(std::vector<double>& p, const ModelSettings&
   return t;
 }
 
-int kernel_frames(const Plan& plan) { return plan.frames_approximated() ? 1 : plan.model.frames; }
+int kernel_frames(const Plan& plan, const ModelSettings& m) { return plan.frames_approximated() ? 1 : m.frames; }
 
-double kernel_netd(const Plan& plan) {
-  return plan.frames_approximated() ? plan.model.netd / std::sqrt(double(plan.model.frames)) : plan.model.netd;
+double kernel_netd(const Plan& plan, const ModelSettings& m) {
+  return plan.frames_approximated() ? m.netd / std::sqrt(double(m.frames)) : m.netd;
 }
 
 }  // namespace portalsim::opencl

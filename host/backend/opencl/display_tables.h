@@ -18,8 +18,9 @@ struct DisplayTables {
 DisplayTables append_display_tables(std::vector<double>& p, const ModelSettings& m, int W, int H, int RW, int RH);
 
 // The frames the kernels draw, and the NETD each frame's draw is scaled from: every frame
-// with the NETD, or, where the plan approximates them, one frame of NETD / sqrt(frames).
-int kernel_frames(const Plan& plan);
-double kernel_netd(const Plan& plan);
+// with the NETD, or, where the plan approximates them, one frame of NETD / sqrt(frames);
+// `m` is the view's knobs (ModelSettings::for_view).
+int kernel_frames(const Plan& plan, const ModelSettings& m);
+double kernel_netd(const Plan& plan, const ModelSettings& m);
 
 }  // namespace portalsim::opencl

@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "backend/opencl/gauss_table.h"
-#include "backend/opencl/table_key.h"
 #include "shared.h"
 
 namespace portalsim::opencl {
@@ -59,49 +58,26 @@ size_t mmw_display_scratch(const Sensor& s, int raw_width, int raw_height) {
   return PS_MMW_DISPLAY_SCRATCH(s.width, s.height, raw_width, raw_height);
 }
 
-cl::Buffer PhysicsParams::operator()(bool fp64, const Plan& plan, int view, PsViewLaunch& L) {
-  L.psf_radius = L.phys_wx = L.phys_wy = L.phys_cband = L.phys_rband = L.phys_base = L.phys_gauss = 0;
-  L.phys_off_body = 0;
-  L.display_stride = L.phys_dx = L.phys_dxband = L.phys_dy = L.phys_dyband = 0;
-  if (plan.model.model != Model::physics) return none_.at_least(ctx_, 16);
-  Tables& t = tables_[table_key(plan, "view=" + std::to_string(view) + ";fp64=" + std::to_string(fp64))];
-  if (t.values.empty()) t = make(plan, cat_.sensors[view], view);
-  L.psf_radius = t.radius;
-  L.phys_wx = t.wx;
-  L.phys_wy = t.wy;
-  L.phys_cband = t.cband;
-  L.phys_rband = t.rband;
-  L.phys_base = t.base;
-  L.phys_gauss = t.gauss;
-  L.phys_off_body = t.off_body;
-  L.display_stride = t.display.stride;
-  L.phys_dx = t.display.dx;
-  L.phys_dxband = t.display.dxband;
-  L.phys_dy = t.display.dy;
-  L.phys_dyband = t.display.dyband;
-  if (!t.buffer()) t.buffer = params(ctx_, fp64, t.values);
-  return t.buffer;
-}
-
-PhysicsParams::Tables PhysicsParams::make(const Plan& plan, const Sensor& s, int view) const {
-  const PhysicsConfig& pc = cat_.physics;
-  const ModelSettings& m = plan.model;
+PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const Plan& plan, const ModelSettings& m,
+                             int view) {
+  const Sensor& s = cat.sensors[view];
+  const PhysicsConfig& pc = cat.physics;
   const bool ir = s.camera == Camera::ir;
   const auto seen = [&](double e, double t) {
     return pc.clothing_transmission * (e * t + (1 - e) * m.illumination) +
            (1 - pc.clothing_transmission) * pc.clothing_temperature;
   };
-  Tables t;
+  PhysicsTables t;
   std::vector<double>& p = t.values;
   p.assign(PS_PHYS_SUBJECTS, 0.0);
   p[PS_PHYS_BACKGROUND] = pc.background_temperature;
   p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : m.window_lo;
   p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : m.window_hi;
-  p[PS_PHYS_NETD] = ir ? m.ir_netd : kernel_netd(plan);
+  p[PS_PHYS_NETD] = ir ? m.ir_netd : kernel_netd(plan, m);
   // Per subject, its base image's value to kelvin: the IR index map, or the MMW's gray
   // between the room behind and the bare body.
   const double body = seen(pc.skin_emissivity, pc.skin_temperature);
-  for (const Subject& subj : cat_.subjects) {
+  for (const Subject& subj : cat.subjects) {
     const double gain = ir ? (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0
                            : (body - pc.background_temperature) / (subj.mmw_level - pc.base_background_gray);
     p.push_back(gain);
@@ -110,8 +86,8 @@ PhysicsParams::Tables PhysicsParams::make(const Plan& plan, const Sensor& s, int
   // Per variant: the IR surface's contact shadow (and, for phys_off_body, the same against
   // the room), or the MMW apparent temperature.
   std::vector<double> off_body_shadow;
-  for (size_t v = 0; v < cat_.variant_list.size(); ++v) {
-    const Material& mat = cat_.materials.at(cat_.object_of(static_cast<int>(v)).material_id);
+  for (size_t v = 0; v < cat.variant_list.size(); ++v) {
+    const Material& mat = cat.materials.at(cat.object_of(static_cast<int>(v)).material_id);
     const double worn = worn_temperature(pc, mat, m.worn_minutes);
     p.push_back(ir ? -pc.ir_coupling * (pc.skin_temperature - worn) : seen(mat.emissivity, worn));
     if (ir) off_body_shadow.push_back(-pc.ir_coupling * (pc.room_temperature - worn));
@@ -138,7 +114,7 @@ PhysicsParams::Tables PhysicsParams::make(const Plan& plan, const Sensor& s, int
     std::vector<double> off_body;
     const double per_index = (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0;
     const double body_from = (pc.room_temperature + pc.skin_temperature) / 2;
-    for (size_t subj = 0; subj < cat_.subjects.size(); ++subj)
+    for (size_t subj = 0; subj < cat.subjects.size(); ++subj)
       off_body.push_back(std::ceil((body_from - pc.ir_index_min_k) / per_index));
     off_body.insert(off_body.end(), off_body_shadow.begin(), off_body_shadow.end());
     t.off_body = append(off_body);
@@ -155,9 +131,9 @@ PhysicsParams::Tables PhysicsParams::make(const Plan& plan, const Sensor& s, int
   t.rband = append(rband);
   t.display = append_display_tables(p, m, W, H, RW, RH);
   // Each subject's bare raw grid: wy . T . wx^T over its base image in kelvin.
-  std::vector<double> bare(cat_.subjects.size() * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
-  for (size_t subj = 0; subj < cat_.subjects.size(); ++subj) {
-    const Image& base = assets_.bases[subj][view];
+  std::vector<double> bare(cat.subjects.size() * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
+  for (size_t subj = 0; subj < cat.subjects.size(); ++subj) {
+    const Image& base = assets.bases[subj][view];
     const double gain = p[PS_PHYS_SUBJECTS + 2 * subj], offset = p[PS_PHYS_SUBJECTS + 2 * subj + 1];
     std::fill(rows.begin(), rows.end(), 0.0);
     for (int y = 0; y < H; ++y)

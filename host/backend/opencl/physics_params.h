@@ -1,47 +1,26 @@
-// The physics model's parameters for a view's launch (kernels/shared.h, PS_PHYS_*), at the
-// kernels' parameter precision, with the MMW raw-grid path's tables. The same formulas as
-// the reference's, written again here: the two never share code. Kept per (view, knobs,
-// precision): the bare raw grids cost a few milliseconds.
+// The physics model's parameters for a view's launch (kernels/shared.h, PS_PHYS_*), with the
+// MMW raw-grid path's tables; view_derive.h keeps them per (plan, view). The same formulas
+// as the reference's, written again here: the two never share code.
 #pragma once
-#include <CL/opencl.hpp>
-#include <map>
-#include <string>
+#include <cstdint>
 #include <vector>
 
 #include "assets/assets.h"
-#include "backend/opencl/buffers.h"
 #include "backend/opencl/display_tables.h"
-#include "base/lru_cache.h"
 #include "plan/plan.h"
 #include "scene/catalogue.h"
 
 namespace portalsim::opencl {
 
-class PhysicsParams {
- public:
-  PhysicsParams(const Catalogue& cat, const AssetSet& assets, cl::Context& ctx)
-      : cat_(cat), assets_(assets), ctx_(ctx) {}
-  // The parameters of `view` under `plan`; fills L's offsets into them (all 0, and a
-  // placeholder buffer, under the thesis model).
-  cl::Buffer operator()(bool fp64, const Plan& plan, int view, PsViewLaunch& L);
-
-  struct Tables {
-    std::vector<double> values;
-    int32_t radius = 0, wx = 0, wy = 0, cband = 0, rband = 0, base = 0, gauss = 0, off_body = 0;
-    DisplayTables display;  // stage_mmw_display's (MMW views)
-    cl::Buffer buffer;
-  };
-
- private:
-  Tables make(const Plan& plan, const Sensor& s, int view) const;
-
-  const Catalogue& cat_;
-  const AssetSet& assets_;
-  cl::Context& ctx_;
-  // Per (knobs, view, precision); a run uses one per view and precision.
-  LruCache<std::string, Tables> tables_{32};
-  Grown none_;
+// The physics parameters and tables of view `view`, its knobs `m` (ModelSettings::for_view)
+// under `plan`: the values, and where each table starts in them (PsViewLaunch's phys_*).
+struct PhysicsTables {
+  std::vector<double> values;
+  int32_t radius = 0, wx = 0, wy = 0, cband = 0, rband = 0, base = 0, gauss = 0, off_body = 0;
+  DisplayTables display;  // stage_mmw_display's (MMW views)
 };
+PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const Plan& plan, const ModelSettings& m,
+                             int view);
 
 // stage_mmw_display's scratch values per scenario: each view row's vertically
 // interpolated raw row, then 16 values per raw row for the pixels after the last run of 16.

@@ -30,13 +30,15 @@ class ReferenceBackend final : public Backend {
     const int views = static_cast<int>(cat_.sensors.size());
     std::vector<std::vector<uint8_t>> images(views);
     reference::Field field;
+    std::vector<ModelSettings> view_model;  // each view's knobs, its own camera's numbers over the run's
+    for (const Sensor& sensor : cat_.sensors) view_model.push_back(plan.model.for_view(sensor));
     for (size_t i = 0; i < n; ++i) {
       const Scenario s = batch.at(i);
       const uint64_t index = batch.first_index + i;
       for (int k = 0; k < views; ++k) {
         const Sensor& sensor = cat_.sensors[k];
         if (!plan.renders(sensor, k)) continue;
-        reference::ViewScene vs = reference::view_scene(cat_, assets_, plan.model, k, s, index);
+        reference::ViewScene vs = reference::view_scene(cat_, assets_, view_model[k], k, s, index);
         vs.follow(plan);
         for (const std::string& stage : sensor.chain_for(plan.model.model)) view_stage(stage).reference(vs, field);
         images[k].assign(field.v.begin(), field.v.end());  // display left whole numbers 0..255

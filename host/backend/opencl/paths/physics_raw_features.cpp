@@ -11,8 +11,6 @@
 #include "backend/opencl/launch.h"
 #include "backend/opencl/paths/paths.h"
 #include "backend/opencl/raw_grid_pooling.h"
-#include "backend/opencl/table_key.h"
-#include "base/lru_cache.h"
 #include "base/sizes.h"
 
 namespace portalsim::opencl {
@@ -30,20 +28,21 @@ bool boxes_meet(const Rect& a, const Rect& b) {
   return a.x - 2 < b.x + b.w + 2 && b.x - 2 < a.x + a.w + 2 && a.y - 2 < b.y + b.h + 2 && b.y - 2 < a.y + a.h + 2;
 }
 
-// The plan of the raw grid: without sensor noise, which is drawn per feature.
-Plan quiet(const Plan& plan) {
-  Plan q = plan;
-  q.model.netd = 0;
-  return q;
-}
-
 class PhysicsRawFeatures final : public FeaturePath {
  public:
   explicit PhysicsRawFeatures(Device& d) : d_(d) {}
   const char* name() const override { return "physics_raw_features"; }
   enum Variant { kUntabulated, kTabulated };
+  // Features only, physics model, sparse pooling, the block-mean noise model (the raw grid
+  // leaves single pixels' rounding and clipping out), fused, and physics_raw's chain on the
+  // view. The tables fold the bilinear interpolation and a fixed window into each feature,
+  // so the automatic window, the bicubic filter and smoothing take the dense path.
   Gate gate(const Plan& plan, const Sensor& sensor) const override {
-    if (!plan.physics_sparse_features() || !physics_raw_path().applies(quiet(plan), sensor)) return {};
+    const ModelSettings& m = plan.model;
+    const bool plan_ok = plan.features && plan.images == 0 && m.model == Model::physics &&
+                         plan.fidelity.pooling == Pooling::sparse && plan.fidelity.noise == NoiseModel::block_mean &&
+                         !m.window_auto && m.display_filter == DisplayFilter::bilinear && m.smooth == 0;
+    if (!plan_ok || !physics_raw_path().applies(plan, sensor)) return {};
     // Tables where objects stand at their places, and while the pairs' index (subjects x
     // (variants x regions)^2) stays small.
     const size_t combos = d_.cat.variant_list.size() * d_.cat.regions.size();
@@ -55,13 +54,16 @@ class PhysicsRawFeatures final : public FeaturePath {
   void features(Kernels& K, const Plan& plan, const Gate& g, const DeviceBatch& b, cl::Buffer& feats) override;
 
  private:
-  struct Tables {
+  // A pooled view's tables, kept with its derivation under the noise-free plan.
+  struct Tables final : PathTables {
+    bool tabulated = false;
     int count = 0;
     cl::Buffer first, cells, weights, columns;
     cl_int8 dims{};  // blocks_x, blocks_y, band_x, band_y, regions (RawGridNoise), the first block's column
     cl::Buffer noise, base_features, object_range, object_feature, object_value;
   };
-  Tables& tables(Kernels& K, const Plan& quiet, const FeatureLayout& lay, int slot, bool tabulated);
+  Tables& tables(Kernels& K, const Plan& plan, ViewDerived& derived, const FeatureLayout& lay, int slot,
+                 bool tabulated);
   // The raw grid of view `view` for batch b (place_view, then physics_raw) into Device::raw.
   void raw_grid(ViewLaunch& v) {
     v.run("place_view", v.batch.n);
@@ -69,8 +71,6 @@ class PhysicsRawFeatures final : public FeaturePath {
   }
 
   Device& d_;
-  // Per (knobs, view, tabulated, program variant); a run uses one per pooled view.
-  LruCache<std::string, Tables> tables_{8};
   Grown scratch_;
 };
 
@@ -78,13 +78,15 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const Gate& g, c
                                   cl::Buffer& feats) {
   const Catalogue& cat = d_.cat;
   const FeatureLayout lay = FeatureLayout::of(cat, plan.model.block);
-  const Plan q = quiet(plan);
   const bool tabulated = g.variant == kTabulated;
   cl::Context& ctx = d_.ctx();
   for (size_t slot = 0; slot < lay.pooled.size(); ++slot) {
     const int view = lay.pooled[slot];
-    Tables& t = tables(K, q, lay, static_cast<int>(slot), tabulated);
-    ViewLaunch v(d_, K, q, view, b, d_.pooled_only[view].at_least(ctx, 1), false, tabulated);
+    // The tables first: making them runs a batch of their own through the same buffers. The
+    // raw grid is noise-free: physics_features draws the NETD per feature.
+    const std::shared_ptr<ViewDerived> derived = d_.derived(plan, view, true);
+    Tables& t = tables(K, plan, *derived, lay, static_cast<int>(slot), tabulated);
+    ViewLaunch v(d_, K, plan, view, b, d_.pooled_only[view].at_least(ctx, 1), false, tabulated, true);
     raw_grid(v);
     const auto& d = t.dims.s;
     const size_t per = PS_FEATURE_SPACE(size_t(d[0]), size_t(d[1]), size_t(d[2]), size_t(d[3]), size_t(d[4]));
@@ -102,7 +104,7 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const Gate& g, c
                                    .weights = t.weights,
                                    .columns = t.columns,
                                    .count = t.count,
-                                   .raw_cells = plan.model.raw_width * plan.model.raw_height,
+                                   .raw_cells = static_cast<int>(v.derived->raw_values),
                                    .phys = v.args().phys,
                                    .row_len = lay.image_features(),
                                    .features = feats,
@@ -114,7 +116,7 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const Gate& g, c
                                    .object_range = t.object_range,
                                    .object_feature = t.object_feature,
                                    .object_value = t.object_value,
-                                   .sd = {kernel_netd(plan)},
+                                   .sd = {kernel_netd(plan, plan.model.for_view(cat.sensors[view]))},
                                    .dims = t.dims,
                                    .noise = t.noise,
                                    .scratch = scratch};
@@ -128,20 +130,20 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const Gate& g, c
 // and each (subject, variant, region)'s change to them, made by physics_raw itself on one
 // scenario per object (so a tabulated scenario differs from its raw grid only in the order
 // of float sums).
-PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& quiet, const FeatureLayout& lay,
-                                                       int slot, bool tabulated) {
+PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& plan, ViewDerived& derived,
+                                                       const FeatureLayout& lay, int slot, bool tabulated) {
   const Catalogue& cat = d_.cat;
   const int view = lay.pooled[slot];
   const Sensor& sv = cat.sensors[view];
-  const ModelSettings& m = quiet.model;
+  const ModelSettings& m = derived.model;
   const int RW = m.raw_width, RH = m.raw_height, cells = RW * RH;
-  // Per program variant too (&K): tables made by another variant's arithmetic (fast math)
-  // would make a run's features depend on what ran before it.
-  char variant[32];
-  std::snprintf(variant, sizeof variant, "%p", static_cast<const void*>(&K));
-  Tables& t = tables_[table_key(
-      quiet, "view=" + std::to_string(view) + ";tabulated=" + std::to_string(tabulated) + ";variant=" + variant)];
-  if (t.first()) return t;
+  // The derivation's key holds every knob, so the program variant (precision, fast math)
+  // whose arithmetic made them too.
+  std::unique_ptr<PathTables>& kept = derived.path_tables;
+  if (auto* t = dynamic_cast<Tables*>(kept.get()); t && t->tabulated == tabulated) return *t;
+  auto made = std::make_unique<Tables>();  // kept only once whole
+  Tables& t = *made;
+  t.tabulated = tabulated;
   cl::Context& ctx = d_.ctx();
   const bool fp64 = K.fp64();
   const RawGridPooling p = raw_grid_pooling(sv, lay, slot, RW, RH);
@@ -203,7 +205,7 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& q
                                   .objects = constant(ctx, b.objects),
                                   .seed = {{0, 0}},
                                   .first = {{0, 0}}};
-    ViewLaunch v(d_, K, quiet, view, table_batch, d_.pooled_only[view].at_least(ctx, 1), false);
+    ViewLaunch v(d_, K, plan, view, table_batch, d_.pooled_only[view].at_least(ctx, 1), false, false, true);
     raw_grid(v);
     std::vector<double> raw(N * cells);
     if (fp64) {
@@ -260,7 +262,8 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& q
   t.object_range = constant(ctx, object_range);
   t.object_feature = constant(ctx, features);
   t.object_value = params(ctx, fp64, values);
-  t.first = constant(ctx, p.first);  // last: a table without it is made again
+  t.first = constant(ctx, p.first);
+  kept = std::move(made);
   return t;
 }
 

@@ -4,11 +4,10 @@
 // image is rendered. It implements the thesis chain on MMW views whose sprites stay at
 // their places, with no per-pixel noise (the block-mean model adds its noise after).
 #include <algorithm>
-#include <map>
+#include <memory>
 
 #include "backend/opencl/launch.h"
 #include "backend/opencl/paths/paths.h"
-#include "backend/opencl/table_key.h"
 
 namespace portalsim::opencl {
 
@@ -19,10 +18,15 @@ class ThesisSparseFeatures final : public FeaturePath {
   explicit ThesisSparseFeatures(Device& d) : d_(d) {}
   const char* name() const override { return "thesis_sparse_features"; }
   enum Variant { kNoPatterns, kPatterns };
-  // The chain the tables implement: thesis_images's; with pattern noise, the tables hold a
-  // footprint's change per noise pattern and each scenario's patterns are drawn first.
+  // Features only, thesis model, sparse pooling, no per-pixel noise, sprites at their places,
+  // and the chain the tables implement: thesis_images's; with pattern noise, the tables hold
+  // a footprint's change per noise pattern and each scenario's patterns are drawn first.
+  // Block sums stay exact in fp32 (255 * 256^2 < 2^24).
   Gate gate(const Plan& plan, const Sensor& sensor) const override {
-    if (!plan.sparse_features() || sensor.camera != Camera::mmw ||
+    const bool plan_ok = plan.features && plan.images == 0 && plan.model.model == Model::thesis &&
+                         plan.fidelity.pooling == Pooling::sparse && !plan.pixel_noise_per_pixel() &&
+                         plan.model.block <= 256 && !plan.model.moves_sprites();
+    if (!plan_ok || sensor.camera != Camera::mmw ||
         sensor.chain_for(plan.model.model) != thesis_images_path().chain() ||
         !FeatureLayout::of(d_.cat, plan.model.block).uniform)
       return {};
@@ -32,26 +36,27 @@ class ThesisSparseFeatures final : public FeaturePath {
   void features(Kernels& K, const Plan& plan, const Gate& g, const DeviceBatch& b, cl::Buffer& feats) override;
 
  private:
-  struct Tables {
-    std::string key;
+  // The tables of every pooled view, kept with the first pooled view's derivation.
+  struct Tables final : PathTables {
     int patterns = 1;
     bool noise = false;
     cl::Buffer fps, deltas, region_deltas, base_sums, base_means;
   };
-  Tables& tables(Kernels& K, const Plan& plan, bool noise);
+  Tables& tables(Kernels& K, const Plan& plan, ViewDerived& derived, bool noise);
   // The tables assume every pooled view has the first one's size (the gate's uniform).
   const Sensor& pooled_view(const FeatureLayout& lay) const { return d_.cat.sensors[lay.pooled.at(0)]; }
 
   Device& d_;
-  std::map<const Kernels*, Tables> tables_;  // per program variant: the last knobs' tables
   Grown patterns_;
 };
 
-ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Plan& plan, bool noise) {
-  Tables& t = tables_[&K];
-  const std::string key = table_key(plan, "");
-  if (t.key == key) return t;
-  t.key.clear();  // until the tables below are whole
+ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Plan& plan, ViewDerived& derived,
+                                                           bool noise) {
+  // The derivation's key holds every knob, so the program variant whose arithmetic made them.
+  std::unique_ptr<PathTables>& kept = derived.path_tables;
+  if (auto* t = dynamic_cast<Tables*>(kept.get()); t && t->noise == noise) return *t;
+  auto made = std::make_unique<Tables>();  // kept only once whole
+  Tables& t = *made;
   const Catalogue& cat = d_.cat;
   const DeviceCatalogue& c = d_.data;
   const ImagesConfig& ic = cat.images;
@@ -156,17 +161,18 @@ ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Pla
   q.finish();
   t.noise = noise;
   t.patterns = P;
-  t.key = key;
+  kept = std::move(made);
   return t;
 }
 
 void ThesisSparseFeatures::features(Kernels& K, const Plan& plan, const Gate& g, const DeviceBatch& b,
                                     cl::Buffer& feats) {
-  const Tables& t = tables(K, plan, g.variant == kPatterns);
   const Catalogue& cat = d_.cat;
+  const FeatureLayout lay = FeatureLayout::of(cat, plan.model.block);
+  const std::shared_ptr<ViewDerived> derived = d_.derived(plan, lay.pooled.at(0));
+  const Tables& t = tables(K, plan, *derived, g.variant == kPatterns);
   const DeviceCatalogue& c = d_.data;
   const ImagesConfig& ic = cat.images;
-  const FeatureLayout lay = FeatureLayout::of(cat, plan.model.block);
   const Sensor& view = pooled_view(lay);
   cl::CommandQueue& q = d_.queue();
   cl::Buffer& patterns = patterns_.at_least(d_.ctx(), b.n * sizeof(cl_int));
