@@ -42,6 +42,35 @@ Other other_value(const Knob& k, const Plan& defaults) {
   return {};
 }
 
+// Each model knob's default is written once, in its declaration: a plan made with no
+// arguments holds each declared default. A fidelity knob's default is the tier's.
+TEST(Knobs, EachDefaultIsItsDeclaration) {
+  const Plan defaults;
+  for (const Knob& k : knobs()) {
+    SCOPED_TRACE(k.key);
+    if (k.fidelity) {
+      EXPECT_EQ(k.def, "") << "a fidelity knob's default is its tier's";
+      continue;
+    }
+    ASSERT_FALSE(k.def.empty());
+    Plan p{.model = ModelSettings(ModelSettings::Bare{}), .fidelity = {}};
+    set_knob(p, k, k.def, "test");
+    EXPECT_EQ(k.get(defaults), k.get(p));
+    EXPECT_EQ(knob_text(k.get(defaults)), k.def) << "the declared default reads back as written";
+  }
+  // The thesis's values, as the golden hashes were made with them.
+  const ModelSettings m;
+  EXPECT_EQ(m.model, Model::thesis);
+  EXPECT_EQ(m.block, 10);
+  EXPECT_EQ(m.netd, 3.0);
+  EXPECT_EQ(m.raw_width * 10000 + m.raw_height, 280028);
+  EXPECT_EQ(m.frames, 10);
+  EXPECT_TRUE(m.pattern_noise);
+  EXPECT_FALSE(m.transforms());
+  EXPECT_EQ(m.seed, 0u);
+  EXPECT_EQ(defaults.palette, procedural::PaletteName::ironbow);
+}
+
 TEST(Knobs, EachIsASpecKeyThatSetsThePlanAndReachesTheManifest) {
   ASSERT_GE(knobs().size(), 10u);
   const Plan defaults = RunSpec{}.settings();

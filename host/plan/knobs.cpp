@@ -17,9 +17,10 @@ std::string format_number(double v) {
 }
 
 // A knob of numbers within [lo, hi] (integer, number; each side of a grid).
-Knob bounded(KnobKind kind, std::string key, double lo, double hi, std::string unit, std::string help,
+Knob bounded(KnobKind kind, std::string key, std::string def, double lo, double hi, std::string unit, std::string help,
              std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
   return Knob{.key = std::move(key),
+              .def = std::move(def),
               .kind = kind,
               .min = lo,
               .max = hi,
@@ -29,21 +30,22 @@ Knob bounded(KnobKind kind, std::string key, double lo, double hi, std::string u
               .get = std::move(get)};
 }
 
-Knob integer(std::string key, int lo, int hi, std::string unit, std::string help,
+Knob integer(std::string key, std::string def, int lo, int hi, std::string unit, std::string help,
              std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
-  return bounded(KnobKind::integer, std::move(key), lo, hi, std::move(unit), std::move(help), std::move(set),
-                 std::move(get));
+  return bounded(KnobKind::integer, std::move(key), std::move(def), lo, hi, std::move(unit), std::move(help),
+                 std::move(set), std::move(get));
 }
 
-Knob number(std::string key, double lo, double hi, std::string unit, std::string help,
+Knob number(std::string key, std::string def, double lo, double hi, std::string unit, std::string help,
             std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
-  return bounded(KnobKind::number, std::move(key), lo, hi, std::move(unit), std::move(help), std::move(set),
-                 std::move(get));
+  return bounded(KnobKind::number, std::move(key), std::move(def), lo, hi, std::move(unit), std::move(help),
+                 std::move(set), std::move(get));
 }
 
-Knob on_off(std::string key, std::string help, bool fidelity, std::function<void(Plan&, double)> set,
+Knob on_off(std::string key, std::string def, std::string help, bool fidelity, std::function<void(Plan&, double)> set,
             std::function<nlohmann::json(const Plan&)> get) {
   return Knob{.key = std::move(key),
+              .def = std::move(def),
               .kind = KnobKind::on_off,
               .min = 0,
               .max = 1,
@@ -54,15 +56,16 @@ Knob on_off(std::string key, std::string help, bool fidelity, std::function<void
               .get = std::move(get)};
 }
 
-Knob grid(std::string key, int lo, int hi, std::string unit, std::string help, std::function<void(Plan&, double)> set,
-          std::function<nlohmann::json(const Plan&)> get) {
-  return bounded(KnobKind::grid, std::move(key), lo, hi, std::move(unit), std::move(help), std::move(set),
-                 std::move(get));
+Knob grid(std::string key, std::string def, int lo, int hi, std::string unit, std::string help,
+          std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
+  return bounded(KnobKind::grid, std::move(key), std::move(def), lo, hi, std::move(unit), std::move(help),
+                 std::move(set), std::move(get));
 }
 
-Knob choice(std::string key, std::vector<std::string> choices, std::string help, bool fidelity, bool identity,
-            std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
+Knob choice(std::string key, std::string def, std::vector<std::string> choices, std::string help, bool fidelity,
+            bool identity, std::function<void(Plan&, double)> set, std::function<nlohmann::json(const Plan&)> get) {
   return Knob{.key = std::move(key),
+              .def = std::move(def),
               .kind = KnobKind::choice,
               .choices = std::move(choices),
               .help = std::move(help),
@@ -73,9 +76,10 @@ Knob choice(std::string key, std::vector<std::string> choices, std::string help,
 }
 
 // A range A..B of numbers within [lo, hi]; `symmetric`: one number X means -X..X.
-Knob range(std::string key, double lo, double hi, bool symmetric, std::string unit, std::string help,
+Knob range(std::string key, std::string def, double lo, double hi, bool symmetric, std::string unit, std::string help,
            std::function<void(Plan&, double, double)> set, std::function<std::pair<double, double>(const Plan&)> get) {
   Knob k{.key = std::move(key),
+         .def = std::move(def),
          .kind = KnobKind::range,
          .min = lo,
          .max = hi,
@@ -95,38 +99,39 @@ std::vector<Knob> declare() {
   std::vector<Knob> k;
   // The sensor model (docs/model/thesis.md); defaults are the thesis's.
   k.push_back(choice(
-      "model", {"thesis", "physics"},
+      "model", "thesis", {"thesis", "physics"},
       "the sensor model: the thesis's composite (its exact examples), or the physically based one (apparent "
       "temperature, optics, raw grid, NETD; contact shadow in IR; coil fields and polarizability for metal)",
       false, true, [](Plan& p, double v) { p.model.model = static_cast<Model>(v); },
       [](const Plan& p) { return model_name(p.model.model); }));
   k.push_back(number(
-      "illumination", 1, 1000, "K",
+      "illumination", "293", 1, 1000, "K",
       "physics: the temperature the scene reflects (the room indoors; about 50 K for a clear sky outdoors)",
       [](Plan& p, double v) { p.model.illumination = v; }, [](const Plan& p) { return p.model.illumination; }));
   k.push_back(number(
-      "netd", 0, 100, "K", "physics: MMW sensor noise, rms per raw pixel (Vela 125: 3 K)",
+      "netd", "3", 0, 100, "K", "physics: MMW sensor noise, rms per raw pixel (Vela 125: 3 K)",
       [](Plan& p, double v) { p.model.netd = v; }, [](const Plan& p) { return p.model.netd; }));
   k.push_back(grid(
-      "mmw_raw", 1, 4096, "raw pixels", "physics: the MMW camera's raw grid over each view, at most the view's size",
+      "mmw_raw", "28x28", 1, 4096, "raw pixels",
+      "physics: the MMW camera's raw grid over each view, at most the view's size",
       [](Plan& p, double v) {
         p.model.raw_width = static_cast<int>(v) / 65536;
         p.model.raw_height = static_cast<int>(v) % 65536;
       },
       [](const Plan& p) { return std::to_string(p.model.raw_width) + "x" + std::to_string(p.model.raw_height); }));
   k.push_back(number(
-      "worn_minutes", 0, 1440, "minutes",
+      "worn_minutes", "5", 0, 1440, "minutes",
       "physics: how long the objects have been carried; they warm from the room towards the skin",
       [](Plan& p, double v) { p.model.worn_minutes = v; }, [](const Plan& p) { return p.model.worn_minutes; }));
   // The MMW camera's own processing (docs/model/physics-mmw.md).
   k.push_back(integer(
-      "frames", 1, 1000, "frames",
+      "frames", "10", 1, 1000, "frames",
       "physics: raw MMW frames at the camera's 10 Hz averaged into each image, each with its own NETD draw "
       "(the fast tier: one draw of NETD/sqrt(frames))",
       [](Plan& p, double v) { p.model.frames = static_cast<int>(v); }, [](const Plan& p) { return p.model.frames; }));
   {
     Knob w = range(
-        "window", 0, 1000, false, "K",
+        "window", "290..302", 0, 1000, false, "K",
         "physics: the MMW display window, kelvin shown as gray 0 and 255: fixed, or auto, per image from the raw "
         "grid's 1st and 99th percentiles as a camera's automatic gain does",
         [](Plan& p, double a, double b) {
@@ -139,40 +144,41 @@ std::vector<Knob> declare() {
     k.push_back(std::move(w));
   }
   k.push_back(choice(
-      "display_filter", {"bilinear", "bicubic"},
+      "display_filter", "bilinear", {"bilinear", "bicubic"},
       "physics: how the MMW raw grid is interpolated to the view's pixels (bicubic: Keys' cubic convolution, "
       "a = -1/2)",
       false, true, [](Plan& p, double v) { p.model.display_filter = static_cast<DisplayFilter>(v); },
       [](const Plan& p) { return p.model.display_filter == DisplayFilter::bicubic ? "bicubic" : "bilinear"; }));
   k.push_back(number(
-      "smooth", 0, 50, "view pixels",
+      "smooth", "0", 0, 50, "view pixels",
       "physics: sigma of a Gaussian smoothing of the MMW view after interpolation (0: none)",
       [](Plan& p, double v) { p.model.smooth = v; }, [](const Plan& p) { return p.model.smooth; }));
   k.push_back(number(
-      "ir_netd", 0, 10, "K", "physics: IR sensor noise, rms per pixel (thermal cameras: about 0.05 K)",
+      "ir_netd", "0.05", 0, 10, "K", "physics: IR sensor noise, rms per pixel (thermal cameras: about 0.05 K)",
       [](Plan& p, double v) { p.model.ir_netd = v; }, [](const Plan& p) { return p.model.ir_netd; }));
   k.push_back(integer(
-      "block", 1, 65536, "pixels", "side of the averaged pixel blocks of the features (thesis 5.6)",
+      "block", "10", 1, 65536, "pixels", "side of the averaged pixel blocks of the features (thesis 5.6)",
       [](Plan& p, double v) { p.model.block = static_cast<int>(v); }, [](const Plan& p) { return p.model.block; }));
   k.push_back(on_off(
-      "pattern_noise", "the thesis's MMW noise patterns, one over each object (thesis 4.2)", false,
+      "pattern_noise", "on", "the thesis's MMW noise patterns, one over each object (thesis 4.2)", false,
       [](Plan& p, double v) { p.model.pattern_noise = v != 0; }, [](const Plan& p) { return p.model.pattern_noise; }));
   k.push_back(number(
-      "pixel_noise", 0, 1000, "gray levels", "per-pixel Gaussian sensor noise sigma (MMW and IR)",
+      "pixel_noise", "0", 0, 1000, "gray levels", "per-pixel Gaussian sensor noise sigma (MMW and IR)",
       [](Plan& p, double v) { p.model.pixel_sigma = v; }, [](const Plan& p) { return p.model.pixel_sigma; }));
   k.push_back(integer(
-      "metal_noise", 0, 199, "counts", "metal detector noise: triangular integer noise of this half-width",
+      "metal_noise", "0", 0, 199, "counts", "metal detector noise: triangular integer noise of this half-width",
       [](Plan& p, double v) { p.model.metal_noise = static_cast<int>(v); },
       [](const Plan& p) { return p.model.metal_noise; }));
   k.push_back(choice(
-      "placement", {"integer", "bilinear"}, "sprite placement: whole pixels, or sub-pixel with bilinear sampling",
-      false, true, [](Plan& p, double v) { p.model.bilinear = v != 0; },
+      "placement", "integer", {"integer", "bilinear"},
+      "sprite placement: whole pixels, or sub-pixel with bilinear sampling", false, true,
+      [](Plan& p, double v) { p.model.bilinear = v != 0; },
       [](const Plan& p) { return p.model.bilinear ? "bilinear" : "integer"; }));
   k.push_back(number(
-      "jitter", 0, 1000, "pixels", "move each object by up to this much in x and y",
+      "jitter", "0", 0, 1000, "pixels", "move each object by up to this much in x and y",
       [](Plan& p, double v) { p.model.jitter = v; }, [](const Plan& p) { return p.model.jitter; }));
   k.push_back(range(
-      "rotate", -180, 180, true, "degrees",
+      "rotate", "0", -180, 180, true, "degrees",
       "turn each object about its centre by an angle drawn uniformly from the range (X: -X..X), "
       "counter-clockwise in the image",
       [](Plan& p, double a, double b) {
@@ -181,7 +187,7 @@ std::vector<Knob> declare() {
       },
       [](const Plan& p) { return std::pair(p.model.rotate_lo, p.model.rotate_hi); }));
   k.push_back(range(
-      "scale", 0.1, 10, false, "",
+      "scale", "1", 0.1, 10, false, "",
       "scale each object about its centre by a factor drawn uniformly from the range (X: X..X)",
       [](Plan& p, double a, double b) {
         p.model.scale_lo = a;
@@ -189,40 +195,40 @@ std::vector<Knob> declare() {
       },
       [](const Plan& p) { return std::pair(p.model.scale_lo, p.model.scale_hi); }));
   k.push_back(on_off(
-      "flip", "mirror each object left to right with probability 1/2", false,
+      "flip", "off", "mirror each object left to right with probability 1/2", false,
       [](Plan& p, double v) { p.model.flip = v != 0; }, [](const Plan& p) { return p.model.flip; }));
   k.push_back(choice(
-      "palette", {"ironbow", "gray", "rainbow"},
+      "palette", "ironbow", {"ironbow", "gray", "rainbow"},
       "how the IR temperature index is written as RGB: ironbow (the thesis's), gray (white hot), rainbow; "
       "the index itself is unchanged",
       false, true, [](Plan& p, double v) { p.palette = static_cast<procedural::PaletteName>(v); },
       [](const Plan& p) { return procedural::palette_name(p.palette); }));
   // The fidelity tiers' knobs (docs/model/tiers.md): each overrides --tier.
   k.push_back(choice(
-      "precision", {"fp32", "fp64", "fixed16"},
+      "precision", "", {"fp32", "fp64", "fixed16"},
       "the kernels' pixel arithmetic: fp32; fp64 with the reference's formulas; 8.8 fixed point in "
       "integers (alpha and noise gain quantised to 1/256)",
       true, true, [](Plan& p, double v) { p.fidelity.precision = static_cast<Precision>(v); },
       [](const Plan& p) { return precision_name(p.fidelity.precision); }));
   // Sparse and dense pooling agree to the bit, so pooling is not part of the identity.
   k.push_back(choice(
-      "pooling", {"sparse", "dense"},
+      "pooling", "", {"sparse", "dense"},
       "features-only runs from precomputed tables and overlap pixels (sparse), or by rendering "
       "every image and pooling it (dense); identical results",
       true, false, [](Plan& p, double v) { p.fidelity.pooling = static_cast<Pooling>(v); },
       [](const Plan& p) { return p.fidelity.pooling == Pooling::dense ? "dense" : "sparse"; }));
   k.push_back(on_off(
-      "fast_math", "-cl-fast-relaxed-math for the kernel build", true,
+      "fast_math", "", "-cl-fast-relaxed-math for the kernel build", true,
       [](Plan& p, double v) { p.fidelity.fast_math = v != 0; }, [](const Plan& p) { return p.fidelity.fast_math; }));
   k.push_back(choice(
-      "noise_model", {"per-pixel", "block-mean"},
+      "noise_model", "", {"per-pixel", "block-mean"},
       "in features-only runs with pixel noise: draw every pixel's noise, or give each mean over c "
       "pixels one draw of N(0, sigma^2/c) (ignores rounding and clipping of single pixels, keeps the sparse path); "
       "physics: draw the NETD per feature with the covariance per-raw-pixel noise gives",
       true, true, [](Plan& p, double v) { p.fidelity.noise = static_cast<NoiseModel>(v); },
       [](const Plan& p) { return p.fidelity.noise == NoiseModel::block_mean ? "block-mean" : "per-pixel"; }));
   k.push_back(choice(
-      "noise_draw", {"box-muller", "irwin-hall"},
+      "noise_draw", "", {"box-muller", "irwin-hall"},
       "how the sensor noise is drawn: Box-Muller (thesis) or the quantile table (physics), both normal; or "
       "Irwin-Hall (both models), eight values to a Philox draw (two bytes summed, shaped by a quintic: sd 1, KS "
       "distance 0.0033 from the normal, none beyond 3.37 sd)",
@@ -238,7 +244,22 @@ bool parse_number(const std::string& text, double& v) {
   return r.ec == std::errc() && r.ptr == end;
 }
 
+// Every knob's declared default set on a bare plan: the one source of the defaults.
+const Plan& declared_defaults() {
+  static const Plan defaults = [] {
+    Plan d{.model = ModelSettings(ModelSettings::Bare{}), .fidelity = {}, .palette = {}};
+    for (const Knob& k : knobs())
+      if (!k.fidelity) set_knob(d, k, k.def, "the default of " + k.flag());
+    return d;
+  }();
+  return defaults;
+}
+
 }  // namespace
+
+ModelSettings::ModelSettings() : ModelSettings(declared_defaults().model) {}
+
+procedural::PaletteName default_palette() { return declared_defaults().palette; }
 
 std::string Knob::flag() const {
   std::string f = "--" + key;
@@ -311,7 +332,7 @@ void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::
               : !parse_number(text.substr(0, dots), a) || !parse_number(text.substr(dots + 2), b))
         throw InputError(where + ": \"" + text + "\" is not " +
                          (knob.symmetric ? "a number X (for -X..X) or a range A..B" : "a range A..B (or one number)"));
-      if (one) a = knob.symmetric ? -b : b;
+      if (one) a = knob.symmetric ? 0.0 - b : b;  // 0 - 0 is +0, as an unset range's end
       if (!std::isfinite(a) || !std::isfinite(b) || a < knob.min || b > knob.max || a > b ||
           (!knob.word.empty() && a == b))
         throw InputError(where + ": \"" + text + "\" must be " + (knob.word.empty() ? "" : knob.word + " or ") +

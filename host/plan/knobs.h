@@ -17,6 +17,10 @@ enum class KnobKind { integer, number, on_off, choice, grid, range };
 // Filled by field name (designated initializers): each field left out takes its default.
 struct Knob {
   std::string key{};  // spec-file key and manifest entry; the flag is "--" + key with '-' for '_'
+  // The default as set_knob reads it ("3", "28x28", "290..302", "thesis"): the one place it
+  // is written (a ModelSettings made with no arguments holds the knobs' defaults). Empty for
+  // a fidelity knob, whose default is the tier's.
+  std::string def{};
   KnobKind kind{};
   double min = 0, max = 0;             // integer and number; each side of a grid; each end of a range
   std::vector<std::string> choices{};  // choice

@@ -15,45 +15,52 @@ namespace portalsim {
 // convolution (a = -1/2), edges held.
 enum class DisplayFilter { bilinear, bicubic };
 
-// The knobs of the sensor model (docs/model/thesis.md). Defaults are the thesis's.
+// The knobs of the sensor model (docs/model/thesis.md). Each field's default is its
+// knob's declaration (plan/knobs.cpp; the thesis's values): ModelSettings() holds them all.
 struct ModelSettings {
-  uint64_t seed = 0;
-  Model model = Model::thesis;
-  bool pattern_noise = true;  // thesis 4.2: one of the MMW noise patterns over each object
-  double pixel_sigma = 0.0;   // per-pixel Gaussian sensor noise, gray levels (MMW and IR)
-  int metal_noise = 0;        // detector noise: triangular integer noise, half-width in counts
-  int block = 10;             // side of the averaged pixel blocks (thesis 5.6)
+  ModelSettings();
+  // Every field zero, what the knobs' defaults are set on (plan/knobs.cpp).
+  struct Bare {};
+  explicit ModelSettings(Bare) {}
+
+  uint64_t seed = 0;  // the run's, not a knob
+  Model model{};
+  bool pattern_noise{};  // thesis 4.2: one of the MMW noise patterns over each object
+  double pixel_sigma{};  // per-pixel Gaussian sensor noise, gray levels (MMW and IR)
+  int metal_noise{};     // detector noise: triangular integer noise, half-width in counts
+  int block{};           // side of the averaged pixel blocks (thesis 5.6)
   // Sprite placement: each object moves by jitter * (2u - 1) pixels in x and y (u from
   // the counter generator), rounded to whole pixels, or kept sub-pixel with bilinear
   // sampling. The noise tiles stay where the unmoved sprite would be.
-  bool bilinear = false;
-  double jitter = 0.0;
+  bool bilinear{};
+  double jitter{};
   // Randomised objects (docs/model/randomised-objects.md): each object turns by an angle
   // uniform in [rotate_lo, rotate_hi] degrees about its sprite's centre (counter-clockwise
   // as seen in the image), scales by a factor uniform in [scale_lo, scale_hi], and with
   // `flip` is mirrored left to right with probability 1/2; drawn per (scenario, region)
   // from the counter generator (object_transform), the same in every view. Any of them
   // on makes the composite sample sprites through the inverse affine map, bilinearly.
-  double rotate_lo = 0.0, rotate_hi = 0.0;
-  double scale_lo = 1.0, scale_hi = 1.0;
-  bool flip = false;
+  double rotate_lo{}, rotate_hi{};
+  double scale_lo{}, scale_hi{};
+  bool flip{};
   // The physics model (docs/model/physics-mmw.md); ignored by the thesis model.
-  double illumination = 293.0;          // K: what the body and objects reflect (the room, indoors)
-  double netd = 3.0;                    // K rms: MMW sensor noise per raw pixel
-  int raw_width = 28, raw_height = 28;  // the MMW camera's raw grid over each view
-  double worn_minutes = 5.0;            // how long the objects have been carried (their temperature)
-  double ir_netd = 0.05;                // K rms: IR sensor noise per pixel
+  double illumination{};          // K: what the body and objects reflect (the room, indoors)
+  double netd{};                  // K rms: MMW sensor noise per raw pixel
+  int raw_width{}, raw_height{};  // the MMW camera's raw grid over each view
+  double worn_minutes{};          // how long the objects have been carried (their temperature)
+  double ir_netd{};               // K rms: IR sensor noise per pixel
   // The MMW camera's own processing (docs/model/physics-mmw.md, "The camera's defaults"):
-  // raw frames at 10 Hz averaged, each with its own NETD draw (10: one second, the body 5+
-  // times the noise in both views); the display window, fixed [window_lo, window_hi] kelvin
-  // (room 293 K and body 298.6 K well inside it, 3 sigma of noise unclipped) or set per
-  // image from the raw grid's 1st and 99th percentiles (window_auto); the interpolation
-  // from the raw grid to the view, and a Gaussian of `smooth` view pixels.
-  int frames = 10;
-  bool window_auto = false;
-  double window_lo = 290.0, window_hi = 302.0;
-  DisplayFilter display_filter = DisplayFilter::bilinear;
-  double smooth = 0.0;
+  // raw frames at 10 Hz averaged, each with its own NETD draw (the default 10: one second,
+  // the body 5+ times the noise in both views); the display window, fixed [window_lo,
+  // window_hi] kelvin (the default 290..302: room 293 K and body 298.6 K well inside it,
+  // 3 sigma of noise unclipped) or set per image from the raw grid's 1st and 99th
+  // percentiles (window_auto); the interpolation from the raw grid to the view, and a
+  // Gaussian of `smooth` view pixels.
+  int frames{};
+  bool window_auto{};
+  double window_lo{}, window_hi{};
+  DisplayFilter display_filter{};
+  double smooth{};
   // The knobs as view `s` takes them: its own camera parameters (Sensor::netd, raw) over
   // the run's. Both backends read a view's knobs through this, and nothing else.
   ModelSettings for_view(const Sensor& s) const;
@@ -102,6 +109,9 @@ Tier parse_tier(const std::string& name, const std::string& where);
 const char* tier_name(Tier t);
 const char* precision_name(Precision p);
 
+// The palette knob's default (plan/knobs.cpp).
+procedural::PaletteName default_palette();
+
 // Bit k of Plan::images: camera view k (Catalogue::sensors) is materialised.
 constexpr uint32_t kAllViews = ~0u;
 
@@ -113,8 +123,8 @@ struct Plan {
   ModelSettings model;
   Fidelity fidelity;
   // How the IR temperature index is written as RGB (images, h5 `ir`, serve); not part of
-  // either model: the stored index is the same.
-  procedural::PaletteName palette = procedural::PaletteName::ironbow;
+  // either model: the stored index is the same. Its default is its knob's.
+  procedural::PaletteName palette = default_palette();
 
   bool image(int view) const { return (images >> view) & 1u; }
   // A view is rendered when its images are kept or it is pooled into features; views
