@@ -1473,7 +1473,9 @@ TEST(PortalCameras, AViewsOwnRawGridAndNetdHoldOverTheRunsKnobs) {
   ASSERT_EQ(own->cat.sensors[0].netd, 1.5);
   ASSERT_FALSE(own->cat.sensors[1].netd.has_value());
   World& plain = default_world();
-  const SceneBatch batch = test::batch_of(coverage(own->cat, 12, 4, false), 300);
+  // Under the sanitizers a third of the scenarios: the reference's loops are the time.
+  const size_t scenes = test::kSanitized ? 4 : 12;
+  const SceneBatch batch = test::batch_of(coverage(own->cat, scenes, 4, false), 300);
   ModelSettings run = physics_model(171);
   run.netd = 4.0;
   run.ir_netd = 0.3;
@@ -1484,7 +1486,10 @@ TEST(PortalCameras, AViewsOwnRawGridAndNetdHoldOverTheRunsKnobs) {
   upper_knobs.raw_height = 24;
   upper_knobs.netd = 1.5;
   ir_knobs.ir_netd = 0;
-  for (Tier tier : {Tier::standard, Tier::exact}) {
+  // Under the sanitizers one tier too.
+  const std::vector<Tier> tiers =
+      test::kSanitized ? std::vector<Tier>{Tier::standard} : std::vector<Tier>{Tier::standard, Tier::exact};
+  for (Tier tier : tiers) {
     SCOPED_TRACE(tier_name(tier));
     for (const bool reference : {false, true}) {
       SCOPED_TRACE(reference ? "reference" : "opencl");
@@ -1508,7 +1513,7 @@ TEST(PortalCameras, AViewsOwnRawGridAndNetdHoldOverTheRunsKnobs) {
   auto raw_only = make_world(own_cameras_text("raw = [20, 24]\n", ""));
   ModelSettings m = physics_model(172);
   m.raw_width = m.raw_height = 32;
-  const SceneBatch singles = test::batch_of(coverage(raw_only->cat, 12, 4, true), 310);
+  const SceneBatch singles = test::batch_of(coverage(raw_only->cat, scenes, 4, true), 310);
   ASSERT_EQ(test::features_path(*raw_only->cl, features_plan(m, Tier::fast)), "physics_raw_features");
   const auto p = expect_parity(*raw_only, singles, m, "the upper view's own raw grid");
   BatchOutput at_run;
