@@ -939,7 +939,14 @@ TEST(CliCatalogueCmd, ListsObjectsAndRegions) {
                     [&](const std::string& l) { return split(l.substr(l.find_first_not_of(' ')), ' ')[0] == name; }))
         << name << " is not listed";
   EXPECT_TRUE(has(r.out, "left-chest"));
+  EXPECT_TRUE(has(r.out, "camera views: upper mmw 200x200; lower mmw 200x200; ir ir 100x200; alpha 0.9"));
   EXPECT_TRUE(names_in(t.w()).empty()) << "listing writes nothing";
+  // A view's own camera is listed with it.
+  const Result portal =
+      run(t, {"catalogue", "--catalogue", std::string(PORTALSIM_SOURCE_DIR) + "/tests/portals/portal-20x33.toml"});
+  ExpectSuccess(portal);
+  EXPECT_TRUE(has(portal.out, " back_upper mmw back 200x200 raw 24x24;")) << portal.out;
+  EXPECT_TRUE(has(portal.out, " upper mmw 200x200;")) << portal.out;
 }
 
 TEST(CliCatalogueCmd, ImagesWritesEveryImage) {

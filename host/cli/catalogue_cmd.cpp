@@ -20,9 +20,14 @@ int list(CatalogueOptions& o) {
   const Catalogue& c = s.catalogue;
   std::printf("catalogue %s (hash %s)\n", c.source.c_str(), c.hash.c_str());
   std::printf("camera views:");
-  for (const Sensor& v : c.sensors)
-    std::printf(" %s %s%s %dx%d;", v.name.c_str(), camera_name(v.camera), v.side == Side::back ? " back" : "", v.width,
+  for (const Sensor& v : c.sensors) {
+    std::printf(" %s %s%s %dx%d", v.name.c_str(), camera_name(v.camera), v.side == Side::back ? " back" : "", v.width,
                 v.height);
+    // Its own camera's numbers, where they differ from the run's knobs.
+    if (v.raw) std::printf(" raw %dx%d", (*v.raw)[0], (*v.raw)[1]);
+    if (v.netd) std::printf(" netd %g K", *v.netd);
+    std::printf(";");
+  }
   std::printf(" alpha %.3g\n", c.images.alpha);
   std::printf("\nsubjects:\n");
   for (size_t i = 0; i < c.subjects.size(); ++i)  // what the body is drawn as: width and stature scales
