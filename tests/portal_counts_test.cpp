@@ -110,6 +110,10 @@ TEST(PortalCounts, CocoHasEveryViewAndTheBackRegions) {
     back_regions += coco.find("\"region\":" + std::to_string(r) + ",") != std::string::npos;
   EXPECT_GT(back_regions, 3u) << "objects in the back regions 14-20 are annotated";
   EXPECT_TRUE(fs::exists(out / "images" / "00000000" / "mask_back_ir.png"));
+  // The thesis model reads no camera numbers, so its card names no view's own camera.
+  const std::string card = test::slurp(out / "README.md");
+  EXPECT_NE(card.find("**Sensor model:** `thesis`"), std::string::npos) << card;
+  EXPECT_EQ(card.find("has a camera of its own"), std::string::npos) << card;
 }
 
 }  // namespace

@@ -574,8 +574,9 @@ std::string card_text(const json& m, const Description& d) {
        ".\n";
   y += "- **Sensor model:** `" + s.value("model", "thesis") + "`, tier `" + s.value("tier", "standard") +
        "`; every parameter is in the front matter's `sensor_model`.\n";
+  // A view's own camera (raw grid, NETD) is the physics model's; the thesis model reads neither.
   for (const Portal::View& v : p.views)
-    if (!v.own_camera.empty())
+    if (!v.own_camera.empty() && s.value("model", "thesis") == "physics")
       y += "- **View " + v.name + "** has a camera of its own, over the run's parameters: " + v.own_camera + ".\n";
   y += "- **Make it again** (the same bytes; `--batch`, `--threads` and MPI ranks never change them):\n\n";
   y += "  ```sh\n  " + regenerate_command(m) + "\n  ```\n\n";
