@@ -241,15 +241,26 @@ TEST(TradeoffModels, BothModelsByDefault) {
   }
 }
 
+// On a catalogue whose upper view has a camera of its own (its raw grid), which the report
+// and the printed line name beside the run's knobs.
 TEST(TradeoffModelsOption, SelectsOneModel) {
   test::TempDir t;
-  const fs::path out = t.w() / "trade";
-  const test::Result r = test::finish(test::start(t.cap(), {"tradeoff", "--count", "10", "--models", "physics",
-                                                            "--no-classifier", "--out", out.string()}),
-                                      600);
+  const fs::path out = t.w() / "trade", cat = t.w() / "own-camera.toml";
+  std::string text = test::slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "catalogue.toml");
+  const std::string field = "field = [0, 0, 200, 200]\n";
+  ASSERT_NE(text.find(field), std::string::npos);
+  text.insert(text.find(field) + field.size(), "raw = [24, 24]\n");
+  test::spit(cat, text);
+  const test::Result r =
+      test::finish(test::start(t.cap(), {"tradeoff", "--count", "10", "--models", "physics", "--no-classifier",
+                                         "--catalogue", cat.string(), "--out", out.string()}),
+                   600);
   ASSERT_TRUE(r.exited && r.status == 0) << test::describe(r);
   const json report = json::parse(test::slurp(out / "tradeoff.json"));
   EXPECT_EQ(report["models"], json({"physics"}));
+  EXPECT_EQ(report["physics"]["mmw_raw"], "28x28");
+  EXPECT_EQ(report["physics"]["views"], json::parse(R"({"upper": {"mmw_raw": "24x24"}})"));
+  EXPECT_NE(r.out.find("raw grid 28x28, illumination 293 K; upper: raw grid 24x24\n"), std::string::npos) << r.out;
   ASSERT_EQ(report["rows"].size(), 4u);
   for (const json& row : report["rows"]) {
     EXPECT_EQ(row["model"], "physics");

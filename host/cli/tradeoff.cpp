@@ -230,9 +230,15 @@ int tradeoff(TradeoffOptions& o) {
     const std::string mname = model_name(m);
     std::printf("tradeoff, %s model: %llu scenarios (case 1, balanced), pixel noise %.3g, block %d", mname.c_str(),
                 static_cast<unsigned long long>(o.count), model.pixel_sigma, model.block);
-    if (m == Model::physics)
+    if (m == Model::physics) {
       std::printf(", NETD %.3g K, raw grid %dx%d, illumination %.4g K", model.netd, model.raw_width, model.raw_height,
                   model.illumination);
+      // The views whose camera keeps its own numbers over those (ModelSettings::for_view).
+      for (const Sensor& v : cat.sensors) {
+        if (v.netd) std::printf("; %s: NETD %.3g K", v.name.c_str(), *v.netd);
+        if (v.raw) std::printf("; %s: raw grid %dx%d", v.name.c_str(), (*v.raw)[0], (*v.raw)[1]);
+      }
+    }
     std::printf("\n");
     std::fflush(stdout);
     auto reference = make_reference_backend(cat, s.assets);
@@ -399,6 +405,11 @@ int tradeoff(TradeoffOptions& o) {
                        {"mmw_raw", std::to_string(base.raw_width) + "x" + std::to_string(base.raw_height)},
                        {"illumination_k", base.illumination},
                        {"worn_minutes", base.worn_minutes}};
+  for (const Sensor& v : cat.sensors) {  // a view's own camera, where it has one
+    if (v.netd) report["physics"]["views"][v.name]["netd_k"] = *v.netd;
+    if (v.raw)
+      report["physics"]["views"][v.name]["mmw_raw"] = std::to_string((*v.raw)[0]) + "x" + std::to_string((*v.raw)[1]);
+  }
   report["scenario_set"] = "thesis case 1: rule gun, balanced, 0..4 objects from every object";
   report["case2_scenario_set"] =
       "thesis case 2: rule iron-rod & metal-plate, balanced, 0..4 objects from metal-plate, iron-rod, compact-disk, "
