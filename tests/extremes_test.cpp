@@ -1463,8 +1463,7 @@ TEST(PortalCounts, CountsPastTheCapacitiesAreRefusedNamingTheField) {
 // other views follow the run. Each view's image is the one a run with its numbers as the
 // knobs gives, on both backends.
 std::string own_cameras_text(const std::string& upper, const std::string& ir) {
-  std::string text = replace_once(default_text(), "field = [0, 0, 200, 200]\n", "field = [0, 0, 200, 200]\n" + upper);
-  return replace_once(text, "field = [0, 0, 200, 400]\n", "field = [0, 0, 200, 400]\n" + ir);
+  return test::with_view_line(test::with_view_line(default_text(), "upper", upper), "ir", ir);
 }
 
 TEST(PortalCameras, AViewsOwnRawGridAndNetdHoldOverTheRunsKnobs) {

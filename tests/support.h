@@ -68,6 +68,16 @@ inline std::string with_subject_line(std::string text, int k, const std::string&
   return text;
 }
 
+// Catalogue text `text` with `line` (ending in a newline, or empty: nothing) added to the
+// [[views]] entry called `view`, right after its name line.
+inline std::string with_view_line(std::string text, const std::string& view, const std::string& line) {
+  const size_t name = text.find("[[views]]\nname = \"" + view + "\"");
+  EXPECT_NE(name, std::string::npos) << "the catalogue has no view " << view;
+  if (name == std::string::npos || line.empty()) return text;
+  text.insert(text.find('\n', name + 10) + 1, line);
+  return text;
+}
+
 // Every variant in every region (one object per scenario, rotating subjects), then random
 // crowds of up to `max_objects` (random_scenario from k = 0) until there are `n`.
 inline std::vector<Scenario> coverage(const Catalogue& c, size_t n, int max_objects, bool singles = true) {

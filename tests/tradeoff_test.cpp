@@ -246,11 +246,8 @@ TEST(TradeoffModels, BothModelsByDefault) {
 TEST(TradeoffModelsOption, SelectsOneModel) {
   test::TempDir t;
   const fs::path out = t.w() / "trade", cat = t.w() / "own-camera.toml";
-  std::string text = test::slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "catalogue.toml");
-  const std::string field = "field = [0, 0, 200, 200]\n";
-  ASSERT_NE(text.find(field), std::string::npos);
-  text.insert(text.find(field) + field.size(), "raw = [24, 24]\n");
-  test::spit(cat, text);
+  test::spit(cat, test::with_view_line(test::slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "catalogue.toml"),
+                                       "upper", "raw = [24, 24]\n"));
   const test::Result r =
       test::finish(test::start(t.cap(), {"tradeoff", "--count", "10", "--models", "physics", "--no-classifier",
                                          "--catalogue", cat.string(), "--out", out.string()}),
