@@ -67,13 +67,19 @@ TEST(OpenCLPaths, EachGateDecidesItsVariantAndTimingNamesIt) {
   EXPECT_EQ(cl->paths(features), (std::vector<std::string>{"features: physics_raw_features (tabulated)"}));
   features.model.jitter = 3;  // objects move: no pair tables
   EXPECT_EQ(cl->paths(features), (std::vector<std::string>{"features: physics_raw_features (untabulated)"}));
+  EXPECT_EQ(cl->rendered_views(features), std::vector<int>{}) << "a features path renders no view";
   Plan thesis;
   thesis.images = 1u << 2;  // the IR view alone, and the MMW views pooled for the features
   EXPECT_EQ(cl->paths(thesis),
             (std::vector<std::string>{"upper: thesis_images", "lower: thesis_images", "ir: thesis_images",
                                       "features: pooled from the rendered views"}));
+  EXPECT_EQ(cl->rendered_views(thesis), (std::vector<int>{0, 1, 2}));
   thesis.features = false;
   EXPECT_EQ(cl->paths(thesis), (std::vector<std::string>{"ir: thesis_images"}));
+  EXPECT_EQ(cl->rendered_views(thesis), std::vector<int>{2});
+  // The reference renders every view it keeps or pools.
+  features.model.jitter = 0;
+  EXPECT_EQ(make_reference_backend(cat, assets())->rendered_views(features), (std::vector<int>{0, 1}));
 }
 
 // A features-only physics run under the block-mean model (the fast tier's), on views whose

@@ -59,6 +59,9 @@ class Backend {
   // How run() makes `plan`'s outputs, as --timing names it: per rendered view and for the
   // features, the path taken ("upper: physics_raw (fixed window)").
   virtual std::vector<std::string> paths(const Plan& plan) const = 0;
+  // The camera views run() renders for `plan` (indices into Catalogue::sensors): those whose
+  // images are kept, and the pooled ones where no features path makes the features.
+  virtual std::vector<int> rendered_views(const Plan& plan) const = 0;
   // paths()'s name for features made by pooling the rendered views, the way both backends can.
   static constexpr const char* kPooledFeatures = "pooled from the rendered views";
 

@@ -320,9 +320,7 @@ void write_manifest(const std::string& dir, std::vector<std::unique_ptr<Sink>>& 
 // cache rather than from memory (docs/guide/deep-learning.md).
 size_t default_batch(const Plan& plan, const Catalogue& cat, const Backend& backend) {
   size_t bytes = 64 + static_cast<size_t>(cat.zones);
-  // The views its paths render ("upper: thesis_images"); a features path renders none.
-  for (const std::string& taken : backend.paths(plan))
-    if (const int k = cat.sensor_index(taken.substr(0, taken.find(':'))); k >= 0) bytes += cat.sensors[k].pixels();
+  for (int k : backend.rendered_views(plan)) bytes += cat.sensors[k].pixels();  // none where a features path runs
   if (plan.features) bytes += sizeof(float) * FeatureLayout::of(cat, plan.model.block).image_features();
   // A multiple of data.h5's chunk rows: a batch ends where a chunk does, so no piece of it
   // waits in memory for the next batch before the file's hash can take it (file_order_hash.h).

@@ -97,6 +97,14 @@ class OpenCLBackend final : public Backend {
     return taken;
   }
 
+  std::vector<int> rendered_views(const Plan& plan) const override {
+    const Route r = route(plan, FeatureLayout::of(cat_, plan.model.block));
+    std::vector<int> views;
+    for (size_t k = 0; k < cat_.sensors.size(); ++k)
+      if (r.views[k].path) views.push_back(static_cast<int>(k));
+    return views;
+  }
+
  private:
   // Every choice of paths run() makes for `plan`, made here alone: the features path, and
   // for each view that is rendered, its path (null: the view is not rendered).

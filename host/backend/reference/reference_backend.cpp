@@ -17,10 +17,15 @@ class ReferenceBackend final : public Backend {
   std::string name() const override { return "reference"; }
   std::vector<std::string> paths(const Plan& plan) const override {
     std::vector<std::string> taken;
-    for (size_t k = 0; k < cat_.sensors.size(); ++k)
-      if (plan.renders(cat_.sensors[k], static_cast<int>(k))) taken.push_back(cat_.sensors[k].name + ": fp64 stages");
+    for (int k : rendered_views(plan)) taken.push_back(cat_.sensors[k].name + ": fp64 stages");
     if (plan.features) taken.push_back(std::string("features: ") + kPooledFeatures);
     return taken;
+  }
+  std::vector<int> rendered_views(const Plan& plan) const override {
+    std::vector<int> views;
+    for (size_t k = 0; k < cat_.sensors.size(); ++k)
+      if (plan.renders(cat_.sensors[k], static_cast<int>(k))) views.push_back(static_cast<int>(k));
+    return views;
   }
 
   void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) override {
