@@ -240,5 +240,16 @@ TEST(Mpi, AFailingRankStopsEveryRankAndIsNamed) {
   EXPECT_FALSE(fs::exists(dir / "manifest.json"));
 }
 
+TEST(Mpi, AnOutputMergeCannotJoinIsRefusedBeforeAnyRankWrites) {
+  TempDir t;
+  const fs::path dir = t.w() / "out";
+  const Result r =
+      finish(start_mpi(t, 2, gen({"--count", "20", "--what", "images", "--annotations", "--quiet"}, dir)), 300);
+  EXPECT_TRUE(r.exited && r.status != 0) << describe(r);
+  EXPECT_NE(r.err.find("--annotations: not with an MPI launch: merge cannot join COCO annotations"), std::string::npos)
+      << describe(r);
+  EXPECT_FALSE(fs::exists(dir / "manifest.json"));
+}
+
 }  // namespace
 }  // namespace portalsim::test

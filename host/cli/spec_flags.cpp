@@ -2,6 +2,8 @@
 
 #include "base/error.h"
 #include "io/input_file.h"
+#include "schedule/scenario_source.h"
+#include "sink/sink_kinds.h"
 
 namespace portalsim::cli {
 
@@ -17,9 +19,7 @@ void add_spec_flags(CLI::App* sub, SpecFlags* o, bool outputs) {
   sub->add_flag("--balance", o->spec.balance, "equal classes: even indices threats, odd not");
   if (outputs) {
     sub->add_option("--what", o->spec.what, "features, images or both (default features)");
-    sub->add_option("--format", o->formats,
-                    "arff,csv,npy feature tables; h5: data.h5 with image tensors and labels; npy with --what images: "
-                    "image tensors as .npy (default arff)");
+    sub->add_option("--format", o->formats, format_help());
     sub->add_flag("--compress", o->spec.compress, "gzip data.h5's datasets (--format h5)");
     sub->add_flag("--annotations", o->spec.annotations,
                   "per-object boxes and instance masks: annotations.json (COCO), YOLO .txt and mask images");
@@ -86,6 +86,7 @@ RunSpec build_spec(SpecFlags& o) {
     spec.set_knob_text(key, text, spec.where(key));
   }
   spec.validate();
+  check_formats(spec);
   return spec;
 }
 

@@ -13,6 +13,7 @@
 #include "plan/knobs.h"
 #include "schedule/run_spec.h"
 #include "sink/h5_file.h"
+#include "sink/sink_kinds.h"
 #include "sink/sinks.h"
 #include "sink/staging.h"
 
@@ -117,22 +118,12 @@ std::string tensor_meaning(const std::string& name, const Portal& portal) {
 }
 
 // What each file of a data set holds.
+// What a file holds: its sink kind's words (sink/sink_kinds.h), or the card's for its own
+// files and for tensors.
 std::string file_meaning(const std::string& name, const Portal& portal) {
-  const std::string rows = "the image features, the " + std::to_string(portal.zones) + " metal zones and the class";
+  if (const SinkKind* k = sink_kind_of(name); k && k->meaning)
+    if (std::string m = k->meaning(name, portal.regions, portal.zones); !m.empty()) return m;
   const std::map<std::string, std::string> m{
-      {"features.arff", "WEKA ARFF: one row per scenario: " + rows},
-      {"features.csv", "the same rows as CSV with a header: " + rows},
-      {"features.npy",
-       "float32 matrix, one row per scenario: " + rows + " (1/0) last; column names in features.columns.txt"},
-      {"features.columns.txt", "the names of features.npy's columns, one a line"},
-      {"scenarios.csv",
-       "the scenario list: subject, the object in each of the " + std::to_string(portal.regions) +
-           " regions, the label (and each object's random transform); generate --scenarios makes the data set "
-           "again from it"},
-      {"data.h5", "HDF5: every tensor, one row per scenario (the datasets are described in croissant.json)"},
-      {"annotations.json",
-       "COCO: categories, one image per scenario and camera view, and each object's box, "
-       "area and run-length mask"},
       {"manifest.json",
        "the run's identity (version, catalogue, spec, shard), counts, and each file's size and "
        "XXH3-64"},

@@ -22,6 +22,7 @@
 #include "sink/append_file.h"
 #include "sink/h5_file.h"
 #include "sink/output_folder.h"
+#include "sink/sink_kinds.h"
 #include "sink/staging.h"
 #include "sink/tensors.h"
 
@@ -41,18 +42,17 @@ json shared_identity(const json& manifest) {
   return id;
 }
 
-enum class Kind { text, npy, h5 };
-
-Kind kind_of(const std::string& name, const std::string& part) {
-  if (name == "data.h5") return Kind::h5;
-  if (name == "annotations.json")
-    throw InputError(part +
-                     "/manifest.json: outputs: annotations.json (generate --annotations): merge cannot join "
-                     "COCO annotations yet; make the data set in one run (--batch and --threads never change it)");
-  const auto ends = [&](const char* e) { return name.size() > std::strlen(e) && name.ends_with(e); };
-  if (ends(".npy")) return Kind::npy;
-  if (ends(".csv") || ends(".arff")) return Kind::text;
-  throw InputError(part + "/manifest.json: outputs: \"" + name + "\" is no output portalsim knows how to join");
+// How merge joins a manifest's file: its sink kind says (sink/sink_kinds.h).
+JoinAs join_of(const std::string& name, const std::string& part) {
+  const SinkKind* k = sink_kind_of(name);
+  if (!k || !k->join)
+    throw InputError(part + "/manifest.json: outputs: \"" + name + "\" is no output portalsim knows how to join");
+  const JoinAs how = k->join(name);
+  if (how == JoinAs::refused)
+    throw InputError(part + "/manifest.json: outputs: " + name + " (generate " + std::string(k->flag) +
+                     "): " + std::string(k->refusal) +
+                     "; make the data set in one run (--batch and --threads never change it)");
+  return how;
 }
 
 // The header of a text table: its first line (CSV), or everything through "@data" (ARFF).
@@ -333,8 +333,8 @@ JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir
   ranks.together([&] {
     for (const json& o : first["outputs"]) {
       const std::string name = o.at("name").get<std::string>();
-      const Kind kind = kind_of(name, parts[0].dir);
-      if (kind == Kind::h5) {
+      const JoinAs kind = join_of(name, parts[0].dir);
+      if (kind == JoinAs::h5) {
         has_h5 = true;
         std::vector<H5Layout> layouts;
         for (const Part& p : parts) layouts.push_back(read_h5_layout((fs::path(p.dir) / name).string()));
@@ -390,7 +390,7 @@ JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir
           throw InputError(src + ": " + std::to_string(size) + " bytes; its manifest.json records " +
                            std::to_string(want) + " (changed or damaged since)");
         std::string header;
-        if (kind == Kind::text) {
+        if (kind == JoinAs::text) {
           const size_t h = text_header_bytes(src, header);
           if (k == 0) t.header = header;
           if (header != t.header) throw InputError(src + ": its header differs from " + parts[0].dir + "/" + name);

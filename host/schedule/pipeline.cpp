@@ -194,49 +194,6 @@ FolderStart examine_folder(const std::string& dir, const json& identity, bool re
   return start;
 }
 
-// The run's sinks, each continuing from its checkpointed state when resuming.
-std::vector<std::unique_ptr<Sink>> open_sinks(const RunSpec& spec, const Plan& plan, const SinkContext& ctx,
-                                              const ThreatRule* rule, const json& identity, const FolderStart& start,
-                                              uint64_t first) {
-  std::map<std::string, FileState> saved;
-  if (start.resuming)
-    for (const json& f : start.checkpoint["files"])
-      saved[f["name"]] = FileState{f["name"], f["bytes"].get<uint64_t>(), f["xxh3"].get<uint64_t>()};
-  const auto resume_state = [&](const std::string& name) -> const FileState* {
-    if (!start.resuming) return nullptr;
-    auto it = saved.find(name);
-    if (it == saved.end()) throw OutputError(ctx.dir + "/.portalsim/checkpoint.json: no state for " + name);
-    return &it->second;
-  };
-  std::vector<std::unique_ptr<Sink>> sinks;
-  sinks.push_back(make_scenario_list_sink(ctx, resume_state("scenarios.csv")));
-  if (plan.features)
-    for (const std::string& f : spec.formats)
-      if (f != "h5") sinks.push_back(make_table_sink(f, ctx, resume_state("features." + f)));
-  if (plan.images && !spec.image_tensors()) sinks.push_back(make_image_sink(ctx, start.resuming, first));
-  TensorOptions topt = h5_tensor_options(spec, plan, rule);
-  topt.identity = identity;
-  if (spec.has_format("h5")) {
-    sinks.push_back(make_tensor_sink(ctx, topt, start.resuming ? &saved : nullptr));
-  }
-  if (spec.npy_image_tensors()) {
-    topt.h5 = false;
-    topt.images = true;
-    sinks.push_back(make_tensor_sink(ctx, topt, start.resuming ? &saved : nullptr));
-  }
-  if (plan.annotations) {
-    CocoOptions copt;
-    if (!spec.image_tensors()) copt.image_folder_ext = spec.image_format;
-    if (spec.has_format("h5")) copt.tensor_file = "data.h5";
-    copt.info = {{"description", "portalsim"},
-                 {"version", identity["portalsim"]},
-                 {"catalogue_hash", identity["catalogue"]["hash"]},
-                 {"spec", identity["spec"]}};
-    sinks.push_back(make_coco_sink(ctx, copt, start.resuming ? &saved : nullptr));
-  }
-  return sinks;
-}
-
 // Generates, computes and writes scenarios [written, res.end) batch by batch: the main
 // thread generates and computes batch k while a writer thread writes batch k-1, records
 // `checkpoint(next)` and advances `written` (which an error leaves where it stood).
@@ -399,7 +356,12 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   ctx.png_level = spec.png_level;
   ctx.rows = res.end - res.begin;
   ctx.done = first - res.begin;
-  std::vector<std::unique_ptr<Sink>> sinks = open_sinks(spec, plan, ctx, source.rule(), identity, start, first);
+  std::map<std::string, FileState> saved;
+  if (start.resuming)
+    for (const json& f : start.checkpoint["files"])
+      saved[f["name"]] = FileState{f["name"], f["bytes"].get<uint64_t>(), f["xxh3"].get<uint64_t>()};
+  Sinks sinks = open_sinks(sink_request(spec, plan, source.rule(), identity), ctx,
+                           SinkStart{start.resuming ? &saved : nullptr, first});
 
   const auto checkpoint = [&](uint64_t next) {
     json c;

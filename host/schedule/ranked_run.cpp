@@ -11,7 +11,9 @@
 
 #include "base/error.h"
 #include "schedule/join.h"
+#include "schedule/scenario_source.h"
 #include "sink/output_folder.h"
+#include "sink/sink_kinds.h"
 #include "sink/staging.h"
 
 namespace portalsim {
@@ -101,8 +103,12 @@ PipelineResult run_ranked(const RunSpec& spec, const Catalogue& cat, const Asset
                           const std::string& dir, const PipelineOptions& opt, Ranks& ranks) {
   const auto t0 = Clock::now();
   if (opt.shards != 1) throw InputError("--shard: not with an MPI launch; the ranks split the range among them");
-  if (spec.annotations)
-    throw InputError("--annotations: not with an MPI launch: merge cannot join annotations.json yet; run on one rank");
+  // The ranks' parts are joined as merge joins shards: an output merge cannot join is refused.
+  const SinkRequest req = sink_request(spec, run_plan(spec, cat), nullptr);
+  for (const SinkKind* k : sink_kinds())
+    if (k->wanted(req) && k->join && k->join(k->name) == JoinAs::refused)
+      throw InputError(std::string(k->flag) + ": not with an MPI launch: " + std::string(k->refusal) +
+                       "; run on one rank");
   const fs::path out(dir), job = parts_dir(dir) / "job.json";
   PipelineResult res;
   res.end = spec.scenarios.empty() ? spec.count : 0;

@@ -59,9 +59,8 @@ void RunSpec::validate() const {
   if (what != "features" && what != "images" && what != "both")
     throw InputError(where("what") + ": \"" + what + "\" is not features, images or both");
   if (wants_features() && formats.empty()) throw InputError(where("format") + ": give at least one of arff, csv, npy");
+  // Each value's meaning is its sink kind's (check_formats, scenario_source.h).
   for (size_t i = 0; i < formats.size(); ++i) {
-    if (formats[i] != "arff" && formats[i] != "csv" && formats[i] != "npy" && formats[i] != "h5")
-      throw InputError(where("format") + ": \"" + formats[i] + "\" is not arff, csv, npy or h5");
     for (size_t j = 0; j < i; ++j)
       if (formats[j] == formats[i]) throw InputError(where("format") + ": \"" + formats[i] + "\" given twice");
   }

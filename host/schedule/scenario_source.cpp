@@ -1,5 +1,6 @@
 #include "schedule/scenario_source.h"
 
+#include <algorithm>
 #include <exception>
 #include <mutex>
 
@@ -99,15 +100,31 @@ SinkContext plan_sink_context(const Plan& plan, const Catalogue& cat, const Asse
   return ctx;
 }
 
-TensorOptions h5_tensor_options(const RunSpec& spec, const Plan& plan, const ThreatRule* rule) {
-  TensorOptions topt;
-  topt.rule = rule;
-  topt.annotations = plan.annotations;
-  topt.h5 = true;
-  topt.compress = spec.compress;
-  topt.images = spec.wants_images();
-  topt.features = spec.wants_features();
-  return topt;
+void check_formats(const RunSpec& spec) {
+  const std::vector<std::string> known = format_values();
+  for (const std::string& f : spec.formats)
+    if (std::find(known.begin(), known.end(), f) == known.end()) {
+      std::string list;
+      for (size_t k = 0; k < known.size(); ++k)
+        list += (k == 0 ? "" : k + 1 == known.size() ? " or " : ", ") + known[k];
+      throw InputError(spec.where("format") + ": \"" + f + "\" is not " + list);
+    }
+}
+
+SinkRequest sink_request(const RunSpec& spec, const Plan& plan, const ThreatRule* rule,
+                         const nlohmann::json& identity) {
+  SinkRequest r;
+  r.formats = spec.formats;
+  r.features = spec.wants_features();
+  r.images = spec.wants_images();
+  r.annotations = plan.annotations;
+  r.image_tensors = spec.image_tensors();
+  r.npy_image_tensors = spec.npy_image_tensors();
+  r.compress = spec.compress;
+  r.image_format = spec.image_format;
+  r.rule = rule;
+  r.identity = identity;
+  return r;
 }
 
 }  // namespace portalsim

@@ -9,6 +9,7 @@
 #include "backend/backend.h"
 #include "scene/scenario_list.h"
 #include "schedule/run_spec.h"
+#include "sink/sink_kinds.h"
 #include "sink/sinks.h"
 #include "sink/tensors.h"
 
@@ -49,7 +50,11 @@ Plan run_plan(const RunSpec& spec, const Catalogue& cat);
 SinkContext plan_sink_context(const Plan& plan, const Catalogue& cat, const AssetSet& assets, unsigned threads,
                               const std::string& image_format);
 
-// data.h5's tensors for `spec` (generate --format h5).
-TensorOptions h5_tensor_options(const RunSpec& spec, const Plan& plan, const ThreatRule* rule);
+// Throws InputError naming the option where a --format value is none a sink kind answers.
+void check_formats(const RunSpec& spec);
+
+// What `spec` asks of its outputs, for the sinks (sink/sink_kinds.h).
+SinkRequest sink_request(const RunSpec& spec, const Plan& plan, const ThreatRule* rule,
+                         const nlohmann::json& identity = {});
 
 }  // namespace portalsim

@@ -9,6 +9,7 @@
 #include "base/error.h"
 #include "base/parallel.h"
 #include "sink/output_folder.h"
+#include "sink/sink_kinds.h"
 
 namespace portalsim {
 
@@ -220,5 +221,33 @@ std::unique_ptr<Sink> make_coco_sink(const SinkContext& ctx, const CocoOptions& 
                                      const std::map<std::string, FileState>* resume) {
   return std::make_unique<CocoSink>(ctx, opt, resume);
 }
+
+// annotations.json (generate --annotations).
+extern const SinkKind coco_kind{
+    .name = "annotations.json",
+    .flag = "--annotations",
+    .formats = {},
+    .format_help = "",
+    .wanted = [](const SinkRequest& r) { return r.annotations; },
+    .open =
+        [](const SinkRequest& r, const SinkContext& ctx, const SinkStart& start, Sinks& out) {
+          CocoOptions opt;
+          if (!r.image_tensors) opt.image_folder_ext = r.image_format;
+          if (r.has_format("h5")) opt.tensor_file = "data.h5";
+          opt.info = {{"description", "portalsim"},
+                      {"version", r.identity.at("portalsim")},
+                      {"catalogue_hash", r.identity.at("catalogue").at("hash")},
+                      {"spec", r.identity.at("spec")}};
+          out.push_back(make_coco_sink(ctx, opt, start.saved));
+        },
+    .writes = [](std::string_view f) { return f == "annotations.json"; },
+    .join = [](std::string_view) { return JoinAs::refused; },
+    .refusal = "merge cannot join COCO annotations yet",
+    .meaning =
+        [](std::string_view, int, int) {
+          return std::string(
+              "COCO: categories, one image per scenario and camera view, and each object's box, area and run-length "
+              "mask");
+        }};
 
 }  // namespace portalsim

@@ -11,6 +11,7 @@
 #include "base/parallel.h"
 #include "sink/feature_rows.h"
 #include "sink/scenario_folder.h"
+#include "sink/sink_kinds.h"
 #include "sink/staging.h"
 #include "sink/tensors.h"
 
@@ -241,5 +242,74 @@ std::unique_ptr<Sink> make_scenario_list_sink(const SinkContext& ctx, const File
 std::unique_ptr<Sink> make_image_sink(const SinkContext& ctx, bool resume, uint64_t resume_from) {
   return std::make_unique<ImageSink>(ctx, resume, resume_from);
 }
+
+// scenarios.csv: every run writes it.
+extern const SinkKind scenario_list_kind{
+    .name = "scenarios.csv",
+    .flag = "generate",
+    .formats = {},
+    .format_help = "",
+    .wanted = [](const SinkRequest&) { return true; },
+    .open = [](const SinkRequest&, const SinkContext& ctx, const SinkStart& start,
+               Sinks& out) { out.push_back(make_scenario_list_sink(ctx, start.state(ctx.dir, "scenarios.csv"))); },
+    .writes = [](std::string_view f) { return f == "scenarios.csv"; },
+    .join = [](std::string_view) { return JoinAs::text; },
+    .refusal = "",
+    .meaning =
+        [](std::string_view, int regions, int) {
+          return "the scenario list: subject, the object in each of the " + std::to_string(regions) +
+                 " regions, the label (and each object's random transform); generate --scenarios makes the data set "
+                 "again from it";
+        }};
+
+namespace {
+bool table_format(std::string_view f) { return f == "arff" || f == "csv" || f == "npy"; }
+}  // namespace
+
+// The feature tables, one per --format value, in the order given.
+extern const SinkKind feature_tables_kind{
+    .name = "features.<format>",
+    .flag = "--format",
+    .formats = {"arff", "csv", "npy"},
+    .format_help = "arff,csv,npy feature tables",
+    .wanted =
+        [](const SinkRequest& r) {
+          return r.features &&
+                 std::any_of(r.formats.begin(), r.formats.end(), [](const std::string& f) { return table_format(f); });
+        },
+    .open =
+        [](const SinkRequest& r, const SinkContext& ctx, const SinkStart& start, Sinks& out) {
+          for (const std::string& f : r.formats)
+            if (table_format(f)) out.push_back(make_table_sink(f, ctx, start.state(ctx.dir, "features." + f)));
+        },
+    .writes =
+        [](std::string_view f) {
+          return f == "features.arff" || f == "features.csv" || f == "features.npy" || f == "features.columns.txt";
+        },
+    .join = [](std::string_view f) { return f.ends_with(".npy") ? JoinAs::npy : JoinAs::text; },
+    .refusal = "",
+    .meaning = [](std::string_view f, int, int zones) -> std::string {
+      const std::string rows = "the image features, the " + std::to_string(zones) + " metal zones and the class";
+      if (f == "features.arff") return "WEKA ARFF: one row per scenario: " + rows;
+      if (f == "features.csv") return "the same rows as CSV with a header: " + rows;
+      if (f == "features.npy")
+        return "float32 matrix, one row per scenario: " + rows + " (1/0) last; column names in features.columns.txt";
+      return "the names of features.npy's columns, one a line";
+    }};
+
+// images/<index>/ folders, where images are not tensors. Not among the manifest's outputs:
+// its `images` entry says they are there, and merge links them (join.cpp).
+extern const SinkKind image_folders_kind{
+    .name = "images/",
+    .flag = "--what images",
+    .formats = {},
+    .format_help = "",
+    .wanted = [](const SinkRequest& r) { return r.images && !r.image_tensors; },
+    .open = [](const SinkRequest&, const SinkContext& ctx, const SinkStart& start,
+               Sinks& out) { out.push_back(make_image_sink(ctx, start.saved != nullptr, start.first)); },
+    .writes = [](std::string_view) { return false; },
+    .join = nullptr,
+    .refusal = "",
+    .meaning = nullptr};
 
 }  // namespace portalsim

@@ -588,4 +588,52 @@ std::unique_ptr<Sink> make_tensor_sink(const SinkContext& ctx, const TensorOptio
   return std::make_unique<TensorSink>(ctx, opt, resume);
 }
 
+TensorOptions data_h5_options(const SinkRequest& r) {
+  TensorOptions topt;
+  topt.rule = r.rule;
+  topt.annotations = r.annotations;
+  topt.h5 = true;
+  topt.compress = r.compress;
+  topt.images = r.images;
+  topt.features = r.features;
+  topt.identity = r.identity;
+  return topt;
+}
+
+// data.h5: every tensor of the run.
+extern const SinkKind data_h5_kind{
+    .name = "data.h5",
+    .flag = "--format h5",
+    .formats = {"h5"},
+    .format_help = "h5: data.h5 with image tensors and labels",
+    .wanted = [](const SinkRequest& r) { return r.has_format("h5"); },
+    .open = [](const SinkRequest& r, const SinkContext& ctx, const SinkStart& start,
+               Sinks& out) { out.push_back(make_tensor_sink(ctx, data_h5_options(r), start.saved)); },
+    .writes = [](std::string_view f) { return f == "data.h5"; },
+    .join = [](std::string_view) { return JoinAs::h5; },
+    .refusal = "",
+    .meaning =
+        [](std::string_view, int, int) {
+          return std::string("HDF5: every tensor, one row per scenario (the datasets are described in croissant.json)");
+        }};
+
+// <view>.npy and the scenario tensors as .npy files (--format npy with --what images).
+extern const SinkKind npy_tensors_kind{
+    .name = "<tensor>.npy",
+    .flag = "--format npy --what images",
+    .formats = {"npy"},
+    .format_help = "npy with --what images: image tensors as .npy",
+    .wanted = [](const SinkRequest& r) { return r.npy_image_tensors; },
+    .open =
+        [](const SinkRequest& r, const SinkContext& ctx, const SinkStart& start, Sinks& out) {
+          TensorOptions topt = data_h5_options(r);
+          topt.h5 = false;
+          topt.images = true;
+          out.push_back(make_tensor_sink(ctx, topt, start.saved));
+        },
+    .writes = [](std::string_view f) { return f.ends_with(".npy"); },
+    .join = [](std::string_view) { return JoinAs::npy; },
+    .refusal = "",
+    .meaning = [](std::string_view, int, int) { return std::string(); }};  // the card's tensor words
+
 }  // namespace portalsim

@@ -25,6 +25,7 @@
 
 #include "scene/rules.h"
 #include "sink/h5_file.h"
+#include "sink/sink_kinds.h"
 #include "sink/sinks.h"
 
 namespace portalsim {
@@ -61,6 +62,9 @@ struct TensorColumn {
 
 // The tensors `opt` asks for, in data.h5's order.
 std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOptions& opt);
+
+// The tensors data.h5 holds for a run that asks `r` (generate --format h5; Python's batches).
+TensorOptions data_h5_options(const SinkRequest& r);
 
 // `resume` maps a file name (as FileState::name) to its checkpointed state; null when new.
 std::unique_ptr<Sink> make_tensor_sink(const SinkContext& ctx, const TensorOptions& opt,

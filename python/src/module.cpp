@@ -159,7 +159,7 @@ class Engine {
     plan_ = run_plan(req_.spec, session_.catalogue);
     threads_ = req_.threads ? req_.threads : default_threads();
     ctx_ = plan_sink_context(plan_, session_.catalogue, session_.assets, threads_, req_.spec.image_format);
-    const TensorOptions topt = h5_tensor_options(req_.spec, plan_, source_->rule());
+    const TensorOptions topt = data_h5_options(sink_request(req_.spec, plan_, source_->rule()));
     columns_ = tensor_columns(ctx_, topt);
     if (datasets) {
       TensorOptions every = topt;  // every dataset a data.h5 of this catalogue can hold
