@@ -2,8 +2,8 @@
 // double-precision reference function (backend/reference/), its kernel (kernels/, named
 // stage_<name>), its test and its benchmark. A sensor's chain (scene/sensor.h) lists
 // stage names; both backends run the chain through this table. A new stage is its
-// reference file, its kernel and one line in stages.cpp. The OpenCL backend's fast paths
-// declare which chains they implement (backend/opencl/paths/).
+// reference file, its kernel and its line in reference/stage_list.h. The OpenCL backend's
+// fast paths declare which chains they implement (backend/opencl/paths/).
 #pragma once
 #include <string>
 #include <string_view>

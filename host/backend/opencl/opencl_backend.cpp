@@ -23,8 +23,9 @@ class OpenCLBackend final : public Backend {
         kernels_(*rt_, KernelCounts::of(cat)),
         metal_(device_) {
     for (const Sensor& s : cat.sensors) check_chain(s);
-    features_paths_.push_back(thesis_sparse_features_path(device_));
-    features_paths_.push_back(physics_raw_features_path(device_));
+#define PORTALSIM_OPEN_FEATURE_PATH(name) features_paths_.push_back(name##_path(device_));
+    PORTALSIM_FEATURE_PATHS(PORTALSIM_OPEN_FEATURE_PATH)
+#undef PORTALSIM_OPEN_FEATURE_PATH
   }
 
   std::string name() const override { return "opencl"; }

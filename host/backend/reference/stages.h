@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "assets/assets.h"
+#include "backend/reference/stage_list.h"
 #include "plan/plan.h"
 #include "scene/scene.h"
 
@@ -75,26 +76,13 @@ ViewScene view_scene(const Catalogue& cat, const AssetSet& assets, const ModelSe
 void lay_objects(const ViewScene& vs, Field& f, double alpha,
                  double (*value)(const ViewScene&, const Placed&, int, int));
 
-// The view's chain (thesis model), in order. Each transforms the field in place.
-void composite(const ViewScene& vs, Field& f);      // base image, then sprites in region order
-void pattern_noise(const ViewScene& vs, Field& f);  // the scenario's MMW noise tile over each object
-void sensor_noise(const ViewScene& vs, Field& f);   // per-pixel Gaussian noise, Box-Muller
-void display(const ViewScene& vs, Field& f);        // round half up, clamp to 0..255
-
-// The physics model's MMW chain (docs/model/physics-mmw.md), in order.
-void radiometry(const ViewScene& vs, Field& f);   // apparent temperature, K, objects under clothing
-void optics(const ViewScene& vs, Field& f);       // Gaussian PSF of the Airy core's FWHM, edges held
-void sample(const ViewScene& vs, Field& f);       // integrate onto the raw grid (the field shrinks)
-void netd(const ViewScene& vs, Field& f);         // frames averaged, each NETD kelvin rms per raw pixel
-void window(const ViewScene& vs, Field& f);       // automatic window: raw grid onto the fixed window's scale
-void mmw_display(const ViewScene& vs, Field& f);  // interpolate to the view, smooth, window to gray, round
-
-// The physics model's IR chain (docs/model/physics-ir.md), in order.
-void contact_shadow(const ViewScene& vs, Field& f);  // dT of objects under clothing, K, alone
-void heat_spread(const ViewScene& vs, Field& f);     // Gaussian of ir_spread_mm over the shadow
-void ir_surface(const ViewScene& vs, Field& f);      // plus the bare body's surface, K
-void ir_netd(const ViewScene& vs, Field& f);         // Gaussian noise per pixel, ir_netd kelvin rms
-void ir_display(const ViewScene& vs, Field& f);      // window to temperature index, round
+// The stages (stage_list.h), each transforming the field in place: the thesis chain
+// (composite, pattern_noise, sensor_noise, display), the physics MMW chain (radiometry,
+// optics, sample, netd, window, mmw_display) and the IR chain (contact_shadow, heat_spread,
+// ir_surface, ir_netd, ir_display).
+#define PORTALSIM_DECLARE_STAGE(name, ...) void name(const ViewScene& vs, Field& f);
+PORTALSIM_STAGES(PORTALSIM_DECLARE_STAGE)
+#undef PORTALSIM_DECLARE_STAGE
 
 // The physics model's quantities, from the catalogue and the knobs.
 double body_temperature(const Catalogue& cat, const ModelSettings& m);               // bare body under clothing, K

@@ -53,11 +53,16 @@ inline const ViewPath& view_path(const Plan& plan, const Sensor& sensor) { retur
 // "physics_raw (fixed window)": a path's name and its variant's, as --timing shows them.
 std::string describe(const char* path, const Gate& g);
 
-// The fast view paths (paths/*.cpp) and the general one.
-const ViewPath& thesis_images_path();
-const ViewPath& physics_raw_path();
-const ViewPath& ir_fused_path();
-const ViewPath& stage_chain_path();
+// The view paths, one line each, in the order they are tried: the fast paths, then the
+// stage chain, which applies to every view. NAME is paths/NAME.cpp, defining NAME_path().
+#define PORTALSIM_VIEW_PATHS(X) \
+  X(thesis_images)              \
+  X(physics_raw)                \
+  X(ir_fused)                   \
+  X(stage_chain)
+#define PORTALSIM_DECLARE_VIEW_PATH(name) const ViewPath& name##_path();
+PORTALSIM_VIEW_PATHS(PORTALSIM_DECLARE_VIEW_PATH)
+#undef PORTALSIM_DECLARE_VIEW_PATH
 
 // The stage chain from its stage `from` on, each stage's kernels in order.
 void run_stages(ViewLaunch& v, size_t from);
@@ -76,8 +81,14 @@ class FeaturePath {
   virtual void features(Kernels& K, const Plan& plan, const Gate& g, const DeviceBatch& b, cl::Buffer& features) = 0;
 };
 
-std::unique_ptr<FeaturePath> thesis_sparse_features_path(Device& d);
-std::unique_ptr<FeaturePath> physics_raw_features_path(Device& d);
+// The features paths, one line each, in the order they are tried (where none applies, the
+// rendered pooled views are pooled). NAME is paths/NAME.cpp, defining NAME_path(Device&).
+#define PORTALSIM_FEATURE_PATHS(X) \
+  X(thesis_sparse_features)        \
+  X(physics_raw_features)
+#define PORTALSIM_DECLARE_FEATURE_PATH(name) std::unique_ptr<FeaturePath> name##_path(Device& d);
+PORTALSIM_FEATURE_PATHS(PORTALSIM_DECLARE_FEATURE_PATH)
+#undef PORTALSIM_DECLARE_FEATURE_PATH
 
 // Block and region means of one rendered pooled view (slot of `lay`) into its columns of
 // the feature rows: the features of every plan no features path takes.

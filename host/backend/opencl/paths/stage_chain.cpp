@@ -32,8 +32,9 @@ const ViewPath& stage_chain_path() {
 }
 
 const std::vector<const ViewPath*>& view_paths() {
-  static const std::vector<const ViewPath*> paths = {&thesis_images_path(), &physics_raw_path(), &ir_fused_path(),
-                                                     &stage_chain_path()};
+#define PORTALSIM_VIEW_PATH_ADDRESS(name) &name##_path(),
+  static const std::vector<const ViewPath*> paths = {PORTALSIM_VIEW_PATHS(PORTALSIM_VIEW_PATH_ADDRESS)};
+#undef PORTALSIM_VIEW_PATH_ADDRESS
   return paths;
 }
 
