@@ -282,16 +282,28 @@ TEST(Calibrate, EveryMmwViewOfTheCatalogueIsFitted) {
 }
 
 // The rule for captures that do not look like a raw-grid camera's: a raw grid the view's
-// own size, or noise under a tenth of a gray level; either is enough (issue 36).
+// own size, or noise under a tenth of a gray level, in any view; either is enough (issue 36).
 TEST(Calibrate, NotCameraLikeIsAFullSizeGridOrNoNoise) {
   portalsim::calibrate::Captures cap;
   cap.views.resize(2);
   for (auto& v : cap.views) v.width = v.height = 200;
-  const auto why = [&](int w, int h, double noise) {
+  // Both views fitted alike, unless the lower view is given its own grid and noise.
+  const auto why = [&](int w, int h, double noise, int lower_w = 0, double lower_noise = -1) {
     portalsim::calibrate::CameraFit f;
-    f.raw_w = w;
-    f.raw_h = h;
     f.noise_gray = noise;
+    f.views.resize(2);
+    f.views[0].name = "upper";
+    f.views[1].name = "lower";
+    for (auto& v : f.views) {
+      v.raw_w = w;
+      v.raw_h = h;
+      v.noise_gray = noise;
+    }
+    if (lower_w > 0) f.views[1].raw_w = f.views[1].raw_h = lower_w;
+    if (lower_noise >= 0) {
+      f.views[1].noise_gray = lower_noise;
+      f.views[1].noise_agrees = false;
+    }
     return portalsim::calibrate::not_camera_like(cap, f);
   };
   EXPECT_EQ(why(28, 28, 3.0), "");
@@ -303,6 +315,12 @@ TEST(Calibrate, NotCameraLikeIsAFullSizeGridOrNoNoise) {
   EXPECT_EQ(why(28, 28, 0.04), "the noise, 0.04 gray levels per raw pixel, is under 0.1 of a gray level");
   EXPECT_TRUE(portalsim::test::has(why(200, 200, 0.0), "own size")) << why(200, 200, 0.0);
   EXPECT_TRUE(portalsim::test::has(why(200, 200, 0.0), ", and the noise, 0 gray levels")) << why(200, 200, 0.0);
+  // Each view is held to it: one rendered view among a camera's is named.
+  EXPECT_EQ(why(28, 28, 3.0, 200),
+            "the fitted raw grid of the lower view, 200x200, is the view's own size (no coarser grid reproduces "
+            "the images)");
+  EXPECT_EQ(why(28, 28, 3.0, 0, 0.04),
+            "the noise of the lower view, 0.04 gray levels per raw pixel, is under 0.1 of a gray level");
 }
 
 // The thesis model's images (rendered, no raw grid) are refused naming the folder, with
