@@ -10,10 +10,13 @@
 
 #include "assets/assets.h"
 #include "assets/image_io.h"
+#include "base/error.h"
+#include "calibrate/camera_files.h"
 #include "calibrate/captures.h"
 #include "calibrate/fit.h"
 #include "run_binary.h"
 #include "scene/catalogue.h"
+#include "support.h"
 
 namespace portalsim::embedded {
 extern const std::string_view default_catalogue;
@@ -45,10 +48,11 @@ portalsim::test::Result run(const TempDir& t, const std::vector<std::string>& ar
   return portalsim::test::finish(portalsim::test::start(t.cap(), args), 300);
 }
 
-// `count` captures of `cam` made by generate (objects 0..2 on random subjects) in t/w/NAME.
+// `count` captures of `cam` made by generate (objects 0..2 on random subjects) in t/w/NAME,
+// with the built-in catalogue or `catalogue` (its text), the camera's aperture set in it.
 fs::path make_captures(const TempDir& t, const Camera& cam, int count, uint64_t seed,
-                       const std::vector<std::string>& extra = {}) {
-  std::string cat(portalsim::embedded::default_catalogue);
+                       const std::vector<std::string>& extra = {},
+                       std::string cat = std::string(portalsim::embedded::default_catalogue)) {
   cat = with_physics(cat, "aperture_m", cam.aperture_m);
   const fs::path cat_path = t.w() / (std::string(cam.name) + ".catalogue.toml");
   portalsim::test::spit(cat_path, cat);
@@ -252,6 +256,118 @@ TEST(Calibrate, GenerateWithItsOutputMakesTheSameCamera) {
   EXPECT_NEAR(f2.display_min, f1.display_min, 0.1 * (f1.display_max - f1.display_min));
 }
 
+// The number a spec's `key = N` line sets (NaN where it has none).
+double spec_number(const std::string& spec, const std::string& key) {
+  const size_t at = spec.find("\n" + key + " = ");
+  return at == std::string::npos ? NAN : std::stod(spec.substr(at + key.size() + 4));
+}
+
+// A portal whose views have cameras of their own: the lower view a 20x20 raw grid and 1 K
+// NETD, the upper the run's 28x28 and 3 K. calibrate fits each view's grid and noise from
+// its own captures, gives the lower view its own in camera.catalogue.toml (replacing the
+// stale raw line of the catalogue it was given) and the upper view none, and generate with
+// its outputs makes each view's camera again.
+TEST(Calibrate, FitsEachViewsOwnCamera) {
+  TempDir t;
+  const std::string builtin(portalsim::embedded::default_catalogue);
+  const Camera c{"perview", 3.0, 28, 28, 0.125, 285, 305};
+  const fs::path real =
+      make_captures(t, c, 8, 5, {}, portalsim::test::with_view_line(builtin, "lower", "raw = [20, 20]\nnetd = 1\n"));
+  const fs::path given = t.w() / "given.toml";
+  portalsim::test::spit(given, portalsim::test::with_view_line(builtin, "lower", "raw = [24, 24]  # the old camera\n"));
+  const fs::path spec = t.w() / "camera.toml", catalogue = t.w() / "camera.catalogue.toml";
+  auto r = run(t, {"calibrate", "--catalogue", given.string(), "--real", real.string(), "--out", spec.string()});
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+
+  // The run's camera is the upper view's.
+  const std::string spec_text = portalsim::test::slurp(spec);
+  EXPECT_TRUE(portalsim::test::has(spec_text, "\nmmw_raw = \"28x28\"\n")) << spec_text;
+  const double run_netd = spec_number(spec_text, "netd");
+  EXPECT_NEAR(run_netd, 3.0, 0.3) << spec_text;
+  // The lower view's own, written in its entry; the stale line gone.
+  const std::string text = portalsim::test::slurp(catalogue);
+  EXPECT_FALSE(portalsim::test::has(text, "raw = [24, 24]")) << text;
+  const portalsim::Catalogue fitted = portalsim::load_catalogue(catalogue.string());
+  const portalsim::Sensor& upper = fitted.sensors[fitted.sensor_index("upper")];
+  const portalsim::Sensor& lower = fitted.sensors[fitted.sensor_index("lower")];
+  EXPECT_FALSE(upper.raw || upper.netd) << text;
+  ASSERT_TRUE(lower.raw && lower.netd) << text;
+  EXPECT_EQ(*lower.raw, (std::array<int, 2>{20, 20}));
+  EXPECT_NEAR(*lower.netd, 1.0, 0.1);
+  const nlohmann::json report = nlohmann::json::parse(portalsim::test::slurp(t.w() / "camera-report" / "report.json"));
+  const nlohmann::json& views = report["fit"]["views"];
+  ASSERT_EQ(views.size(), 2u);
+  // The report's simulated images have each view's own noise: their noise power along rows
+  // is the captures' (within 25%: the captures' objects add some), not the run's camera's.
+  for (const char* view : {"upper", "lower"}) {
+    double real = 0, sim = 0;
+    for (double p : report["statistics"][view]["noise_power"]["real"]) real += p;
+    for (double p : report["statistics"][view]["noise_power"]["sim"]) sim += p;
+    EXPECT_NEAR(sim / real, 1.0, 0.25) << view;
+  }
+  EXPECT_EQ(views[0]["raw_grid"]["width"], 28);
+  EXPECT_EQ(views[1]["raw_grid"]["width"], 20);
+  EXPECT_EQ(views[1]["raw_grid"]["height"], 20);
+  EXPECT_TRUE(
+      portalsim::test::has(portalsim::test::slurp(t.w() / "camera-report" / "report.md"), "| lower | 20x20 | "));
+
+  // generate with the outputs, fitted again (the built-in catalogue: no view's own camera given).
+  const fs::path again = t.w() / "again";
+  r = run(t, {"generate", "--spec", spec.string(), "--catalogue", catalogue.string(), "--what", "images", "--count",
+              "8", "--seed", "11", "--objects", "0..2", "--out", again.string(), "--quiet"});
+  ASSERT_TRUE(r.exited && r.status == 0) << portalsim::test::describe(r);
+  const auto f = fit(again);
+  ASSERT_EQ(f.views.size(), 2u);
+  EXPECT_EQ(f.views[0].raw_w, 28);
+  EXPECT_EQ(f.views[0].raw_h, 28);
+  EXPECT_EQ(f.views[1].raw_w, 20);
+  EXPECT_EQ(f.views[1].raw_h, 20);
+  EXPECT_FALSE(f.views[0].own_raw || f.views[0].own_netd);
+  EXPECT_TRUE(f.views[1].own_raw && f.views[1].own_netd);
+  EXPECT_NEAR(f.netd, run_netd, 0.1 * run_netd);
+  EXPECT_NEAR(f.views[1].netd, *lower.netd, 0.1 * *lower.netd);
+}
+
+// camera.catalogue.toml's text: a view's own raw grid and NETD replace its lines (a
+// multi-line array's continuation too) or follow its last key, wherever its name is; a
+// view that follows the run's camera loses a line that would override it; comments, other
+// tables and array rows that look like headers are kept.
+TEST(Calibrate, CatalogueTextGivesEachViewItsOwnCamera) {
+  portalsim::calibrate::CameraFit f;
+  f.aperture_m = 0.2;
+  f.fwhm_pixels = 7.5;
+  f.raw_w = f.raw_h = 28;
+  f.netd = 3;
+  f.gain = 10;
+  f.views.resize(2);
+  f.views[0].name = "upper";
+  f.views[0].raw_w = f.views[0].raw_h = 28;
+  f.views[1].name = "lower";
+  f.views[1].raw_w = f.views[1].raw_h = 20;
+  f.views[1].netd = 1.25;
+  f.views[1].noise_agrees = false;
+  f.views[1].own_raw = f.views[1].own_netd = true;
+  const std::string text =
+      "# my portal\n[[views]]\ncamera = \"mmw\"\nname = 'lower'  # named last\nraw = [\n  24,\n  24,\n]  # old\n"
+      "pooled = true\n\n# the next one\n[[views]]\nname = \"upper\"\nnetd = 9  # stale\ncamera = \"mmw\"\n\n"
+      "[metal.influence]\nnone = [\n  [0, 0],\n]\n[physics]\naperture_m = 0.125  # old\n";
+  EXPECT_EQ(portalsim::calibrate::camera_catalogue(text, f, "mine.toml"),
+            "# my portal\n[[views]]\ncamera = \"mmw\"\nname = 'lower'  # named last\n"
+            "raw = [20, 20]  # this view's own raw grid (fitted by calibrate)\npooled = true\n"
+            "netd = 1.2500  # K rms per raw pixel: 12.500 gray levels, this view's own (fitted by calibrate)\n\n"
+            "# the next one\n[[views]]\nname = \"upper\"\ncamera = \"mmw\"\n\n"
+            "[metal.influence]\nnone = [\n  [0, 0],\n]\n[physics]\n"
+            "aperture_m = 0.2  # PSF FWHM 7.50 view pixels (fitted by calibrate)\n");
+  // A view to be given its own camera whose entry is not in the text: refused, naming the file.
+  f.views[1].name = "back_lower";
+  try {
+    portalsim::calibrate::camera_catalogue(text, f, "mine.toml");
+    ADD_FAILURE() << "not refused";
+  } catch (const portalsim::InputError& e) {
+    EXPECT_TRUE(portalsim::test::has(e.what(), "mine.toml: no [[views]] entry with name = \"back_lower\"")) << e.what();
+  }
+}
+
 // Every MMW view of the catalogue is a capture of the camera: the front-and-back portal's
 // four, fitted together; a scenario folder without one of them is refused naming them all.
 TEST(Calibrate, EveryMmwViewOfTheCatalogueIsFitted) {
@@ -282,16 +398,28 @@ TEST(Calibrate, EveryMmwViewOfTheCatalogueIsFitted) {
 }
 
 // The rule for captures that do not look like a raw-grid camera's: a raw grid the view's
-// own size, or noise under a tenth of a gray level; either is enough (issue 36).
+// own size, or noise under a tenth of a gray level, in any view; either is enough (issue 36).
 TEST(Calibrate, NotCameraLikeIsAFullSizeGridOrNoNoise) {
   portalsim::calibrate::Captures cap;
   cap.views.resize(2);
   for (auto& v : cap.views) v.width = v.height = 200;
-  const auto why = [&](int w, int h, double noise) {
+  // Both views fitted alike, unless the lower view is given its own grid and noise.
+  const auto why = [&](int w, int h, double noise, int lower_w = 0, double lower_noise = -1) {
     portalsim::calibrate::CameraFit f;
-    f.raw_w = w;
-    f.raw_h = h;
     f.noise_gray = noise;
+    f.views.resize(2);
+    f.views[0].name = "upper";
+    f.views[1].name = "lower";
+    for (auto& v : f.views) {
+      v.raw_w = w;
+      v.raw_h = h;
+      v.noise_gray = noise;
+    }
+    if (lower_w > 0) f.views[1].raw_w = f.views[1].raw_h = lower_w;
+    if (lower_noise >= 0) {
+      f.views[1].noise_gray = lower_noise;
+      f.views[1].noise_agrees = false;
+    }
     return portalsim::calibrate::not_camera_like(cap, f);
   };
   EXPECT_EQ(why(28, 28, 3.0), "");
@@ -303,6 +431,12 @@ TEST(Calibrate, NotCameraLikeIsAFullSizeGridOrNoNoise) {
   EXPECT_EQ(why(28, 28, 0.04), "the noise, 0.04 gray levels per raw pixel, is under 0.1 of a gray level");
   EXPECT_TRUE(portalsim::test::has(why(200, 200, 0.0), "own size")) << why(200, 200, 0.0);
   EXPECT_TRUE(portalsim::test::has(why(200, 200, 0.0), ", and the noise, 0 gray levels")) << why(200, 200, 0.0);
+  // Each view is held to it: one rendered view among a camera's is named.
+  EXPECT_EQ(why(28, 28, 3.0, 200),
+            "the fitted raw grid of the lower view, 200x200, is the view's own size (no coarser grid reproduces "
+            "the images)");
+  EXPECT_EQ(why(28, 28, 3.0, 0, 0.04),
+            "the noise of the lower view, 0.04 gray levels per raw pixel, is under 0.1 of a gray level");
 }
 
 // The thesis model's images (rendered, no raw grid) are refused naming the folder, with

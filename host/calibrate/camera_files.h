@@ -1,5 +1,5 @@
 // What calibrate writes for `generate`: a spec of the fitted knobs (the window among them)
-// and a copy of the catalogue with the fitted aperture.
+// and a copy of the catalogue with the fitted aperture and the views' own cameras.
 #pragma once
 #include <string>
 
@@ -12,8 +12,12 @@ namespace portalsim::calibrate {
 std::string camera_spec(const CameraFit& fit, const ModelSettings& model, const std::string& spec_name,
                         const std::string& catalogue_name);
 
-// `catalogue_text` with [physics]'s aperture_m set to the fit
-// (each key's line replaced, or added after [physics] where missing).
-std::string camera_catalogue(const std::string& catalogue_text, const CameraFit& fit);
+// `catalogue_text` with [physics]'s aperture_m set to the fit, and each fitted view's
+// [[views]] entry given its own `raw` and `netd` where the fit gives it a camera of its own
+// (ViewFit::own_raw, own_netd) and neither where it follows the run's. Each key's line is
+// replaced, or added after the table's last key where missing; the rest, comments
+// included, is kept. Throws InputError naming `source` where a view that needs its own
+// camera has no entry to be found in the text.
+std::string camera_catalogue(const std::string& catalogue_text, const CameraFit& fit, const std::string& source);
 
 }  // namespace portalsim::calibrate

@@ -104,12 +104,15 @@ Simulated simulate_captures(const Captures& captures, const CameraFit& fit, cons
   Simulated out;
   for (const ViewCaptures& v : captures.views) {
     const int view = fc.sensor_index(v.name);
+    // The view's own raw grid and NETD where the fit gives it a camera of its own, as
+    // generate takes them from camera.catalogue.toml.
+    const ModelSettings mv = m.for_view(fc.sensors[view]);
     std::map<int, reference::Field> raw;  // each subject's blurred raw grid, made once
     std::vector<std::vector<uint8_t>> noisy, clean;
     for (size_t c = 0; c < captures.count(); ++c) {
       Scenario s;
       s.subject = fit.subject[c];
-      const reference::ViewScene vs = reference::view_scene(fc, assets, m, view, s, c);
+      const reference::ViewScene vs = reference::view_scene(fc, assets, mv, view, s, c);
       if (!raw.count(s.subject)) {
         reference::Field f;
         reference::radiometry(vs, f);

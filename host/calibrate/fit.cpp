@@ -1,6 +1,7 @@
 #include "calibrate/fit.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -103,7 +104,7 @@ double trimmed_ms(std::vector<double> sq) {
 
 struct Problem {
   const Captures& cap;
-  int raw_w, raw_h;
+  std::vector<std::array<int, 2>> raw;                // [view] its raw grid
   std::vector<std::vector<reference::Field>> kelvin;  // [subject][view] bare subject, K
   std::vector<std::vector<Cells>> cells;              // [capture][view]
 };
@@ -112,7 +113,8 @@ struct Evaluation {
   double cost = INFINITY;
   Line line;
   std::vector<int> subject;
-  std::vector<double> x, y;  // every cell: the subject's kelvin and the capture's gray
+  std::vector<double> x, y;           // every cell: the subject's kelvin and the capture's gray
+  std::vector<int> view_of, capture;  // and whose cell it is
   size_t pairs = 0;
 };
 
@@ -121,29 +123,30 @@ std::vector<std::vector<std::vector<double>>> predictions(const Problem& p, doub
   std::vector<std::vector<std::vector<double>>> out(p.kelvin.size());
   for (size_t v = 0; v < p.cap.views.size(); ++v) {
     const int W = p.cap.views[v].width, H = p.cap.views[v].height;
-    const std::vector<double> kx = optics_sampling(W, p.raw_w, fwhm / kFwhmPerSigma);
-    const std::vector<double> ky = optics_sampling(H, p.raw_h, fwhm / kFwhmPerSigma);
+    const int raw_w = p.raw[v][0], raw_h = p.raw[v][1];
+    const std::vector<double> kx = optics_sampling(W, raw_w, fwhm / kFwhmPerSigma);
+    const std::vector<double> ky = optics_sampling(H, raw_h, fwhm / kFwhmPerSigma);
     // Where each raw column's weights are not zero.
-    std::vector<std::pair<int, int>> xs(p.raw_w, {W, 0});
-    for (int c = 0; c < p.raw_w; ++c)
+    std::vector<std::pair<int, int>> xs(raw_w, {W, 0});
+    for (int c = 0; c < raw_w; ++c)
       for (int x = 0; x < W; ++x)
         if (kx[static_cast<size_t>(c) * W + x] != 0) xs[c] = {std::min(xs[c].first, x), x + 1};
     for (size_t j = 0; j < p.kelvin.size(); ++j) {
       const reference::Field& t = p.kelvin[j][v];
-      std::vector<double> mid(static_cast<size_t>(H) * p.raw_w, 0.0);
+      std::vector<double> mid(static_cast<size_t>(H) * raw_w, 0.0);
       for (int y = 0; y < H; ++y)
-        for (int c = 0; c < p.raw_w; ++c) {
+        for (int c = 0; c < raw_w; ++c) {
           double acc = 0;
           for (int x = xs[c].first; x < xs[c].second; ++x) acc += kx[static_cast<size_t>(c) * W + x] * t.at(x, y);
-          mid[static_cast<size_t>(y) * p.raw_w + c] = acc;
+          mid[static_cast<size_t>(y) * raw_w + c] = acc;
         }
-      std::vector<double> raw(static_cast<size_t>(p.raw_w) * p.raw_h, 0.0);
-      for (int r = 0; r < p.raw_h; ++r)
+      std::vector<double> raw(static_cast<size_t>(raw_w) * raw_h, 0.0);
+      for (int r = 0; r < raw_h; ++r)
         for (int y = 0; y < H; ++y) {
           const double w = ky[static_cast<size_t>(r) * H + y];
           if (w == 0) continue;
-          for (int c = 0; c < p.raw_w; ++c)
-            raw[static_cast<size_t>(r) * p.raw_w + c] += w * mid[static_cast<size_t>(y) * p.raw_w + c];
+          for (int c = 0; c < raw_w; ++c)
+            raw[static_cast<size_t>(r) * raw_w + c] += w * mid[static_cast<size_t>(y) * raw_w + c];
         }
       out[j].push_back(std::move(raw));
     }
@@ -180,11 +183,14 @@ Evaluation evaluate(const Problem& p, double fwhm) {
   // Then one window for all: fit it, re-match each capture under it, fit again.
   for (int round = 0; round < 3; ++round) {
     std::vector<double> x, y;
+    std::vector<int> view_of, capture;
     for (size_t c = 0; c < n; ++c)
       for (size_t v = 0; v < p.cells[c].size(); ++v)
         for (size_t k = 0; k < p.cells[c][v].index.size(); ++k) {
           x.push_back(pred[e.subject[c]][v][p.cells[c][v].index[k]]);
           y.push_back(p.cells[c][v].value[k]);
+          view_of.push_back(static_cast<int>(v));
+          capture.push_back(static_cast<int>(c));
         }
     e.line = robust_line(x, y);
     e.pairs = x.size();
@@ -194,6 +200,8 @@ Evaluation evaluate(const Problem& p, double fwhm) {
       e.cost = trimmed_ms(std::move(sq));
       e.x = std::move(x);
       e.y = std::move(y);
+      e.view_of = std::move(view_of);
+      e.capture = std::move(capture);
       break;
     }
     for (size_t c = 0; c < n; ++c) {
@@ -230,26 +238,44 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
                      const ModelSettings& model) {
   check_captures(captures);
   CameraFit fit;
-  // The raw grid: one for both views (the camera's), from both views' lines together.
-  std::vector<const std::vector<uint8_t>*> imgs;
   const ViewCaptures& v0 = captures.views[0];
-  for (const ViewCaptures& v : captures.views) {
+  bool raw_view_found = false, noise_view_found = false;
+  for (size_t k = 0; k < captures.views.size(); ++k) {
+    const ViewCaptures& v = captures.views[k];
     const int s = cat.sensor_index(v.name);
     if (s < 0) throw InputError(captures.source + ": the catalogue has no camera view \"" + v.name + "\"");
-    if (cat.sensors[s].width != v.width || cat.sensors[s].height != v.height)
+    const Sensor& sensor = cat.sensors[s];
+    if (sensor.width != v.width || sensor.height != v.height)
       throw InputError(v.files.front() + ": is " + std::to_string(v.width) + "x" + std::to_string(v.height) +
-                       " but the catalogue's " + v.name + " view is " + std::to_string(cat.sensors[s].width) + "x" +
-                       std::to_string(cat.sensors[s].height));
+                       " but the catalogue's " + v.name + " view is " + std::to_string(sensor.width) + "x" +
+                       std::to_string(sensor.height));
     if (v.width != v0.width || v.height != v0.height)
       throw InputError(v.files.front() + ": the views differ in size from " + v0.files.front());
+    // Each view's raw grid from its own captures: a portal's cameras may differ.
+    ViewFit vf;
+    vf.name = v.name;
+    std::vector<const std::vector<uint8_t>*> imgs;
     for (const auto& img : v.images) imgs.push_back(&img);
+    vf.grid_x = raw_grid_axis(imgs, v.width, v.height, true);
+    vf.grid_y = raw_grid_axis(imgs, v.width, v.height, false);
+    vf.raw_w = vf.grid_x.raw;
+    vf.raw_h = vf.grid_y.raw;
+    fit.views.push_back(std::move(vf));
+    // The run's camera is the first view's that the catalogue gives none of its own.
+    if (!sensor.raw && !raw_view_found) {
+      fit.raw_view = k;
+      raw_view_found = true;
+    }
+    if (!sensor.netd && !noise_view_found) {
+      fit.noise_view = k;
+      noise_view_found = true;
+    }
   }
-  fit.grid_x = raw_grid_axis(imgs, v0.width, v0.height, true);
-  fit.grid_y = raw_grid_axis(imgs, v0.width, v0.height, false);
-  fit.raw_w = fit.grid_x.raw;
-  fit.raw_h = fit.grid_y.raw;
+  fit.raw_w = fit.views[fit.raw_view].raw_w;
+  fit.raw_h = fit.views[fit.raw_view].raw_h;
 
-  Problem p{captures, fit.raw_w, fit.raw_h, {}, {}};
+  Problem p{captures, {}, {}, {}};
+  for (const ViewFit& vf : fit.views) p.raw.push_back({vf.raw_w, vf.raw_h});
   ModelSettings m = model;
   m.model = Model::physics;
   for (size_t j = 0; j < cat.subjects.size(); ++j) {
@@ -266,10 +292,11 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
   }
   p.cells.resize(captures.count());
   for (size_t c = 0; c < captures.count(); ++c)
-    for (const ViewCaptures& v : captures.views) {
+    for (size_t k = 0; k < captures.views.size(); ++k) {
+      const ViewCaptures& v = captures.views[k];
       std::vector<double> raw;
       std::vector<char> valid;
-      recover_raw(v.images[c], v.width, v.height, fit.raw_w, fit.raw_h, raw, valid);
+      recover_raw(v.images[c], v.width, v.height, p.raw[k][0], p.raw[k][1], raw, valid);
       // At most about 1,024 cells a view: plenty for a robust fit, and the search stays quick
       // on a full-size raw grid.
       const size_t stride = std::max<size_t>(1, raw.size() / 1024);
@@ -338,12 +365,59 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
   }
   fit.display_min = -offset / fit.gain;
   fit.display_max = fit.display_min + 255.0 / fit.gain;
-  std::vector<double> absr(e.x.size());
-  for (size_t i = 0; i < e.x.size(); ++i) absr[i] = std::abs(e.y[i] - offset - fit.gain * e.x[i]);
-  const double s = 1.4826 * median(absr);
-  const double round = rounding_variance(v0.width, v0.height, fit.raw_w, fit.raw_h);
-  fit.noise_gray = std::sqrt(std::max(0.0, s * s - round));
+  // The noise: each view's robust spread of what the bare subject leaves, less its grid's
+  // rounding; and each capture's alone, whose scatter gives the figure's standard error.
+  const size_t V = captures.views.size(), n = captures.count();
+  std::vector<std::vector<double>> absr(V);
+  std::vector<std::vector<std::vector<double>>> by_capture(V, std::vector<std::vector<double>>(n));
+  for (size_t i = 0; i < e.x.size(); ++i) {
+    const double r = std::abs(e.y[i] - offset - fit.gain * e.x[i]);
+    absr[e.view_of[i]].push_back(r);
+    by_capture[e.view_of[i]][e.capture[i]].push_back(r);
+  }
+  const auto noise_of = [](std::vector<double> r, double round) {
+    const double s = 1.4826 * median(std::move(r));
+    return std::sqrt(std::max(0.0, s * s - round));
+  };
+  std::vector<double> round(V);
+  for (size_t v = 0; v < V; ++v) {
+    ViewFit& vf = fit.views[v];
+    round[v] = rounding_variance(captures.views[v].width, captures.views[v].height, vf.raw_w, vf.raw_h);
+    vf.noise_gray = noise_of(absr[v], round[v]);
+    vf.netd = vf.noise_gray / fit.gain;
+    vf.cells = static_cast<int>(absr[v].size());
+    double sum = 0, sum2 = 0, k = 0;
+    for (const std::vector<double>& r : by_capture[v])
+      if (!r.empty()) {
+        const double one = noise_of(r, round[v]);
+        sum += one;
+        sum2 += one * one;
+        k += 1;
+      }
+    vf.noise_se = k > 1 ? std::sqrt(std::max(0.0, sum2 - sum * sum / k) / (k - 1) / k) : INFINITY;
+  }
+  // The run's noise is pooled over the views that agree with the run view's: one camera's
+  // views share one NETD, fitted from all their cells.
+  const ViewFit& ref = fit.views[fit.noise_view];
+  std::vector<double> pooled;
+  double pooled_round = 0;
+  for (size_t v = 0; v < V; ++v) {
+    ViewFit& vf = fit.views[v];
+    const double gap = std::abs(vf.noise_gray - ref.noise_gray);
+    vf.noise_agrees = v == fit.noise_view || gap <= kNoiseAgreement * std::hypot(vf.noise_se, ref.noise_se) ||
+                      gap <= std::max(kNoiseTolerance * ref.noise_gray, kMinCameraNoiseGray);
+    if (!vf.noise_agrees) continue;
+    pooled.insert(pooled.end(), absr[v].begin(), absr[v].end());
+    pooled_round += round[v] * static_cast<double>(absr[v].size());
+  }
+  fit.noise_gray = noise_of(pooled, pooled.empty() ? 0.0 : pooled_round / static_cast<double>(pooled.size()));
   fit.netd = fit.noise_gray / fit.gain;
+  for (size_t v = 0; v < V; ++v) {
+    ViewFit& vf = fit.views[v];
+    const Sensor& sensor = cat.sensors[cat.sensor_index(vf.name)];
+    vf.own_raw = vf.raw_w != fit.raw_w || vf.raw_h != fit.raw_h || sensor.raw.has_value();
+    vf.own_netd = !vf.noise_agrees || sensor.netd.has_value();
+  }
   fit.subject = e.subject;
   fit.cells = static_cast<int>(e.pairs);
   return fit;
@@ -352,6 +426,13 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
 Catalogue fitted_catalogue(const Catalogue& cat, const CameraFit& fit) {
   Catalogue out = cat;
   out.physics.aperture_m = fit.aperture_m;
+  for (size_t v = 0; v < fit.views.size(); ++v) {
+    const int s = out.sensor_index(fit.views[v].name);
+    if (s < 0) throw InputError(cat.source + ": the catalogue has no camera view \"" + fit.views[v].name + "\"");
+    Sensor& sensor = out.sensors[s];
+    sensor.raw = fit.views[v].own_raw ? std::optional(fit.view_raw(v)) : std::nullopt;
+    sensor.netd = fit.views[v].own_netd ? std::optional(fit.view_netd(v)) : std::nullopt;
+  }
   return out;
 }
 
@@ -377,14 +458,34 @@ std::string not_camera_like(const Captures& captures, const CameraFit& fit) {
     std::snprintf(text, sizeof text, "%.3g", v);
     return std::string(text);
   };
+  // "the X view", "the X and Y views": where only some views are at fault.
+  const auto of_views = [&](const std::vector<size_t>& vs) {
+    std::string s;
+    for (size_t k = 0; k < vs.size(); ++k)
+      s += (k == 0 ? "" : k + 1 == vs.size() ? " and " : ", ") + fit.views[vs[k]].name;
+    return " of the " + s + (vs.size() == 1 ? " view" : " views");
+  };
+  std::vector<size_t> full, quiet;
+  double loudest = 0;
+  for (size_t v = 0; v < fit.views.size() && v < captures.views.size(); ++v) {
+    const ViewFit& vf = fit.views[v];
+    if (vf.raw_w == captures.views[v].width && vf.raw_h == captures.views[v].height) full.push_back(v);
+    if (fit.view_noise_gray(v) < kMinCameraNoiseGray) {
+      quiet.push_back(v);
+      loudest = std::max(loudest, fit.view_noise_gray(v));
+    }
+  }
   std::string why;
   const auto add = [&](const std::string& w) { why += (why.empty() ? "" : ", and ") + w; };
-  if (!captures.views.empty() && fit.raw_w == captures.views[0].width && fit.raw_h == captures.views[0].height)
-    add("the fitted raw grid, " + std::to_string(fit.raw_w) + "x" + std::to_string(fit.raw_h) +
+  if (!full.empty()) {
+    const ViewFit& vf = fit.views[full.front()];
+    add("the fitted raw grid" + (full.size() == fit.views.size() ? std::string() : of_views(full)) + ", " +
+        std::to_string(vf.raw_w) + "x" + std::to_string(vf.raw_h) +
         ", is the view's own size (no coarser grid reproduces the images)");
-  if (fit.noise_gray < kMinCameraNoiseGray)
-    add("the noise, " + g(fit.noise_gray) + " gray levels per raw pixel, is under " + g(kMinCameraNoiseGray) +
-        " of a gray level");
+  }
+  if (!quiet.empty())
+    add("the noise" + (quiet.size() == fit.views.size() ? std::string() : of_views(quiet)) + ", " + g(loudest) +
+        " gray levels per raw pixel, is under " + g(kMinCameraNoiseGray) + " of a gray level");
   return why;
 }
 

@@ -1,7 +1,8 @@
 // `portalsim calibrate --real DIR [--out camera.toml]`: fits the physics model's camera
 // (raw grid, blur, display window, noise) to a folder of MMW captures and writes what
-// `generate` takes: a spec (camera.toml), a catalogue with the fitted window and aperture
-// (camera.catalogue.toml) and a report with its plot (camera-report/).
+// `generate` takes: a spec (camera.toml), a catalogue with the fitted aperture and each
+// view's own camera where it differs (camera.catalogue.toml) and a report with its plot
+// (camera-report/).
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -50,10 +51,28 @@ std::string fixed(double v, int decimals) {
 }
 
 nlohmann::json fit_json(const calibrate::CameraFit& f, size_t captures) {
+  nlohmann::json views = nlohmann::json::array();
+  for (size_t v = 0; v < f.views.size(); ++v) {
+    const calibrate::ViewFit& vf = f.views[v];
+    views.push_back(
+        {{"name", vf.name},
+         {"raw_grid", {{"width", vf.raw_w}, {"height", vf.raw_h}}},
+         {"raw_grid_residual",
+          {{"x", vf.grid_x.ms}, {"y", vf.grid_y.ms}, {"bound_x", vf.grid_x.bound}, {"bound_y", vf.grid_y.bound}}},
+         {"noise_gray", vf.noise_gray},
+         {"noise_gray_se", vf.noise_se},
+         {"netd", vf.netd},
+         {"noise_agrees_with_run", vf.noise_agrees},
+         {"cells", vf.cells},
+         {"own_raw", vf.own_raw},
+         {"own_netd", vf.own_netd},
+         {"camera",
+          {{"raw_grid", {{"width", f.view_raw(v)[0]}, {"height", f.view_raw(v)[1]}}}, {"netd", f.view_netd(v)}}}});
+  }
   return {{"captures", captures},
           {"raw_grid", {{"width", f.raw_w}, {"height", f.raw_h}}},
-          {"raw_grid_residual",
-           {{"x", f.grid_x.ms}, {"y", f.grid_y.ms}, {"bound_x", f.grid_x.bound}, {"bound_y", f.grid_y.bound}}},
+          {"raw_grid_view", f.views[f.raw_view].name},
+          {"noise_view", f.views[f.noise_view].name},
           {"psf_fwhm_pixels", f.fwhm_pixels},
           {"aperture_m", f.aperture_m},
           {"blur_told", f.blur_told},
@@ -66,19 +85,33 @@ nlohmann::json fit_json(const calibrate::CameraFit& f, size_t captures) {
           {"noise_gray", f.noise_gray},
           {"netd", f.netd},
           {"cells", f.cells},
-          {"subject", f.subject}};
+          {"subject", f.subject},
+          {"views", views}};
+}
+
+// "a, b and c".
+std::string listed(const std::vector<std::string>& names) {
+  std::string s;
+  for (size_t k = 0; k < names.size(); ++k) s += (k == 0 ? "" : k + 1 == names.size() ? " and " : ", ") + names[k];
+  return s;
 }
 
 std::string markdown(const Options& o, const calibrate::CameraFit& f, const calibrate::Captures& captures, bool plotted,
                      const std::string& spec_name, const std::string& catalogue_name) {
-  std::string views;
-  for (size_t k = 0; k < captures.views.size(); ++k)
-    views += (k == 0 ? "" : k + 1 == captures.views.size() ? " and " : ", ") + captures.views[k].name;
+  std::vector<std::string> names, own_raw, own_netd, pooled;
+  for (size_t k = 0; k < f.views.size(); ++k) {
+    const calibrate::ViewFit& v = f.views[k];
+    names.push_back(v.name);
+    if (v.own_raw) own_raw.push_back(v.name + " " + std::to_string(v.raw_w) + "x" + std::to_string(v.raw_h));
+    if (v.own_netd) own_netd.push_back(v.name + " " + fixed(f.view_netd(k), 4) + " K");
+    if (v.noise_agrees) pooled.push_back(v.name);
+  }
+  const std::string run_raw = f.views[f.raw_view].name, run_noise = f.views[f.noise_view].name;
   std::ostringstream md;
   md << "# Camera calibrated from " << o.real << "\n\n"
-     << captures.count() << " captures (" << views << " views), matched to the catalogue's subjects.\n\n"
+     << captures.count() << " captures (" << listed(names) << " views), matched to the catalogue's subjects.\n\n"
      << "| parameter | fitted | how |\n| --- | --- | --- |\n"
-     << "| raw grid | " << f.raw_w << "x" << f.raw_h
+     << "| raw grid | " << f.raw_w << "x" << f.raw_h << (own_raw.empty() ? "" : " (own: " + listed(own_raw) + ")")
      << " | the fewest raw pixels whose bilinear interpolation reproduces every row and column to rounding |\n"
      << "| PSF FWHM | " << fixed(f.fwhm_pixels, 2) << " view pixels (aperture " << fixed(f.aperture_m * 1000, 2)
      << " mm)" << (f.blur_told ? "" : " (not told: the captures hardly change with the blur)")
@@ -89,9 +122,31 @@ std::string markdown(const Options& o, const calibrate::CameraFit& f, const cali
                        : "; not told: the captures show too little body against room, so the catalogue's "
                          "width is kept and only the level fitted)")
      << " | the captures' raw grids against the subject's kelvin, a robust line |\n"
-     << "| noise | " << fixed(f.netd, 4) << " K rms per raw pixel (" << fixed(f.noise_gray, 3)
-     << " gray) | the robust spread of what the bare subject leaves, less rounding |\n\n"
-     << "Use it: `portalsim generate --spec " << spec_name << " --catalogue " << catalogue_name
+     << "| noise | " << fixed(f.netd, 4) << " K rms per raw pixel (" << fixed(f.noise_gray, 3) << " gray)"
+     << (own_netd.empty() ? "" : " (own: " + listed(own_netd) + ")")
+     << " | the robust spread of what the bare subject leaves, less rounding |\n\n"
+     << "Each view's raw grid and noise are fitted from its own captures, the blur and the window from all of "
+        "them. "
+     << spec_name << " holds " << run_raw << "'s raw grid and "
+     << (pooled.size() > 1
+             ? "the noise pooled over " + listed(pooled) + ", whose own noise agrees with " + run_noise + "'s"
+             : run_noise + "'s noise, which no other view's agrees with")
+     << " (within " << fixed(calibrate::kNoiseAgreement, 0) << " standard errors, "
+     << fixed(100 * calibrate::kNoiseTolerance, 0) << "% or " << fixed(calibrate::kMinCameraNoiseGray, 1) << " gray); "
+     << catalogue_name
+     << " gives a view its own `raw` or `netd` where its camera differs, or where your catalogue gave it one.\n\n"
+     << "| view | raw grid | noise, K rms per raw pixel | gray levels | in " << catalogue_name << " |\n"
+     << "| --- | --- | --- | --- | --- |\n";
+  for (size_t v = 0; v < f.views.size(); ++v) {
+    const calibrate::ViewFit& vf = f.views[v];
+    std::string own;
+    if (vf.own_raw) own = "raw = [" + std::to_string(vf.raw_w) + ", " + std::to_string(vf.raw_h) + "]";
+    if (vf.own_netd) own += (own.empty() ? "" : ", ") + std::string("netd = ") + fixed(f.view_netd(v), 4);
+    md << "| " << vf.name << " | " << vf.raw_w << "x" << vf.raw_h << " | " << fixed(vf.netd, 4) << " | "
+       << fixed(vf.noise_gray, 3) << " +- " << fixed(vf.noise_se, 3) << " | " << (own.empty() ? "the run's" : own)
+       << " |\n";
+  }
+  md << "\nUse it: `portalsim generate --spec " << spec_name << " --catalogue " << catalogue_name
      << " --what images --out DIR`.\n\n";
   if (plotted)
     md << "![captures against the fitted camera](calibrate.png)\n\n";
@@ -132,6 +187,8 @@ int run_calibrate(const Options& o) {
                      "thesis model's, do not): " +
                      why + "; nothing written (--accept-non-camera fits them anyway)");
   const calibrate::Simulated sim = calibrate::simulate_captures(captures, fit, cat, assets, model, o.seed);
+  const std::string fitted_text =
+      calibrate::camera_catalogue(catalogue_text, fit, o.catalogue.empty() ? "the built-in catalogue" : o.catalogue);
 
   const fs::path out(o.out);
   const std::string stem = out.stem().string();
@@ -150,7 +207,7 @@ int run_calibrate(const Options& o) {
     const std::string md =
         markdown(o, fit, captures, plotted, out.filename().string(), catalogue_path.filename().string());
     write_text_atomic(folder.path("report.md"), md);
-    write_text_atomic(catalogue_path.string(), calibrate::camera_catalogue(catalogue_text, fit));
+    write_text_atomic(catalogue_path.string(), fitted_text);
     write_text_atomic(out.string(),
                       calibrate::camera_spec(fit, model, out.filename().string(), catalogue_path.filename().string()));
     folder.commit();
