@@ -74,7 +74,11 @@
 #define PS_STREAM_FEATURE_NOISE 9u     /* physics features-only: NETD noise in feature space; PS_GAUSS_ELEMENT */
 #define PS_STREAM_PIXEL_NOISE_FAST 10u /* per-pixel sensor noise, Irwin-Hall draws; PS_GAUSS_ELEMENT */
 #define PS_STREAM_METAL_MAP 11u        /* metal maps' detector noise (host only); element = zone */
+#define PS_STREAM_KNOB_DRAW 12u        /* knobs drawn per scenario (A..B); element = PS_DRAWN_* */
 #define PS_STREAM_GENERATE 16u         /* scenario generators (host only) */
+/* The knobs a run may draw per scenario, each its element of PS_STREAM_KNOB_DRAW. */
+#define PS_DRAWN_METAL_NOISE 0u
+#define PS_DRAWN_KNOBS 1
 /* physics: frame k >= 1 of the MMW camera's integration draws its NETD from stream
  * PS_STREAM_FRAME_NOISE + k (frame 0 from PS_STREAM_RAW_NOISE); element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_FRAME_NOISE 32u

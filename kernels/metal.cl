@@ -3,12 +3,22 @@
 // subject's base values, then clamped to [1, 200]. Integer arithmetic throughout, so it
 // matches the reference exactly. One work-item per scenario.
 
+// The scenario's detector noise (the knob metal_noise): noise_lo, or where the knob is
+// drawn per scenario (noise_hi > noise_lo), noise_lo + below(word 0, noise_hi - noise_lo + 1)
+// of PS_STREAM_KNOB_DRAW (host: metal_noise_at).
+inline int metal_noise_of(uint2 seed, ulong index, int noise_lo, int noise_hi) {
+  if (noise_hi <= noise_lo) return noise_lo;
+  return noise_lo + (int)below(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_METAL_NOISE).x,
+                               (uint)(noise_hi - noise_lo) + 1u);
+}
+
 kernel void metal_zones(global const uchar* influence, global const uchar* variant_category,
                         global const uchar* base_zones, global const uchar* subject, global const short* objects,
-                        uint n, uint2 seed, uint2 first, int noise, global uchar* out) {
+                        uint n, uint2 seed, uint2 first, int noise_lo, int noise_hi, global uchar* out) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const ulong index = upsample(first.y, first.x) + i;
+  const int noise = metal_noise_of(seed, index, noise_lo, noise_hi);
   int sum[PS_ZONES];
   for (int z = 0; z < PS_ZONES; ++z) sum[z] = 0;
   for (int r = 0; r < PS_REGIONS; ++r) {

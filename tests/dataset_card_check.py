@@ -249,7 +249,7 @@ def main():
         "npy": ["--count", "30", "--seed", "5", "--rule", "iron-rod&metal-plate", "--what", "images", "--format", "npy",
                 "--annotations"],
         "physics": ["--count", "50", "--seed", "6", "--rule", "gun", "--what", "features", "--format", "h5,csv",
-                    "--model", "physics", "--pattern-noise", "off", "--netd", "2.5"],
+                    "--model", "physics", "--pattern-noise", "off", "--netd", "2.5", "--metal-noise", "0..6"],
     }
     cards = {}
     for name, args in cases.items():

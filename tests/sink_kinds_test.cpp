@@ -57,13 +57,17 @@ TEST(SinkKinds, EachFileARunWritesIsAKindsInTheOrderTheKindsOpen) {
   EXPECT_EQ(coco->join("annotations.json"), JoinAs::refused);
   // Every kind but the image folders (the manifest's `images` entry) wrote a file.
   for (const SinkKind* k : sink_kinds())
-    if (k != kind_named("images/")) EXPECT_NE(std::find(seen.begin(), seen.end(), k), seen.end()) << k->name;
+    if (k != kind_named("images/")) {
+      EXPECT_NE(std::find(seen.begin(), seen.end(), k), seen.end()) << k->name;
+    }
 }
 
 TEST(SinkKinds, FormatValuesAndHelpAreTheKinds) {
   EXPECT_EQ(format_values(), (std::vector<std::string>{"arff", "csv", "npy", "h5"}));
   for (const SinkKind* k : sink_kinds())
-    if (!k->format_help.empty()) EXPECT_NE(format_help().find(k->format_help), std::string::npos) << k->name;
+    if (!k->format_help.empty()) {
+      EXPECT_NE(format_help().find(k->format_help), std::string::npos) << k->name;
+    }
   TempDir t;
   const Result r = finish(
       start(t.cap(), {"generate", "--count", "4", "--format", "arff,parquet", "--out", (t.w() / "o").string()}), 120);

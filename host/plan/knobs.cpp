@@ -95,6 +95,19 @@ Knob range(std::string key, std::string def, double lo, double hi, bool symmetri
   return k;
 }
 
+// `k` drawn per scenario where given A..B (Knob::drawn).
+Knob drawable(Knob k, unsigned element) {
+  if (element >= kDrawnKnobKeys.size() || k.key != kDrawnKnobKeys[element])
+    throw std::logic_error("knob " + k.key + ": not drawn knob " + std::to_string(element) + " (scene.h)");
+  k.drawn = static_cast<int>(element);
+  k.get = [get = std::move(k.get), element](const Plan& p) -> nlohmann::json {
+    const DrawnRange& d = p.model.drawn[element];
+    if (d.varies()) return format_number(d.lo) + ".." + format_number(d.hi);
+    return get(p);
+  };
+  return k;
+}
+
 std::vector<Knob> declare() {
   std::vector<Knob> k;
   // The sensor model (docs/model/thesis.md); defaults are the thesis's.
@@ -165,10 +178,12 @@ std::vector<Knob> declare() {
   k.push_back(number(
       "pixel_noise", "0", 0, 1000, "gray levels", "per-pixel Gaussian sensor noise sigma (MMW and IR)",
       [](Plan& p, double v) { p.model.pixel_sigma = v; }, [](const Plan& p) { return p.model.pixel_sigma; }));
-  k.push_back(integer(
-      "metal_noise", "0", 0, 199, "counts", "metal detector noise: triangular integer noise of this half-width",
-      [](Plan& p, double v) { p.model.metal_noise = static_cast<int>(v); },
-      [](const Plan& p) { return p.model.metal_noise; }));
+  k.push_back(drawable(
+      integer(
+          "metal_noise", "0", 0, 199, "counts", "metal detector noise: triangular integer noise of this half-width",
+          [](Plan& p, double v) { p.model.metal_noise = static_cast<int>(v); },
+          [](const Plan& p) { return p.model.metal_noise; }),
+      PS_DRAWN_METAL_NOISE));
   k.push_back(choice(
       "placement", "integer", {"integer", "bilinear"},
       "sprite placement: whole pixels, or sub-pixel with bilinear sampling", false, true,
@@ -275,7 +290,8 @@ std::string Knob::values() const {
     return (word.empty() ? std::string("X or A..B") : word + " or A..B") + ", each " + format_number(min) + " .. " +
            format_number(max) + (unit.empty() ? "" : " " + unit);
   if (kind == KnobKind::integer || kind == KnobKind::number)
-    return format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit);
+    return format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit) +
+           (drawn >= 0 ? ", or A..B drawn per scenario" : "");
   std::string s;
   for (const std::string& c : choices) s += (s.empty() ? "" : ", ") + c;
   return s;
@@ -292,7 +308,37 @@ const Knob* find_knob(std::string_view key) {
   return nullptr;
 }
 
+namespace {
+
+// One end of an integer or number knob's value, checked as the knob's own value.
+double knob_number(const Knob& knob, const std::string& text, const std::string& where) {
+  double v = 0;
+  if (knob.kind == KnobKind::integer) {
+    if (!parse_number(text, v) || v != std::floor(v) || text.find_first_of(".eE") != std::string::npos)
+      throw InputError(where + ": \"" + text + "\" is not a whole number");
+    if (v < knob.min || v > knob.max)
+      throw InputError(where + ": " + text + " is out of range [" + knob.values() + "]");
+  } else if (!parse_number(text, v) || !std::isfinite(v) || v < knob.min || v > knob.max) {
+    throw InputError(where + ": \"" + text + "\" must be a finite number between " + knob.values());
+  }
+  return v;
+}
+
+}  // namespace
+
 void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::string& where) {
+  if (knob.drawn >= 0) {
+    DrawnRange& d = plan.model.drawn[static_cast<size_t>(knob.drawn)];
+    d = {};
+    if (const size_t dots = text.find(".."); dots != std::string::npos) {
+      const double a = knob_number(knob, text.substr(0, dots), where + " (A of A..B)");
+      const double b = knob_number(knob, text.substr(dots + 2), where + " (B of A..B)");
+      if (a > b) throw InputError(where + ": \"" + text + "\" is reversed: A..B needs A <= B");
+      knob.set(plan, a);
+      d = {a, b};
+      return;
+    }
+  }
   double v = 0;
   switch (knob.kind) {
     case KnobKind::integer:
@@ -355,9 +401,16 @@ void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::
 void check_knobs(const Plan& plan) {
   for (const Knob& k : knobs()) {
     if (k.kind != KnobKind::integer && k.kind != KnobKind::number) continue;
-    const double v = k.get(plan).get<double>();
-    if (!std::isfinite(v) || v < k.min || v > k.max)
-      throw InputError(k.flag() + ": " + format_number(v) + " must be a finite number between " + k.values());
+    std::vector<double> ends;
+    if (k.drawn >= 0 && plan.model.drawn[static_cast<size_t>(k.drawn)].varies()) {
+      const DrawnRange& d = plan.model.drawn[static_cast<size_t>(k.drawn)];
+      ends = {d.lo, d.hi};
+    } else {
+      ends = {k.get(plan).get<double>()};
+    }
+    for (const double v : ends)
+      if (!std::isfinite(v) || v < k.min || v > k.max)
+        throw InputError(k.flag() + ": " + format_number(v) + " must be a finite number between " + k.values());
   }
 }
 

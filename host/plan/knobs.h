@@ -40,6 +40,10 @@ struct Knob {
   // A range that also takes this one word ("auto"), set as set_range(NaN, NaN); its A..B
   // must then have A < B.
   std::string word{};
+  // An integer or number knob that may be drawn per scenario: its PS_DRAWN_* element, or -1.
+  // "A..B" (A <= B, each within its range) then sets ModelSettings::drawn and the field to A;
+  // get gives "A..B" back where A < B.
+  int drawn = -1;
 
   std::string flag() const;
   // "0 .. 1000 gray levels", "on, off", "fp32, fp64, fixed16", "X or A..B, each 0.1 .. 10".

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "base/error.h"
 #include "plan/knobs.h"
@@ -17,6 +18,22 @@ ObjectTransform object_transform(const ModelSettings& m, uint64_t index, int reg
   t.scale = m.scale_lo + (m.scale_hi - m.scale_lo) * uniform24(q[1]);
   t.flip = m.flip && (q[2] >> 31) != 0;
   return t;
+}
+
+int metal_noise_at(const ModelSettings& m, uint64_t index) {
+  const DrawnRange& d = m.drawn[PS_DRAWN_METAL_NOISE];
+  if (!d.varies()) return m.metal_noise;
+  const int lo = static_cast<int>(d.lo), span = static_cast<int>(d.hi) - lo + 1;
+  return lo + static_cast<int>(
+                  below(draw(m.seed, index, kStreamKnobDraw, PS_DRAWN_METAL_NOISE)[0], static_cast<uint32_t>(span)));
+}
+
+double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index) {
+  switch (element) {
+    case PS_DRAWN_METAL_NOISE:
+      return metal_noise_at(m, index);
+  }
+  throw std::logic_error("no drawn knob " + std::to_string(element));
 }
 
 FeatureLayout FeatureLayout::of(const Catalogue& cat, int block) {

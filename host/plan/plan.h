@@ -1,6 +1,7 @@
 // What a batch needs: which sensors, images or features only, and the model's knobs.
 // Both backends read the same Plan; what it leaves out is never computed.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -14,6 +15,12 @@ namespace portalsim {
 // How the MMW camera interpolates its raw grid to the view: bilinear, or Keys' cubic
 // convolution (a = -1/2), edges held.
 enum class DisplayFilter { bilinear, bicubic };
+
+// A knob drawn per scenario: uniform in [lo, hi], whole numbers for an integer knob.
+struct DrawnRange {
+  double lo = 0, hi = 0;
+  bool varies() const { return hi > lo; }
+};
 
 // The knobs of the sensor model (docs/model/thesis.md). Each field's default is its
 // knob's declaration (plan/knobs.cpp; the thesis's values): ModelSettings() holds them all.
@@ -61,6 +68,16 @@ struct ModelSettings {
   double window_lo{}, window_hi{};
   DisplayFilter display_filter{};
   double smooth{};
+  // Knobs drawn per scenario (docs/model/drawn-knobs.md), indexed by PS_DRAWN_*: a knob
+  // given A..B takes in each scenario a value uniform in [A, B] (whole numbers for an
+  // integer knob) from the counter generator, the same in every view, batch and backend.
+  // Its field above then holds A; each knob's value of a scenario is its *_at function.
+  std::array<DrawnRange, PS_DRAWN_KNOBS> drawn{};
+  bool draws_knobs() const {
+    for (const DrawnRange& d : drawn)
+      if (d.varies()) return true;
+    return false;
+  }
   // The knobs as view `s` takes them: its own camera parameters (Sensor::netd, raw) over
   // the run's. Both backends read a view's knobs through this, and nothing else.
   ModelSettings for_view(const Sensor& s) const;
@@ -73,6 +90,13 @@ struct ModelSettings {
 // 0 and 1 uniform (24 bits) for the angle and the scale, the top bit of word 2 for the flip.
 // kernels/composite.cl's place_view draws the same numbers on its own.
 ObjectTransform object_transform(const ModelSettings& m, uint64_t index, int region);
+
+// Scenario `index`'s metal detector noise (the knob metal_noise): the knob's value, or where
+// it is drawn (A..B), A + below(word 0, B - A + 1) of PS_STREAM_KNOB_DRAW, element
+// PS_DRAWN_METAL_NOISE. kernels/metal.cl and metal_physics.cl draw the same on their own.
+int metal_noise_at(const ModelSettings& m, uint64_t index);
+// Scenario `index`'s value of the drawn knob `element` (PS_DRAWN_*), as its *_at gives it.
+double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index);
 
 // How block and region means are computed. Both give the same numbers to the bit
 // (under -cl-fast-relaxed-math, to the division's approximation); sparse is used for

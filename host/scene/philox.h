@@ -41,6 +41,7 @@ enum Stream : uint32_t {
   kStreamTransform = PS_STREAM_TRANSFORM,
   kStreamFeatureNoise = PS_STREAM_FEATURE_NOISE,
   kStreamPixelNoiseFast = PS_STREAM_PIXEL_NOISE_FAST,
+  kStreamKnobDraw = PS_STREAM_KNOB_DRAW,
   kStreamGenerate = PS_STREAM_GENERATE,
 };
 

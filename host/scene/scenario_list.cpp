@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <charconv>
 #include <cmath>
@@ -69,7 +70,9 @@ ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, c
     else if (int r = numbered(h, "region"); r != 0) {
       if (r < 0) throw InputError(column + "there are " + regions + " only");
       col_region_[r - 1] = static_cast<int>(c);
-    } else if (h == "index") {
+    } else if (h == "index" || std::any_of(kDrawnKnobKeys.begin(), kDrawnKnobKeys.end(),
+                                           [&](const char* k) { return normalise_name(k) == h; })) {
+      // A drawn knob's column records the run's draw; a run draws it again from its seed.
     } else if (
         int t = 0, tr = 0; [&] {
           for (t = 0; t < 3; ++t)

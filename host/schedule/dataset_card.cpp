@@ -99,6 +99,9 @@ std::string tensor_meaning(const std::string& name, const Portal& portal) {
       {"region_flip", "per region: 1 where the object is mirrored left to right"},
   };
   if (const auto it = m.find(name); it != m.end()) return it->second;
+  if (name.starts_with("param_"))
+    return "per scenario: the value the knob " + name.substr(6) +
+           " was drawn for it (uniform over the run's A..B; the manifest gives the range)";
   if (name == "region_object")
     return "per region 1-" + R + ": the object's index in the catalogue (object_names), -1 none";
   const bool mask = name.starts_with("mask_"), index = name.ends_with("_index");

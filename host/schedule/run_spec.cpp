@@ -111,9 +111,11 @@ namespace {
 // A TOML value as the knob's text ("10", "2.5", "on", "bilinear"); the type is checked here,
 // the value by set_knob.
 std::string knob_value(const Knob& k, const toml::node& n, const std::string& at) {
+  if (k.drawn >= 0 && n.is_string()) return n.as_string()->get();  // "A..B", drawn per scenario
   switch (k.kind) {
     case KnobKind::integer:
-      if (!n.is_integer()) throw InputError(at + ": expected an integer");
+      if (!n.is_integer())
+        throw InputError(at + (k.drawn >= 0 ? ": expected an integer or a string \"A..B\"" : ": expected an integer"));
       return std::to_string(n.as_integer()->get());
     case KnobKind::number:
       if (n.is_integer()) return std::to_string(n.as_integer()->get());

@@ -120,6 +120,8 @@ class ScenarioListSink final : public Sink {
       if (ctx.model.transforms())
         for (const char* what : {",rotation", ",scale", ",flip"})
           for (int r = 1; r <= R; ++r) h += what + std::to_string(r);
+      for (unsigned e = 0; e < kDrawnKnobKeys.size(); ++e)
+        if (ctx.model.drawn[e].varies()) h += std::string(",") + kDrawnKnobKeys[e];
       file_.append(h + ",label\n");
     }
     for (size_t v = 0; v < ctx.cat->variant_list.size(); ++v)
@@ -157,6 +159,15 @@ class ScenarioListSink final : public Sink {
             s.append(buf, res.ptr);
           }
       }
+      // Each knob drawn per scenario (plan.h, drawn_knob_at): the shortest text that reads
+      // back as the same double.
+      for (unsigned e = 0; e < kDrawnKnobKeys.size(); ++e)
+        if (ctx_.model.drawn[e].varies()) {
+          char buf[32];
+          const auto res = std::to_chars(buf, buf + sizeof buf, drawn_knob_at(ctx_.model, e, scenes.first_index + i));
+          s += ',';
+          s.append(buf, res.ptr);
+        }
       s += scenes.label[i] == 1 ? ",yes\n" : ",no\n";
     }
     file_.append(s);

@@ -216,6 +216,18 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
                                           [](const ObjectTransform& x) { return uint8_t(x.flip); });
           });
     }
+    // Each knob drawn per scenario (plan.h, drawn_knob_at): float64, the doubles
+    // scenarios.csv records.
+    for (unsigned e = 0; e < kDrawnKnobKeys.size(); ++e)
+      if (ctx.model.drawn[e].varies())
+        add(std::string("param_") + kDrawnKnobKeys[e], TensorType::f64, {},
+            [model, e](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+              for (size_t i = lo; i < hi; ++i) {
+                const double v = drawn_knob_at(model, e, b.first_index + i);
+                std::memcpy(dst + (i - lo) * sizeof v, &v, sizeof v);
+              }
+              return std::string_view(dst, (hi - lo) * sizeof(double));
+            });
   }
   return columns;
 }

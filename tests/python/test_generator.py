@@ -14,6 +14,8 @@ CASES = {
     "physics-rotated": dict(what="both", model="physics", rotate="-30..30", scale="0.8..1.2", flip=True),
     "thesis-annotations": dict(what="images", annotations=True, objects="1..4", rotate=20, rule="gun"),
     "physics-annotations": dict(what="images", model="physics", annotations=True, objects="2..3"),
+    # A knob drawn per scenario: its draws are the batch's param_metal_noise.
+    "drawn-metal-noise": dict(what="features", metal_noise="0..9"),
     "spec-file": dict(spec="scenarios/case1-gun.toml", what="both", seed=5),
     # 20 regions, 33 zones, front and back MMW and IR views (tools/portal_catalogues.py).
     "portal-20x33": dict(catalogue="tests/portals/portal-20x33.toml", what="images", annotations=True,

@@ -114,7 +114,8 @@ PS_KERNEL_ARGS(PoolRegionsArgs, PS_POOL_REGIONS_ARGS)
   X(cl_uint, n)                   \
   X(cl_uint2, seed)               \
   X(cl_uint2, first)              \
-  X(cl_int, noise)                \
+  X(cl_int, noise_lo)             \
+  X(cl_int, noise_hi)             \
   X(cl::Buffer, out)
 PS_KERNEL_ARGS(MetalZonesArgs, PS_METAL_ZONES_ARGS)
 
@@ -129,7 +130,8 @@ PS_KERNEL_ARGS(MetalZonesArgs, PS_METAL_ZONES_ARGS)
   X(cl_uint, n)                  \
   X(cl_uint2, seed)              \
   X(cl_uint2, first)             \
-  X(cl_int, noise)               \
+  X(cl_int, noise_lo)            \
+  X(cl_int, noise_hi)            \
   X(cl_double, jitter)           \
   X(cl_double, half_width)       \
   X(cl_double, scale)            \

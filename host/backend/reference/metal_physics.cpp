@@ -88,14 +88,15 @@ void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSett
                    uint64_t index, uint8_t* zones) {
   const MetalPhysics& mp = cat.metal_physics;
   const std::vector<MetalObject> objects = metal_objects(cat, assets, m, s, index);
+  const int noise = metal_noise_at(m, index);  // the knob's, or this scenario's draw
   for (int z = 0; z < cat.zones; ++z) {
     double signal = 0;
     for (const MetalObject& o : objects) signal += zone_signal(mp, z, o);
     const int deduction = deduction_of(mp.gain[z] * std::fabs(signal));
     int value = cat.subjects[s.subject].base_zones[z] - deduction;
-    if (m.metal_noise > 0 && deduction > 0) {
+    if (noise > 0 && deduction > 0) {
       const Philox4 r = draw(m.seed, index, kStreamMetalNoise, static_cast<uint32_t>(z));
-      value += static_cast<int>(below(r[0], m.metal_noise + 1)) - static_cast<int>(below(r[1], m.metal_noise + 1));
+      value += static_cast<int>(below(r[0], noise + 1)) - static_cast<int>(below(r[1], noise + 1));
     }
     zones[z] = static_cast<uint8_t>(std::clamp(value, 1, 200));
   }

@@ -65,7 +65,10 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
                              .n = n,
                              .seed = b.seed,
                              .first = b.first,
-                             .noise = plan.model.metal_noise,
+                             .noise_lo = plan.model.metal_noise,
+                             .noise_hi = plan.model.drawn[PS_DRAWN_METAL_NOISE].varies()
+                                             ? static_cast<cl_int>(plan.model.drawn[PS_DRAWN_METAL_NOISE].hi)
+                                             : plan.model.metal_noise,
                              .jitter = plan.model.jitter,
                              .half_width = kFieldWidth / 2.0,
                              .scale = cat.metres_per_field_unit(),
@@ -82,7 +85,10 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
                            .n = n,
                            .seed = b.seed,
                            .first = b.first,
-                           .noise = plan.model.metal_noise,
+                           .noise_lo = plan.model.metal_noise,
+                           .noise_hi = plan.model.drawn[PS_DRAWN_METAL_NOISE].varies()
+                                           ? static_cast<cl_int>(plan.model.drawn[PS_DRAWN_METAL_NOISE].hi)
+                                           : plan.model.metal_noise,
                            .out = metal},
             b.n);
   }

@@ -1,0 +1,156 @@
+// Knobs drawn per scenario (A..B, plan.h ModelSettings::drawn): each scenario's value from
+// the counter generator, the same on both backends and in every batch, recorded per row,
+// and a fixed value (A..A) keeping today's bytes.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "plan/knobs.h"
+#include "run_binary.h"
+#include "sink/h5_file.h"
+#include "support.h"
+
+namespace portalsim {
+namespace {
+
+namespace fs = std::filesystem;
+using test::assets;
+using test::catalogue;
+
+Plan metal_plan(Model model, uint64_t seed, const std::string& metal_noise) {
+  Plan plan;
+  plan.images = 0;
+  plan.features = false;
+  plan.model.model = model;
+  plan.model.seed = seed;
+  set_knob(plan, *find_knob("metal_noise"), metal_noise, "--metal-noise");
+  return plan;
+}
+
+std::vector<uint8_t> metal(Backend& b, const SceneBatch& batch, const Plan& plan) {
+  BatchOutput out;
+  b.run(batch, plan, out);
+  return out.metal;
+}
+
+TEST(DrawnKnobs, MetalNoiseDrawnPerScenarioIsTheReferencesOnBothModels) {
+  auto ref = make_reference_backend(catalogue(), assets());
+  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  std::vector<Scenario> scenes;
+  for (uint64_t k = 0; k < 2000; ++k) scenes.push_back(test::random_scenario(catalogue(), k));
+  const SceneBatch batch = test::batch_of(scenes, 5000);
+  for (Model model : {Model::thesis, Model::physics}) {
+    const Plan drawn = metal_plan(model, 77, "0..12");
+    const std::vector<uint8_t> a = metal(*ref, batch, drawn), b = metal(*ocl, batch, drawn);
+    ASSERT_EQ(a.size(), b.size());
+    size_t differ = 0;
+    for (size_t i = 0; i < a.size(); ++i) differ += a[i] != b[i];
+    EXPECT_EQ(differ, 0u) << model_name(model);
+    // A range of one value is that value, to the byte; the range's ends on their own too.
+    for (const auto& [range, fixed] : {std::pair{"0..0", "0"}, {"7..7", "7"}, {"199..199", "199"}})
+      for (Backend* be : {ref.get(), ocl.get()})
+        EXPECT_EQ(metal(*be, batch, metal_plan(model, 77, range)), metal(*be, batch, metal_plan(model, 77, fixed)))
+            << model_name(model) << " " << range << " on " << be->name();
+    // The drawn noise moves zones a fixed noise leaves alone, and differs from either end.
+    EXPECT_NE(a, metal(*ref, batch, metal_plan(model, 77, "0")));
+    EXPECT_NE(a, metal(*ref, batch, metal_plan(model, 77, "12")));
+  }
+  // Every value of the range is drawn, none outside it, the same for a scenario however asked.
+  const ModelSettings m = metal_plan(Model::thesis, 77, "3..9").model;
+  std::set<int> seen;
+  for (uint64_t i = 0; i < 2000; ++i) {
+    const int v = metal_noise_at(m, i);
+    EXPECT_GE(v, 3);
+    EXPECT_LE(v, 9);
+    EXPECT_EQ(drawn_knob_at(m, PS_DRAWN_METAL_NOISE, i), v);
+    seen.insert(v);
+  }
+  EXPECT_EQ(seen.size(), 7u);
+}
+
+std::vector<std::vector<std::string>> csv_rows(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+    rows.push_back(f);
+  }
+  return rows;
+}
+
+test::Result gen(const test::TempDir& t, std::vector<std::string> args, const fs::path& out) {
+  const bool listed = std::find(args.begin(), args.end(), "--scenarios") != args.end();
+  args.insert(args.begin(), "generate");
+  if (!listed) args.insert(args.end(), {"--count", "40"});
+  for (const char* a : {"--seed", "9", "--quiet", "--out"}) args.push_back(a);
+  args.push_back(out.string());
+  return test::finish(test::start(t.cap(), args), 300);
+}
+
+TEST(DrawnKnobs, EachScenariosDrawIsRecordedAndAFixedRangeKeepsTheBytes) {
+  test::TempDir t;
+  // A..A is A: the same files, byte for byte (the manifest records "3" both times).
+  ASSERT_EQ(gen(t, {"--metal-noise", "3"}, t.w() / "fixed").status, 0);
+  ASSERT_EQ(gen(t, {"--metal-noise", "3..3"}, t.w() / "one").status, 0);
+  for (const char* f : {"scenarios.csv", "features.arff", "manifest.json"})
+    EXPECT_EQ(test::slurp(t.w() / "fixed" / f), test::slurp(t.w() / "one" / f)) << f;
+  // Drawn: the same bytes for any batch and thread count; each row's draw recorded.
+  const test::Result a = gen(t, {"--metal-noise", "0..8", "--format", "csv,h5", "--batch", "7"}, t.w() / "a");
+  ASSERT_EQ(a.status, 0) << test::describe(a);
+  ASSERT_EQ(
+      gen(t, {"--metal-noise", "0..8", "--format", "csv,h5", "--batch", "40", "--threads", "1"}, t.w() / "b").status,
+      0);
+  for (const char* f : {"scenarios.csv", "features.csv", "data.h5"})
+    EXPECT_EQ(test::slurp(t.w() / "a" / f), test::slurp(t.w() / "b" / f)) << f;
+  const auto rows = csv_rows(t.w() / "a" / "scenarios.csv");
+  ASSERT_EQ(rows.size(), 41u);
+  const auto col = std::find(rows[0].begin(), rows[0].end(), "metal_noise");
+  ASSERT_NE(col, rows[0].end());
+  const size_t c = static_cast<size_t>(col - rows[0].begin());
+  const ModelSettings m = metal_plan(Model::thesis, 9, "0..8").model;
+  for (size_t i = 1; i < rows.size(); ++i) EXPECT_EQ(rows[i][c], std::to_string(metal_noise_at(m, i - 1))) << i;
+  // The features' metal zones are the drawn noise's: 3 of them differ from a run at 0.
+  EXPECT_NE(test::slurp(t.w() / "a" / "features.csv"), test::slurp(t.w() / "fixed" / "features.csv"));
+  bool param = false;
+  for (const H5Dataset& d : read_h5_layout((t.w() / "a" / "data.h5").string()).datasets)
+    param = param || (d.name == "param_metal_noise" && d.type == TensorType::f64);
+  EXPECT_TRUE(param);
+  EXPECT_NE(test::slurp(t.w() / "a" / "croissant.json").find("the value the knob metal_noise was drawn"),
+            std::string::npos);
+  // The list re-runs: its metal_noise column is read as the record it is.
+  ASSERT_EQ(
+      gen(t, {"--metal-noise", "0..8", "--scenarios", (t.w() / "a" / "scenarios.csv").string()}, t.w() / "c").status,
+      0);
+  EXPECT_EQ(test::slurp(t.w() / "a" / "scenarios.csv"), test::slurp(t.w() / "c" / "scenarios.csv"));
+}
+
+TEST(DrawnKnobs, BadRangesAreRefusedNamingTheFlagOrTheLine) {
+  test::TempDir t;
+  const std::vector<std::pair<std::string, std::string>> flags = {
+      {"6..0", "--metal-noise: \"6..0\" is reversed"},
+      {"0..200", "--metal-noise (B of A..B): 200 is out of range"},
+      {"nan..3", "--metal-noise (A of A..B): \"nan\" is not a whole number"},
+      {"1.5..3", "is not a whole number"},
+      {"..3", "(A of A..B)"},
+  };
+  for (const auto& [value, says] : flags) {
+    const test::Result r = gen(t, {"--metal-noise", value}, t.w() / "o");
+    EXPECT_EQ(r.status, 2) << value;
+    EXPECT_NE(r.err.find(says), std::string::npos) << value << ": " << r.err;
+    EXPECT_FALSE(fs::exists(t.w() / "o")) << value;
+  }
+  test::spit(t.w() / "spec.toml", "count = 10\nmetal_noise = \"9..2\"\n");
+  const test::Result r = test::finish(
+      test::start(t.cap(), {"generate", "--spec", (t.w() / "spec.toml").string(), "--out", (t.w() / "s").string()}),
+      120);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("spec.toml:2: metal_noise: \"9..2\" is reversed"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(t.w() / "s"));
+}
+
+}  // namespace
+}  // namespace portalsim
