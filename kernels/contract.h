@@ -78,7 +78,8 @@
 #define PS_STREAM_GENERATE 16u         /* scenario generators (host only) */
 /* The knobs a run may draw per scenario, each its element of PS_STREAM_KNOB_DRAW. */
 #define PS_DRAWN_METAL_NOISE 0u
-#define PS_DRAWN_KNOBS 1
+#define PS_DRAWN_IR_NETD 1u
+#define PS_DRAWN_KNOBS 2
 /* physics: frame k >= 1 of the MMW camera's integration draws its NETD from stream
  * PS_STREAM_FRAME_NOISE + k (frame 0 from PS_STREAM_RAW_NOISE); element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_FRAME_NOISE 32u
@@ -192,7 +193,8 @@ typedef struct {
 #define PS_PHYS_WINDOW_MIN 1 /* K shown as gray 0 */
 #define PS_PHYS_WINDOW_MAX 2 /* K shown as gray 255 */
 #define PS_PHYS_NETD 3       /* K rms per raw pixel */
-#define PS_PHYS_SUBJECTS 4
+#define PS_PHYS_NETD_HI 4    /* the IR NETD drawn per scenario: its upper end; NETD where fixed */
+#define PS_PHYS_SUBJECTS 5
 
 /* A camera view's placement record per scenario, written by place_view and read by
  * every render stage: the objects it draws, in region order, and the noise pattern. */

@@ -30,9 +30,18 @@ kernel void stage_ir_surface(VIEW_STAGE_ARGS) {
 // Gaussian each from the counter generator (PS_STREAM_IR_NOISE, PS_GAUSS_ELEMENT), or the
 // fast tier's draw (PS_FLAG_FAST_DRAWS). One work-item per scenario: fp32 builds draw 128
 // pixels at a time (gauss128, ih128).
+// The scenario's IR NETD: the knob's, or where it is drawn per scenario (PS_PHYS_NETD_HI
+// above PS_PHYS_NETD), NETD + (hi - NETD) uniform24(word 0) of PS_STREAM_KNOB_DRAW (host:
+// ir_netd_at).
+inline preal ir_netd_of(global const param* phys, uint2 seed, ulong index) {
+  const preal lo = (preal)phys[PS_PHYS_NETD], hi = (preal)phys[PS_PHYS_NETD_HI];
+  if (hi <= lo) return lo;
+  return lo + (hi - lo) * (preal)uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_IR_NETD).x);
+}
+
 kernel void stage_ir_netd(VIEW_STAGE_ARGS) {
   VIEW_STAGE_SCENARIO;
-  const preal sd = (preal)phys[PS_PHYS_NETD];
+  const preal sd = ir_netd_of(phys, seed, index);
   if (sd > 0)
     noise_cells((global preal*)field + (size_t)i * L.width * L.height, L.width * L.height, sd, seed, index,
                 PS_STREAM_IR_NOISE, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);

@@ -220,7 +220,7 @@ kernel void ir_surface_noise_display_fused(VIEW_STAGE_ARGS) {
   const int pixels = L.width * L.height;
   global const preal* T = (global const preal*)field + (size_t)i * pixels;
   global uchar* o = out + (size_t)i * pixels;
-  const preal sd = (preal)phys[PS_PHYS_NETD];
+  const preal sd = ir_netd_of(phys, seed, index);
   if (sd > 0)
     ir_noisy_window(T, o, phys, pixels, sd, seed, index, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);
   else

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "backend/compare.h"
 #include "plan/knobs.h"
 #include "run_binary.h"
 #include "sink/h5_file.h"
@@ -68,6 +69,70 @@ TEST(DrawnKnobs, MetalNoiseDrawnPerScenarioIsTheReferencesOnBothModels) {
     seen.insert(v);
   }
   EXPECT_EQ(seen.size(), 7u);
+}
+
+// The IR NETD drawn per scenario: the kernels' images are the reference's within the IR
+// parity test's stated tolerance (IrPhysics.KernelsMatchTheReferenceInEveryTier), on the
+// fused path and the chain of stage kernels; a scenario's noise is its own draw's.
+TEST(DrawnKnobs, IrNetdDrawnPerScenarioIsTheReferencesOnEveryPath) {
+  std::vector<Scenario> scenes;
+  for (size_t k = 0; k < 40; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
+  const SceneBatch batch = test::batch_of(scenes, 300);
+  auto ref = make_reference_backend(catalogue(), assets());
+  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  const auto plan_of = [](const std::string& ir_netd, bool fused, Tier tier) {
+    Plan plan = test::physics_plan(31);
+    plan.fidelity = tier_fidelity(tier);
+    plan.fidelity.fused = fused;
+    set_knob(plan, *find_knob("ir_netd"), ir_netd, "--ir-netd");
+    return plan;
+  };
+  const size_t ir = static_cast<size_t>(catalogue().sensor_index("ir"));
+  for (Tier tier : {Tier::standard, Tier::exact})
+    for (bool fused : {true, false}) {
+      SCOPED_TRACE(std::string(tier_name(tier)) + (fused ? " fused" : " stage chain"));
+      const Plan drawn = plan_of("0..0.6", fused, tier);
+      BatchOutput r, k;
+      ref->run(batch, drawn, r);
+      ocl->run(batch, drawn, k);
+      const OutputDiff d = compare_outputs(k, r);
+      EXPECT_GT(d.ir.pixels, 0u);
+      EXPECT_LE(d.ir.max_abs, 1);
+      EXPECT_LE(d.ir.share_differing, 0.005);
+      // A range of one value is that value, to the byte.
+      BatchOutput one, fixed;
+      ocl->run(batch, plan_of("0.2..0.2", fused, tier), one);
+      ocl->run(batch, plan_of("0.2", fused, tier), fixed);
+      EXPECT_EQ(one.views[ir].pixels, fixed.views[ir].pixels);
+      // Each scenario's image is noisier where its draw is larger: against the noise-free
+      // image, the mean squared difference follows the drawn NETD.
+      BatchOutput quiet;
+      ocl->run(batch, plan_of("0", fused, tier), quiet);
+      const ModelSettings m = drawn.model;
+      double low = 0, high = 0;
+      int nl = 0, nh = 0;
+      for (size_t i = 0; i < batch.size(); ++i) {
+        const ViewImages& a = k.views[ir];
+        const ViewImages& b = quiet.views[ir];
+        double ms = 0;
+        for (size_t p = 0; p < a.pixels_per_image(); ++p) {
+          const double e = double(a.of(i)[p]) - double(b.of(i)[p]);
+          ms += e * e;
+        }
+        ms /= double(a.pixels_per_image());
+        const double netd = ir_netd_at(m, batch.first_index + i);
+        if (netd < 0.15) {
+          low += ms;
+          ++nl;
+        } else if (netd > 0.45) {
+          high += ms;
+          ++nh;
+        }
+      }
+      ASSERT_GT(nl, 0);
+      ASSERT_GT(nh, 0);
+      EXPECT_GT(high / nh, 4 * (low / nl));
+    }
 }
 
 std::vector<std::vector<std::string>> csv_rows(const fs::path& p) {

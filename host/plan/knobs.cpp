@@ -166,9 +166,11 @@ std::vector<Knob> declare() {
       "smooth", "0", 0, 50, "view pixels",
       "physics: sigma of a Gaussian smoothing of the MMW view after interpolation (0: none)",
       [](Plan& p, double v) { p.model.smooth = v; }, [](const Plan& p) { return p.model.smooth; }));
-  k.push_back(number(
-      "ir_netd", "0.05", 0, 10, "K", "physics: IR sensor noise, rms per pixel (thermal cameras: about 0.05 K)",
-      [](Plan& p, double v) { p.model.ir_netd = v; }, [](const Plan& p) { return p.model.ir_netd; }));
+  k.push_back(drawable(
+      number(
+          "ir_netd", "0.05", 0, 10, "K", "physics: IR sensor noise, rms per pixel (thermal cameras: about 0.05 K)",
+          [](Plan& p, double v) { p.model.ir_netd = v; }, [](const Plan& p) { return p.model.ir_netd; }),
+      PS_DRAWN_IR_NETD));
   k.push_back(integer(
       "block", "10", 1, 65536, "pixels", "side of the averaged pixel blocks of the features (thesis 5.6)",
       [](Plan& p, double v) { p.model.block = static_cast<int>(v); }, [](const Plan& p) { return p.model.block; }));

@@ -28,10 +28,18 @@ int metal_noise_at(const ModelSettings& m, uint64_t index) {
                   below(draw(m.seed, index, kStreamKnobDraw, PS_DRAWN_METAL_NOISE)[0], static_cast<uint32_t>(span)));
 }
 
+double ir_netd_at(const ModelSettings& m, uint64_t index) {
+  const DrawnRange& d = m.drawn[PS_DRAWN_IR_NETD];
+  if (!d.varies()) return m.ir_netd;
+  return d.lo + (d.hi - d.lo) * uniform24(draw(m.seed, index, kStreamKnobDraw, PS_DRAWN_IR_NETD)[0]);
+}
+
 double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index) {
   switch (element) {
     case PS_DRAWN_METAL_NOISE:
       return metal_noise_at(m, index);
+    case PS_DRAWN_IR_NETD:
+      return ir_netd_at(m, index);
   }
   throw std::logic_error("no drawn knob " + std::to_string(element));
 }
@@ -82,6 +90,7 @@ std::vector<std::string> FeatureLayout::names() const {
 ModelSettings ModelSettings::for_view(const Sensor& s) const {
   ModelSettings m = *this;
   if (s.netd) (s.camera == Camera::ir ? m.ir_netd : m.netd) = *s.netd;
+  if (s.netd && s.camera == Camera::ir) m.drawn[PS_DRAWN_IR_NETD] = {};  // its own camera's, never drawn
   if (s.raw) {
     m.raw_width = (*s.raw)[0];
     m.raw_height = (*s.raw)[1];

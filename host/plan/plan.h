@@ -95,6 +95,10 @@ ObjectTransform object_transform(const ModelSettings& m, uint64_t index, int reg
 // it is drawn (A..B), A + below(word 0, B - A + 1) of PS_STREAM_KNOB_DRAW, element
 // PS_DRAWN_METAL_NOISE. kernels/metal.cl and metal_physics.cl draw the same on their own.
 int metal_noise_at(const ModelSettings& m, uint64_t index);
+// Scenario `index`'s IR NETD (the knob ir_netd, K): the knob's value, or where it is drawn
+// (A..B), A + (B - A) uniform24(word 0) of PS_STREAM_KNOB_DRAW, element PS_DRAWN_IR_NETD.
+// kernels/ir_surface.cl's ir_netd_of draws the same at the kernels' precision.
+double ir_netd_at(const ModelSettings& m, uint64_t index);
 // Scenario `index`'s value of the drawn knob `element` (PS_DRAWN_*), as its *_at gives it.
 double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index);
 

@@ -74,6 +74,8 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : m.window_lo;
   p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : m.window_hi;
   p[PS_PHYS_NETD] = ir ? m.ir_netd : kernel_netd(plan, m);
+  const DrawnRange& drawn_ir_netd = m.drawn[PS_DRAWN_IR_NETD];
+  p[PS_PHYS_NETD_HI] = ir && drawn_ir_netd.varies() ? drawn_ir_netd.hi : p[PS_PHYS_NETD];
   // Per subject, its base image's value to kelvin: the IR index map, or the MMW's gray
   // between the room behind and the bare body.
   const double body = seen(pc.skin_emissivity, pc.skin_temperature);

@@ -34,6 +34,6 @@ void netd(const ViewScene& vs, Field& f) {
 }
 
 // The IR camera's NETD, per view pixel.
-void ir_netd(const ViewScene& vs, Field& f) { add_noise(vs, f, vs.model.ir_netd, kStreamIrNoise); }
+void ir_netd(const ViewScene& vs, Field& f) { add_noise(vs, f, ir_netd_at(vs.model, vs.index), kStreamIrNoise); }
 
 }  // namespace portalsim::reference

@@ -25,7 +25,8 @@ class IrFused final : public ViewPath {
       return {};
     // The stages after the fused ones; ir_netd at 0 K draws nothing.
     std::vector<std::string> rest(c.begin() + static_cast<std::ptrdiff_t>(chain().size()), c.end());
-    if (plan.model.for_view(sensor).ir_netd == 0) std::erase(rest, "ir_netd");
+    const ModelSettings m = plan.model.for_view(sensor);
+    if (m.ir_netd == 0 && !m.drawn[PS_DRAWN_IR_NETD].varies()) std::erase(rest, "ir_netd");
     if (rest == std::vector<std::string>{"ir_display"})
       return {.runs = true, .variant = kDisplayFused, .variant_name = "surface and display fused"};
     if (rest == std::vector<std::string>{"ir_netd", "ir_display"})
