@@ -344,14 +344,8 @@ void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::
   double v = 0;
   switch (knob.kind) {
     case KnobKind::integer:
-      if (!parse_number(text, v) || v != std::floor(v) || text.find_first_of(".eE") != std::string::npos)
-        throw InputError(where + ": \"" + text + "\" is not a whole number");
-      if (v < knob.min || v > knob.max)
-        throw InputError(where + ": " + text + " is out of range [" + knob.values() + "]");
-      break;
     case KnobKind::number:
-      if (!parse_number(text, v) || !std::isfinite(v) || v < knob.min || v > knob.max)
-        throw InputError(where + ": \"" + text + "\" must be a finite number between " + knob.values());
+      v = knob_number(knob, text, where);
       break;
     case KnobKind::on_off:
       if (text != "on" && text != "off") throw InputError(where + ": \"" + text + "\" is not on or off");
