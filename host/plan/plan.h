@@ -73,11 +73,6 @@ struct ModelSettings {
   // integer knob) from the counter generator, the same in every view, batch and backend.
   // Its field above then holds A; each knob's value of a scenario is its *_at function.
   std::array<DrawnRange, PS_DRAWN_KNOBS> drawn{};
-  bool draws_knobs() const {
-    for (const DrawnRange& d : drawn)
-      if (d.varies()) return true;
-    return false;
-  }
   // The knobs as view `s` takes them: its own camera parameters (Sensor::netd, raw) over
   // the run's. Both backends read a view's knobs through this, and nothing else.
   ModelSettings for_view(const Sensor& s) const;

@@ -48,6 +48,9 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
   const Catalogue& cat = d_.cat;
   cl::Buffer& metal = out_.at_least(d_.ctx(), b.n * cat.zones);
   const cl_uint n = static_cast<cl_uint>(b.n);
+  // The detector noise's range: the kernels draw each scenario's from it (metal_noise_at).
+  const DrawnRange& drawn = plan.model.drawn[PS_DRAWN_METAL_NOISE];
+  const cl_int noise_hi = drawn.varies() ? static_cast<cl_int>(drawn.hi) : plan.model.metal_noise;
   if (plan.model.model == Model::physics) {
     if (!d_.rt.has_fp64())
       throw EnvironmentError("--model physics computes metal zones in fp64, and " + d_.rt.device_name() +
@@ -66,9 +69,7 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
                              .seed = b.seed,
                              .first = b.first,
                              .noise_lo = plan.model.metal_noise,
-                             .noise_hi = plan.model.drawn[PS_DRAWN_METAL_NOISE].varies()
-                                             ? static_cast<cl_int>(plan.model.drawn[PS_DRAWN_METAL_NOISE].hi)
-                                             : plan.model.metal_noise,
+                             .noise_hi = noise_hi,
                              .jitter = plan.model.jitter,
                              .half_width = kFieldWidth / 2.0,
                              .scale = cat.metres_per_field_unit(),
@@ -86,9 +87,7 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
                            .seed = b.seed,
                            .first = b.first,
                            .noise_lo = plan.model.metal_noise,
-                           .noise_hi = plan.model.drawn[PS_DRAWN_METAL_NOISE].varies()
-                                           ? static_cast<cl_int>(plan.model.drawn[PS_DRAWN_METAL_NOISE].hi)
-                                           : plan.model.metal_noise,
+                           .noise_hi = noise_hi,
                            .out = metal},
             b.n);
   }
