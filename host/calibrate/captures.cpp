@@ -5,6 +5,7 @@
 
 #include "assets/image_io.h"
 #include "base/error.h"
+#include "base/spoken_list.h"
 #include "sink/h5_file.h"
 
 namespace portalsim::calibrate {
@@ -15,10 +16,9 @@ namespace fs = std::filesystem;
 
 // "upper.png and lower.png": the files each scenario folder holds.
 std::string files_of(const std::vector<std::string>& views) {
-  std::string s;
-  for (size_t k = 0; k < views.size(); ++k)
-    s += (k == 0 ? "" : k + 1 == views.size() ? " and " : ", ") + views[k] + ".png";
-  return s;
+  std::vector<std::string> files;
+  for (const std::string& v : views) files.push_back(v + ".png");
+  return spoken_list(files);
 }
 
 void add_image(ViewCaptures& v, const Image& img, const std::string& file) {

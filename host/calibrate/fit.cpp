@@ -7,6 +7,7 @@
 
 #include "backend/reference/stages.h"
 #include "base/error.h"
+#include "base/spoken_list.h"
 
 namespace portalsim::calibrate {
 
@@ -460,10 +461,9 @@ std::string not_camera_like(const Captures& captures, const CameraFit& fit) {
   };
   // "the X view", "the X and Y views": where only some views are at fault.
   const auto of_views = [&](const std::vector<size_t>& vs) {
-    std::string s;
-    for (size_t k = 0; k < vs.size(); ++k)
-      s += (k == 0 ? "" : k + 1 == vs.size() ? " and " : ", ") + fit.views[vs[k]].name;
-    return " of the " + s + (vs.size() == 1 ? " view" : " views");
+    std::vector<std::string> names;
+    for (size_t v : vs) names.push_back(fit.views[v].name);
+    return " of the " + spoken_list(names) + (vs.size() == 1 ? " view" : " views");
   };
   std::vector<size_t> full, quiet;
   double loudest = 0;

@@ -14,6 +14,7 @@
 
 #include "assets/assets.h"
 #include "base/error.h"
+#include "base/spoken_list.h"
 #include "calibrate/camera_files.h"
 #include "calibrate/compare.h"
 #include "cli/commands.h"
@@ -89,13 +90,6 @@ nlohmann::json fit_json(const calibrate::CameraFit& f, size_t captures) {
           {"views", views}};
 }
 
-// "a, b and c".
-std::string listed(const std::vector<std::string>& names) {
-  std::string s;
-  for (size_t k = 0; k < names.size(); ++k) s += (k == 0 ? "" : k + 1 == names.size() ? " and " : ", ") + names[k];
-  return s;
-}
-
 std::string markdown(const Options& o, const calibrate::CameraFit& f, const calibrate::Captures& captures, bool plotted,
                      const std::string& spec_name, const std::string& catalogue_name) {
   std::vector<std::string> names, own_raw, own_netd, pooled;
@@ -109,9 +103,9 @@ std::string markdown(const Options& o, const calibrate::CameraFit& f, const cali
   const std::string run_raw = f.views[f.raw_view].name, run_noise = f.views[f.noise_view].name;
   std::ostringstream md;
   md << "# Camera calibrated from " << o.real << "\n\n"
-     << captures.count() << " captures (" << listed(names) << " views), matched to the catalogue's subjects.\n\n"
+     << captures.count() << " captures (" << spoken_list(names) << " views), matched to the catalogue's subjects.\n\n"
      << "| parameter | fitted | how |\n| --- | --- | --- |\n"
-     << "| raw grid | " << f.raw_w << "x" << f.raw_h << (own_raw.empty() ? "" : " (own: " + listed(own_raw) + ")")
+     << "| raw grid | " << f.raw_w << "x" << f.raw_h << (own_raw.empty() ? "" : " (own: " + spoken_list(own_raw) + ")")
      << " | the fewest raw pixels whose bilinear interpolation reproduces every row and column to rounding |\n"
      << "| PSF FWHM | " << fixed(f.fwhm_pixels, 2) << " view pixels (aperture " << fixed(f.aperture_m * 1000, 2)
      << " mm)" << (f.blur_told ? "" : " (not told: the captures hardly change with the blur)")
@@ -123,13 +117,13 @@ std::string markdown(const Options& o, const calibrate::CameraFit& f, const cali
                          "width is kept and only the level fitted)")
      << " | the captures' raw grids against the subject's kelvin, a robust line |\n"
      << "| noise | " << fixed(f.netd, 4) << " K rms per raw pixel (" << fixed(f.noise_gray, 3) << " gray)"
-     << (own_netd.empty() ? "" : " (own: " + listed(own_netd) + ")")
+     << (own_netd.empty() ? "" : " (own: " + spoken_list(own_netd) + ")")
      << " | the robust spread of what the bare subject leaves, less rounding |\n\n"
      << "Each view's raw grid and noise are fitted from its own captures, the blur and the window from all of "
         "them. "
      << spec_name << " holds " << run_raw << "'s raw grid and "
      << (pooled.size() > 1
-             ? "the noise pooled over " + listed(pooled) + ", whose own noise agrees with " + run_noise + "'s"
+             ? "the noise pooled over " + spoken_list(pooled) + ", whose own noise agrees with " + run_noise + "'s"
              : run_noise + "'s noise, which no other view's agrees with")
      << " (within " << fixed(calibrate::kNoiseAgreement, 0) << " standard errors, "
      << fixed(100 * calibrate::kNoiseTolerance, 0) << "% or " << fixed(calibrate::kMinCameraNoiseGray, 1) << " gray); "

@@ -6,6 +6,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "base/spoken_list.h"
 
 namespace portalsim {
 
@@ -103,12 +104,8 @@ SinkContext plan_sink_context(const Plan& plan, const Catalogue& cat, const Asse
 void check_formats(const RunSpec& spec) {
   const std::vector<std::string> known = format_values();
   for (const std::string& f : spec.formats)
-    if (std::find(known.begin(), known.end(), f) == known.end()) {
-      std::string list;
-      for (size_t k = 0; k < known.size(); ++k)
-        list += (k == 0 ? "" : k + 1 == known.size() ? " or " : ", ") + known[k];
-      throw InputError(spec.where("format") + ": \"" + f + "\" is not " + list);
-    }
+    if (std::find(known.begin(), known.end(), f) == known.end())
+      throw InputError(spec.where("format") + ": \"" + f + "\" is not " + spoken_list(known, " or "));
 }
 
 SinkRequest sink_request(const RunSpec& spec, const Plan& plan, const ThreatRule* rule,
