@@ -79,7 +79,12 @@
 /* The knobs a run may draw per scenario, each its element of PS_STREAM_KNOB_DRAW. */
 #define PS_DRAWN_METAL_NOISE 0u
 #define PS_DRAWN_IR_NETD 1u
-#define PS_DRAWN_KNOBS 2
+#define PS_DRAWN_PIXEL_NOISE 2u
+#define PS_DRAWN_NETD 3u
+#define PS_DRAWN_FRAMES 4u
+#define PS_DRAWN_ILLUMINATION 5u
+#define PS_DRAWN_WORN_MINUTES 6u
+#define PS_DRAWN_KNOBS 7
 /* physics: frame k >= 1 of the MMW camera's integration draws its NETD from stream
  * PS_STREAM_FRAME_NOISE + k (frame 0 from PS_STREAM_RAW_NOISE); element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_FRAME_NOISE 32u
@@ -192,9 +197,22 @@ typedef struct {
 #define PS_PHYS_BACKGROUND 0 /* K */
 #define PS_PHYS_WINDOW_MIN 1 /* K shown as gray 0 */
 #define PS_PHYS_WINDOW_MAX 2 /* K shown as gray 255 */
-#define PS_PHYS_NETD 3       /* K rms per raw pixel */
-#define PS_PHYS_NETD_HI 4    /* the IR NETD drawn per scenario: its upper end; NETD where fixed */
-#define PS_PHYS_SUBJECTS 5
+#define PS_PHYS_NETD 3       /* K rms per raw pixel (MMW: over the frames, kernel_netd, where neither is drawn) */
+#define PS_PHYS_NETD_HI 4    /* the view's NETD drawn per scenario: its upper end; NETD where fixed */
+/* MMW: the frames drawn per scenario, lowest and highest (both the knob's where fixed), and
+ * 1 where the frames' mean is one draw of NETD / sqrt(frames) (Plan::frames_approximated). */
+#define PS_PHYS_FRAMES_LO 5
+#define PS_PHYS_FRAMES_HI 6
+#define PS_PHYS_FRAMES_AS_ONE 7
+/* Where the illumination or the worn time is drawn per scenario, the offset of the scene
+ * block (0: neither is): whether the illumination is drawn, the worn time's ends (minutes),
+ * then per subject the change of its (gain, offset) over the illumination's range, per
+ * variant its value's change over that range, its change per unit of exp(-worn / tau), 1 / tau
+ * and exp(-worn_lo / tau) (PS_SCENE_*), then (MMW) each subject's bare raw grid's change over
+ * the illumination's range (kernels/radiometry.cl, scene_draw). */
+#define PS_PHYS_SCENE 8
+#define PS_PHYS_SUBJECTS 9
+#define PS_SCENE_SUBJECTS 3 /* kernels/shared.h: PS_SCENE_VARIANTS, PS_SCENE_BARE */
 
 /* A camera view's placement record per scenario, written by place_view and read by
  * every render stage: the objects it draws, in region order, and the noise pattern. */

@@ -11,10 +11,13 @@ kernel void stage_contact_shadow(VIEW_STAGE_ARGS) {
   global const param* off_body = phys + L.phys_off_body + L.subjects;
   global const uchar* restrict base = base_row(atlas, bases, subject, &L, i, y);
   const int body_from = (int)phys[L.phys_off_body + subject[i]];
+  const SceneDraw scene = scene_draw(phys, seed, index);
+  preal delta[PS_MAX_LAYERS];
   Layers Ly;
   composite_layers(&Ly, rec, &L, y);
+  layer_deltas(&Ly, phys, &scene, L.subjects, delta);
   for (int x = 0; x < L.width; ++x)
-    dT[x] = lay_values(&Ly, atlas, x, (int)base[x] >= body_from ? shadow : off_body, (preal)0);
+    dT[x] = lay_values(&Ly, atlas, x, (int)base[x] >= body_from ? shadow : off_body, delta, (preal)0);
 }
 
 kernel void stage_ir_surface(VIEW_STAGE_ARGS) {

@@ -6,6 +6,33 @@
 // NETD / sqrt(frames).
 inline uint frame_stream(int k) { return k == 0 ? PS_STREAM_RAW_NOISE : PS_STREAM_FRAME_NOISE + (uint)k; }
 
+// Scenario index's MMW noise where the NETD or the frames are drawn per scenario (host:
+// netd_at, frames_at): NETD in [lo, hi] (PS_STREAM_KNOB_DRAW, PS_DRAWN_NETD, real), frames
+// in [flo, fhi] (PS_DRAWN_FRAMES, whole); *frames frames of the returned sd each, or under
+// the block-mean noise model (as_one) one of NETD / sqrt(frames).
+inline preal mmw_noise_drawn(preal lo, preal hi, int flo, int fhi, bool as_one, uint2 seed, ulong index,
+                             int* frames) {
+  const preal netd =
+      hi > lo ? lo + (hi - lo) * (preal)uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_NETD).x) : lo;
+  const int f =
+      fhi > flo ? flo + (int)below(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_FRAMES).x, (uint)(fhi - flo) + 1u)
+                : flo;
+  *frames = as_one ? 1 : f;
+  return as_one ? netd / sqrt((preal)f) : netd / (preal)f;
+}
+
+// Scenario index's MMW noise from the view's parameters: *frames frames (the launch's
+// kframes where nothing is drawn) of the returned sd each.
+inline preal mmw_noise_of(global const param* phys, int kframes, uint2 seed, ulong index, int* frames) {
+  const preal lo = (preal)phys[PS_PHYS_NETD], hi = (preal)phys[PS_PHYS_NETD_HI];
+  const int flo = (int)phys[PS_PHYS_FRAMES_LO], fhi = (int)phys[PS_PHYS_FRAMES_HI];
+  if (hi <= lo && fhi <= flo) {
+    *frames = kframes;
+    return lo / (preal)kframes;
+  }
+  return mmw_noise_drawn(lo, hi, flo, fhi, phys[PS_PHYS_FRAMES_AS_ONE] != 0, seed, index, frames);
+}
+
 // The fast tier's draws (PS_FLAG_FAST_DRAWS): sensor_noise.cl's Irwin-Hall draws (ih_cell,
 // ih128) of the table Gaussians' cells and streams.
 
@@ -40,10 +67,11 @@ inline void noise_cells(global preal* restrict v, int cells, preal sd, uint2 see
 
 kernel void stage_netd(VIEW_STAGE_ARGS) {
   RAW_STAGE_ROW;
-  const preal sd = (preal)phys[PS_PHYS_NETD] / (preal)L.frames;
+  int frames;
+  const preal sd = mmw_noise_of(phys, L.frames, seed, index, &frames);
   if (sd <= 0) return;
   const bool fast = L.flags & PS_FLAG_FAST_DRAWS;
-  for (int k = 0; k < L.frames; ++k)
+  for (int k = 0; k < frames; ++k)
     for (int c = 0; c < L.raw_width; ++c)
       r[c] += sd * (fast ? ih_cell(seed, index, frame_stream(k), L.view, j * L.raw_width + c)
                          : gauss_cell(seed, index, frame_stream(k), L.view, j * L.raw_width + c, phys + L.phys_gauss));

@@ -126,10 +126,18 @@ kernel void physics_features(global const preal* raw, global const int* first, g
                              global const param* phys, int row_len, global float* features, PsViewLaunch L,
                              global const int* records, global const uchar* subject, global const short* objects,
                              global const param* base_features, global const int2* object_range,
-                             global const int* object_feature, global const param* object_value, param sd,
-                             int8 dims, global const param* noise, global preal* scratch) {
+                             global const int* object_feature, global const param* object_value, param netd_lo,
+                             param netd_hi, int2 frames, int8 dims, global const param* noise,
+                             global preal* scratch) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
+  // The NETD over the frames' mean: netd_lo where neither is drawn (the host's NETD /
+  // sqrt(frames)), else the scenario's draw (kernels/netd.cl).
+  int one;
+  const preal sd = netd_hi <= netd_lo && frames.y <= frames.x
+                       ? (preal)netd_lo
+                       : mmw_noise_drawn((preal)netd_lo, (preal)netd_hi, frames.x, frames.y, true,
+                                         (uint2)(L.seed_lo, L.seed_hi), upsample(L.first_hi, L.first_lo) + i, &one);
   global float* row = features + (size_t)i * row_len;
   const int band_x = dims.s2, band_y = dims.s3, zlen = dims.s0 * dims.s1 + dims.s4;
   const int space = PS_FEATURE_SPACE(dims.s0, dims.s1, band_x, band_y, dims.s4);

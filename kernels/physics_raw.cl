@@ -42,7 +42,14 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   global preal* restrict d = acc + RW;
   const int s = subject[i];
   global const param* bare = phys + L.phys_base + (size_t)s * cells;
-  for (int k = 0; k < cells; ++k) r[k] = (preal)bare[k];
+  // The scenario's illumination moves the bare grid along its change (PS_SCENE_BARE).
+  const SceneDraw scene = scene_draw(phys, seed, index);
+  if (scene.at == 0) {
+    for (int k = 0; k < cells; ++k) r[k] = (preal)bare[k];
+  } else {
+    global const param* moved = phys + scene.at + PS_SCENE_BARE(L.subjects, L.variants) + (size_t)s * cells;
+    for (int k = 0; k < cells; ++k) r[k] = (preal)bare[k] + (preal)moved[k] * scene.t;
+  }
 
   // The view rows any object can touch.
   int y_lo = H, y_hi = 0;
@@ -51,7 +58,8 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     y_lo = min(y_lo, max(rows.x, 0));
     y_hi = max(y_hi, min(rows.y, H));
   }
-  const preal gain = (preal)phys[PS_PHYS_SUBJECTS + 2 * s], offset = (preal)phys[PS_PHYS_SUBJECTS + 2 * s + 1];
+  preal gain, offset, delta[PS_MAX_LAYERS];
+  subject_kelvin(phys, &scene, s, L.subjects, &gain, &offset);
   global const param* object_t = phys + PS_PHYS_VARIANTS(L.subjects);
   global const param* wx = phys + L.phys_wx;
   global const param* wy = phys + L.phys_wy;
@@ -61,6 +69,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     Layers Ly;
     composite_layers(&Ly, rec, &L, y);
     if (Ly.count == 0) continue;
+    layer_deltas(&Ly, phys, &scene, L.subjects, delta);
     int x_lo = W, x_hi = 0;
     for (int k = 0; k < Ly.count; ++k) {
       x_lo = min(x_lo, max(Ly.x0[k], 0));
@@ -70,7 +79,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     global const uchar* base = base_row(atlas, bases, subject, &L, i, y);
     for (int x = x_lo; x < x_hi; ++x) {
       const preal t0 = gain * (preal)base[x] + offset;
-      d[x] = lay_values(&Ly, atlas, x, object_t, t0) - t0;
+      d[x] = lay_values(&Ly, atlas, x, object_t, delta, t0) - t0;
     }
     // Each raw column's share of the row: its weights (zero outside its band) against
     // the change, as dot products over the span; fp32 builds in 16-lane partial sums.
@@ -96,7 +105,8 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     }
   }
 
-  // The netd stage: L.frames frames averaged (kernels/netd.cl).
-  const preal sd = (preal)phys[PS_PHYS_NETD] / (preal)L.frames;
-  if (sd > 0) netd_frames(r, cells, sd, L.frames, seed, index, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);
+  // The netd stage: the scenario's frames averaged (kernels/netd.cl).
+  int frames;
+  const preal sd = mmw_noise_of(phys, L.frames, seed, index, &frames);
+  if (sd > 0) netd_frames(r, cells, sd, frames, seed, index, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);
 }

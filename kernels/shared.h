@@ -45,5 +45,8 @@
 /* Offsets in the physics parameters (kernels/contract.h, PS_PHYS_*). */
 #define PS_PHYS_VARIANTS(S) (PS_PHYS_SUBJECTS + 2 * (S))
 #define PS_PHYS_TAPS(S, V) (PS_PHYS_VARIANTS(S) + (V))
+/* The scene block's per-variant entries and bare grids' changes (PS_PHYS_SCENE). */
+#define PS_SCENE_VARIANTS(S) (PS_SCENE_SUBJECTS + 2 * (S))
+#define PS_SCENE_BARE(S, V) (PS_SCENE_VARIANTS(S) + 4 * (V))
 
 #endif

@@ -3,6 +3,7 @@
 // and a fixed value (A..A) keeping today's bytes.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -71,6 +72,16 @@ TEST(DrawnKnobs, MetalNoiseDrawnPerScenarioIsTheReferencesOnBothModels) {
   EXPECT_EQ(seen.size(), 7u);
 }
 
+// Image i's mean squared difference between a and b (a noisy image against its noise-free one).
+double mean_square_difference(const ViewImages& a, const ViewImages& b, size_t i) {
+  double ms = 0;
+  for (size_t p = 0; p < a.pixels_per_image(); ++p) {
+    const double e = double(a.of(i)[p]) - double(b.of(i)[p]);
+    ms += e * e;
+  }
+  return ms / double(a.pixels_per_image());
+}
+
 // The IR NETD drawn per scenario: the kernels' images are the reference's within the IR
 // parity test's stated tolerance (IrPhysics.KernelsMatchTheReferenceInEveryTier), on the
 // fused path and the chain of stage kernels; a scenario's noise is its own draw's.
@@ -112,14 +123,7 @@ TEST(DrawnKnobs, IrNetdDrawnPerScenarioIsTheReferencesOnEveryPath) {
       double low = 0, high = 0;
       int nl = 0, nh = 0;
       for (size_t i = 0; i < batch.size(); ++i) {
-        const ViewImages& a = k.views[ir];
-        const ViewImages& b = quiet.views[ir];
-        double ms = 0;
-        for (size_t p = 0; p < a.pixels_per_image(); ++p) {
-          const double e = double(a.of(i)[p]) - double(b.of(i)[p]);
-          ms += e * e;
-        }
-        ms /= double(a.pixels_per_image());
+        const double ms = mean_square_difference(k.views[ir], quiet.views[ir], i);
         const double netd = ir_netd_at(m, batch.first_index + i);
         if (netd < 0.15) {
           low += ms;
@@ -133,6 +137,202 @@ TEST(DrawnKnobs, IrNetdDrawnPerScenarioIsTheReferencesOnEveryPath) {
       ASSERT_GT(nh, 0);
       EXPECT_GT(high / nh, 4 * (low / nl));
     }
+}
+
+// The MMW camera's NETD and frames drawn per scenario (netd_at, frames_at): the kernels'
+// MMW images are the reference's within the MMW camera's parity tolerance
+// (Physics.KernelsMatchTheReferenceInEveryTier: 1 gray level, at most 0.5% off by one) in
+// every tier (the fast tier's frames as one draw, Irwin-Hall), fused and as the chain of
+// stage kernels; each scenario's noise is its own draw's.
+TEST(DrawnKnobs, MmwNetdAndFramesDrawnPerScenarioAreTheReferencesOnEveryPath) {
+  std::vector<Scenario> scenes;
+  for (size_t k = 0; k < 40; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
+  const SceneBatch batch = test::batch_of(scenes, 700);
+  auto ref = make_reference_backend(catalogue(), assets());
+  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  const auto plan_of = [](const std::string& netd, const std::string& frames, bool fused, Tier tier) {
+    Plan plan = test::physics_plan(41);
+    plan.fidelity = tier_fidelity(tier);
+    plan.fidelity.fused = fused;
+    set_knob(plan, *find_knob("netd"), netd, "--netd");
+    set_knob(plan, *find_knob("frames"), frames, "--frames");
+    return plan;
+  };
+  for (Tier tier : {Tier::standard, Tier::exact, Tier::fast})
+    for (bool fused : {true, false}) {
+      SCOPED_TRACE(std::string(tier_name(tier)) + (fused ? " fused" : " stage chain"));
+      const Plan drawn = plan_of("0.2..2", "1..9", fused, tier);
+      BatchOutput r, k;
+      ref->run(batch, drawn, r);
+      ocl->run(batch, drawn, k);
+      const OutputDiff d = compare_outputs(k, r);
+      EXPECT_GT(d.mmw.pixels, 0u);
+      EXPECT_LE(d.mmw.max_abs, 1);
+      EXPECT_LE(d.mmw.share_differing, 0.005);
+      // A range of one value is that value, to the byte.
+      BatchOutput one, fixed;
+      ocl->run(batch, plan_of("1.5..1.5", "4..4", fused, tier), one);
+      ocl->run(batch, plan_of("1.5", "4", fused, tier), fixed);
+      for (size_t v = 0; v < one.views.size(); ++v) EXPECT_EQ(one.views[v].pixels, fixed.views[v].pixels) << v;
+      // Each scenario's image is as noisy as its draw: against the noise-free image, the
+      // mean squared difference follows NETD^2 / frames.
+      BatchOutput quiet;
+      ocl->run(batch, plan_of("0", "1", fused, tier), quiet);
+      const size_t upper = static_cast<size_t>(catalogue().sensor_index("upper"));
+      double low = 0, high = 0;
+      int nl = 0, nh = 0;
+      for (size_t i = 0; i < batch.size(); ++i) {
+        const double ms = mean_square_difference(k.views[upper], quiet.views[upper], i);
+        const double sd = netd_at(drawn.model, batch.first_index + i) /
+                          std::sqrt(double(frames_at(drawn.model, batch.first_index + i)));
+        if (sd < 0.3) {
+          low += ms;
+          ++nl;
+        } else if (sd > 0.9) {
+          high += ms;
+          ++nh;
+        }
+      }
+      ASSERT_GT(nl, 0);
+      ASSERT_GT(nh, 0);
+      EXPECT_GT(high / nh, 4 * (low / nl));
+    }
+  // Every frame count of the range is drawn, none outside it; the NETD stays in its range.
+  const ModelSettings m = plan_of("0.2..2", "1..9", true, Tier::standard).model;
+  std::set<int> seen;
+  for (uint64_t i = 0; i < 2000; ++i) {
+    seen.insert(frames_at(m, i));
+    EXPECT_GE(netd_at(m, i), 0.2);
+    EXPECT_LT(netd_at(m, i), 2.0);
+    EXPECT_EQ(drawn_knob_at(m, PS_DRAWN_FRAMES, i), frames_at(m, i));
+  }
+  EXPECT_EQ(seen, (std::set<int>{1, 2, 3, 4, 5, 6, 7, 8, 9}));
+}
+
+// The features-only path of the physics model (physics_raw_features) draws the NETD per
+// feature, scaled by the scenario's NETD / sqrt(frames) under the block-mean model: with
+// the same draws, a scenario's noise is its draw times the noise of NETD 1 over one frame.
+// Tolerance: 0.01 gray levels, for fp32 features near 128 (rounding about 1e-5 of them)
+// summed over up to a hundred noise terms; the smallest drawn noise is 100 times that.
+TEST(DrawnKnobs, MmwNetdAndFramesDrawnPerScenarioScaleTheFeatureNoise) {
+  const SceneBatch batch = test::batch_of(test::coverage(catalogue(), 200, 6), 900);
+  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  const auto plan_of = [](const std::string& netd, const std::string& frames) {
+    Plan plan = test::physics_plan(43);
+    plan.fidelity = tier_fidelity(Tier::fast);
+    plan.images = 0;
+    plan.metal = false;
+    set_knob(plan, *find_knob("netd"), netd, "--netd");
+    set_knob(plan, *find_knob("frames"), frames, "--frames");
+    return plan;
+  };
+  const Plan drawn = plan_of("0.5..3", "1..9");
+  ASSERT_EQ(test::features_path(*ocl, drawn), "physics_raw_features");
+  BatchOutput d, unit, quiet;
+  ocl->run(batch, drawn, d);
+  ocl->run(batch, plan_of("1", "1"), unit);
+  ocl->run(batch, plan_of("0", "1"), quiet);
+  const size_t row = d.layout.image_features();
+  ASSERT_EQ(d.features.size(), unit.features.size());
+  size_t checked = 0, off = 0;
+  double worst = 0;
+  for (size_t i = 0; i < batch.size(); ++i) {
+    const uint64_t index = batch.first_index + i;
+    const double s = netd_at(drawn.model, index) / std::sqrt(double(frames_at(drawn.model, index)));
+    for (size_t c = 0; c < row; ++c) {
+      const size_t at = i * row + c;
+      const double q = quiet.features[at], u = unit.features[at], v = d.features[at];
+      if (q < 20 || q > 235 || u <= 0 || u >= 255 || v <= 0 || v >= 255) continue;  // the window may clamp
+      const double e = std::abs((v - q) - s * (u - q));
+      worst = std::max(worst, e);
+      off += e > 0.01;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 10000u);
+  EXPECT_EQ(off, 0u) << "worst " << worst;
+}
+
+// The illumination and the worn time drawn per scenario (illumination_at,
+// worn_minutes_at): the kernels' MMW and IR images are the reference's within each camera's
+// parity tolerance (1 gray level or index, at most 0.5% off by one), fused and as the chain
+// of stage kernels, and the features-only path's features within the tolerance table's
+// (it leaves its tables for the raw grid then); each scenario shows its own draw.
+TEST(DrawnKnobs, IlluminationAndWornTimeDrawnPerScenarioAreTheReferencesOnEveryPath) {
+  std::vector<Scenario> scenes;
+  for (size_t k = 0; k < 40; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
+  const SceneBatch batch = test::batch_of(scenes, 1100);
+  auto ref = make_reference_backend(catalogue(), assets());
+  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  const auto plan_of = [](const std::string& ill, const std::string& worn, bool fused, Tier tier) {
+    Plan plan = test::physics_plan(47);
+    plan.model.netd = 0;
+    plan.model.ir_netd = 0;
+    plan.fidelity = tier_fidelity(tier);
+    plan.fidelity.fused = fused;
+    set_knob(plan, *find_knob("illumination"), ill, "--illumination");
+    set_knob(plan, *find_knob("worn_minutes"), worn, "--worn-minutes");
+    return plan;
+  };
+  const size_t upper = static_cast<size_t>(catalogue().sensor_index("upper"));
+  for (Tier tier : {Tier::standard, Tier::exact})
+    for (bool fused : {true, false}) {
+      SCOPED_TRACE(std::string(tier_name(tier)) + (fused ? " fused" : " stage chain"));
+      const Plan drawn = plan_of("280..310", "0..60", fused, tier);
+      BatchOutput r, k;
+      ref->run(batch, drawn, r);
+      ocl->run(batch, drawn, k);
+      const OutputDiff d = compare_outputs(k, r);
+      EXPECT_GT(d.mmw.pixels, 0u);
+      EXPECT_GT(d.ir.pixels, 0u);
+      EXPECT_LE(d.mmw.max_abs, 1);
+      EXPECT_LE(d.mmw.share_differing, 0.005);
+      EXPECT_LE(d.ir.max_abs, 1);
+      EXPECT_LE(d.ir.share_differing, 0.005);
+      // A range of one value is that value, to the byte.
+      BatchOutput one, fixed;
+      ocl->run(batch, plan_of("300..300", "20..20", fused, tier), one);
+      ocl->run(batch, plan_of("300", "20", fused, tier), fixed);
+      for (size_t v = 0; v < one.views.size(); ++v) EXPECT_EQ(one.views[v].pixels, fixed.views[v].pixels) << v;
+      // The body reflects the illumination: a scenario's MMW view is brighter the warmer its draw.
+      double warm = 0, cold = 0;
+      int nw = 0, nc = 0;
+      for (size_t i = 0; i < batch.size(); ++i) {
+        const ViewImages& a = k.views[upper];
+        double mean = 0;
+        for (size_t p = 0; p < a.pixels_per_image(); ++p) mean += a.of(i)[p];
+        mean /= double(a.pixels_per_image());
+        const double ill = illumination_at(drawn.model, batch.first_index + i);
+        if (ill > 302) warm += mean, ++nw;
+        if (ill < 288) cold += mean, ++nc;
+      }
+      ASSERT_GT(nw, 0);
+      ASSERT_GT(nc, 0);
+      EXPECT_GT(warm / nw, cold / nc + 10);
+    }
+  // Features only: the raw-grid path, its untabulated variant, which leaves the pixels'
+  // clipping out: a window no draw's body reaches.
+  Plan with_images = plan_of("280..310", "0..60", true, Tier::fast);
+  with_images.model.window_lo = 250;
+  with_images.model.window_hi = 340;
+  Plan features = with_images;
+  features.images = 0;
+  ASSERT_EQ(test::features_path(*ocl, features), "physics_raw_features");
+  const std::vector<std::string> paths = ocl->paths(features);
+  EXPECT_NE(std::find(paths.begin(), paths.end(), "features: physics_raw_features (untabulated)"), paths.end());
+  BatchOutput r, k;
+  ref->run(batch, with_images, r);
+  ocl->run(batch, features, k);
+  const OutputDiff d = compare_outputs(k, r);
+  ASSERT_TRUE(d.features_only);
+  EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, Tier::fast)), "");
+  // Each knob's draws stay in its range.
+  for (uint64_t i = 0; i < 2000; ++i) {
+    EXPECT_GE(illumination_at(features.model, i), 280.0);
+    EXPECT_LT(illumination_at(features.model, i), 310.0);
+    EXPECT_GE(worn_minutes_at(features.model, i), 0.0);
+    EXPECT_LT(worn_minutes_at(features.model, i), 60.0);
+  }
 }
 
 std::vector<std::vector<std::string>> csv_rows(const fs::path& p) {

@@ -117,13 +117,16 @@ std::vector<Knob> declare() {
       "temperature, optics, raw grid, NETD; contact shadow in IR; coil fields and polarizability for metal)",
       false, true, [](Plan& p, double v) { p.model.model = static_cast<Model>(v); },
       [](const Plan& p) { return model_name(p.model.model); }));
-  k.push_back(number(
-      "illumination", "293", 1, 1000, "K",
-      "physics: the temperature the scene reflects (the room indoors; about 50 K for a clear sky outdoors)",
-      [](Plan& p, double v) { p.model.illumination = v; }, [](const Plan& p) { return p.model.illumination; }));
-  k.push_back(number(
-      "netd", "3", 0, 100, "K", "physics: MMW sensor noise, rms per raw pixel (Vela 125: 3 K)",
-      [](Plan& p, double v) { p.model.netd = v; }, [](const Plan& p) { return p.model.netd; }));
+  k.push_back(drawable(
+      number(
+          "illumination", "293", 1, 1000, "K",
+          "physics: the temperature the scene reflects (the room indoors; about 50 K for a clear sky outdoors)",
+          [](Plan& p, double v) { p.model.illumination = v; }, [](const Plan& p) { return p.model.illumination; }),
+      PS_DRAWN_ILLUMINATION));
+  k.push_back(drawable(number(
+                           "netd", "3", 0, 100, "K", "physics: MMW sensor noise, rms per raw pixel (Vela 125: 3 K)",
+                           [](Plan& p, double v) { p.model.netd = v; }, [](const Plan& p) { return p.model.netd; }),
+                       PS_DRAWN_NETD));
   k.push_back(grid(
       "mmw_raw", "28x28", 1, 4096, "raw pixels",
       "physics: the MMW camera's raw grid over each view, at most the view's size",
@@ -132,16 +135,21 @@ std::vector<Knob> declare() {
         p.model.raw_height = static_cast<int>(v) % 65536;
       },
       [](const Plan& p) { return std::to_string(p.model.raw_width) + "x" + std::to_string(p.model.raw_height); }));
-  k.push_back(number(
-      "worn_minutes", "5", 0, 1440, "minutes",
-      "physics: how long the objects have been carried; they warm from the room towards the skin",
-      [](Plan& p, double v) { p.model.worn_minutes = v; }, [](const Plan& p) { return p.model.worn_minutes; }));
+  k.push_back(drawable(
+      number(
+          "worn_minutes", "5", 0, 1440, "minutes",
+          "physics: how long the objects have been carried; they warm from the room towards the skin",
+          [](Plan& p, double v) { p.model.worn_minutes = v; }, [](const Plan& p) { return p.model.worn_minutes; }),
+      PS_DRAWN_WORN_MINUTES));
   // The MMW camera's own processing (docs/model/physics-mmw.md).
-  k.push_back(integer(
-      "frames", "10", 1, 1000, "frames",
-      "physics: raw MMW frames at the camera's 10 Hz averaged into each image, each with its own NETD draw "
-      "(the fast tier: one draw of NETD/sqrt(frames))",
-      [](Plan& p, double v) { p.model.frames = static_cast<int>(v); }, [](const Plan& p) { return p.model.frames; }));
+  k.push_back(drawable(
+      integer(
+          "frames", "10", 1, 1000, "frames",
+          "physics: raw MMW frames at the camera's 10 Hz averaged into each image, each with its own NETD draw "
+          "(the fast tier: one draw of NETD/sqrt(frames))",
+          [](Plan& p, double v) { p.model.frames = static_cast<int>(v); },
+          [](const Plan& p) { return p.model.frames; }),
+      PS_DRAWN_FRAMES));
   {
     Knob w = range(
         "window", "290..302", 0, 1000, false, "K",

@@ -28,10 +28,50 @@ int metal_noise_at(const ModelSettings& m, uint64_t index) {
                   below(draw(m.seed, index, kStreamKnobDraw, PS_DRAWN_METAL_NOISE)[0], static_cast<uint32_t>(span)));
 }
 
+namespace {
+
+// Element e's real draw over [lo, hi]: lo + (hi - lo) uniform24(word 0).
+double drawn_real(const ModelSettings& m, unsigned e, uint64_t index) {
+  const DrawnRange& d = m.drawn[e];
+  return d.lo + (d.hi - d.lo) * uniform24(draw(m.seed, index, kStreamKnobDraw, e)[0]);
+}
+
+}  // namespace
+
 double ir_netd_at(const ModelSettings& m, uint64_t index) {
-  const DrawnRange& d = m.drawn[PS_DRAWN_IR_NETD];
-  if (!d.varies()) return m.ir_netd;
-  return d.lo + (d.hi - d.lo) * uniform24(draw(m.seed, index, kStreamKnobDraw, PS_DRAWN_IR_NETD)[0]);
+  return m.drawn[PS_DRAWN_IR_NETD].varies() ? drawn_real(m, PS_DRAWN_IR_NETD, index) : m.ir_netd;
+}
+
+double netd_at(const ModelSettings& m, uint64_t index) {
+  return m.drawn[PS_DRAWN_NETD].varies() ? drawn_real(m, PS_DRAWN_NETD, index) : m.netd;
+}
+
+int frames_at(const ModelSettings& m, uint64_t index) {
+  const DrawnRange& d = m.drawn[PS_DRAWN_FRAMES];
+  if (!d.varies()) return m.frames;
+  const int lo = static_cast<int>(d.lo), span = static_cast<int>(d.hi) - lo + 1;
+  return lo +
+         static_cast<int>(below(draw(m.seed, index, kStreamKnobDraw, PS_DRAWN_FRAMES)[0], static_cast<uint32_t>(span)));
+}
+
+double illumination_at(const ModelSettings& m, uint64_t index) {
+  return m.drawn[PS_DRAWN_ILLUMINATION].varies() ? drawn_real(m, PS_DRAWN_ILLUMINATION, index) : m.illumination;
+}
+
+double worn_minutes_at(const ModelSettings& m, uint64_t index) {
+  return m.drawn[PS_DRAWN_WORN_MINUTES].varies() ? drawn_real(m, PS_DRAWN_WORN_MINUTES, index) : m.worn_minutes;
+}
+
+ModelSettings ModelSettings::at_scenario(uint64_t index) const {
+  ModelSettings m = *this;
+  m.metal_noise = metal_noise_at(*this, index);
+  m.ir_netd = ir_netd_at(*this, index);
+  m.netd = netd_at(*this, index);
+  m.frames = frames_at(*this, index);
+  m.illumination = illumination_at(*this, index);
+  m.worn_minutes = worn_minutes_at(*this, index);
+  m.drawn = {};
+  return m;
 }
 
 double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index) {
@@ -40,6 +80,14 @@ double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index) {
       return metal_noise_at(m, index);
     case PS_DRAWN_IR_NETD:
       return ir_netd_at(m, index);
+    case PS_DRAWN_NETD:
+      return netd_at(m, index);
+    case PS_DRAWN_FRAMES:
+      return frames_at(m, index);
+    case PS_DRAWN_ILLUMINATION:
+      return illumination_at(m, index);
+    case PS_DRAWN_WORN_MINUTES:
+      return worn_minutes_at(m, index);
   }
   throw std::logic_error("no drawn knob " + std::to_string(element));
 }
@@ -90,7 +138,7 @@ std::vector<std::string> FeatureLayout::names() const {
 ModelSettings ModelSettings::for_view(const Sensor& s) const {
   ModelSettings m = *this;
   if (s.netd) (s.camera == Camera::ir ? m.ir_netd : m.netd) = *s.netd;
-  if (s.netd && s.camera == Camera::ir) m.drawn[PS_DRAWN_IR_NETD] = {};  // its own camera's, never drawn
+  if (s.netd) m.drawn[s.camera == Camera::ir ? PS_DRAWN_IR_NETD : PS_DRAWN_NETD] = {};  // its own, never drawn
   if (s.raw) {
     m.raw_width = (*s.raw)[0];
     m.raw_height = (*s.raw)[1];

@@ -76,6 +76,9 @@ struct ModelSettings {
   // The knobs as view `s` takes them: its own camera parameters (Sensor::netd, raw) over
   // the run's. Both backends read a view's knobs through this, and nothing else.
   ModelSettings for_view(const Sensor& s) const;
+  // The knobs of scenario `index`: each drawn knob at its value there (its *_at), nothing
+  // drawn. The CPU reference computes each scenario from these.
+  ModelSettings at_scenario(uint64_t index) const;
   bool transforms() const { return rotate_lo != 0 || rotate_hi != 0 || scale_lo != 1 || scale_hi != 1 || flip; }
   bool moves_sprites() const { return bilinear || jitter > 0 || transforms(); }
 };
@@ -94,6 +97,15 @@ int metal_noise_at(const ModelSettings& m, uint64_t index);
 // (A..B), A + (B - A) uniform24(word 0) of PS_STREAM_KNOB_DRAW, element PS_DRAWN_IR_NETD.
 // kernels/ir_surface.cl's ir_netd_of draws the same at the kernels' precision.
 double ir_netd_at(const ModelSettings& m, uint64_t index);
+// Scenario `index`'s MMW NETD (the knob netd, K) and raw frames (frames): as ir_netd_at and
+// metal_noise_at, elements PS_DRAWN_NETD and PS_DRAWN_FRAMES. kernels/netd.cl's
+// mmw_noise_of draws the same.
+double netd_at(const ModelSettings& m, uint64_t index);
+int frames_at(const ModelSettings& m, uint64_t index);
+// Scenario `index`'s illumination (K) and worn time (minutes), as ir_netd_at, elements
+// PS_DRAWN_ILLUMINATION and PS_DRAWN_WORN_MINUTES. kernels/radiometry.cl's scene_draw.
+double illumination_at(const ModelSettings& m, uint64_t index);
+double worn_minutes_at(const ModelSettings& m, uint64_t index);
 // Scenario `index`'s value of the drawn knob `element` (PS_DRAWN_*), as its *_at gives it.
 double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index);
 
@@ -159,7 +171,9 @@ struct Plan {
   }
   // The MMW camera's frames as the kernels draw them: one each, or (block-mean noise model,
   // the fast tier) one draw of NETD / sqrt(frames).
-  bool frames_approximated() const { return fidelity.noise == NoiseModel::block_mean && model.frames > 1; }
+  bool frames_approximated() const {
+    return fidelity.noise == NoiseModel::block_mean && (model.frames > 1 || model.drawn[PS_DRAWN_FRAMES].varies());
+  }
   // The physics cameras' noise draws (MMW NETD, IR NETD) under noise_draw irwin-hall (the
   // fast tier's), the knob the thesis model's pixel noise follows: Irwin-Hall draws without
   // the table (kernels/contract.h, PS_IH_*); the reference draws them alike.

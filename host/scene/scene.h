@@ -14,7 +14,8 @@ constexpr int16_t kNoObject = -1;
 // The keys of the knobs a run may draw per scenario, by their PS_DRAWN_* element: each is
 // its knob's key (plan/knobs.cpp checks) and, where drawn, a column of scenarios.csv and
 // data.h5's param_<key>.
-inline constexpr std::array<const char*, PS_DRAWN_KNOBS> kDrawnKnobKeys = {"metal_noise", "ir_netd"};
+inline constexpr std::array<const char*, PS_DRAWN_KNOBS> kDrawnKnobKeys = {
+    "metal_noise", "ir_netd", "pixel_noise", "netd", "frames", "illumination", "worn_minutes"};
 
 struct Scenario {
   int subject = 0;  // 0-based

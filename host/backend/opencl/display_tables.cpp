@@ -90,4 +90,17 @@ double kernel_netd(const Plan& plan, const ModelSettings& m) {
   return plan.frames_approximated() ? m.netd / std::sqrt(double(m.frames)) : m.netd;
 }
 
+MmwNoise mmw_noise(const Plan& plan, const ModelSettings& m) {
+  const DrawnRange &netd = m.drawn[PS_DRAWN_NETD], &frames = m.drawn[PS_DRAWN_FRAMES];
+  if (!netd.varies() && !frames.varies()) {
+    const double sd = kernel_netd(plan, m);
+    return {.netd_lo = sd, .netd_hi = sd, .frames_lo = m.frames, .frames_hi = m.frames};
+  }
+  return {.netd_lo = m.netd,
+          .netd_hi = netd.varies() ? netd.hi : m.netd,
+          .frames_lo = m.frames,
+          .frames_hi = frames.varies() ? static_cast<int>(frames.hi) : m.frames,
+          .as_one = plan.frames_approximated()};
+}
+
 }  // namespace portalsim::opencl

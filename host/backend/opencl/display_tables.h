@@ -23,4 +23,15 @@ DisplayTables append_display_tables(std::vector<double>& p, const ModelSettings&
 int kernel_frames(const Plan& plan, const ModelSettings& m);
 double kernel_netd(const Plan& plan, const ModelSettings& m);
 
+// The MMW noise the kernels draw per scenario (kernels/netd.cl, mmw_noise_of): where
+// neither the NETD nor the frames is drawn, netd_lo = netd_hi = kernel_netd and one frame
+// count; else the knobs' ranges (netd_at, frames_at), as_one under the block-mean model.
+struct MmwNoise {
+  double netd_lo = 0, netd_hi = 0;
+  int frames_lo = 1, frames_hi = 1;
+  bool as_one = false;
+  bool drawn() const { return netd_hi > netd_lo || frames_hi > frames_lo; }
+};
+MmwNoise mmw_noise(const Plan& plan, const ModelSettings& m);
+
 }  // namespace portalsim::opencl

@@ -264,7 +264,9 @@ PS_KERNEL_ARGS(AnalyticNoiseArgs, PS_ANALYTIC_NOISE_ARGS)
   X(cl::Buffer, object_range)       \
   X(cl::Buffer, object_feature)     \
   X(cl::Buffer, object_value)       \
-  X(Real, sd)                       \
+  X(Real, netd_lo)                  \
+  X(Real, netd_hi)                  \
+  X(cl_int2, frames)                \
   X(cl_int8, dims)                  \
   X(cl::Buffer, noise)              \
   X(cl::Buffer, scratch)

@@ -73,9 +73,21 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   p[PS_PHYS_BACKGROUND] = pc.background_temperature;
   p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : m.window_lo;
   p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : m.window_hi;
-  p[PS_PHYS_NETD] = ir ? m.ir_netd : kernel_netd(plan, m);
-  const DrawnRange& drawn_ir_netd = m.drawn[PS_DRAWN_IR_NETD];
-  p[PS_PHYS_NETD_HI] = ir && drawn_ir_netd.varies() ? drawn_ir_netd.hi : p[PS_PHYS_NETD];
+  // The view's NETD, and its range and the frames' where drawn per scenario (mmw_noise_of,
+  // ir_netd_of).
+  if (ir) {
+    const DrawnRange& drawn_ir_netd = m.drawn[PS_DRAWN_IR_NETD];
+    p[PS_PHYS_NETD] = m.ir_netd;
+    p[PS_PHYS_NETD_HI] = drawn_ir_netd.varies() ? drawn_ir_netd.hi : m.ir_netd;
+    p[PS_PHYS_FRAMES_LO] = p[PS_PHYS_FRAMES_HI] = 1;
+  } else {
+    const MmwNoise noise = mmw_noise(plan, m);
+    p[PS_PHYS_NETD] = noise.netd_lo;
+    p[PS_PHYS_NETD_HI] = noise.netd_hi;
+    p[PS_PHYS_FRAMES_LO] = noise.frames_lo;
+    p[PS_PHYS_FRAMES_HI] = noise.frames_hi;
+    p[PS_PHYS_FRAMES_AS_ONE] = noise.as_one;
+  }
   // Per subject, its base image's value to kelvin: the IR index map, or the MMW's gray
   // between the room behind and the bare body.
   const double body = seen(pc.skin_emissivity, pc.skin_temperature);
@@ -110,6 +122,35 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     return at;
   };
   t.gauss = append(gauss_table());  // the sensor noise's table Gaussians
+  // Where the illumination or the worn time is drawn per scenario, the scene block
+  // (PS_PHYS_SCENE): the values above hold at the ranges' low ends, and each scenario's
+  // moves from them, linearly in the illumination and in each material's exp(-worn / tau).
+  const DrawnRange &ill = m.drawn[PS_DRAWN_ILLUMINATION], &worn = m.drawn[PS_DRAWN_WORN_MINUTES];
+  const bool scene_drawn = ill.varies() || worn.varies();
+  const double ill_span = ill.varies() ? ill.hi - ill.lo : 0.0;
+  std::vector<double> scene;
+  if (scene_drawn) {
+    scene = {ill.varies() ? 1.0 : 0.0, m.worn_minutes, worn.varies() ? worn.hi : m.worn_minutes};
+    // The bare body's apparent temperature moves by tc (1 - e_skin) per kelvin of illumination.
+    const double body_span = ir ? 0.0 : pc.clothing_transmission * (1 - pc.skin_emissivity) * ill_span;
+    for (const Subject& subj : cat.subjects) {
+      const double dgain = ir ? 0.0 : body_span / (subj.mmw_level - pc.base_background_gray);
+      scene.push_back(dgain);
+      scene.push_back(-dgain * pc.base_background_gray);
+    }
+    for (size_t v = 0; v < cat.variant_list.size(); ++v) {
+      const Material& mat = cat.materials.at(cat.object_of(static_cast<int>(v)).material_id);
+      // worn = skin - (skin - room) exp(-worn / tau): the IR shadow (against skin or room)
+      // moves by -coupling (skin - room) per unit of it, the MMW value by -tc e (skin - room).
+      const double per_decay =
+          ir ? -pc.ir_coupling * (pc.skin_temperature - pc.room_temperature)
+             : -pc.clothing_transmission * mat.emissivity * (pc.skin_temperature - pc.room_temperature);
+      scene.push_back(ir ? 0.0 : pc.clothing_transmission * (1 - mat.emissivity) * ill_span);
+      scene.push_back(per_decay);
+      scene.push_back(1.0 / mat.warm_minutes);
+      scene.push_back(std::exp(-m.worn_minutes / mat.warm_minutes));
+    }
+  }
   if (ir) {
     // Where an object reaches past the body's outline, its shadow is taken against the room
     // it touches there, not the skin (PsViewLaunch::phys_off_body).
@@ -120,6 +161,7 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
       off_body.push_back(std::ceil((body_from - pc.ir_index_min_k) / per_index));
     off_body.insert(off_body.end(), off_body_shadow.begin(), off_body_shadow.end());
     t.off_body = append(off_body);
+    if (scene_drawn) p[PS_PHYS_SCENE] = append(scene);
     return t;
   }
   // The MMW raw-grid path's tables (kernels/physics_raw.cl).
@@ -132,24 +174,34 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   t.cband = append(cband);
   t.rband = append(rband);
   t.display = append_display_tables(p, m, W, H, RW, RH);
-  // Each subject's bare raw grid: wy . T . wx^T over its base image in kelvin.
-  std::vector<double> bare(cat.subjects.size() * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
-  for (size_t subj = 0; subj < cat.subjects.size(); ++subj) {
-    const Image& base = assets.bases[subj][view];
-    const double gain = p[PS_PHYS_SUBJECTS + 2 * subj], offset = p[PS_PHYS_SUBJECTS + 2 * subj + 1];
-    std::fill(rows.begin(), rows.end(), 0.0);
-    for (int y = 0; y < H; ++y)
-      for (int x = 0; x < W; ++x) {
-        const double kelvin = gain * base.at(x, y) + offset;
-        for (int c = int(cband[2 * x]); c <= int(cband[2 * x + 1]); ++c)
-          rows[size_t(y) * RW + c] += wx[size_t(c) * W + x] * kelvin;
-      }
-    double* out = &bare[subj * size_t(RW) * RH];
-    for (int y = 0; y < H; ++y)
-      for (int r = int(rband[2 * y]); r <= int(rband[2 * y + 1]); ++r)
-        for (int c = 0; c < RW; ++c) out[size_t(r) * RW + c] += wy[size_t(r) * H + y] * rows[size_t(y) * RW + c];
+  // Each subject's bare raw grid: wy . T . wx^T over its base image in kelvin at the
+  // subject's (gain, offset); with the scene block, also its change over the illumination's
+  // range, the same sums at the change of (gain, offset).
+  const auto bare_grids = [&](const double* gains, size_t stride) {
+    std::vector<double> bare(cat.subjects.size() * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
+    for (size_t subj = 0; subj < cat.subjects.size(); ++subj) {
+      const Image& base = assets.bases[subj][view];
+      const double gain = gains[stride * subj], offset = gains[stride * subj + 1];
+      std::fill(rows.begin(), rows.end(), 0.0);
+      for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+          const double kelvin = gain * base.at(x, y) + offset;
+          for (int c = int(cband[2 * x]); c <= int(cband[2 * x + 1]); ++c)
+            rows[size_t(y) * RW + c] += wx[size_t(c) * W + x] * kelvin;
+        }
+      double* out = &bare[subj * size_t(RW) * RH];
+      for (int y = 0; y < H; ++y)
+        for (int r = int(rband[2 * y]); r <= int(rband[2 * y + 1]); ++r)
+          for (int c = 0; c < RW; ++c) out[size_t(r) * RW + c] += wy[size_t(r) * H + y] * rows[size_t(y) * RW + c];
+    }
+    return bare;
+  };
+  t.base = append(bare_grids(&p[PS_PHYS_SUBJECTS], 2));
+  if (scene_drawn) {
+    const std::vector<double> moved = bare_grids(&scene[PS_SCENE_SUBJECTS], 2);
+    scene.insert(scene.end(), moved.begin(), moved.end());
+    p[PS_PHYS_SCENE] = append(scene);
   }
-  t.base = append(bare);
   return t;
 }
 

@@ -67,7 +67,10 @@ std::shared_ptr<ViewDerived> ViewDerivations::operator()(const Plan& plan, int v
   auto d = std::make_shared<ViewDerived>();
   const Sensor& s = cat_.sensors[view];
   d->model = plan.model.for_view(s);
-  if (noise_free) d->model.netd = 0;
+  if (noise_free) {
+    d->model.netd = 0;
+    d->model.drawn[PS_DRAWN_NETD] = d->model.drawn[PS_DRAWN_FRAMES] = {};
+  }
   const ModelSettings& m = d->model;
   d->L = settings(cat_, plan, m, view);
   const bool fp64 = plan.fidelity.precision == Precision::fp64;

@@ -43,7 +43,9 @@ class ReferenceBackend final : public Backend {
       for (int k = 0; k < views; ++k) {
         const Sensor& sensor = cat_.sensors[k];
         if (!plan.renders(sensor, k)) continue;
-        reference::ViewScene vs = reference::view_scene(cat_, assets_, view_model[k], k, s, index);
+        // Each scenario's own knobs where a knob is drawn (ModelSettings::at_scenario).
+        const ModelSettings scenario_model = view_model[k].at_scenario(index);
+        reference::ViewScene vs = reference::view_scene(cat_, assets_, scenario_model, k, s, index);
         vs.follow(plan);
         for (const std::string& stage : sensor.chain_for(plan.model.model)) view_stage(stage).reference(vs, field);
         images[k].assign(field.v.begin(), field.v.end());  // display left whole numbers 0..255

@@ -43,10 +43,12 @@ class PhysicsRawFeatures final : public FeaturePath {
                          plan.fidelity.pooling == Pooling::sparse && plan.fidelity.noise == NoiseModel::block_mean &&
                          !m.window_auto && m.display_filter == DisplayFilter::bilinear && m.smooth == 0;
     if (!plan_ok || !physics_raw_path().applies(plan, sensor)) return {};
-    // Tables where objects stand at their places, and while the pairs' index (subjects x
-    // (variants x regions)^2) stays small.
+    // Tables where objects stand at their places and their values are the run's (no drawn
+    // illumination or worn time), and while the pairs' index (subjects x (variants x
+    // regions)^2) stays small.
     const size_t combos = d_.cat.variant_list.size() * d_.cat.regions.size();
-    if (plan.model.jitter <= 0 && !plan.model.transforms() &&
+    const bool scene_drawn = m.drawn[PS_DRAWN_ILLUMINATION].varies() || m.drawn[PS_DRAWN_WORN_MINUTES].varies();
+    if (plan.model.jitter <= 0 && !plan.model.transforms() && !scene_drawn &&
         d_.cat.subjects.size() * combos * combos <= kMaxTabulatedPairs)
       return {.runs = true, .variant = kTabulated, .variant_name = "tabulated"};
     return {.runs = true, .variant = kUntabulated, .variant_name = "untabulated"};
@@ -98,6 +100,7 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const Gate& g, c
                              : padded(b.n);
     cl::Buffer& scratch =
         scratch_.at_least(ctx, per > PS_FEATURE_NOISE_PRIVATE ? std::min(chunk, padded(b.n)) * per * rb : 1);
+    const MmwNoise noise = mmw_noise(plan, plan.model.for_view(cat.sensors[view]));
     const PhysicsFeaturesArgs args{.raw = d_.raw.buf,
                                    .first = t.first,
                                    .cells = t.cells,
@@ -116,7 +119,9 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const Gate& g, c
                                    .object_range = t.object_range,
                                    .object_feature = t.object_feature,
                                    .object_value = t.object_value,
-                                   .sd = {kernel_netd(plan, plan.model.for_view(cat.sensors[view]))},
+                                   .netd_lo = {noise.netd_lo},
+                                   .netd_hi = {noise.netd_hi},
+                                   .frames = {{noise.frames_lo, noise.frames_hi}},
                                    .dims = t.dims,
                                    .noise = t.noise,
                                    .scratch = scratch};
