@@ -12,12 +12,12 @@ kernel void stage_contact_shadow(VIEW_STAGE_ARGS) {
   global const uchar* restrict base = base_row(atlas, bases, subject, &L, i, y);
   const int body_from = (int)phys[L.phys_off_body + subject[i]];
   const SceneDraw scene = scene_draw(phys, seed, index);
-  preal delta[PS_MAX_LAYERS];
+  preal on[PS_MAX_LAYERS], off[PS_MAX_LAYERS];
   Layers Ly;
   composite_layers(&Ly, rec, &L, y);
-  layer_deltas(&Ly, phys, &scene, L.subjects, delta);
-  for (int x = 0; x < L.width; ++x)
-    dT[x] = lay_values(&Ly, atlas, x, (int)base[x] >= body_from ? shadow : off_body, delta, (preal)0);
+  layer_values(&Ly, shadow, phys, &scene, L.subjects, on);
+  layer_values(&Ly, off_body, phys, &scene, L.subjects, off);
+  for (int x = 0; x < L.width; ++x) dT[x] = lay_values(&Ly, atlas, x, (int)base[x] >= body_from ? on : off, (preal)0);
 }
 
 kernel void stage_ir_surface(VIEW_STAGE_ARGS) {

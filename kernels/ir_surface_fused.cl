@@ -58,11 +58,12 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
   const int body_from = (int)phys[L->phys_off_body + s];
   global const param* taps = psf_taps(phys, L);
   const SceneDraw scene = scene_draw(phys, (uint2)(L->seed_lo, L->seed_hi), upsample(L->first_hi, L->first_lo) + i);
-  preal delta[PS_MAX_LAYERS];
+  preal on[PS_MAX_LAYERS], off[PS_MAX_LAYERS];
   for (int y = y_lo; y < y_hi; ++y) {
     Layers Ly;
     composite_layers(&Ly, rec, L, y);
-    layer_deltas(&Ly, phys, &scene, L->subjects, delta);
+    layer_values(&Ly, shadow, phys, &scene, L->subjects, on);
+    layer_values(&Ly, off_body, phys, &scene, L->subjects, off);
     int a = W, b = 0;
     for (int k = 0; k < Ly.count; ++k) {
       a = min(a, max(Ly.x0[k], 0));
@@ -77,7 +78,7 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
     for (int x = max(a - 2 * R, 0); x < a; ++x) src[x] = 0;
     global const uchar* restrict base_y = base_row(atlas, bases, subject, L, i, y);
     for (int x = a; x < b; ++x)
-      src[x] = lay_values(&Ly, atlas, x, (int)base_y[x] >= body_from ? shadow : off_body, delta, (preal)0);
+      src[x] = lay_values(&Ly, atlas, x, (int)base_y[x] >= body_from ? on : off, (preal)0);
     for (int x = b; x < min(b + 2 * R, W); ++x) src[x] = 0;
     global preal* restrict dst = S + (size_t)y * W;
     const int lo = max(a - R, 0), hi = min(b + R, W);

@@ -58,7 +58,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     y_lo = min(y_lo, max(rows.x, 0));
     y_hi = max(y_hi, min(rows.y, H));
   }
-  preal gain, offset, delta[PS_MAX_LAYERS];
+  preal gain, offset, lv[PS_MAX_LAYERS];
   subject_kelvin(phys, &scene, s, L.subjects, &gain, &offset);
   global const param* object_t = phys + PS_PHYS_VARIANTS(L.subjects);
   global const param* wx = phys + L.phys_wx;
@@ -69,7 +69,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     Layers Ly;
     composite_layers(&Ly, rec, &L, y);
     if (Ly.count == 0) continue;
-    layer_deltas(&Ly, phys, &scene, L.subjects, delta);
+    layer_values(&Ly, object_t, phys, &scene, L.subjects, lv);
     int x_lo = W, x_hi = 0;
     for (int k = 0; k < Ly.count; ++k) {
       x_lo = min(x_lo, max(Ly.x0[k], 0));
@@ -79,7 +79,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     global const uchar* base = base_row(atlas, bases, subject, &L, i, y);
     for (int x = x_lo; x < x_hi; ++x) {
       const preal t0 = gain * (preal)base[x] + offset;
-      d[x] = lay_values(&Ly, atlas, x, object_t, delta, t0) - t0;
+      d[x] = lay_values(&Ly, atlas, x, lv, t0) - t0;
     }
     // Each raw column's share of the row: its weights (zero outside its band) against
     // the change, as dot products over the span; fp32 builds in 16-lane partial sums.

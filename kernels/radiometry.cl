@@ -37,22 +37,21 @@ inline void subject_kelvin(global const param* phys, const SceneDraw* d, int s, 
   *offset += (preal)b[1] * d->t;
 }
 
-// Each of a row's layers' value change in the scenario (its variant's, 0 where nothing is
-// drawn), for lay_values.
-inline void layer_deltas(const Layers* Ly, global const param* phys, const SceneDraw* d, int subjects,
-                         preal* delta) {
+// Each of a row's layers' value in the scenario: its variant's in `value`, moved where the
+// illumination or the worn time is drawn.
+inline void layer_values(const Layers* Ly, global const param* value, global const param* phys, const SceneDraw* d,
+                         int subjects, preal* lv) {
   for (int k = 0; k < Ly->count; ++k) {
-    delta[k] = 0;
+    lv[k] = (preal)value[Ly->variant[k]];
     if (d->at == 0) continue;
     global const param* v = phys + d->at + PS_SCENE_VARIANTS(subjects) + 4 * Ly->variant[k];
-    delta[k] = (preal)v[0] * d->t + (preal)v[1] * (exp(-d->w * (preal)v[2]) - (preal)v[3]);
+    lv[k] += (preal)v[0] * d->t + (preal)v[1] * (exp(-d->w * (preal)v[2]) - (preal)v[3]);
   }
 }
 
-// Lays a row's objects over v at column x, each by its coverage, with its variant's value
-// plus the layer's delta (layer_deltas).
-inline preal lay_values(const Layers* Ly, global const uchar* atlas, int x, global const param* value,
-                        const preal* delta, preal v) {
+// Lays a row's objects over v at column x, each by its coverage, with its layer's value
+// (layer_values).
+inline preal lay_values(const Layers* Ly, global const uchar* atlas, int x, const preal* lv, preal v) {
   for (int k = 0; k < Ly->count; ++k) {
     const int sx = x - Ly->x0[k];
     if (sx < 0 || sx >= Ly->width[k]) continue;
@@ -64,7 +63,7 @@ inline preal lay_values(const Layers* Ly, global const uchar* atlas, int x, glob
     } else {
       c = (preal)atlas[Ly->offset[k] + 2 * sx + 1] * ((preal)1 / (preal)255);
     }
-    v = c * ((preal)value[Ly->variant[k]] + delta[k]) + ((preal)1 - c) * v;
+    v = c * lv[k] + ((preal)1 - c) * v;
   }
   return v;
 }
@@ -75,12 +74,10 @@ kernel void stage_radiometry(VIEW_STAGE_ARGS) {
   global preal* T = (global preal*)field + row0;
   const int s = subject[i];
   const SceneDraw scene = scene_draw(phys, seed, index);
-  preal gain, offset, delta[PS_MAX_LAYERS];
+  preal gain, offset, lv[PS_MAX_LAYERS];
   subject_kelvin(phys, &scene, s, L.subjects, &gain, &offset);
-  global const param* object_t = phys + PS_PHYS_VARIANTS(L.subjects);
   Layers Ly;
   composite_layers(&Ly, rec, &L, y);
-  layer_deltas(&Ly, phys, &scene, L.subjects, delta);
-  for (int x = 0; x < L.width; ++x)
-    T[x] = lay_values(&Ly, atlas, x, object_t, delta, gain * (preal)base[x] + offset);
+  layer_values(&Ly, phys + PS_PHYS_VARIANTS(L.subjects), phys, &scene, L.subjects, lv);
+  for (int x = 0; x < L.width; ++x) T[x] = lay_values(&Ly, atlas, x, lv, gain * (preal)base[x] + offset);
 }

@@ -15,6 +15,7 @@ std::function<int()> add_features(CLI::App& app);
 std::function<int()> add_tradeoff(CLI::App& app);
 std::function<int()> add_serve(CLI::App& app);
 std::function<int()> add_validate(CLI::App& app);
+std::function<int()> add_transfer(CLI::App& app);
 std::function<int()> add_knobs(CLI::App& app);
 std::function<int()> add_merge(CLI::App& app);
 std::function<int()> add_calibrate(CLI::App& app);

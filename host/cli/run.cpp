@@ -55,6 +55,7 @@ int run(int argc, char** argv, const std::map<std::string, AddCommand>& more) {
   commands["tradeoff"] = add_tradeoff(app);
   commands["serve"] = add_serve(app);
   commands["validate"] = add_validate(app);
+  commands["transfer"] = add_transfer(app);
   commands["knobs"] = add_knobs(app);
   commands["merge"] = add_merge(app);
   commands["calibrate"] = add_calibrate(app);

@@ -22,6 +22,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "cli/features_table.h"
+#include "cli/learning_sets.h"
 #include "cli/validate_demo.h"
 #include "cli/validate_stats.h"
 #include "cli/validate_tables.h"
@@ -39,27 +40,6 @@ namespace portalsim::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A table file, or a folder of scenario folders made into one (in `work`) as `portalsim
-// features` makes it.
-Table load(const std::string& path, const std::string& work, const std::string& tag, int block,
-           const std::string& catalogue) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) {
-    const std::string table = (fs::path(work) / (".features-" + tag + ".arff")).string();
-    const FeaturesCount n = write_features({path}, table, "arff", block, catalogue);
-    std::fprintf(stderr, "validate: %s: %zu scenario folders\n", path.c_str(), n.rows);
-    Table t = read_arff(table);
-    t.path = path;
-    return t;
-  }
-  if (!fs::exists(path, ec)) throw InputError(path + ": no such file or folder");
-  const std::string ext = lower(fs::path(path).extension().string());
-  if (ext == ".arff") return read_arff(path);
-  if (ext == ".csv") return read_csv(path);
-  if (ext == ".h5") return read_h5_table(path);
-  throw InputError(path + ": a feature table must be .arff, .csv or .h5, or a folder of scenario folders");
-}
 
 bool has_column(const Table& t, bool (*kind)(std::string_view)) {
   return std::any_of(t.names.begin(), t.names.end(), [&](const std::string& n) { return kind(n); });
@@ -114,41 +94,6 @@ void check_usable(const Table& a, int folds) {
                      std::to_string(folds) + " cross-validation folds");
 }
 
-void check_same_attributes(const Table& sim, const Table& real) {
-  for (size_t i = 0; i < std::max(sim.names.size(), real.names.size()); ++i) {
-    if (i < sim.names.size() && i < real.names.size() && lower(sim.names[i]) == lower(real.names[i])) continue;
-    if (i >= real.names.size())
-      throw InputError(sim.path + ":" + std::to_string(sim.name_lines[i]) + ": attribute '" + sim.names[i] +
-                       "' has no counterpart in " + real.path);
-    if (i >= sim.names.size())
-      throw InputError(real.path + ":" + std::to_string(real.name_lines[i]) + ": attribute '" + real.names[i] +
-                       "' has no counterpart in " + sim.path);
-    throw InputError(real.path + ":" + std::to_string(real.name_lines[i]) + ": attribute '" + real.names[i] +
-                     "' differs from " + sim.path + ":" + std::to_string(sim.name_lines[i]) + " '" + sim.names[i] +
-                     "'");
-  }
-}
-
-// The table as ARFF with a class declaration shared by both sets, so WEKA sees one header.
-void write_arff(const Table& t, const std::set<std::string>& classes, const std::string& path) {
-  std::string s = "@relation validate\n";
-  auto q = [](const std::string& n) {
-    std::string r = "'";
-    for (char c : n) r += c == '\'' ? std::string("\\'") : std::string(1, c);
-    return r + "'";
-  };
-  for (size_t i = 0; i + 1 < t.names.size(); ++i) s += "@attribute " + q(t.names[i]) + " numeric\n";
-  s += "@attribute class {";
-  bool first = true;
-  for (const auto& c : classes) s += (first ? "" : ",") + q(c), first = false;
-  s += "}\n@data\n";
-  for (const auto& r : t.rows) {
-    for (size_t i = 0; i + 1 < r.size(); ++i) s += r[i] + ",";
-    s += q(r.back()) + "\n";
-  }
-  write_text_atomic(path, s);
-}
-
 bool on_path(const std::string& program) {
   const char* path = std::getenv("PATH");
   if (!path) return false;
@@ -173,23 +118,6 @@ std::string fmt_p(double p) {
   std::snprintf(b, sizeof b, p < 0.001 ? "%.2g" : "%.3f", p);
   return b;
 }
-
-// A scratch folder for the tables handed to WEKA, removed on every way out.
-struct WorkDir {
-  std::string path;
-  WorkDir() {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string tmpl = (fs::path(tmp && *tmp ? tmp : "/tmp") / "portalsim-validate-XXXXXX").string();
-    if (!::mkdtemp(tmpl.data())) throw EnvironmentError(tmpl + ": cannot create a scratch folder");
-    path = tmpl;
-  }
-  ~WorkDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  WorkDir(const WorkDir&) = delete;
-  WorkDir& operator=(const WorkDir&) = delete;
-};
 
 struct Options {
   std::string sim, real, out, features = "both", classifiers = "j48,mlp,svm", catalogue, grid;
@@ -395,8 +323,8 @@ int run_validate(Options o) {
     o.sim = (fs::path(o.out) / "demo" / fs::path(sim_path).filename()).string();
     o.real = (fs::path(o.out) / "demo" / fs::path(real_path).filename()).string();
   }
-  const Table sim = load(sim_path, work, "sim", o.block, o.catalogue);
-  const Table real = load(real_path, work, "real", o.block, o.catalogue);
+  const Table sim = load_table(sim_path, work, "sim", o.block, o.catalogue);
+  const Table real = load_table(real_path, work, "real", o.block, o.catalogue);
 
   nlohmann::json report = {{"sim", o.sim},
                            {"real", o.real},

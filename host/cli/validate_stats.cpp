@@ -50,4 +50,23 @@ TTest corrected_resampled(const std::vector<double>& d, double test_train_ratio)
   return finish(m, std::sqrt((1.0 / d.size() + test_train_ratio) * var), static_cast<double>(d.size() - 1));
 }
 
+namespace {
+constexpr double kZ95 = 1.959963984540054;  // the normal's 97.5% point
+}
+
+Interval wilson(long correct, long n) {
+  if (n <= 0) throw std::invalid_argument("wilson: no trials");
+  const double p = double(correct) / n, z2 = kZ95 * kZ95, d = 1 + z2 / n;
+  const double centre = (p + z2 / (2.0 * n)) / d;
+  const double half = kZ95 / d * std::sqrt(p * (1 - p) / n + z2 / (4.0 * n * n));
+  return {centre - half, centre + half};
+}
+
+Interval newcombe_difference(long a, long na, long b, long nb) {
+  const Interval ia = wilson(a, na), ib = wilson(b, nb);
+  const double pa = double(a) / na, pb = double(b) / nb, d = pa - pb;
+  return {d - std::sqrt((pa - ia.lo) * (pa - ia.lo) + (ib.hi - pb) * (ib.hi - pb)),
+          d + std::sqrt((ia.hi - pa) * (ia.hi - pa) + (pb - ib.lo) * (pb - ib.lo))};
+}
+
 }  // namespace portalsim::cli

@@ -18,4 +18,16 @@ TTest student_two_sample(const std::vector<double>& a, const std::vector<double>
 // cross-validation test_train_ratio = n_test / n_train = 1 / (k - 1).
 TTest corrected_resampled(const std::vector<double>& differences, double test_train_ratio);
 
+// A 95% interval of a proportion or of a difference of two, as fractions.
+struct Interval {
+  double lo = 0, hi = 0;
+};
+// Wilson's score interval of `correct` of `n` (Newcombe 1998, "Two-sided confidence
+// intervals for the single proportion", method 3). Needs n > 0.
+Interval wilson(long correct, long n);
+// The difference a/na - b/nb of two independent proportions: Newcombe's hybrid score
+// interval (Newcombe 1998, "Interval estimation for the difference between independent
+// proportions", method 10), from each one's Wilson interval.
+Interval newcombe_difference(long a, long na, long b, long nb);
+
 }  // namespace portalsim::cli

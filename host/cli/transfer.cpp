@@ -1,0 +1,257 @@
+// `portalsim transfer`: does a detector trained on one data set hold on others (issue 34:
+// held-out bodies, another camera)? WEKA's classifiers (default settings) are trained once
+// per test set on the training set and scored on that test set; each accuracy gets Wilson's
+// 95% interval, and each set's loss against the first test set (the in-domain one) an
+// interval for the difference of two independent proportions (Newcombe's hybrid score).
+// A set is a run spec (.toml, generated here under OUT/sets/NAME/), a feature table (ARFF,
+// CSV, data.h5) or a folder of scenario folders.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "base/error.h"
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "cli/learning_sets.h"
+#include "cli/validate_stats.h"
+#include "cli/weka.h"
+#include "schedule/pipeline.h"
+#include "schedule/run_spec.h"
+#include "sink/staging.h"
+
+namespace portalsim::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The classifiers by their flag name: WEKA's class and the report's name.
+struct Classifier {
+  const char* key;
+  const char* weka_class;
+  const char* name;
+};
+constexpr Classifier kClassifiers[] = {{"j48", "weka.classifiers.trees.J48", "J48"},
+                                       {"svm", "weka.classifiers.functions.SMO", "SMO"},
+                                       {"mlp", "weka.classifiers.functions.MultilayerPerceptron", "MLP"}};
+
+struct Options {
+  std::string train, out, classifiers = "j48,svm", catalogue;
+  std::vector<std::string> tests;
+  int block = 10;
+  double max_loss = 3.0;
+};
+
+// One data set: its name in the report, where it comes from, and its spec when it is one.
+struct Set {
+  std::string name, source;
+  std::unique_ptr<RunSpec> spec;
+  Table table;
+};
+
+bool is_spec(const std::string& path) { return fs::path(path).extension() == ".toml"; }
+
+// A name of letters, digits, '-', '_' and '.', not starting with '.': a folder's name too.
+bool good_name(const std::string& n) {
+  if (n.empty() || n.size() > 64 || n[0] == '.') return false;
+  return std::all_of(n.begin(), n.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' ||
+           c == '.';
+  });
+}
+
+Set make_set(const std::string& name, const std::string& source, const std::string& flag) {
+  Set s{.name = name, .source = source, .spec = nullptr, .table = {}};
+  if (source.empty()) throw InputError(flag + ": " + name + ": no data set given");
+  if (is_spec(source)) {
+    // Read now: a bad spec stops the command before anything is made.
+    s.spec = std::make_unique<RunSpec>();
+    read_spec_file(source, *s.spec);
+    s.spec->what = "features";
+    s.spec->formats = {"arff"};
+    s.spec->validate();
+  } else {
+    std::error_code ec;
+    if (!fs::exists(source, ec)) throw InputError(flag + ": " + source + ": no such file or folder");
+  }
+  return s;
+}
+
+std::string percent(double fraction) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.1f", 100 * fraction);
+  return b;
+}
+
+int run_transfer(const Options& o) {
+  // Every argument is checked before anything is written or run.
+  std::vector<const Classifier*> chosen;
+  for (const std::string& c : split_commas(o.classifiers)) {
+    const auto it = std::find_if(std::begin(kClassifiers), std::end(kClassifiers),
+                                 [&](const Classifier& k) { return lower(c) == k.key; });
+    if (it == std::end(kClassifiers))
+      throw InputError("--classifiers: unknown classifier '" + c + "' (j48, svm or mlp)");
+    if (std::find(chosen.begin(), chosen.end(), &*it) == chosen.end()) chosen.push_back(&*it);
+  }
+  if (chosen.empty()) throw InputError("--classifiers: none given (j48, svm or mlp)");
+  std::vector<Set> sets;
+  sets.push_back(make_set("train", o.train, "--train"));
+  std::set<std::string> names{"train"};
+  for (const std::string& t : o.tests) {
+    const size_t eq = t.find('=');
+    if (eq == std::string::npos) throw InputError("--test: '" + t + "' is not NAME=SET");
+    const std::string name = t.substr(0, eq);
+    if (!good_name(name))
+      throw InputError("--test: '" + name + "' is not a name (letters, digits, '-', '_', '.'; at most 64)");
+    if (!names.insert(name).second) throw InputError("--test: the name '" + name + "' is given twice");
+    sets.push_back(make_set(name, t.substr(eq + 1), "--test"));
+  }
+  if (sets.size() < 2) throw InputError("--test: at least one test set is needed (NAME=SET)");
+  std::string why;
+  if (!fs::exists("/usr/share/java/weka.jar"))
+    throw EnvironmentError("/usr/share/java/weka.jar not found (apt-get install weka)");
+
+  const WorkDir scratch;
+  StagedFolder folder(o.out);
+  // The specs' sets, made here and kept under sets/.
+  const bool any_spec = std::any_of(sets.begin(), sets.end(), [](const Set& s) { return s.spec != nullptr; });
+  if (any_spec) {
+    const std::string made = folder.path("sets");
+    fs::create_directories(made);
+    CommonOptions co;
+    co.catalogue = o.catalogue;
+    Session session;
+    open_catalogue(session, co);
+    for (const Set& s : sets)
+      if (s.spec) validate(s.spec->settings(), session.catalogue);
+    open_backend(session, co);
+    PipelineOptions popt;
+    popt.progress = false;
+    for (Set& s : sets) {
+      if (!s.spec) continue;
+      const std::string dir = (fs::path(made) / s.name).string();
+      run_pipeline(*s.spec, session.catalogue, session.assets, *session.backend, dir, popt);
+      std::fprintf(stderr, "transfer: %s: %llu scenarios from %s\n", s.name.c_str(),
+                   static_cast<unsigned long long>(s.spec->count), s.source.c_str());
+      s.table = read_arff((fs::path(dir) / "features.arff").string());
+      s.table.path = (fs::path(o.out) / "sets" / s.name / "features.arff").string();
+    }
+  }
+  for (Set& s : sets)
+    if (!s.spec) s.table = load_table(s.source, scratch.path, s.name, o.block, o.catalogue);
+  std::set<std::string> classes;
+  for (const Set& s : sets) {
+    check_same_attributes(sets[0].table, s.table);
+    if (s.table.rows.empty()) throw InputError(s.table.path + ": no instances");
+    classes.insert(s.table.classes.begin(), s.table.classes.end());
+  }
+  if (sets[0].table.classes.size() < 2) throw InputError(sets[0].table.path + ": the training set has a single class");
+  std::vector<std::string> arff;
+  for (const Set& s : sets) {
+    arff.push_back((fs::path(scratch.path) / (s.name + ".arff")).string());
+    write_arff(s.table, classes, arff.back());
+  }
+
+  // Scores: per classifier, per test set, correct of n.
+  nlohmann::json report = {{"train", {{"source", sets[0].source}, {"instances", sets[0].table.rows.size()}}},
+                           {"attributes", sets[0].table.names.size() - 1},
+                           {"reference", sets[1].name},
+                           {"max_loss_points", o.max_loss},
+                           {"interval", "95%: Wilson (accuracy), Newcombe's hybrid score (loss)"}};
+  std::vector<std::vector<long>> correct(chosen.size(), std::vector<long>(sets.size(), 0));
+  for (size_t c = 0; c < chosen.size(); ++c)
+    for (size_t k = 1; k < sets.size(); ++k) {
+      const auto s = weka_score(chosen[c]->weka_class, arff[0], arff[k], 0, 1, why);
+      if (!s) throw EnvironmentError(std::string("WEKA ") + chosen[c]->name + ": " + why);
+      const long n = static_cast<long>(sets[k].table.rows.size());
+      correct[c][k] = n - s->misclassified;
+      std::fprintf(stderr, "transfer: %s on %s: %s%%\n", chosen[c]->name, sets[k].name.c_str(),
+                   percent(double(correct[c][k]) / n).c_str());
+    }
+
+  std::ostringstream md;
+  md << "# portalsim transfer\n\nTrained on `" << sets[0].source << "` (" << sets[0].table.rows.size() << " instances, "
+     << sets[0].table.names.size() - 1
+     << " attributes), tested on each set below. Accuracy in percent with Wilson's 95% interval; loss: `"
+     << sets[1].name
+     << "`'s accuracy minus the set's, in points, with the 95% interval of a difference of two independent "
+        "proportions (Newcombe's hybrid score).\n\n| test set | instances |";
+  for (const Classifier* c : chosen) md << " " << c->name << " | " << c->name << " loss |";
+  md << "\n| --- | --- |";
+  for (size_t c = 0; c < chosen.size(); ++c) md << " --- | --- |";
+  md << "\n";
+  for (size_t k = 1; k < sets.size(); ++k) {
+    const long n = static_cast<long>(sets[k].table.rows.size()), n0 = static_cast<long>(sets[1].table.rows.size());
+    nlohmann::json row = {{"name", sets[k].name}, {"source", sets[k].source}, {"instances", n}};
+    md << "| " << sets[k].name << " | " << n << " |";
+    for (size_t c = 0; c < chosen.size(); ++c) {
+      const Interval a = wilson(correct[c][k], n);
+      nlohmann::json score = {{"correct", correct[c][k]},
+                              {"percent_correct", 100.0 * correct[c][k] / n},
+                              {"interval", {100 * a.lo, 100 * a.hi}}};
+      md << " " << percent(double(correct[c][k]) / n) << " [" << percent(a.lo) << ", " << percent(a.hi) << "] |";
+      if (k == 1) {
+        md << " |";
+      } else {
+        const Interval d = newcombe_difference(correct[c][1], n0, correct[c][k], n);
+        const double loss = double(correct[c][1]) / n0 - double(correct[c][k]) / n;
+        score["loss_points"] = {{"value", 100 * loss}, {"interval", {100 * d.lo, 100 * d.hi}}};
+        md << " " << percent(loss) << " [" << percent(d.lo) << ", " << percent(d.hi) << "] |";
+      }
+      row["scores"][chosen[c]->name] = score;
+    }
+    md << "\n";
+    report["tests"].push_back(row);
+  }
+  // The verdict: whether each classifier loses at most max_loss points on every other set.
+  md << "\nHolds (loses at most " << o.max_loss << " points against `" << sets[1].name << "` on every other set):";
+  for (size_t c = 0; c < chosen.size(); ++c) {
+    std::string worst;
+    double worst_loss = -1e9;
+    for (size_t k = 2; k < sets.size(); ++k) {
+      const double loss = 100.0 * (double(correct[c][1]) / double(sets[1].table.rows.size()) -
+                                   double(correct[c][k]) / double(sets[k].table.rows.size()));
+      if (loss > worst_loss) worst_loss = loss, worst = sets[k].name;
+    }
+    const bool holds = sets.size() < 3 || worst_loss <= o.max_loss;
+    report["holds"][chosen[c]->name] = holds;
+    md << " " << chosen[c]->name << ": " << (holds ? "yes" : "no");
+    if (sets.size() >= 3) md << " (largest loss " << percent(worst_loss / 100) << " points, `" << worst << "`)";
+    md << (c + 1 < chosen.size() ? ";" : ".\n");
+  }
+  write_text_atomic(folder.path("report.md"), md.str());
+  write_text_atomic(folder.path("report.json"), report.dump(2) + "\n");
+  folder.commit();
+  std::printf("%s", md.str().c_str());
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> add_transfer(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand(
+      "transfer", "Train on one data set, test on others: accuracy and loss against the first, with intervals");
+  cmd->add_option("--train", o->train,
+                  "Training set: a run spec (.toml, generated under OUT/sets/train), a feature table (ARFF, CSV, "
+                  "data.h5) or a folder of scenario folders")
+      ->required();
+  cmd->add_option("--test", o->tests,
+                  "NAME=SET, repeated: the sets to test on, the first the in-domain one the others' loss is "
+                  "measured against")
+      ->required();
+  cmd->add_option("--out", o->out, "Folder for report.md, report.json and the specs' sets")->required();
+  cmd->add_option("--classifiers", o->classifiers, "Comma-separated: j48, svm, mlp (default j48,svm)");
+  cmd->add_option("--catalogue", o->catalogue, "Catalogue TOML for the specs and folders (default: built-in)");
+  cmd->add_option("--block", o->block, "Block side for folders turned into tables (default 10)")
+      ->check(CLI::Range(1, 65536));
+  cmd->add_option("--max-loss", o->max_loss, "Points a classifier may lose and still hold (default 3)")
+      ->check(CLI::Range(0.0, 100.0));
+  return [o]() { return run_transfer(*o); };
+}
+
+}  // namespace portalsim::cli

@@ -1,0 +1,142 @@
+// `portalsim transfer` as a user meets it: the intervals against Newcombe's published
+// examples, a test set that moved losing what the in-domain one keeps, specs generated into
+// the output folder, and bad arguments refused before anything is written.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+
+#include "cli/validate_stats.h"
+#include "run_binary.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using portalsim::test::finish;
+using portalsim::test::slurp;
+using portalsim::test::spit;
+using portalsim::test::start;
+
+// Two attributes; `a` separates the classes: guns near `gun_at`, the rest near 0.
+std::string table(int n, unsigned seed, double gun_at, const std::string& second = "b") {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0, 0.4);
+  std::ostringstream s;
+  s << "@relation t\n@attribute a numeric\n@attribute " << second << " numeric\n@attribute class {gun,none}\n@data\n";
+  for (int i = 0; i < n; ++i) {
+    const bool gun = i % 2;
+    s << (gun ? gun_at : 0.0) + noise(rng) << "," << noise(rng) << "," << (gun ? "gun" : "none") << "\n";
+  }
+  return s.str();
+}
+
+portalsim::test::Result transfer(const portalsim::test::TempDir& t, std::vector<std::string> args) {
+  args.insert(args.begin(), "transfer");
+  return finish(start(t.cap(), args), 600);
+}
+
+// Newcombe (1998), Statistics in Medicine 17: the single proportion 81/263, Wilson's score
+// interval (method 3, Table I) 0.2553 to 0.3662; the difference 56/70 - 48/80, hybrid score
+// interval (method 10, Table II) 0.0524 to 0.3339. Four decimals as published.
+TEST(Transfer, IntervalsAreNewcombesPublishedOnes) {
+  const portalsim::cli::Interval w = portalsim::cli::wilson(81, 263);
+  EXPECT_NEAR(w.lo, 0.2553, 5e-5);
+  EXPECT_NEAR(w.hi, 0.3662, 5e-5);
+  const portalsim::cli::Interval d = portalsim::cli::newcombe_difference(56, 70, 48, 80);
+  EXPECT_NEAR(d.lo, 0.0524, 5e-5);
+  EXPECT_NEAR(d.hi, 0.3339, 5e-5);
+  // All correct: the interval reaches 1 and stays below it at its lower end.
+  EXPECT_NEAR(portalsim::cli::wilson(50, 50).hi, 1.0, 1e-12);
+  EXPECT_LT(portalsim::cli::wilson(50, 50).lo, 1.0);
+}
+
+// Trained where guns sit at a = 2: the in-domain set (another draw) keeps its accuracy, a
+// set whose guns moved to a = -2 loses about half of it, and the report says it does not hold.
+TEST(Transfer, AMovedTestSetLosesWhatTheInDomainOneKeeps) {
+  const portalsim::test::TempDir t;
+  const fs::path d = t.w();
+  spit(d / "train.arff", table(300, 1, 2.0));
+  spit(d / "in.arff", table(300, 2, 2.0));
+  spit(d / "moved.arff", table(300, 3, -2.0));
+  const auto r =
+      transfer(t, {"--train", (d / "train.arff").string(), "--test", "in=" + (d / "in.arff").string(), "--test",
+                   "moved=" + (d / "moved.arff").string(), "--classifiers", "j48", "--out", (d / "out").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  ASSERT_EQ(j["tests"].size(), 2u);
+  const auto& in = j["tests"][0]["scores"]["J48"];
+  const auto& moved = j["tests"][1]["scores"]["J48"];
+  EXPECT_GT(in["percent_correct"].get<double>(), 95.0);
+  EXPECT_LT(moved["percent_correct"].get<double>(), 60.0);
+  for (const auto* s : {&in, &moved}) {
+    const double p = (*s)["percent_correct"].get<double>();
+    EXPECT_DOUBLE_EQ(p, 100.0 * (*s)["correct"].get<double>() / 300);
+    EXPECT_LE((*s)["interval"][0].get<double>(), p);
+    EXPECT_GE((*s)["interval"][1].get<double>(), p);
+  }
+  const double loss = moved["loss_points"]["value"].get<double>();
+  EXPECT_DOUBLE_EQ(loss, in["percent_correct"].get<double>() - moved["percent_correct"].get<double>());
+  EXPECT_GT(moved["loss_points"]["interval"][0].get<double>(), 30.0);
+  EXPECT_FALSE(j["holds"]["J48"].get<bool>());
+  EXPECT_NE(r.out.find("| moved | 300 |"), std::string::npos) << r.out;
+  // Tested on another draw of its own distribution only, it holds.
+  const auto same =
+      transfer(t, {"--train", (d / "train.arff").string(), "--test", "in=" + (d / "in.arff").string(), "--test",
+                   "again=" + (d / "train.arff").string(), "--classifiers", "j48", "--out", (d / "out2").string()});
+  ASSERT_EQ(same.status, 0) << same.err;
+  EXPECT_TRUE(nlohmann::json::parse(slurp(d / "out2" / "report.json"))["holds"]["J48"].get<bool>());
+}
+
+// Specs are generated into OUT/sets/NAME/ with their own counts, and scored.
+TEST(Transfer, SpecsAreGeneratedIntoTheOutputFolder) {
+  const portalsim::test::TempDir t;
+  const fs::path d = t.w();
+  const std::string common = "rule = \"gun\"\nbalance = true\nwhat = \"features\"\n";
+  spit(d / "train.toml", "count = 80\nseed = 1\n" + common);
+  spit(d / "test.toml", "count = 40\nseed = 2\n" + common + "pixel_noise = 3\n");
+  const auto r = transfer(t, {"--train", (d / "train.toml").string(), "--test", "in=" + (d / "test.toml").string(),
+                              "--classifiers", "j48", "--out", (d / "out").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const auto& [name, rows] : {std::pair{"train", 80}, {"in", 40}}) {
+    const std::string arff = slurp(d / "out" / "sets" / name / "features.arff");
+    const size_t data = arff.find("@data\n");
+    ASSERT_NE(data, std::string::npos) << name;
+    EXPECT_EQ(std::count(arff.begin() + static_cast<long>(data) + 6, arff.end(), '\n'), rows) << name;
+  }
+  const nlohmann::json j = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  EXPECT_EQ(j["train"]["instances"].get<int>(), 80);
+  EXPECT_EQ(j["tests"][0]["instances"].get<int>(), 40);
+}
+
+TEST(Transfer, BadArgumentsAreRefusedBeforeAnythingIsWritten) {
+  const portalsim::test::TempDir t;
+  const fs::path d = t.w();
+  spit(d / "train.arff", table(40, 1, 2.0));
+  spit(d / "other.arff", table(40, 2, 2.0, "c"));
+  spit(d / "bad.toml", "count = 50\nseed = \"x\"\n");
+  const std::string train = (d / "train.arff").string(), ok = "in=" + train;
+  struct Case {
+    std::vector<std::string> args;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {{"--test", train}, "--test: '" + train + "' is not NAME=SET"},
+      {{"--test", "../x=" + train}, "is not a name"},
+      {{"--test", ok, "--test", ok}, "the name 'in' is given twice"},
+      {{"--test", "in=" + (d / "none.arff").string()}, "no such file or folder"},
+      {{"--test", ok, "--classifiers", "j48,forest"}, "--classifiers: unknown classifier 'forest'"},
+      {{"--test", "in=" + (d / "bad.toml").string()}, "bad.toml:2"},
+      {{"--test", "in=" + (d / "other.arff").string()}, "other.arff:3: attribute 'c' differs"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"--train", train, "--out", (d / "out").string()};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const auto r = transfer(t, args);
+    EXPECT_NE(r.status, 0) << c.says;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(d / "out")) << c.says;
+  }
+}
+
+}  // namespace
