@@ -331,10 +331,16 @@ kernel void features_sparse(global const uchar* restrict atlas, global const int
 // N(0, sigma^2 / c), clipped to the pixel range. Rounding and clipping of single pixels
 // are not modelled; tradeoff measures what that costs. One work-item per scenario.
 kernel void analytic_noise(global float* features, global const int4* rects, global const int4* grids, uint n,
-                           int block, int npooled, int row_len, float sigma, uint2 seed, uint2 first) {
+                           int block, int npooled, int row_len, float sigma_lo, float sigma_hi, uint2 seed,
+                           uint2 first) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const ulong index = upsample(first.y, first.x) + i;
+  // The scenario's sigma: the knob's, or its draw (kernels/sensor_noise.cl).
+  const float sigma = sigma_hi <= sigma_lo ? sigma_lo
+                                           : sigma_lo + (sigma_hi - sigma_lo) *
+                                                            uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW,
+                                                                           PS_DRAWN_PIXEL_NOISE).x);
   // grids: per pooled view (width, height, blocks across, first column); the regions follow.
   const int4 last = grids[npooled - 1];
   const int block_features = last.w + last.z * ((last.y + block - 1) / block);

@@ -260,9 +260,18 @@ inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {
   return gauss_pair_of(seed, index, PS_STREAM_PIXEL_NOISE, view, pair);
 }
 
+// Scenario index's pixel noise sigma (the knob pixel_noise; host: pixel_noise_at): sigma, or
+// where drawn per scenario (sigma_hi above it), sigma + (sigma_hi - sigma) uniform24(word 0)
+// of PS_STREAM_KNOB_DRAW, element PS_DRAWN_PIXEL_NOISE.
+inline param pixel_sigma_of(param lo, param hi, uint2 seed, ulong index) {
+  if (hi <= lo) return lo;
+  return lo + (hi - lo) * (param)uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_PIXEL_NOISE).x);
+}
+
 kernel void stage_sensor_noise(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;
   if (!(L.flags & PS_FLAG_PIXEL_NOISE)) return;
+  sigma = pixel_sigma_of(sigma, sigma_hi, seed, index);
   const int p0 = y * L.width;
 #if defined(NOISE_DRAW_IH)
   for (int x = 0; x < L.width; ++x)

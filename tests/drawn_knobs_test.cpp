@@ -335,6 +335,128 @@ TEST(DrawnKnobs, IlluminationAndWornTimeDrawnPerScenarioAreTheReferencesOnEveryP
   }
 }
 
+// The thesis model's pixel noise drawn per scenario (pixel_noise_at): the kernels' images
+// are the reference's within the thesis tolerance table's, in every tier, on the fused
+// render and the chain of stage kernels; the block-mean features scale their noise by the
+// scenario's sigma (the same draws: a scenario's noise is its sigma times sigma 1's).
+TEST(DrawnKnobs, PixelNoiseDrawnPerScenarioIsTheReferencesOnEveryPath) {
+  std::vector<Scenario> scenes;
+  for (size_t k = 0; k < 40; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
+  const SceneBatch batch = test::batch_of(scenes, 1300);
+  auto ref = make_reference_backend(catalogue(), assets());
+  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  const auto plan_of = [](const std::string& sigma, bool fused, Tier tier) {
+    Plan plan;
+    plan.model.seed = 53;
+    plan.fidelity = tier_fidelity(tier);
+    plan.fidelity.fused = fused;
+    set_knob(plan, *find_knob("pixel_noise"), sigma, "--pixel-noise");
+    return plan;
+  };
+  const size_t upper = static_cast<size_t>(catalogue().sensor_index("upper"));
+  for (Tier tier : {Tier::standard, Tier::exact, Tier::fast})
+    for (bool fused : {true, false}) {
+      SCOPED_TRACE(std::string(tier_name(tier)) + (fused ? " fused" : " stage chain"));
+      const Plan drawn = plan_of("0..6", fused, tier);
+      BatchOutput r, k;
+      ref->run(batch, drawn, r);
+      ocl->run(batch, drawn, k);
+      EXPECT_EQ(check_tolerance(compare_outputs(k, r), model_tolerance(Model::thesis, tier)), "");
+      // A range of one value is that value, to the byte.
+      BatchOutput one, fixed;
+      ocl->run(batch, plan_of("2.5..2.5", fused, tier), one);
+      ocl->run(batch, plan_of("2.5", fused, tier), fixed);
+      for (size_t v = 0; v < one.views.size(); ++v) EXPECT_EQ(one.views[v].pixels, fixed.views[v].pixels) << v;
+      // Each scenario's image is as noisy as its draw.
+      BatchOutput quiet;
+      ocl->run(batch, plan_of("0", fused, tier), quiet);
+      double low = 0, high = 0;
+      int nl = 0, nh = 0;
+      for (size_t i = 0; i < batch.size(); ++i) {
+        const double ms = mean_square_difference(k.views[upper], quiet.views[upper], i);
+        const double sigma = pixel_noise_at(drawn.model, batch.first_index + i);
+        if (sigma < 1.5) low += ms, ++nl;
+        if (sigma > 4.5) high += ms, ++nh;
+      }
+      ASSERT_GT(nl, 0);
+      ASSERT_GT(nh, 0);
+      EXPECT_GT(high / nh, 4 * (low / nl));
+    }
+  // Features only under the block-mean model: each feature's noise is sigma times sigma 1's,
+  // within 0.01 gray levels (fp32 features near 128 and one multiply; the smallest drawn
+  // noise's sd is over 100 times that), where nothing clips.
+  const auto features_of = [&](const std::string& sigma) {
+    Plan plan = plan_of(sigma, true, Tier::fast);
+    plan.images = 0;
+    plan.metal = false;
+    return plan;
+  };
+  const Plan d_plan = features_of("0.5..6");
+  ASSERT_FALSE(d_plan.pixel_noise_per_pixel());
+  BatchOutput d, unit, quiet;
+  ocl->run(batch, d_plan, d);
+  ocl->run(batch, features_of("1"), unit);
+  ocl->run(batch, features_of("0"), quiet);
+  const size_t row = d.layout.image_features();
+  size_t checked = 0, off = 0;
+  for (size_t i = 0; i < batch.size(); ++i) {
+    const double s = pixel_noise_at(d_plan.model, batch.first_index + i);
+    for (size_t c = 0; c < row; ++c) {
+      const size_t at = i * row + c;
+      const double q = quiet.features[at], u = unit.features[at], v = d.features[at];
+      if (q < 20 || q > 235 || u <= 0 || u >= 255 || v <= 0 || v >= 255) continue;
+      off += std::abs((v - q) - s * (u - q)) > 0.01;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1000u);
+  EXPECT_EQ(off, 0u);
+}
+
+// Every drawn knob at the ends of its bounds: a range of one value there is that value to
+// the byte, and the whole bounds drawn hold the kernels to the reference within the
+// tolerance table's (standard tier) on the model the knob acts in.
+TEST(DrawnKnobs, EachKnobAtTheEndsOfItsBoundsIsTheReferences) {
+  std::vector<Scenario> scenes;
+  for (size_t k = 0; k < 12; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
+  const SceneBatch batch = test::batch_of(scenes, 1500);
+  auto ref = make_reference_backend(catalogue(), assets());
+  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  size_t drawable = 0;
+  for (const Knob& knob : knobs()) {
+    if (knob.drawn < 0) continue;
+    ++drawable;
+    const Model model = knob.key == "pixel_noise" ? Model::thesis : Model::physics;
+    const auto plan_of = [&](const std::string& value) {
+      Plan plan = model == Model::physics ? test::physics_plan(59) : Plan{};
+      plan.model.seed = 59;
+      set_knob(plan, knob, value, "--" + knob.key);
+      return plan;
+    };
+    const auto text = [](double v) {
+      std::ostringstream o;
+      o << v;
+      return o.str();
+    };
+    const std::string lo = text(knob.min), hi = text(knob.max);
+    for (const std::string& end : {lo, hi}) {
+      SCOPED_TRACE(knob.key + " = " + end);
+      BatchOutput one, fixed;
+      ocl->run(batch, plan_of(end + ".." + end), one);
+      ocl->run(batch, plan_of(end), fixed);
+      for (size_t v = 0; v < one.views.size(); ++v) EXPECT_EQ(one.views[v].pixels, fixed.views[v].pixels) << v;
+      EXPECT_EQ(one.metal, fixed.metal);
+    }
+    SCOPED_TRACE(knob.key + " = " + lo + ".." + hi);
+    const Plan whole = plan_of(lo + ".." + hi);
+    BatchOutput r, k;
+    ref->run(batch, whole, r);
+    ocl->run(batch, whole, k);
+    EXPECT_EQ(check_tolerance(compare_outputs(k, r), model_tolerance(model, Tier::standard)), "");
+  }
+  EXPECT_EQ(drawable, size_t{PS_DRAWN_KNOBS});
+}
+
 std::vector<std::vector<std::string>> csv_rows(const fs::path& p) {
   std::ifstream in(p);
   std::vector<std::vector<std::string>> rows;

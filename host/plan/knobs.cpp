@@ -185,9 +185,11 @@ std::vector<Knob> declare() {
   k.push_back(on_off(
       "pattern_noise", "on", "the thesis's MMW noise patterns, one over each object (thesis 4.2)", false,
       [](Plan& p, double v) { p.model.pattern_noise = v != 0; }, [](const Plan& p) { return p.model.pattern_noise; }));
-  k.push_back(number(
-      "pixel_noise", "0", 0, 1000, "gray levels", "per-pixel Gaussian sensor noise sigma (MMW and IR)",
-      [](Plan& p, double v) { p.model.pixel_sigma = v; }, [](const Plan& p) { return p.model.pixel_sigma; }));
+  k.push_back(drawable(
+      number(
+          "pixel_noise", "0", 0, 1000, "gray levels", "per-pixel Gaussian sensor noise sigma (MMW and IR)",
+          [](Plan& p, double v) { p.model.pixel_sigma = v; }, [](const Plan& p) { return p.model.pixel_sigma; }),
+      PS_DRAWN_PIXEL_NOISE));
   k.push_back(drawable(
       integer(
           "metal_noise", "0", 0, 199, "counts", "metal detector noise: triangular integer noise of this half-width",

@@ -58,6 +58,10 @@ double illumination_at(const ModelSettings& m, uint64_t index) {
   return m.drawn[PS_DRAWN_ILLUMINATION].varies() ? drawn_real(m, PS_DRAWN_ILLUMINATION, index) : m.illumination;
 }
 
+double pixel_noise_at(const ModelSettings& m, uint64_t index) {
+  return m.drawn[PS_DRAWN_PIXEL_NOISE].varies() ? drawn_real(m, PS_DRAWN_PIXEL_NOISE, index) : m.pixel_sigma;
+}
+
 double worn_minutes_at(const ModelSettings& m, uint64_t index) {
   return m.drawn[PS_DRAWN_WORN_MINUTES].varies() ? drawn_real(m, PS_DRAWN_WORN_MINUTES, index) : m.worn_minutes;
 }
@@ -65,6 +69,7 @@ double worn_minutes_at(const ModelSettings& m, uint64_t index) {
 ModelSettings ModelSettings::at_scenario(uint64_t index) const {
   ModelSettings m = *this;
   m.metal_noise = metal_noise_at(*this, index);
+  m.pixel_sigma = pixel_noise_at(*this, index);
   m.ir_netd = ir_netd_at(*this, index);
   m.netd = netd_at(*this, index);
   m.frames = frames_at(*this, index);
@@ -80,6 +85,8 @@ double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index) {
       return metal_noise_at(m, index);
     case PS_DRAWN_IR_NETD:
       return ir_netd_at(m, index);
+    case PS_DRAWN_PIXEL_NOISE:
+      return pixel_noise_at(m, index);
     case PS_DRAWN_NETD:
       return netd_at(m, index);
     case PS_DRAWN_FRAMES:

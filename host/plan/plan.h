@@ -79,6 +79,10 @@ struct ModelSettings {
   // The knobs of scenario `index`: each drawn knob at its value there (its *_at), nothing
   // drawn. The CPU reference computes each scenario from these.
   ModelSettings at_scenario(uint64_t index) const;
+  // The pixel noise's highest sigma: the knob's, or its drawn range's upper end.
+  double pixel_sigma_hi() const {
+    return drawn[PS_DRAWN_PIXEL_NOISE].varies() ? drawn[PS_DRAWN_PIXEL_NOISE].hi : pixel_sigma;
+  }
   bool transforms() const { return rotate_lo != 0 || rotate_hi != 0 || scale_lo != 1 || scale_hi != 1 || flip; }
   bool moves_sprites() const { return bilinear || jitter > 0 || transforms(); }
 };
@@ -106,6 +110,9 @@ int frames_at(const ModelSettings& m, uint64_t index);
 // PS_DRAWN_ILLUMINATION and PS_DRAWN_WORN_MINUTES. kernels/radiometry.cl's scene_draw.
 double illumination_at(const ModelSettings& m, uint64_t index);
 double worn_minutes_at(const ModelSettings& m, uint64_t index);
+// Scenario `index`'s pixel noise sigma (the knob pixel_noise, gray levels), as ir_netd_at,
+// element PS_DRAWN_PIXEL_NOISE. kernels/sensor_noise.cl's pixel_sigma_of.
+double pixel_noise_at(const ModelSettings& m, uint64_t index);
 // Scenario `index`'s value of the drawn knob `element` (PS_DRAWN_*), as its *_at gives it.
 double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index);
 
@@ -167,7 +174,7 @@ struct Plan {
   bool renders(const Sensor& s, int view) const { return image(view) || (features && s.pooled); }
   // Per-pixel noise drawn pixel by pixel (otherwise none, or the block-mean model).
   bool pixel_noise_per_pixel() const {
-    return model.pixel_sigma > 0 && (images != 0 || fidelity.noise == NoiseModel::per_pixel);
+    return model.pixel_sigma_hi() > 0 && (images != 0 || fidelity.noise == NoiseModel::per_pixel);
   }
   // The MMW camera's frames as the kernels draw them: one each, or (block-mean noise model,
   // the fast tier) one draw of NETD / sqrt(frames).

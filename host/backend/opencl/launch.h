@@ -70,6 +70,7 @@ inline void check_count(cl::Kernel& k, cl_uint given) {
   X(PsViewLaunch, L)           \
   X(Real, alpha)               \
   X(Real, sigma)               \
+  X(Real, sigma_hi)            \
   X(cl::Buffer, records)       \
   X(cl::Buffer, field)         \
   X(cl::Buffer, out)           \
@@ -239,7 +240,8 @@ PS_KERNEL_ARGS(FeaturesSparseArgs, PS_FEATURES_SPARSE_ARGS)
   X(cl_int, block)                \
   X(cl_int, npooled)              \
   X(cl_int, row_len)              \
-  X(cl_float, sigma)              \
+  X(cl_float, sigma_lo)           \
+  X(cl_float, sigma_hi)           \
   X(cl_uint2, seed)               \
   X(cl_uint2, first)
 PS_KERNEL_ARGS(AnalyticNoiseArgs, PS_ANALYTIC_NOISE_ARGS)

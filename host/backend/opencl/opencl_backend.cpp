@@ -73,7 +73,7 @@ class OpenCLBackend final : public Backend {
     if (pooling)
       for (size_t slot = 0; slot < lay.pooled.size(); ++slot)
         pool_view(device_, K, lay, b, static_cast<int>(slot), rendered[lay.pooled[slot]], feats);
-    if (plan.features && plan.model.pixel_sigma > 0 && !plan.pixel_noise_per_pixel())
+    if (plan.features && plan.model.pixel_sigma_hi() > 0 && !plan.pixel_noise_per_pixel())
       block_mean_noise(device_, K, plan, b, feats);
     // The host's boxes and masks while PoCL's threads run what is queued (their outputs
     // are apart); the maps below wait for the kernels.

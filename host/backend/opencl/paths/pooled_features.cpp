@@ -56,7 +56,8 @@ void block_mean_noise(Device& d, Kernels& K, const Plan& plan, const DeviceBatch
                             .block = lay.block,
                             .npooled = static_cast<cl_int>(lay.pooled.size()),
                             .row_len = lay.image_features(),
-                            .sigma = static_cast<cl_float>(plan.model.pixel_sigma),
+                            .sigma_lo = static_cast<cl_float>(plan.model.pixel_sigma),
+                            .sigma_hi = static_cast<cl_float>(plan.model.pixel_sigma_hi()),
                             .seed = b.seed,
                             .first = b.first},
           b.n);
