@@ -18,6 +18,9 @@ namespace portalsim {
 namespace {
 
 namespace fs = std::filesystem;
+// The image tests' scenarios; under the sanitizers (support.h, kSanitized), whose fp64
+// reference loops run several times slower, a quarter of them.
+constexpr size_t kScenes = test::kSanitized ? 10 : 40;
 using test::assets;
 using test::catalogue;
 
@@ -87,7 +90,7 @@ double mean_square_difference(const ViewImages& a, const ViewImages& b, size_t i
 // fused path and the chain of stage kernels; a scenario's noise is its own draw's.
 TEST(DrawnKnobs, IrNetdDrawnPerScenarioIsTheReferencesOnEveryPath) {
   std::vector<Scenario> scenes;
-  for (size_t k = 0; k < 40; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
+  for (size_t k = 0; k < kScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
   const SceneBatch batch = test::batch_of(scenes, 300);
   auto ref = make_reference_backend(catalogue(), assets());
   auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
@@ -145,7 +148,7 @@ TEST(DrawnKnobs, IrNetdDrawnPerScenarioIsTheReferencesOnEveryPath) {
 // every tier (the fast tier's frames as one draw, Irwin-Hall), fused and as the chain of
 // stage kernels; each scenario's noise is its own draw's.
 TEST(DrawnKnobs, MmwNetdAndFramesDrawnPerScenarioAreTheReferencesOnEveryPath) {
-  std::vector<Scenario> scenes;
+  std::vector<Scenario> scenes;  // all 40 under the sanitizers too: both noise groups need members
   for (size_t k = 0; k < 40; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
   const SceneBatch batch = test::batch_of(scenes, 700);
   auto ref = make_reference_backend(catalogue(), assets());
@@ -260,7 +263,7 @@ TEST(DrawnKnobs, MmwNetdAndFramesDrawnPerScenarioScaleTheFeatureNoise) {
 // (it leaves its tables for the raw grid then); each scenario shows its own draw.
 TEST(DrawnKnobs, IlluminationAndWornTimeDrawnPerScenarioAreTheReferencesOnEveryPath) {
   std::vector<Scenario> scenes;
-  for (size_t k = 0; k < 40; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
+  for (size_t k = 0; k < kScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
   const SceneBatch batch = test::batch_of(scenes, 1100);
   auto ref = make_reference_backend(catalogue(), assets());
   auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
@@ -341,7 +344,7 @@ TEST(DrawnKnobs, IlluminationAndWornTimeDrawnPerScenarioAreTheReferencesOnEveryP
 // scenario's sigma (the same draws: a scenario's noise is its sigma times sigma 1's).
 TEST(DrawnKnobs, PixelNoiseDrawnPerScenarioIsTheReferencesOnEveryPath) {
   std::vector<Scenario> scenes;
-  for (size_t k = 0; k < 40; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
+  for (size_t k = 0; k < kScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
   const SceneBatch batch = test::batch_of(scenes, 1300);
   auto ref = make_reference_backend(catalogue(), assets());
   auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
