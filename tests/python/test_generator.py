@@ -16,6 +16,9 @@ CASES = {
     "physics-annotations": dict(what="images", model="physics", annotations=True, objects="2..3"),
     # A knob drawn per scenario: its draws are the batch's param_metal_noise.
     "drawn-metal-noise": dict(what="features", metal_noise="0..9"),
+    # The physics camera and scene drawn per scenario: images, features and each param_<knob>.
+    "drawn-camera": dict(what="both", model="physics", netd="1..4", frames="1..8", illumination="285..305",
+                         worn_minutes="0..60", ir_netd="0.03..0.1"),
     "spec-file": dict(spec="scenarios/case1-gun.toml", what="both", seed=5),
     # 20 regions, 33 zones, front and back MMW and IR views (tools/portal_catalogues.py).
     "portal-20x33": dict(catalogue="tests/portals/portal-20x33.toml", what="images", annotations=True,
