@@ -340,8 +340,9 @@ TEST(DrawnKnobs, IlluminationAndWornTimeDrawnPerScenarioAreTheReferencesOnEveryP
 
 // The thesis model's pixel noise drawn per scenario (pixel_noise_at): the kernels' images
 // are the reference's within the thesis tolerance table's, in every tier, on the fused
-// render and the chain of stage kernels; the block-mean features scale their noise by the
-// scenario's sigma (the same draws: a scenario's noise is its sigma times sigma 1's).
+// render and the chain of stage kernels, and so are the features-only path's features under
+// the per-pixel noise model; the block-mean features scale their noise by the scenario's
+// sigma (the same draws: a scenario's noise is its sigma times sigma 1's).
 TEST(DrawnKnobs, PixelNoiseDrawnPerScenarioIsTheReferencesOnEveryPath) {
   std::vector<Scenario> scenes;
   for (size_t k = 0; k < kScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
@@ -385,6 +386,21 @@ TEST(DrawnKnobs, PixelNoiseDrawnPerScenarioIsTheReferencesOnEveryPath) {
       ASSERT_GT(nh, 0);
       EXPECT_GT(high / nh, 4 * (low / nl));
     }
+  // Features only under the per-pixel noise model (fp32 and fp64): the kernels' features are
+  // the reference's (from its images) within the features-only bounds.
+  for (Tier tier : {Tier::standard, Tier::exact}) {
+    SCOPED_TRACE(std::string(tier_name(tier)) + " features only, per-pixel noise");
+    const Plan with_images = plan_of("0..6", true, tier);
+    Plan features = with_images;
+    features.images = 0;
+    ASSERT_TRUE(features.pixel_noise_per_pixel());
+    BatchOutput r, k;
+    ref->run(batch, with_images, r);
+    ocl->run(batch, features, k);
+    const OutputDiff d = compare_outputs(k, r);
+    ASSERT_TRUE(d.features_only);
+    EXPECT_EQ(check_tolerance(d, model_tolerance(Model::thesis, tier)), "");
+  }
   // Features only under the block-mean model: each feature's noise is sigma times sigma 1's,
   // within 0.01 gray levels (fp32 features near 128 and one multiply; the smallest drawn
   // noise's sd is over 100 times that), where nothing clips.

@@ -16,6 +16,8 @@ CASES = {
     "physics-annotations": dict(what="images", model="physics", annotations=True, objects="2..3"),
     # A knob drawn per scenario: its draws are the batch's param_metal_noise.
     "drawn-metal-noise": dict(what="features", metal_noise="0..9"),
+    # The thesis model's pixel noise drawn per scenario: images, features and param_pixel_noise.
+    "drawn-pixel-noise": dict(what="both", pixel_noise="0..4"),
     # The physics camera and scene drawn per scenario: images, features and each param_<knob>.
     "drawn-camera": dict(what="both", model="physics", netd="1..4", frames="1..8", illumination="285..305",
                          worn_minutes="0..60", ir_netd="0.03..0.1"),
