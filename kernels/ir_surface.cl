@@ -37,9 +37,7 @@ kernel void stage_ir_surface(VIEW_STAGE_ARGS) {
 // above PS_PHYS_NETD), NETD + (hi - NETD) uniform24(word 0) of PS_STREAM_KNOB_DRAW (host:
 // ir_netd_at).
 inline preal ir_netd_of(global const param* phys, uint2 seed, ulong index) {
-  const preal lo = (preal)phys[PS_PHYS_NETD], hi = (preal)phys[PS_PHYS_NETD_HI];
-  if (hi <= lo) return lo;
-  return lo + (hi - lo) * (preal)uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_IR_NETD).x);
+  return knob_draw((preal)phys[PS_PHYS_NETD], (preal)phys[PS_PHYS_NETD_HI], seed, index, PS_DRAWN_IR_NETD);
 }
 
 kernel void stage_ir_netd(VIEW_STAGE_ARGS) {

@@ -7,9 +7,7 @@
 // drawn per scenario (noise_hi > noise_lo), noise_lo + below(word 0, noise_hi - noise_lo + 1)
 // of PS_STREAM_KNOB_DRAW (host: metal_noise_at).
 inline int metal_noise_of(uint2 seed, ulong index, int noise_lo, int noise_hi) {
-  if (noise_hi <= noise_lo) return noise_lo;
-  return noise_lo + (int)below(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_METAL_NOISE).x,
-                               (uint)(noise_hi - noise_lo) + 1u);
+  return knob_draw(noise_lo, noise_hi, seed, index, PS_DRAWN_METAL_NOISE);
 }
 
 kernel void metal_zones(global const uchar* influence, global const uchar* variant_category,

@@ -12,11 +12,8 @@ inline uint frame_stream(int k) { return k == 0 ? PS_STREAM_RAW_NOISE : PS_STREA
 // the block-mean noise model (as_one) one of NETD / sqrt(frames).
 inline preal mmw_noise_drawn(preal lo, preal hi, int flo, int fhi, bool as_one, uint2 seed, ulong index,
                              int* frames) {
-  const preal netd =
-      hi > lo ? lo + (hi - lo) * (preal)uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_NETD).x) : lo;
-  const int f =
-      fhi > flo ? flo + (int)below(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_FRAMES).x, (uint)(fhi - flo) + 1u)
-                : flo;
+  const preal netd = knob_draw(lo, hi, seed, index, PS_DRAWN_NETD);
+  const int f = knob_draw(flo, fhi, seed, index, PS_DRAWN_FRAMES);
   *frames = as_one ? 1 : f;
   return as_one ? netd / sqrt((preal)f) : netd / (preal)f;
 }

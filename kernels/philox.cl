@@ -22,6 +22,22 @@ inline uint4 draw(uint2 seed, ulong index, uint stream, uint element) {
 inline float uniform24(uint r) { return (float)(r >> 8) * (1.0f / 16777216.0f); }
 inline uint below(uint r, uint n) { return mul_hi(r, n); }
 
+// A knob drawn per scenario (docs/model/drawn-knobs.md): element e of PS_STREAM_KNOB_DRAW,
+// lo + (hi - lo) uniform24(word 0) for a real knob (in the precision of lo and hi), or
+// lo + below(word 0, hi - lo + 1) for a whole one; lo where the range is one value.
+inline float __attribute__((overloadable)) knob_draw(float lo, float hi, uint2 seed, ulong index, uint e) {
+  return hi > lo ? lo + (hi - lo) * uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, e).x) : lo;
+}
+#if defined(PRECISION_FP64)
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+inline double __attribute__((overloadable)) knob_draw(double lo, double hi, uint2 seed, ulong index, uint e) {
+  return hi > lo ? lo + (hi - lo) * (double)uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, e).x) : lo;
+}
+#endif
+inline int __attribute__((overloadable)) knob_draw(int lo, int hi, uint2 seed, ulong index, uint e) {
+  return hi > lo ? lo + (int)below(draw(seed, index, PS_STREAM_KNOB_DRAW, e).x, (uint)(hi - lo) + 1u) : lo;
+}
+
 // Box-Muller from two 24-bit uniforms; u1 is shifted into (0, 1] so log() is finite.
 inline float2 gauss2(uint r0, uint r1) {
   const float u1 = 1.0f - uniform24(r0);

@@ -337,10 +337,7 @@ kernel void analytic_noise(global float* features, global const int4* rects, glo
   if (i >= n) return;
   const ulong index = upsample(first.y, first.x) + i;
   // The scenario's sigma: the knob's, or its draw (kernels/sensor_noise.cl).
-  const float sigma = sigma_hi <= sigma_lo ? sigma_lo
-                                           : sigma_lo + (sigma_hi - sigma_lo) *
-                                                            uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW,
-                                                                           PS_DRAWN_PIXEL_NOISE).x);
+  const float sigma = knob_draw(sigma_lo, sigma_hi, seed, index, PS_DRAWN_PIXEL_NOISE);
   // grids: per pooled view (width, height, blocks across, first column); the regions follow.
   const int4 last = grids[npooled - 1];
   const int block_features = last.w + last.z * ((last.y + block - 1) / block);

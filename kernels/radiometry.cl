@@ -20,9 +20,7 @@ inline SceneDraw scene_draw(global const param* phys, uint2 seed, ulong index) {
   if (d.at == 0) return d;
   global const param* b = phys + d.at;
   if (b[0] != 0) d.t = (preal)uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_ILLUMINATION).x);
-  const preal lo = (preal)b[1], hi = (preal)b[2];
-  d.w = hi > lo ? lo + (hi - lo) * (preal)uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_WORN_MINUTES).x)
-                : lo;
+  d.w = knob_draw((preal)b[1], (preal)b[2], seed, index, PS_DRAWN_WORN_MINUTES);
   return d;
 }
 

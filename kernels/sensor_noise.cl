@@ -264,8 +264,7 @@ inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {
 // where drawn per scenario (sigma_hi above it), sigma + (sigma_hi - sigma) uniform24(word 0)
 // of PS_STREAM_KNOB_DRAW, element PS_DRAWN_PIXEL_NOISE.
 inline param pixel_sigma_of(param lo, param hi, uint2 seed, ulong index) {
-  if (hi <= lo) return lo;
-  return lo + (hi - lo) * (param)uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_PIXEL_NOISE).x);
+  return knob_draw(lo, hi, seed, index, PS_DRAWN_PIXEL_NOISE);
 }
 
 kernel void stage_sensor_noise(VIEW_STAGE_ARGS) {

@@ -20,23 +20,25 @@ ObjectTransform object_transform(const ModelSettings& m, uint64_t index, int reg
   return t;
 }
 
-int metal_noise_at(const ModelSettings& m, uint64_t index) {
-  const DrawnRange& d = m.drawn[PS_DRAWN_METAL_NOISE];
-  if (!d.varies()) return m.metal_noise;
-  const int lo = static_cast<int>(d.lo), span = static_cast<int>(d.hi) - lo + 1;
-  return lo + static_cast<int>(
-                  below(draw(m.seed, index, kStreamKnobDraw, PS_DRAWN_METAL_NOISE)[0], static_cast<uint32_t>(span)));
-}
-
 namespace {
 
-// Element e's real draw over [lo, hi]: lo + (hi - lo) uniform24(word 0).
+// Element e's draw over [lo, hi] (docs/model/drawn-knobs.md): lo + (hi - lo) uniform24(word 0)
+// for a real knob, lo + below(word 0, hi - lo + 1) for a whole one.
 double drawn_real(const ModelSettings& m, unsigned e, uint64_t index) {
   const DrawnRange& d = m.drawn[e];
   return d.lo + (d.hi - d.lo) * uniform24(draw(m.seed, index, kStreamKnobDraw, e)[0]);
 }
 
+int drawn_whole(const ModelSettings& m, unsigned e, uint64_t index) {
+  const int lo = static_cast<int>(m.drawn[e].lo), span = static_cast<int>(m.drawn[e].hi) - lo + 1;
+  return lo + static_cast<int>(below(draw(m.seed, index, kStreamKnobDraw, e)[0], static_cast<uint32_t>(span)));
+}
+
 }  // namespace
+
+int metal_noise_at(const ModelSettings& m, uint64_t index) {
+  return m.drawn[PS_DRAWN_METAL_NOISE].varies() ? drawn_whole(m, PS_DRAWN_METAL_NOISE, index) : m.metal_noise;
+}
 
 double ir_netd_at(const ModelSettings& m, uint64_t index) {
   return m.drawn[PS_DRAWN_IR_NETD].varies() ? drawn_real(m, PS_DRAWN_IR_NETD, index) : m.ir_netd;
@@ -47,11 +49,7 @@ double netd_at(const ModelSettings& m, uint64_t index) {
 }
 
 int frames_at(const ModelSettings& m, uint64_t index) {
-  const DrawnRange& d = m.drawn[PS_DRAWN_FRAMES];
-  if (!d.varies()) return m.frames;
-  const int lo = static_cast<int>(d.lo), span = static_cast<int>(d.hi) - lo + 1;
-  return lo +
-         static_cast<int>(below(draw(m.seed, index, kStreamKnobDraw, PS_DRAWN_FRAMES)[0], static_cast<uint32_t>(span)));
+  return m.drawn[PS_DRAWN_FRAMES].varies() ? drawn_whole(m, PS_DRAWN_FRAMES, index) : m.frames;
 }
 
 double illumination_at(const ModelSettings& m, uint64_t index) {

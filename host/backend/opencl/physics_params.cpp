@@ -177,11 +177,11 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   // Each subject's bare raw grid: wy . T . wx^T over its base image in kelvin at the
   // subject's (gain, offset); with the scene block, also its change over the illumination's
   // range, the same sums at the change of (gain, offset).
-  const auto bare_grids = [&](const double* gains, size_t stride) {
+  const auto bare_grids = [&](const double* gains) {
     std::vector<double> bare(cat.subjects.size() * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
     for (size_t subj = 0; subj < cat.subjects.size(); ++subj) {
       const Image& base = assets.bases[subj][view];
-      const double gain = gains[stride * subj], offset = gains[stride * subj + 1];
+      const double gain = gains[2 * subj], offset = gains[2 * subj + 1];
       std::fill(rows.begin(), rows.end(), 0.0);
       for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
@@ -196,9 +196,9 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     }
     return bare;
   };
-  t.base = append(bare_grids(&p[PS_PHYS_SUBJECTS], 2));
+  t.base = append(bare_grids(&p[PS_PHYS_SUBJECTS]));
   if (scene_drawn) {
-    const std::vector<double> moved = bare_grids(&scene[PS_SCENE_SUBJECTS], 2);
+    const std::vector<double> moved = bare_grids(&scene[PS_SCENE_SUBJECTS]);
     scene.insert(scene.end(), moved.begin(), moved.end());
     p[PS_PHYS_SCENE] = append(scene);
   }
