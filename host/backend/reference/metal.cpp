@@ -6,7 +6,7 @@
 namespace portalsim::reference {
 
 void metal(const Catalogue& cat, const ModelSettings& m, const Scenario& s, uint64_t index, uint8_t* zones) {
-  const int noise = metal_noise_at(m, index);  // the knob's, or this scenario's draw
+  const int noise = m.metal_noise;
   for (int z = 0; z < cat.zones; ++z) {
     int sum = 0;
     for (int r = 0; r < cat.region_count(); ++r)

@@ -88,7 +88,7 @@ void metal_physics(const Catalogue& cat, const AssetSet& assets, const ModelSett
                    uint64_t index, uint8_t* zones) {
   const MetalPhysics& mp = cat.metal_physics;
   const std::vector<MetalObject> objects = metal_objects(cat, assets, m, s, index);
-  const int noise = metal_noise_at(m, index);  // the knob's, or this scenario's draw
+  const int noise = m.metal_noise;
   for (int z = 0; z < cat.zones; ++z) {
     double signal = 0;
     for (const MetalObject& o : objects) signal += zone_signal(mp, z, o);

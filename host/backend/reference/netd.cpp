@@ -26,16 +26,14 @@ void add_noise(const ViewScene& vs, Field& f, double sd, uint32_t stream) {
 // (frame 0 from the raw-noise stream, frame k from PS_STREAM_FRAME_NOISE + k).
 // The block-mean noise model (the fast tier) takes the mean of the frames' draws as one draw
 // of NETD / sqrt(frames) from frame 0's stream: the same normal distribution.
-// The NETD and the frames are the scenario's (netd_at, frames_at: drawn where given A..B).
 void netd(const ViewScene& vs, Field& f) {
-  const int n = frames_at(vs.model, vs.index);
-  const double netd = netd_at(vs.model, vs.index);
-  if (vs.frames_as_one) return add_noise(vs, f, netd / std::sqrt(double(n)), kStreamRawNoise);
+  const int n = vs.model.frames;
+  if (vs.frames_as_one) return add_noise(vs, f, vs.model.netd / std::sqrt(double(n)), kStreamRawNoise);
   for (int k = 0; k < n; ++k)
-    add_noise(vs, f, netd / n, k == 0 ? kStreamRawNoise : PS_STREAM_FRAME_NOISE + uint32_t(k));
+    add_noise(vs, f, vs.model.netd / n, k == 0 ? kStreamRawNoise : PS_STREAM_FRAME_NOISE + uint32_t(k));
 }
 
 // The IR camera's NETD, per view pixel.
-void ir_netd(const ViewScene& vs, Field& f) { add_noise(vs, f, ir_netd_at(vs.model, vs.index), kStreamIrNoise); }
+void ir_netd(const ViewScene& vs, Field& f) { add_noise(vs, f, vs.model.ir_netd, kStreamIrNoise); }
 
 }  // namespace portalsim::reference

@@ -54,9 +54,9 @@ class ReferenceBackend final : public Backend {
       }
       if (plan.features) reference::pool(cat_, images, out.layout, &out.features[i * out.layout.image_features()]);
       if (plan.metal && plan.model.model == Model::physics)
-        reference::metal_physics(cat_, assets_, plan.model, s, index, &out.metal[i * cat_.zones]);
+        reference::metal_physics(cat_, assets_, plan.model.at_scenario(index), s, index, &out.metal[i * cat_.zones]);
       else if (plan.metal)
-        reference::metal(cat_, plan.model, s, index, &out.metal[i * cat_.zones]);
+        reference::metal(cat_, plan.model.at_scenario(index), s, index, &out.metal[i * cat_.zones]);
     }
   }
 

@@ -51,7 +51,7 @@ SpriteMap sprite_map(const Placed& p, bool bilinear);
 struct ViewScene {
   const Catalogue& cat;
   const AssetSet& assets;
-  const ModelSettings& model;
+  const ModelSettings& model;  // the view's knobs of this scenario: drawn knobs at their draws
   const Sensor& sensor;
   int view;  // index in Catalogue::sensors
   const Scenario& scenario;
@@ -97,7 +97,8 @@ double psf_fwhm_pixels(const Catalogue& cat, const Sensor& view);   // the Airy 
 // displayed images of every camera view (empty where not rendered).
 void pool(const Catalogue& cat, const std::vector<std::vector<uint8_t>>& views, const FeatureLayout& layout,
           float* row);
-// Metal zones (thesis algorithm step 2): base minus every object's influence, clamped.
+// Metal zones (thesis algorithm step 2): base minus every object's influence, clamped. `m`
+// is the scenario's knobs (ModelSettings::at_scenario), as every stage's.
 void metal(const Catalogue& cat, const ModelSettings& m, const Scenario& s, uint64_t index, uint8_t* zones);
 
 // Metal zones under --model physics (metal_physics.cpp): base minus round(gain |sum of
