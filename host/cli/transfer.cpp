@@ -111,9 +111,7 @@ int run_transfer(const Options& o) {
     sets.push_back(make_set(name, t.substr(eq + 1), "--test"));
   }
   if (sets.size() < 2) throw InputError("--test: at least one test set is needed (NAME=SET)");
-  std::string why;
-  if (!fs::exists("/usr/share/java/weka.jar"))
-    throw EnvironmentError("/usr/share/java/weka.jar not found (apt-get install weka)");
+  if (const auto missing = weka_missing()) throw EnvironmentError("transfer: " + *missing);
 
   const WorkDir scratch;
   StagedFolder folder(o.out);
@@ -163,6 +161,7 @@ int run_transfer(const Options& o) {
                            {"max_loss_points", o.max_loss},
                            {"interval", "95%: Wilson (accuracy), Newcombe's hybrid score (loss)"}};
   std::vector<std::vector<long>> correct(chosen.size(), std::vector<long>(sets.size(), 0));
+  std::string why;
   for (size_t c = 0; c < chosen.size(); ++c)
     for (size_t k = 1; k < sets.size(); ++k) {
       const auto s = weka_score(chosen[c]->weka_class, arff[0], arff[k], 0, 1, why);
@@ -184,6 +183,8 @@ int run_transfer(const Options& o) {
   md << "\n| --- | --- |";
   for (size_t c = 0; c < chosen.size(); ++c) md << " --- | --- |";
   md << "\n";
+  // Each set's loss against the reference, in points (the second set on).
+  std::vector<std::vector<double>> loss(chosen.size(), std::vector<double>(sets.size(), 0));
   for (size_t k = 1; k < sets.size(); ++k) {
     const long n = static_cast<long>(sets[k].table.rows.size()), n0 = static_cast<long>(sets[1].table.rows.size());
     nlohmann::json row = {{"name", sets[k].name}, {"source", sets[k].source}, {"instances", n}};
@@ -198,9 +199,9 @@ int run_transfer(const Options& o) {
         md << " |";
       } else {
         const Interval d = newcombe_difference(correct[c][1], n0, correct[c][k], n);
-        const double loss = double(correct[c][1]) / n0 - double(correct[c][k]) / n;
-        score["loss_points"] = {{"value", 100 * loss}, {"interval", {100 * d.lo, 100 * d.hi}}};
-        md << " " << percent(loss) << " [" << percent(d.lo) << ", " << percent(d.hi) << "] |";
+        loss[c][k] = 100 * (double(correct[c][1]) / n0 - double(correct[c][k]) / n);
+        score["loss_points"] = {{"value", loss[c][k]}, {"interval", {100 * d.lo, 100 * d.hi}}};
+        md << " " << percent(loss[c][k] / 100) << " [" << percent(d.lo) << ", " << percent(d.hi) << "] |";
       }
       row["scores"][chosen[c]->name] = score;
     }
@@ -212,11 +213,8 @@ int run_transfer(const Options& o) {
   for (size_t c = 0; c < chosen.size(); ++c) {
     std::string worst;
     double worst_loss = -1e9;
-    for (size_t k = 2; k < sets.size(); ++k) {
-      const double loss = 100.0 * (double(correct[c][1]) / double(sets[1].table.rows.size()) -
-                                   double(correct[c][k]) / double(sets[k].table.rows.size()));
-      if (loss > worst_loss) worst_loss = loss, worst = sets[k].name;
-    }
+    for (size_t k = 2; k < sets.size(); ++k)
+      if (loss[c][k] > worst_loss) worst_loss = loss[c][k], worst = sets[k].name;
     const bool holds = sets.size() < 3 || worst_loss <= o.max_loss;
     report["holds"][chosen[c]->name] = holds;
     md << " " << chosen[c]->name << ": " << (holds ? "yes" : "no");

@@ -18,15 +18,19 @@ std::string quote(const std::string& s) {
 
 }  // namespace
 
+std::optional<std::string> weka_missing() {
+  if (!std::filesystem::exists("/usr/share/java/weka.jar"))
+    return "/usr/share/java/weka.jar not found (apt-get install weka)";
+  if (std::system("command -v java >/dev/null 2>&1") != 0)
+    return "java not found on PATH (apt-get install default-jre-headless)";
+  return std::nullopt;
+}
+
 std::optional<WekaScore> weka_score(const std::string& classifier, const std::string& train, const std::string& test,
                                     int folds, int seed, std::string& why) {
   const char* jar = "/usr/share/java/weka.jar";
-  if (!std::filesystem::exists(jar)) {
-    why = std::string(jar) + " not found (apt-get install weka)";
-    return std::nullopt;
-  }
-  if (std::system("command -v java >/dev/null 2>&1") != 0) {
-    why = "java not found on PATH (apt-get install default-jre-headless)";
+  if (const auto missing = weka_missing()) {
+    why = *missing;
     return std::nullopt;
   }
   std::string cmd = "java -Xmx4g -cp " + std::string(jar) + " " + classifier + " -o -t " + quote(train);

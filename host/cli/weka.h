@@ -10,6 +10,9 @@ namespace portalsim::cli {
 // WEKA fails.
 std::optional<double> j48_cv_accuracy(const std::string& arff, std::string& why);
 
+// Why WEKA cannot run here (weka.jar or java missing), or nothing when it can.
+std::optional<std::string> weka_missing();
+
 struct WekaScore {
   double correct_percent = 0;
   long misclassified = 0;
