@@ -75,6 +75,7 @@
 #define PS_STREAM_PIXEL_NOISE_FAST 10u /* per-pixel sensor noise, Irwin-Hall draws; PS_GAUSS_ELEMENT */
 #define PS_STREAM_METAL_MAP 11u        /* metal maps' detector noise (host only); element = zone */
 #define PS_STREAM_KNOB_DRAW 12u        /* knobs drawn per scenario (A..B); element = PS_DRAWN_* */
+#define PS_STREAM_BODIES 13u           /* random bodies (host only); index = body, element = draw */
 #define PS_STREAM_GENERATE 16u         /* scenario generators (host only) */
 /* The knobs a run may draw per scenario, each its element of PS_STREAM_KNOB_DRAW. */
 #define PS_DRAWN_METAL_NOISE 0u

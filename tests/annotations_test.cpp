@@ -290,7 +290,7 @@ TEST(Annotations, BoxesAndMasksAgreeWithHandComputedOnes) {
   ASSERT_GE(upper, 0);
   Sensor& view = cat.sensors[upper];
   ASSERT_TRUE(view.sees(0) && view.sees(1) && view.sees(2));
-  ASSERT_EQ(cat.subjects[0].height, 1.0);
+  ASSERT_EQ(cat.subjects[0].shape.height, 1.0);
   view.rects[0] = {40, 30, 20, 10};
   view.rects[1] = {44, 32, 20, 10};
   view.rects[2] = {-4, 100, 8, 10};

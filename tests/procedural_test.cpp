@@ -64,7 +64,7 @@ TEST(ProceduralTest, TheDeclaredShapesAreExactlyTheDrawnOnes) {
 TEST(ProceduralTest, DeterministicBytes) {
   Body b;
   b.subject = 3;
-  b.build = 1.1;
+  b.shape.build = 1.1;
   EXPECT_EQ(mmw_body(b, true, 200, 200).pixels, mmw_body(b, true, 200, 200).pixels);
   EXPECT_EQ(mmw_body(b, false, 200, 200).pixels, mmw_body(b, false, 200, 200).pixels);
   EXPECT_EQ(ir_body(b, 100, 200).pixels, ir_body(b, 100, 200).pixels);
@@ -290,8 +290,8 @@ TEST(ProceduralTest, BuildWidensAndSubjectVaries) {
     return n;
   };
   Body thin, wide;
-  thin.build = 0.85;
-  wide.build = 1.15;
+  thin.shape.build = 0.85;
+  wide.shape.build = 1.15;
   EXPECT_GT(body_width(mmw_body(wide, true, 200, 200), 120), body_width(mmw_body(thin, true, 200, 200), 120) + 10);
   EXPECT_GT(body_width(mmw_body(wide, false, 200, 200), 60), body_width(mmw_body(thin, false, 200, 200), 60) + 10);
   Body s0, s1;
@@ -327,7 +327,7 @@ TEST(ProceduralTest, IrTorsoIsWarmestAndExtremitiesCooler) {
 TEST(ProceduralTest, IrSilhouetteMatchesMmwAtHalfScale) {
   Body b;
   b.subject = 2;
-  b.build = 1.1;
+  b.shape.build = 1.1;
   const Image ir = ir_body(b, 100, 200);
   const Image up = mmw_body(b, true, 200, 200), lo = mmw_body(b, false, 200, 200);
   const int ir_mid = (b.ir_core + b.ir_background) / 2 - 20;

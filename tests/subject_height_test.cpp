@@ -51,9 +51,9 @@ std::string error_of(const std::string& text) {
 }
 
 TEST(SubjectHeight, CatalogueReadsHeightAndRefusesBadValues) {
-  for (const Subject& s : test::catalogue().subjects) EXPECT_EQ(s.height, 1.0) << s.name << ": the default";
-  EXPECT_EQ(parse_catalogue(with_subject_line(1, "height = 1.1"), "h.toml", "").subjects[1].height, 1.1);
-  EXPECT_EQ(parse_catalogue(with_subject_line(0, "height = 0.85"), "h.toml", "").subjects[0].height, 0.85);
+  for (const Subject& s : test::catalogue().subjects) EXPECT_EQ(s.shape.height, 1.0) << s.name << ": the default";
+  EXPECT_EQ(parse_catalogue(with_subject_line(1, "height = 1.1"), "h.toml", "").subjects[1].shape.height, 1.1);
+  EXPECT_EQ(parse_catalogue(with_subject_line(0, "height = 0.85"), "h.toml", "").subjects[0].shape.height, 0.85);
   struct Bad {
     std::string value, says;
   };
@@ -120,7 +120,7 @@ TEST(SubjectHeight, DrawnBodyScalesAboutTheFloor) {
   for (double h : {0.85, 0.9, 1.1, 1.15}) {
     SCOPED_TRACE("height " + std::to_string(h));
     Body b;
-    b.height = h;
+    b.shape.height = h;
     const Image up = procedural::mmw_body(b, true, 200, 200), low = procedural::mmw_body(b, false, 200, 200),
                 ir = procedural::ir_body(b, 100, 200);
     // Upper view (floor 400 rows below its top). Shorter: the shoulders' top (columns

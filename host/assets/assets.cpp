@@ -7,6 +7,7 @@
 #include "assets/image_io.h"
 #include "assets/procedural.h"
 #include "base/error.h"
+#include "base/parallel.h"
 
 namespace portalsim {
 
@@ -83,16 +84,18 @@ AssetSet build_assets(const Catalogue& cat) {
   AssetSet a;
   a.palette = procedural::ir_palette();
   const ImagesConfig& ic = cat.images;
-  for (size_t s = 0; s < cat.subjects.size(); ++s) {
+  // Each subject's base images; drawn ones on every core (a run of random bodies draws up
+  // to 255), files one at a time.
+  a.bases.resize(cat.subjects.size());
+  const auto draw = [&](size_t s) {
     const Subject& sub = cat.subjects[s];
     procedural::Body body;
-    body.subject = static_cast<int>(s);
-    body.build = sub.build;
-    body.height = sub.height;
+    body.subject = sub.texture >= 0 ? static_cast<int>(sub.texture) : static_cast<int>(s);
+    body.shape = sub.shape;
     body.mmw_level = sub.mmw_level;
     body.ir_core = sub.ir_core;
     body.ir_limb = sub.ir_limb;
-    std::vector<Image> views;
+    std::vector<Image>& views = a.bases[s];
     for (const Sensor& view : cat.sensors) {
       const bool ir = view.camera == Camera::ir;
       const ImageSource& src = sub.image(view.name);
@@ -103,8 +106,12 @@ AssetSet build_assets(const Catalogue& cat) {
         views.push_back(ir ? procedural::ir_view(body, view.field, view.side, view.width, view.height)
                            : procedural::mmw_view(body, view.field, view.side, view.width, view.height));
     }
-    a.bases.push_back(std::move(views));
-  }
+  };
+  const bool files =
+      std::any_of(cat.subjects.begin(), cat.subjects.end(), [](const Subject& s) { return !s.images.empty(); });
+  parallel_for(cat.subjects.size(), files ? 1 : default_threads(), [&](size_t begin, size_t end) {
+    for (size_t s = begin; s < end; ++s) draw(s);
+  });
   // Each sprite set's drawings keep the objects' physical size: a catalogue size is in field
   // units, scaled by the set's view pixels per unit. A file is its camera's drawing as given.
   for (const SpriteSet& set : cat.sprite_sets) {

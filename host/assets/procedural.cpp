@@ -183,23 +183,35 @@ struct BodyField {
 class BodyModel {
  public:
   explicit BodyModel(const Body& body) {
-    b_ = std::isfinite(body.build) ? std::clamp(body.build, 0.5, 1.6) : 1.0;
-    h_ = std::isfinite(body.height) ? std::clamp(body.height, 0.5, 2.0) : 1.0;
+    const auto scale = [](double v, double lo, double hi) { return std::isfinite(v) ? std::clamp(v, lo, hi) : 1.0; };
+    shape_ = body.shape;
+    b_ = shape_.build = scale(shape_.build, 0.5, 1.6);
+    shape_.height = scale(shape_.height, 0.5, 2.0);
+    shape_.leg_length = scale(shape_.leg_length, 0.5, 1.5);
+    sh_ = scale(shape_.shoulders_or_build(), 0.5, 1.6);
+    ch_ = scale(shape_.chest_or_build(), 0.5, 1.6);
+    hp_ = scale(shape_.hips_or_build(), 0.5, 1.6);
+    arm_len_ = scale(shape_.arm_length, 0.5, 1.5);
+    // The arms' turn outwards about the shoulder, from hanging down: held out nearly level,
+    // or raised above the head.
+    const double turn = shape_.pose == Pose::arms_out ? 75.0 : (shape_.pose == Pose::arms_raised ? 160.0 : 0.0);
+    arm_cos_ = std::cos(turn * 3.14159265358979323846 / 180.0);
+    arm_sin_ = std::sin(turn * 3.14159265358979323846 / 180.0);
     seed_ = mix64(static_cast<uint64_t>(static_cast<int64_t>(body.subject)) + 0x5eed);
     auto var = [&](int k) { return hash01(k, 0, seed_); };
     arm_spread_ = 4.0 * var(1);
     shoulder_dy_ = 4.0 * var(2) - 2.0;
     stance_ = 3.0 * var(3);
     lean_ = 3.0 * var(4) - 1.5;
-    arm_off_ = 64.5 + (b_ - 1.0) * 52.0;
+    arm_off_ = 64.5 + (sh_ - 1.0) * 52.0;
   }
 
   uint64_t seed() const { return seed_; }
 
   // The body's own row drawn at image row y of the whole-body frame (0..400, floor at 400):
-  // the stature scaled about the floor. Exactly y at height 1.
-  double body_row(double y) const { return h_ == 1.0 ? y : kFloor - (kFloor - y) / h_; }
-  static constexpr double kFloor = 400.0;
+  // the stature and the legs scaled about the floor (scene/body_shape.h). Exactly y at
+  // height 1 and leg length 1.
+  double body_row(double y) const { return portalsim::body_row(shape_, y); }
 
   BodyField eval(double u, double y) const {
     BodyField f{};
@@ -269,8 +281,18 @@ class BodyModel {
 
   double centre_x(double y) const { return 100.0 + lean_ * smoothstep(150.0, 300.0, y); }
 
+  // The width scale at row y: the shoulders' above row 45, the chest's at 100, the hips'
+  // below 228, smoothly between. Exactly `build` where the three are the build.
+  double width_scale(double y) const {
+    if (sh_ == b_ && ch_ == b_ && hp_ == b_) return b_;
+    if (y <= 45.0) return sh_;
+    if (y <= 100.0) return lerp(sh_, ch_, smoothstep(45.0, 100.0, y));
+    if (y < 228.0) return lerp(ch_, hp_, smoothstep(100.0, 228.0, y));
+    return hp_;
+  }
+
   double torso(double u, double y) const {
-    const double side = std::fabs(u - centre_x(y)) - torso_half_width(y) * b_;
+    const double side = std::fabs(u - centre_x(y)) - torso_half_width(y) * width_scale(y);
     return std::max({side, 18.0 - y, y - 262.0});
   }
 
@@ -279,9 +301,16 @@ class BodyModel {
     const double x0 = 100.0 + sgn * arm_off_;
     const P p{u, y};
     const P top{x0, 43 + shoulder_dy_};
-    const P elbow{x0 + sgn * (2.5 + 0.4 * arm_spread_), 113};
-    const P wrist{x0 + sgn * (5.0 + arm_spread_), 171};
-    const P hand{x0 + sgn * (6.0 + 1.1 * arm_spread_), 186};
+    // A joint at (out, down) from the shoulder's top in the hanging arm, stretched by the
+    // arm's length and turned outwards by the pose (exactly the old points hanging at 1).
+    const auto joint = [&](double out, double y) {
+      const double dx = sgn * out * arm_len_, dy = (y - top.y) * arm_len_;
+      if (shape_.pose == Pose::arms_down) return P{x0 + dx, y + (arm_len_ - 1.0) * (y - top.y)};
+      return P{top.x + dx * arm_cos_ + sgn * dy * arm_sin_, top.y - sgn * dx * arm_sin_ + dy * arm_cos_};
+    };
+    const P elbow = joint(2.5 + 0.4 * arm_spread_, 113);
+    const P wrist = joint(5.0 + arm_spread_, 171);
+    const P hand = joint(6.0 + 1.1 * arm_spread_, 186);
     const double upper = sd_round_cone(p, top, elbow, 10.5, 8.2);
     const double fore = sd_round_cone(p, elbow, wrist, 8.2, 6.3);
     const double palm = sd_round_cone(p, wrist, hand, 6.3, 7.2);
@@ -290,14 +319,14 @@ class BodyModel {
 
   double limb_leg(double u, double y, double sgn) const {
     const double bl = 0.5 + 0.5 * b_;
-    const double x0 = 100.0 + lean_ + sgn * (26.5 * b_ + 0.3 * stance_);
+    const double x0 = 100.0 + lean_ + sgn * (26.5 * hp_ + 0.3 * stance_);
     const P p{u, y};
     const P hip{x0, 212}, mid{x0 + sgn * 0.3, 270};
     const P knee{x0 + sgn * (1.0 + 0.5 * stance_), 310};
     const P calf{x0 + sgn * (1.6 + 0.7 * stance_), 333};
     const P ankle{x0 + sgn * (0.5 + 0.5 * stance_), 382};
-    const double thigh =
-        smin(sd_round_cone(p, hip, mid, 26.0 * b_, 24.0 * b_), sd_round_cone(p, mid, knee, 24.0 * b_, 14.5 * bl), 3.0);
+    const double thigh = smin(sd_round_cone(p, hip, mid, 26.0 * hp_, 24.0 * hp_),
+                              sd_round_cone(p, mid, knee, 24.0 * hp_, 14.5 * bl), 3.0);
     const double shin = smin(sd_round_cone(p, knee, calf, 14.5 * bl, 16.5 * bl),
                              sd_round_cone(p, calf, ankle, 16.5 * bl, 7.8 * bl), 2.5);
     // Feet seen from the front: low, wider than the ankle, turned a little outwards.
@@ -305,7 +334,8 @@ class BodyModel {
     return smin(smin(thigh, shin, 2.0), foot, 4.0);
   }
 
-  double b_ = 1.0, h_ = 1.0;
+  BodyShape shape_;
+  double b_ = 1.0, sh_ = 1.0, ch_ = 1.0, hp_ = 1.0, arm_len_ = 1.0, arm_cos_ = 1.0, arm_sin_ = 0.0;
   uint64_t seed_ = 0;
   double arm_spread_ = 0, shoulder_dy_ = 0, stance_ = 0, lean_ = 0, arm_off_ = 64.5;
 };

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "assets/image.h"
+#include "scene/body_shape.h"
 #include "scene/builtin_images.h"
 #include "scene/sensor.h"
 
@@ -17,13 +18,11 @@ namespace portalsim::procedural {
 // body at half scale: IR(x, y) = MMW upper(2x, 2y) for y < h/2, MMW lower(2x, 2(y - h/2))
 // below. Functions scale these proportions to the width and height asked for.
 struct Body {
-  int subject = 0;     // 0-based; varies posture and texture a little
-  double build = 1.0;  // torso/leg width scale, 0.8..1.2
-  // Stature scale about the floor (the bottom edge of the lower view), 0.85..1.15: a point
-  // of the body c units above the floor is drawn c * height above it. The views stay
-  // where they are, so a taller body's shoulders leave the upper view's top and its hips
-  // move up into the upper view. Widths are untouched (that is `build`).
-  double height = 1.0;
+  int subject = 0;  // 0-based; varies posture and texture a little
+  // Widths, stature, limb lengths and pose (scene/body_shape.h). Stature scales about the
+  // floor (the bottom edge of the lower view); the views stay where they are, so a taller
+  // body's shoulders leave the upper view's top and its hips move up into the upper view.
+  BodyShape shape;
   int mmw_level = 150;  // gray of the body in MMW (passive emission of skin)
   int mmw_background = 25;
   int ir_core = 215;  // IR temperature index of the torso (warmest)

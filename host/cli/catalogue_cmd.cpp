@@ -31,8 +31,8 @@ int list(CatalogueOptions& o) {
   std::printf(" alpha %.3g\n", c.images.alpha);
   std::printf("\nsubjects:\n");
   for (size_t i = 0; i < c.subjects.size(); ++i)  // what the body is drawn as: width and stature scales
-    std::printf("  %zu  %s  build %g  height %g\n", i + 1, c.subjects[i].name.c_str(), c.subjects[i].build,
-                c.subjects[i].height);
+    std::printf("  %zu  %s  build %g  height %g\n", i + 1, c.subjects[i].name.c_str(), c.subjects[i].shape.build,
+                c.subjects[i].shape.height);
   std::printf("\nregions:\n");
   for (const Region& r : c.regions) {
     // The MMW view whose rectangles hold it, named in the views line.

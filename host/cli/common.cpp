@@ -8,6 +8,8 @@
 #include "base/error.h"
 #include "io/input_file.h"
 #include "plan/knobs.h"
+#include "scene/bodies.h"
+#include "schedule/run_state.h"
 
 namespace portalsim::cli {
 
@@ -45,9 +47,10 @@ std::map<std::string, std::string> given_knobs(const CLI::App& app, const std::m
   return given;
 }
 
-void open_catalogue(Session& s, const CommonOptions& o) {
+void open_catalogue(Session& s, const CommonOptions& o, const RunSpec* spec) {
   auto t0 = std::chrono::steady_clock::now();
   s.catalogue = o.catalogue.empty() ? default_catalogue(o.assets) : load_catalogue(o.catalogue, o.assets);
+  if (spec && spec->random_bodies()) use_random_bodies(s.catalogue, spec->bodies_seed(), spec->random_bodies());
   s.catalogue_seconds = since(t0);
   t0 = std::chrono::steady_clock::now();
   s.assets = build_assets(s.catalogue);
@@ -91,6 +94,28 @@ void open_backend(Session& s, const CommonOptions& o) {
     s.backend = make_opencl_backend(s.catalogue, s.assets, s.runtime);
   }
   s.backend_seconds = since(t0);
+}
+
+RunSpec bodies_of_folder(const std::string& dir) {
+  RunSpec spec;
+  std::error_code ec;
+  const std::string path = (std::filesystem::path(dir) / "manifest.json").string();
+  if (dir.empty() || !std::filesystem::exists(path, ec)) return spec;  // the reader says what is missing
+  const nlohmann::json manifest = parse_manifest(io::read_text_file(path, "manifest", io::Bom::refuse), path);
+  const nlohmann::json& made = manifest["spec"];
+  if (made.value("bodies", std::string("catalogue")) != "random") return spec;
+  const nlohmann::json& count = made.value("body_count", nlohmann::json());
+  if (!count.is_number_integer() || count.get<int64_t>() < 1 || count.get<int64_t>() > kMaxRandomBodies)
+    throw InputError(path + ": spec.body_count: not a count of random bodies (1 to " +
+                     std::to_string(kMaxRandomBodies) + ")");
+  spec.bodies = "random";
+  spec.body_count = count.get<int>();
+  for (const char* key : {"seed", "body_seed"})
+    if (!made.contains(key) || !made[key].is_string())
+      throw InputError(path + ": spec." + key + ": expected the seed as a string of digits");
+  spec.seed = io::parse_u64(made["seed"].get<std::string>(), path + ": spec.seed");
+  spec.body_seed = io::parse_u64(made["body_seed"].get<std::string>(), path + ": spec.body_seed");
+  return spec;
 }
 
 Session open_session(const CommonOptions& o) {

@@ -12,6 +12,7 @@
 #include "backend/backend.h"
 #include "backend/opencl/runtime.h"
 #include "scene/catalogue.h"
+#include "schedule/run_spec.h"
 #include "sink/staging.h"
 
 namespace portalsim::cli {
@@ -45,8 +46,13 @@ struct Session {
 };
 Session open_session(const CommonOptions& o);
 // Catalogue and assets only (no backend yet): lets a command check its arguments first.
-void open_catalogue(Session& s, const CommonOptions& o);
+// The catalogue and its images; where `spec` asks for random bodies, its drawn bodies in
+// place of the catalogue's subjects.
+void open_catalogue(Session& s, const CommonOptions& o, const RunSpec* spec = nullptr);
 void open_backend(Session& s, const CommonOptions& o);
+// The bodies a generate folder was made with, as a spec for open_catalogue: its manifest's
+// random bodies and seed (the catalogue's subjects where it has none, or no manifest).
+RunSpec bodies_of_folder(const std::string& dir);
 // --timing's line of the paths `backend` takes for `plan` ("paths: upper: thesis_images, ...").
 void print_paths(const Backend& backend, const Plan& plan);
 

@@ -94,7 +94,8 @@ int run_evaluate(EvaluateOptions& o) {
         ": give a generate folder DIR, --spec FILE (generated first), --sweep/--samples, or --metal-map OBJECT");
   if (!o.dir.empty()) {  // a folder is evaluated as it was made: flags that make a data set are refused
     const CLI::App& app = *o.flags.app;
-    for (const char* flag : {"--count", "--rule", "--pool", "--objects", "--subjects", "--balance", "--tier"})
+    for (const char* flag : {"--count", "--rule", "--pool", "--objects", "--subjects", "--bodies", "--body-count",
+                             "--body-seed", "--balance", "--tier"})
       if (app.get_option(flag)->count() > 0)
         throw InputError(std::string(flag) + ": makes a data set; it goes with --spec or --sweep, not with DIR");
     for (const auto& [key, text] : given_knobs(app, o.flags.knobs))
@@ -105,14 +106,12 @@ int run_evaluate(EvaluateOptions& o) {
   if (sweep) return run_sweep(o.flags, o.sweep, o.samples, o.part, o.out, settings);
   check_new_or_empty(o.out);
   Session s;
-  open_catalogue(s, o.flags.common);
   EvaluateTiming timing;
   std::string data = o.dir;
-  RunSpec spec;
-  if (!o.flags.spec_file.empty()) {
-    spec = features_spec(build_spec(o.flags));
-    check_generate(spec, s.catalogue);
-  }
+  // A folder's subjects are those it was made with: its random bodies drawn again.
+  RunSpec spec = o.flags.spec_file.empty() ? bodies_of_folder(o.dir) : features_spec(build_spec(o.flags));
+  open_catalogue(s, o.flags.common, &spec);
+  if (!o.flags.spec_file.empty()) check_generate(spec, s.catalogue);
   StagedFolder folder(o.out);
   if (!o.flags.spec_file.empty()) {
     open_backend(s, o.flags.common);

@@ -221,7 +221,7 @@ int run_sweep(SpecFlags& flags, const std::string& sweep, const std::string& sam
   const std::vector<Setting> points = ranges ? hypercube(axes, n, settings.options.seed) : grid(axes);
   const RunSpec base = features_spec(build_spec(flags));
   Session s;
-  open_catalogue(s, flags.common);
+  open_catalogue(s, flags.common, &base);
   // Every point's spec checked before anything runs.
   std::vector<RunSpec> specs;
   for (const Setting& p : points) {

@@ -14,7 +14,7 @@ namespace portalsim::cli {
 struct SpecFlags {
   CommonOptions common;
   RunSpec spec;
-  std::string count, spec_file, objects, pool, subjects, formats, png_level;
+  std::string count, spec_file, objects, pool, subjects, body_count, body_seed, formats, png_level;
   std::map<std::string, std::string> knobs;
   CLI::App* app = nullptr;
 };

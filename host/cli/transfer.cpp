@@ -132,7 +132,14 @@ int run_transfer(const Options& o) {
     for (Set& s : sets) {
       if (!s.spec) continue;
       const std::string dir = (fs::path(made) / s.name).string();
-      run_pipeline(*s.spec, session.catalogue, session.assets, *session.backend, dir, popt);
+      // A set of random bodies draws its own from its seed.
+      Session own;
+      if (s.spec->random_bodies()) {
+        open_catalogue(own, co, s.spec.get());
+        open_backend(own, co);
+      }
+      const Session& use = s.spec->random_bodies() ? own : session;
+      run_pipeline(*s.spec, use.catalogue, use.assets, *use.backend, dir, popt);
       std::fprintf(stderr, "transfer: %s: %llu scenarios from %s\n", s.name.c_str(),
                    static_cast<unsigned long long>(s.spec->count), s.source.c_str());
       s.table = read_arff((fs::path(dir) / "features.arff").string());

@@ -432,15 +432,29 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   for (size_t i = 0; i < subjects.size(); ++i) {
     const toml::table& t = *subjects.get(i)->as_table();
     const std::string f = "subjects[" + std::to_string(i + 1) + "]";
-    io::reject_unknown_keys(t, {"name", "build", "height", "mmw_level", "ir_core", "ir_limb", "base_zones", "images"},
-                            source_name, f);
+    io::reject_unknown_keys(
+        t,
+        {"name", "build", "height", "shoulders", "chest", "hips", "arm_length", "leg_length", "pose", "skin_emissivity",
+         "skin_temperature", "mmw_level", "ir_core", "ir_limb", "base_zones", "images"},
+        source_name, f);
     Subject s;
     s.name = rd.string(t, "name", f);
-    s.build = rd.number(t, "build", f, 0.5, 1.5, 1.0);
-    // Stature about the 1.75 m body of [metal.physics]: 0.85..1.15 is about 1.49 m to
-    // 2.01 m, most adults. Within it the drawn head stays below the upper view's top edge
-    // and every region's place stays in its own view (docs/model/subjects.md).
-    s.height = rd.number(t, "height", f, 0.85, 1.15, 1.0);
+    const auto in = [&](const char* key, BodyRange r, double dflt) { return rd.number(t, key, f, r.lo, r.hi, dflt); };
+    BodyShape& b = s.shape;
+    b.build = in("build", kBuildRange, 1.0);
+    // Stature about the 1.75 m body of [metal.physics] (docs/model/subjects.md).
+    b.height = in("height", kHeightRange, 1.0);
+    // Breadths default to the build, so a subject that gives only `build` is drawn as before.
+    b.shoulders = in("shoulders", kBreadthRange, b.build);
+    b.chest = in("chest", kBreadthRange, b.build);
+    b.hips = in("hips", kBreadthRange, b.build);
+    b.arm_length = in("arm_length", kArmLengthRange, 1.0);
+    b.leg_length = in("leg_length", kLegLengthRange, 1.0);
+    const std::string pose = rd.string(t, "pose", f, std::string("arms-down"));
+    if (!parse_pose(pose, b.pose))
+      rd.fail(t.get("pose"), f + ".pose", "\"" + pose + "\" is not a pose (arms-down, arms-raised, arms-out)");
+    if (t.get("skin_emissivity")) s.skin_emissivity = in("skin_emissivity", kSkinEmissivityRange, 0.0);
+    if (t.get("skin_temperature")) s.skin_temperature = in("skin_temperature", kSkinTemperatureRange, 0.0);
     s.mmw_level = rd.integer(t, "mmw_level", f, 0, 255, 150);
     s.ir_core = rd.integer(t, "ir_core", f, 0, 255, 215);
     s.ir_limb = rd.integer(t, "ir_limb", f, 0, 255, 175);
@@ -454,10 +468,11 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
         s.images.emplace(std::string(key.str()), rd.image(*it, std::string(key.str()), f + ".images"));
       }
     }
-    // Objects move with the stature; an image file's body would not.
-    if (s.height != 1.0 && !s.images.empty())
-      rd.fail(t.get("height"), f + ".height",
-              "only a procedural body can be drawn at another height; this subject names image files (images)");
+    // Objects move with the stature and the legs; an image file's body would not.
+    for (const char* key : {"height", "leg_length"})
+      if (t.get(key) && rd.number(t, key, f, 0, 2) != 1.0 && !s.images.empty())
+        rd.fail(t.get(key), f + "." + key,
+                "only a procedural body can be drawn at another height; this subject names image files (images)");
     cat.subjects.push_back(std::move(s));
   }
 

@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "scene/body_shape.h"
 #include "scene/sensor.h"
 
 namespace portalsim {
@@ -20,9 +21,16 @@ struct ImageSource {
 
 struct Subject {
   std::string name;
-  double build = 1.0;   // body width scale (procedural::Body::build)
-  double height = 1.0;  // stature scale about the floor (procedural::Body::height)
+  BodyShape shape;  // widths, stature, limbs and pose of its procedural body
   int mmw_level = 150, ir_core = 215, ir_limb = 175;
+  // The physics model's skin at 94 GHz and its temperature, where this subject's differ
+  // from [physics]'s (0: [physics]'s); PhysicsConfig::skin_emissivity_of reads them.
+  double skin_emissivity = 0, skin_temperature = 0;
+  // The seed of its procedural body's posture and texture details: -1 for its index.
+  int64_t texture = -1;
+  // A drawn body's values as scenarios.csv records them (scene/bodies.h, kBodyColumns);
+  // empty for the catalogue's subjects.
+  std::string drawn;
   std::vector<int> base_zones;  // one per zone of the metal detector
   // The base image files the catalogue names, by camera view name (images.NAME); a view
   // with none draws the procedural body.
@@ -69,6 +77,13 @@ struct PhysicsConfig {
   double ir_index_min_k = 290.5, ir_index_max_k = 308.9;
   double ir_coupling = 0.8, ir_spread_mm = 10.0;
   double ir_display_min = 290.5, ir_display_max = 308.9;
+  // A subject's own skin where it gives one, else the values above.
+  double skin_emissivity_of(const Subject& s) const {
+    return s.skin_emissivity > 0 ? s.skin_emissivity : skin_emissivity;
+  }
+  double skin_temperature_of(const Subject& s) const {
+    return s.skin_temperature > 0 ? s.skin_temperature : skin_temperature;
+  }
 };
 
 struct Object {

@@ -42,6 +42,7 @@ enum Stream : uint32_t {
   kStreamFeatureNoise = PS_STREAM_FEATURE_NOISE,
   kStreamPixelNoiseFast = PS_STREAM_PIXEL_NOISE_FAST,
   kStreamKnobDraw = PS_STREAM_KNOB_DRAW,
+  kStreamBodies = PS_STREAM_BODIES,
   kStreamGenerate = PS_STREAM_GENERATE,
 };
 

@@ -14,6 +14,7 @@
 #include "base/sizes.h"
 #include "io/input_file.h"
 #include "io/table_fields.h"
+#include "scene/bodies.h"
 
 namespace portalsim {
 
@@ -70,9 +71,13 @@ ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, c
     else if (int r = numbered(h, "region"); r != 0) {
       if (r < 0) throw InputError(column + "there are " + regions + " only");
       col_region_[r - 1] = static_cast<int>(c);
-    } else if (h == "index" || std::any_of(kDrawnKnobKeys.begin(), kDrawnKnobKeys.end(),
-                                           [&](const char* k) { return normalise_name(k) == h; })) {
-      // A drawn knob's column records the run's draw; a run draws it again from its seed.
+    } else if (h == "index" ||
+               std::any_of(kDrawnKnobKeys.begin(), kDrawnKnobKeys.end(),
+                           [&](const char* k) { return normalise_name(k) == h; }) ||
+               std::any_of(kBodyColumns.begin(), kBodyColumns.end(),
+                           [&](const char* k) { return normalise_name(k) == h; })) {
+      // A drawn knob's or body's column records the run's draw; a run draws it again from
+      // its seed.
     } else if (
         int t = 0, tr = 0; [&] {
           for (t = 0; t < 3; ++t)

@@ -23,14 +23,22 @@ void derive_view(Catalogue& cat, Sensor& s) {
   const auto found = std::find(cat.sprite_sets.begin(), cat.sprite_sets.end(), set);
   s.sprite_set = static_cast<int>(found - cat.sprite_sets.begin());
   if (found == cat.sprite_sets.end()) cat.sprite_sets.push_back(set);
-  // A region's place follows the body drawn for the subject (procedural::Body::height): a
-  // point c rows above the floor is drawn c * height rows above it. Whole pixels, so that
-  // integer placement stays integer and height 1 moves nothing.
+  derive_places(cat, s);
+}
+
+void derive_places(const Catalogue& cat, Sensor& s) {
+  // A region's place follows the body drawn for the subject (scene/body_shape.h): a point
+  // c rows above the floor is drawn c * height rows above it, and the legs' part of c also
+  // scales by the leg length. Whole pixels, so that integer placement stays integer and
+  // height 1 moves nothing.
   s.subject_dy.assign(cat.subjects.size(), {});
   for (size_t k = 0; k < cat.subjects.size(); ++k)
     for (int r = 0; r < cat.region_count(); ++r) {
+      const BodyShape& b = cat.subjects[k].shape;
       const double c = s.rects[r].y + s.rects[r].h / 2.0;
-      s.subject_dy[k][r] = static_cast<int>(std::lround((1.0 - cat.subjects[k].height) * (s.floor_row - c)));
+      const double move = b.leg_length == 1.0 ? (1.0 - b.height) * (s.floor_row - c)
+                                              : (drawn_row(b, s.field_row(c)) - s.field_row(c)) * s.jitter_scale_y;
+      s.subject_dy[k][r] = static_cast<int>(std::lround(move));
     }
 }
 

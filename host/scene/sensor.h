@@ -114,5 +114,7 @@ struct Catalogue;
 // each subject's place offsets. The views' names, cameras, sides, sizes, fields, region
 // rectangles and pooling are read from the catalogue first.
 void derive_view(Catalogue& cat, Sensor& s);
+// The part of it that follows the subjects: each subject's place offsets (subject_dy).
+void derive_places(const Catalogue& cat, Sensor& s);
 
 }  // namespace portalsim

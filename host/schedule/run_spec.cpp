@@ -17,6 +17,11 @@ nlohmann::json RunSpec::to_json() const {
   j["pool"] = pool;
   j["objects"] = {min_objects, max_objects};
   j["subjects"] = subjects;
+  if (random_bodies()) {  // absent for the catalogue's subjects: older runs keep their identity
+    j["bodies"] = bodies;
+    j["body_count"] = random_bodies();
+    j["body_seed"] = std::to_string(bodies_seed());
+  }
   j["rule"] = rule;
   j["balance"] = balance;
   j["scenarios"] = scenarios;
@@ -76,6 +81,15 @@ void RunSpec::validate() const {
                      ": only applies to image folders (--what images or both, without h5 or npy "
                      "image tensors)");
   if (balance && rule.empty()) throw InputError(where("balance") + ": needs a threat rule (--rule)");
+  if (bodies != "catalogue" && bodies != "random")
+    throw InputError(where("bodies") + ": \"" + bodies + "\" is not catalogue or random");
+  if (body_seed && bodies != "random")
+    throw InputError(where("body_seed") + ": only applies to random bodies (--bodies random)");
+  if (body_count != 0 && bodies != "random")
+    throw InputError(where("body_count") + ": only applies to random bodies (--bodies random)");
+  if (body_count < 0 || body_count > kMaxRandomBodies)
+    throw InputError(where("body_count") + ": " + std::to_string(body_count) + " is not between 1 and " +
+                     std::to_string(kMaxRandomBodies));
   (void)settings();  // checks the tier and knobs
 }
 
@@ -204,6 +218,14 @@ void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
       for (const toml::node& e : *a) spec.subjects.push_back(static_cast<int>(integer(e, key, 1, 255)));
     } else if (key == "balance") {
       spec.balance = boolean(node, key);
+    } else if (key == "bodies") {
+      spec.bodies = string(node, key);
+      if (spec.bodies != "catalogue" && spec.bodies != "random")
+        throw InputError(at(node, key) + ": \"" + spec.bodies + "\" is not catalogue or random");
+    } else if (key == "body_seed") {
+      spec.body_seed = static_cast<uint64_t>(integer(node, key, 0, INT64_MAX));
+    } else if (key == "body_count") {
+      spec.body_count = static_cast<int>(integer(node, key, 1, kMaxRandomBodies));
     } else if (key == "what") {
       spec.what = string(node, key);
     } else if (key == "format") {
@@ -225,7 +247,9 @@ void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
       spec.set_knob_text(key, knob_value(*knob, node, at(node, key)), at(node, key));
     } else {
       std::string known =
-          "count, seed, rule, pool, objects, subjects, balance, what, format, image_format, png_level, compress, "
+          "count, seed, rule, pool, objects, subjects, bodies, body_count, body_seed, balance, what, format, "
+          "image_format, "
+          "png_level, compress, "
           "annotations, "
           "scenarios, tier";
       for (const Knob& k : portalsim::knobs()) known += ", " + k.key;

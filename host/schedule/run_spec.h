@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "assets/png_writer.h"
 #include "plan/plan.h"
+#include "scene/bodies.h"
 #include "scene/generator.h"
 
 namespace portalsim {
@@ -20,6 +22,15 @@ struct RunSpec {
   std::vector<std::string> pool;  // object names as given; empty = all
   int min_objects = 0, max_objects = 4;
   std::vector<int> subjects;  // 1-based; empty = all
+  // "catalogue": the catalogue's subjects; "random": body_count bodies drawn from the seed
+  // (scene/bodies.h), which replace them.
+  std::string bodies = "catalogue";
+  int body_count = 0;  // 0: kDefaultRandomBodies where the bodies are random
+  int random_bodies() const { return bodies == "random" ? (body_count ? body_count : kDefaultRandomBodies) : 0; }
+  // The seed the random bodies are drawn from: the run's, unless given apart (to test on
+  // the training bodies with other scenarios, or on other bodies with the same ones).
+  std::optional<uint64_t> body_seed;
+  uint64_t bodies_seed() const { return body_seed.value_or(seed); }
   std::string rule;
   bool balance = false;
   std::string scenarios;          // explicit scenario list (CSV); replaces the generator

@@ -9,6 +9,7 @@
 #include "assets/image_io.h"
 #include "base/error.h"
 #include "base/parallel.h"
+#include "scene/bodies.h"
 #include "sink/feature_rows.h"
 #include "sink/scenario_folder.h"
 #include "sink/sink_kinds.h"
@@ -122,6 +123,8 @@ class ScenarioListSink final : public Sink {
           for (int r = 1; r <= R; ++r) h += what + std::to_string(r);
       for (unsigned e = 0; e < kDrawnKnobKeys.size(); ++e)
         if (ctx.model.drawn[e].varies()) h += std::string(",") + kDrawnKnobKeys[e];
+      if (drawn_bodies(*ctx.cat))
+        for (const char* c : kBodyColumns) h += std::string(",") + c;
       file_.append(h + ",label\n");
     }
     for (size_t v = 0; v < ctx.cat->variant_list.size(); ++v)
@@ -168,6 +171,10 @@ class ScenarioListSink final : public Sink {
           s += ',';
           s.append(buf, res.ptr);
         }
+      if (!ctx_.cat->subjects[scenes.subject[i]].drawn.empty()) {
+        s += ',';
+        s += ctx_.cat->subjects[scenes.subject[i]].drawn;
+      }
       s += scenes.label[i] == 1 ? ",yes\n" : ",no\n";
     }
     file_.append(s);
@@ -269,8 +276,8 @@ extern const SinkKind scenario_list_kind{
     .meaning =
         [](std::string_view, int regions, int) {
           return "the scenario list: subject, the object in each of the " + std::to_string(regions) +
-                 " regions, the label (and each object's random transform); generate --scenarios makes the data set "
-                 "again from it";
+                 " regions, the label (and each object's random transform, each knob drawn per scenario, and with "
+                 "random bodies each row's body as drawn); generate --scenarios makes the data set again from it";
         }};
 
 namespace {

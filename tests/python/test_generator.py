@@ -21,6 +21,8 @@ CASES = {
     # The physics camera and scene drawn per scenario: images, features and each param_<knob>.
     "drawn-camera": dict(what="both", model="physics", netd="1..4", frames="1..8", illumination="285..305",
                          worn_minutes="0..60", ir_netd="0.03..0.1"),
+    # Random bodies drawn from their own seed: images, features and the subject column.
+    "random-bodies": dict(what="both", model="physics", bodies="random", body_count=12, body_seed=8),
     "spec-file": dict(spec="scenarios/case1-gun.toml", what="both", seed=5),
     # 20 regions, 33 zones, front and back MMW and IR views (tools/portal_catalogues.py).
     "portal-20x33": dict(catalogue="tests/portals/portal-20x33.toml", what="images", annotations=True,

@@ -90,8 +90,8 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   }
   // Per subject, its base image's value to kelvin: the IR index map, or the MMW's gray
   // between the room behind and the bare body.
-  const double body = seen(pc.skin_emissivity, pc.skin_temperature);
   for (const Subject& subj : cat.subjects) {
+    const double body = seen(pc.skin_emissivity_of(subj), pc.skin_temperature_of(subj));
     const double gain = ir ? (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0
                            : (body - pc.background_temperature) / (subj.mmw_level - pc.base_background_gray);
     p.push_back(gain);
@@ -132,8 +132,8 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   if (scene_drawn) {
     scene = {ill.varies() ? 1.0 : 0.0, m.worn_minutes, worn.varies() ? worn.hi : m.worn_minutes};
     // The bare body's apparent temperature moves by tc (1 - e_skin) per kelvin of illumination.
-    const double body_span = ir ? 0.0 : pc.clothing_transmission * (1 - pc.skin_emissivity) * ill_span;
     for (const Subject& subj : cat.subjects) {
+      const double body_span = ir ? 0.0 : pc.clothing_transmission * (1 - pc.skin_emissivity_of(subj)) * ill_span;
       const double dgain = ir ? 0.0 : body_span / (subj.mmw_level - pc.base_background_gray);
       scene.push_back(dgain);
       scene.push_back(-dgain * pc.base_background_gray);

@@ -16,9 +16,9 @@ double under_clothing(const PhysicsConfig& pc, const ModelSettings& m, double e,
 
 }  // namespace
 
-double body_temperature(const Catalogue& cat, const ModelSettings& m) {
+double body_temperature(const Catalogue& cat, const ModelSettings& m, const Subject& subject) {
   const PhysicsConfig& pc = cat.physics;
-  return under_clothing(pc, m, pc.skin_emissivity, pc.skin_temperature);
+  return under_clothing(pc, m, pc.skin_emissivity_of(subject), pc.skin_temperature_of(subject));
 }
 
 // The object has warmed from the room towards the skin for worn_minutes, with its
@@ -43,7 +43,7 @@ void radiometry(const ViewScene& vs, Field& f) {
   const Image& base = vs.assets.bases[vs.scenario.subject][vs.view];
   const Subject& subject = vs.cat.subjects[vs.scenario.subject];
   const double g0 = pc.base_background_gray, g1 = subject.mmw_level;
-  const double t0 = pc.background_temperature, t1 = body_temperature(vs.cat, vs.model);
+  const double t0 = pc.background_temperature, t1 = body_temperature(vs.cat, vs.model, subject);
   f.width = base.width;
   f.height = base.height;
   f.v.assign(static_cast<size_t>(f.width) * f.height, 0.0);

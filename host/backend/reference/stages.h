@@ -85,7 +85,7 @@ PORTALSIM_STAGES(PORTALSIM_DECLARE_STAGE)
 #undef PORTALSIM_DECLARE_STAGE
 
 // The physics model's quantities, from the catalogue and the knobs.
-double body_temperature(const Catalogue& cat, const ModelSettings& m);               // bare body under clothing, K
+double body_temperature(const Catalogue& cat, const ModelSettings& m, const Subject& s);  // bare body under clothing, K
 double worn_temperature(const Catalogue& cat, const ModelSettings& m, int variant);  // physical, K, warmed on the body
 double object_temperature(const Catalogue& cat, const ModelSettings& m, int variant);     // apparent, under clothing
 double contact_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant);  // IR surface dT, full cover

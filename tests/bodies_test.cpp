@@ -1,0 +1,366 @@
+// Random bodies (`--bodies random`, scene/bodies.h) and the body shape they are drawn with
+// (scene/body_shape.h): draws are a pure function of (seed, body), follow the ANSUR II
+// statistics they cite, the drawn images follow the shape, object places follow the legs,
+// both backends agree on the drawn bodies and on the extremes, and bad input is refused.
+#include "scene/bodies.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "assets/procedural.h"
+#include "backend/compare.h"
+#include "base/error.h"
+#include "plan/tolerance.h"
+#include "run_binary.h"
+#include "support.h"
+
+namespace portalsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string default_text() {
+  std::ifstream in(std::string(PORTALSIM_SOURCE_DIR) + "/scenarios/catalogue.toml", std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string catalogue_error(const std::string& text) {
+  try {
+    parse_catalogue(text, "b.toml", "");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The number of body pixels (MMW gray above the room's) in rows [y0, y1) and columns
+// [x0, x1) of an image.
+int body_pixels(const Image& im, int x0, int x1, int y0, int y1) {
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) n += im.at(x, y) > 90;
+  return n;
+}
+
+// The body's width (pixels above the room's gray) along row y.
+int row_width(const Image& im, int y) { return body_pixels(im, 0, im.width, y, y + 1); }
+
+TEST(Bodies, DrawIsAPureFunctionOfSeedAndBody) {
+  const Catalogue& cat = test::catalogue();
+  EXPECT_EQ(draw_body(cat, 7, 3).drawn, draw_body(cat, 7, 3).drawn);
+  EXPECT_NE(draw_body(cat, 7, 3).drawn, draw_body(cat, 8, 3).drawn) << "another seed, another body";
+  EXPECT_NE(draw_body(cat, 7, 3).drawn, draw_body(cat, 7, 4).drawn);
+  // A run's first bodies do not depend on how many it draws.
+  Catalogue few = cat, many = cat;
+  use_random_bodies(few, 11, 4);
+  use_random_bodies(many, 11, 40);
+  ASSERT_EQ(few.subjects.size(), 4u);
+  ASSERT_EQ(many.subjects.size(), 40u);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(few.subjects[k].drawn, many.subjects[k].drawn);
+    EXPECT_EQ(few.subjects[k].name, many.subjects[k].name);
+  }
+  EXPECT_EQ(few.subjects[0].name, "body-001");
+  EXPECT_TRUE(drawn_bodies(few));
+  EXPECT_FALSE(drawn_bodies(cat));
+  // Every drawn value inside the ranges the catalogue's keys take.
+  for (const Subject& s : many.subjects) {
+    const BodyShape& b = s.shape;
+    EXPECT_TRUE(b.height >= kHeightRange.lo && b.height <= kHeightRange.hi) << s.name;
+    EXPECT_TRUE(b.leg_length >= kLegLengthRange.lo && b.leg_length <= kLegLengthRange.hi) << s.name;
+    EXPECT_TRUE(b.arm_length >= kArmLengthRange.lo && b.arm_length <= kArmLengthRange.hi) << s.name;
+    for (double w : {b.shoulders, b.chest, b.hips}) EXPECT_TRUE(w >= kBreadthRange.lo && w <= kBreadthRange.hi);
+    EXPECT_TRUE(s.skin_emissivity >= 0.2 && s.skin_emissivity <= 0.7) << s.name;
+    EXPECT_NE(s.mmw_level, cat.physics.base_background_gray);
+    EXPECT_EQ(s.base_zones.size(), static_cast<size_t>(cat.zones));
+  }
+}
+
+// 4000 draws against the survey's statistics. Each mean is held to 4 standard errors
+// (a false failure about once in 16,000 runs, were the draws not fixed by the seed), each
+// correlation to 0.1 (its standard error at n = 2000 is about 0.02; 0.1 catches a dropped
+// Cholesky factor, which moves it by 0.5).
+TEST(Bodies, DrawsFollowTheSurvey) {
+  const Catalogue& cat = test::catalogue();
+  struct Moments {
+    double n = 0, s = 0, sh = 0, ss = 0, shsh = 0, ssh = 0;
+  } men, women;
+  int poses[3] = {0, 0, 0};
+  double emissivity = 0, temperature = 0;
+  const int n = 4000;
+  for (int k = 0; k < n; ++k) {
+    DrawnBody d;
+    const Subject b = draw_body(cat, 2026, k, &d);
+    Moments& m = d.female ? women : men;
+    m.n += 1;
+    m.s += d.stature_mm;
+    m.sh += d.shoulders_mm;
+    m.ss += d.stature_mm * d.stature_mm;
+    m.shsh += d.shoulders_mm * d.shoulders_mm;
+    m.ssh += d.stature_mm * d.shoulders_mm;
+    ++poses[static_cast<int>(b.shape.pose)];
+    emissivity += b.skin_emissivity;
+    temperature += b.skin_temperature;
+  }
+  const auto check = [](const Moments& m, double stature, double stature_sd, double shoulders, double r) {
+    const double ms = m.s / m.n, msh = m.sh / m.n;
+    const double vs = m.ss / m.n - ms * ms, vsh = m.shsh / m.n - msh * msh;
+    EXPECT_NEAR(ms, stature, 4 * stature_sd / std::sqrt(m.n));
+    EXPECT_NEAR(std::sqrt(vs), stature_sd, 4 * stature_sd / std::sqrt(2 * m.n));
+    EXPECT_NEAR(msh, shoulders, 4 * 20.0 / std::sqrt(m.n));
+    EXPECT_NEAR((m.ssh / m.n - ms * msh) / std::sqrt(vs * vsh), r, 0.1);
+  };
+  check(men, 1756.2, 68.6, 415.7, 0.53);
+  check(women, 1628.5, 64.2, 365.3, 0.57);
+  EXPECT_NEAR(men.n / n, 0.5, 4 * 0.5 / std::sqrt(n)) << "men and women equally often";
+  for (int p : poses) EXPECT_NEAR(p / double(n), 1.0 / 3, 4 * std::sqrt(2.0 / 9 / n)) << "each pose a third";
+  // Owda & Salmon's 0.39 +- 0.09, clipped to 0.2..0.7 nearly symmetrically.
+  EXPECT_NEAR(emissivity / n, 0.39, 4 * 0.09 / std::sqrt(n));
+  EXPECT_NEAR(temperature / n, cat.physics.skin_temperature, 4 * 1.0 / std::sqrt(n));
+}
+
+TEST(Bodies, DrawnImagesFollowTheShape) {
+  using procedural::Body;
+  const Body one;
+  const Image up1 = procedural::mmw_body(one, true, 200, 200), low1 = procedural::mmw_body(one, false, 200, 200);
+  // Breadths: the shoulders' row (40) and the hips' (lower view row 30) widen with their own
+  // scale only.
+  Body wide;
+  wide.shape.shoulders = 1.3;
+  Body hips;
+  hips.shape.hips = 1.3;
+  const Image up_wide = procedural::mmw_body(wide, true, 200, 200);
+  EXPECT_GT(row_width(up_wide, 40), row_width(up1, 40) + 20) << "broader shoulders";
+  EXPECT_EQ(procedural::mmw_body(wide, false, 200, 200).pixels, low1.pixels) << "the legs keep the build's";
+  EXPECT_GT(row_width(procedural::mmw_body(hips, false, 200, 200), 30), row_width(low1, 30) + 10) << "wider hips";
+  // Poses: raised arms fill the upper view's top corners (beside the head, outside the
+  // torso); arms held out leave the hips' sides, where hanging hands are.
+  Body raised, out;
+  raised.shape.pose = Pose::arms_raised;
+  out.shape.pose = Pose::arms_out;
+  const Image up_raised = procedural::mmw_body(raised, true, 200, 200);
+  const Image up_out = procedural::mmw_body(out, true, 200, 200);
+  EXPECT_EQ(body_pixels(up1, 0, 40, 0, 20), 0) << "hanging arms leave the top corners empty";
+  EXPECT_GT(body_pixels(up_raised, 0, 40, 0, 20), 100) << "raised arms";
+  const int hands = body_pixels(up1, 10, 45, 150, 200);
+  EXPECT_GT(hands, 300) << "hanging forearms and hands beside the hips";
+  EXPECT_LT(body_pixels(up_out, 10, 45, 150, 200), hands / 10) << "arms held out";
+  EXPECT_GT(body_pixels(up_out, 0, 20, 30, 75), body_pixels(up1, 0, 20, 30, 75) + 50) << "out to the side";
+  // Arm length: a longer arm's hand reaches lower.
+  Body longer;
+  longer.shape.arm_length = 1.15;
+  EXPECT_GT(body_pixels(procedural::mmw_body(longer, false, 200, 200), 10, 45, 0, 20),
+            body_pixels(low1, 10, 45, 0, 20) + 50)
+      << "the hands reach into the lower view";
+  // Leg length: the crotch (the gap between the legs at the centre column) moves as the
+  // shared map says, and the feet stay on the floor.
+  const auto crotch = [](const Image& im) {
+    int y = 0;
+    while (y < im.height && im.at(100, y) > 90) ++y;
+    return y - 1;
+  };
+  const auto lowest = [](const Image& im) {  // the last row with body pixels
+    int y = im.height - 1;
+    while (y > 0 && body_pixels(im, 0, im.width, y, y + 1) == 0) --y;
+    return y;
+  };
+  for (double legs : {0.9, 1.1}) {
+    Body b;
+    b.shape.leg_length = legs;
+    const Image low = procedural::mmw_body(b, false, 200, 200);
+    const double c1 = crotch(low1) + 200.5;  // field row of the pixel's centre
+    EXPECT_NEAR(crotch(low) + 200.5, drawn_row(b.shape, c1), 1.5) << "legs " << legs;
+    EXPECT_GT(std::abs(crotch(low) - crotch(low1)), 8) << "the crotch really moved";
+    EXPECT_NEAR(lowest(low), lowest(low1), 1) << "feet on the floor";
+  }
+  // The default shape draws today's body, to the byte (the catalogue's subjects too: the
+  // golden tests).
+  Body same;
+  same.shape.shoulders = same.shape.chest = same.shape.hips = 1.0;
+  EXPECT_EQ(procedural::mmw_body(same, true, 200, 200).pixels, up1.pixels);
+}
+
+// The drawn map and its inverse agree, and object places follow it for every view.
+TEST(Bodies, PlacesFollowTheLegs) {
+  BodyShape b;
+  b.height = 1.07;
+  b.leg_length = 1.08;
+  for (double y = -60; y <= 400; y += 7.5) EXPECT_NEAR(body_row(b, drawn_row(b, y)), y, 1e-9) << y;
+  EXPECT_DOUBLE_EQ(drawn_row(b, kBodyFloorRow), kBodyFloorRow) << "the feet stay";
+  EXPECT_NEAR(drawn_row(b, kBodyTopRow), kBodyFloorRow - (kBodyFloorRow - kBodyTopRow) * b.height, 1e-9)
+      << "the stature is the height's";
+  Catalogue cat = test::catalogue();
+  cat.subjects[1].shape.leg_length = 1.1;
+  for (Sensor& s : cat.sensors) derive_places(cat, s);
+  for (const Sensor& s : cat.sensors)
+    for (int r = 0; r < cat.region_count(); ++r) {
+      if (!s.sees(r)) continue;
+      const double c = s.rects[r].y + s.rects[r].h / 2.0;
+      const double want = (drawn_row(cat.subjects[1].shape, s.field_row(c)) - s.field_row(c)) * s.jitter_scale_y;
+      EXPECT_NEAR(s.place(1, r).y - s.rects[r].y, want, 0.5) << s.name << " region " << r + 1;
+      EXPECT_EQ(s.place(0, r).y, s.rects[r].y) << "subject 1 keeps its places";
+    }
+  const int knee = 9, low = cat.sensor_index("lower");
+  EXPECT_LT(cat.sensors[low].place(1, knee).y, cat.sensors[low].rects[knee].y - 3) << "longer legs raise the knees";
+}
+
+// Both backends within their parity tolerances on drawn bodies (every pose among them) and
+// on the extremes the catalogue allows, both models; features sparse equal dense.
+TEST(Bodies, BothBackendsAgreeOnDrawnAndExtremeBodies) {
+  Catalogue drawn = test::catalogue();
+  use_random_bodies(drawn, 99, 12);
+  // The smallest and the largest body, each pose, each skin's end.
+  Catalogue extremes = test::catalogue();
+  for (int k = 0; k < 5; ++k) {
+    Subject& s = extremes.subjects[k];
+    const bool big = k % 2 == 1;
+    BodyShape& b = s.shape;
+    b.height = big ? kHeightRange.hi : kHeightRange.lo;
+    b.leg_length = big ? kLegLengthRange.hi : kLegLengthRange.lo;
+    b.arm_length = big ? kArmLengthRange.hi : kArmLengthRange.lo;
+    b.shoulders = b.chest = b.hips = b.build = big ? kBreadthRange.hi : kBreadthRange.lo;
+    b.pose = static_cast<Pose>(k % 3);
+    s.skin_emissivity = big ? kSkinEmissivityRange.hi : kSkinEmissivityRange.lo;
+    s.skin_temperature = big ? kSkinTemperatureRange.hi : kSkinTemperatureRange.lo;
+  }
+  for (Sensor& s : extremes.sensors) derive_places(extremes, s);
+  int poses = 0;
+  for (const Subject& s : drawn.subjects) poses |= 1 << static_cast<int>(s.shape.pose);
+  ASSERT_EQ(poses, 7) << "the drawn bodies hold every pose";
+  for (const Catalogue* cat : {&drawn, &extremes}) {
+    SCOPED_TRACE(cat == &drawn ? "drawn bodies" : "extreme bodies");
+    const AssetSet a = build_assets(*cat);
+    const SceneBatch batch = test::batch_of(test::parity_set(*cat, cat->variant_list.size() * kBuiltinRegions + 60, 8));
+    auto ref = make_reference_backend(*cat, a);
+    auto cl = make_opencl_backend(*cat, a, test::runtime());
+    for (Model model : {Model::thesis, Model::physics}) {
+      SCOPED_TRACE(model_name(model));
+      const Plan p = model == Model::physics ? test::physics_plan() : Plan{};
+      BatchOutput r, k;
+      ref->run(batch, p, r);
+      cl->run(batch, p, k);
+      const OutputDiff d = compare_outputs(k, r);
+      EXPECT_EQ(check_tolerance(d, model_tolerance(model, Tier::standard)), "");  // plan/tolerance.h
+      EXPECT_GT(d.ir.pixels, 0u);
+      EXPECT_EQ(d.metal_exact, 1.0);
+    }
+    // The bodies reach the images: the same scenes on the catalogue's five subjects give
+    // other MMW images.
+    std::vector<Scenario> five = test::coverage(*cat, 40, 4);
+    for (Scenario& s : five) s.subject %= 5;
+    const SceneBatch on_five = test::batch_of(five);
+    Plan p = test::physics_plan();
+    BatchOutput own, plain;
+    cl->run(on_five, p, own);
+    make_opencl_backend(test::catalogue(), test::assets(), test::runtime())->run(on_five, p, plain);
+    EXPECT_NE(own.view("upper").pixels, plain.view("upper").pixels);
+  }
+}
+
+TEST(Bodies, CatalogueKeysAndBadValues) {
+  const std::string text = default_text();
+  const Catalogue c = parse_catalogue(
+      test::with_subject_line(text, 2,
+                              "shoulders = 1.2\nchest = 0.9\nhips = 1.1\narm_length = 1.05\nleg_length = 0.95\n"
+                              "pose = \"arms-raised\"\nskin_emissivity = 0.5\nskin_temperature = 305"),
+      "b.toml", "");
+  const Subject& s = c.subjects[2];
+  EXPECT_EQ(s.shape.shoulders, 1.2);
+  EXPECT_EQ(s.shape.chest, 0.9);
+  EXPECT_EQ(s.shape.hips, 1.1);
+  EXPECT_EQ(s.shape.arm_length, 1.05);
+  EXPECT_EQ(s.shape.leg_length, 0.95);
+  EXPECT_EQ(s.shape.pose, Pose::arms_raised);
+  EXPECT_EQ(c.physics.skin_emissivity_of(s), 0.5);
+  EXPECT_EQ(c.physics.skin_temperature_of(s), 305.0);
+  EXPECT_EQ(c.physics.skin_emissivity_of(c.subjects[0]), c.physics.skin_emissivity) << "the catalogue's skin";
+  EXPECT_EQ(c.subjects[0].shape.shoulders, c.subjects[0].shape.build) << "breadths default to the build";
+  struct Bad {
+    std::string line, field, says;
+  };
+  for (const Bad& b : std::vector<Bad>{{"pose = \"arms-up\"", "subjects[2].pose", "is not a pose"},
+                                       {"pose = 3", "subjects[2].pose", "expected a string"},
+                                       {"shoulders = 1.6", "subjects[2].shoulders", "out of range"},
+                                       {"leg_length = nan", "subjects[2].leg_length", "NaN"},
+                                       {"arm_length = 0.5", "subjects[2].arm_length", "out of range"},
+                                       {"skin_emissivity = 0.95", "subjects[2].skin_emissivity", "out of range"},
+                                       {"skin_temperature = 250", "subjects[2].skin_temperature", "out of range"}}) {
+    int line = 0;
+    const std::string e = catalogue_error(test::with_subject_line(text, 1, b.line, &line));
+    EXPECT_NE(e.find("b.toml:" + std::to_string(line) + ": " + b.field + ": "), std::string::npos) << e;
+    EXPECT_NE(e.find(b.says), std::string::npos) << e;
+  }
+}
+
+// generate --bodies random: scenarios.csv records each row's body, the run's bytes do not
+// depend on the batch, a scenario list of it makes the same data again, and bad values are
+// refused before anything is written.
+test::Result gen(const test::TempDir& t, std::vector<std::string> args, const fs::path& out) {
+  args.insert(args.begin(), "generate");
+  for (const char* a : {"--quiet", "--out"}) args.push_back(a);
+  args.push_back(out.string());
+  return test::finish(test::start(t.cap(), args), 300);
+}
+
+TEST(Bodies, GenerateRecordsEachRowsBody) {
+  test::TempDir t;
+  const std::vector<std::string> run = {"--model", "physics", "--bodies", "random", "--body-count", "9",
+                                        "--seed",  "5",       "--what",   "both",   "--format",     "csv"};
+  const auto with = [&](std::vector<std::string> more) {
+    std::vector<std::string> a = run;
+    a.insert(a.end(), more.begin(), more.end());
+    return a;
+  };
+  const test::Result a = gen(t, with({"--count", "120", "--batch", "7"}), t.w() / "a");
+  ASSERT_EQ(a.status, 0) << test::describe(a);
+  ASSERT_EQ(gen(t, with({"--count", "120", "--batch", "64", "--threads", "1"}), t.w() / "b").status, 0);
+  for (const char* f : {"scenarios.csv", "features.csv", "images/00000037/upper.png", "images/00000101/ir.png"})
+    EXPECT_EQ(test::slurp(t.w() / "a" / f), test::slurp(t.w() / "b" / f)) << f;
+  std::istringstream list(test::slurp(t.w() / "a" / "scenarios.csv"));
+  std::string header, row;
+  std::getline(list, header);
+  for (const char* col : kBodyColumns) EXPECT_TRUE(test::has(header, std::string(",") + col)) << col;
+  std::set<std::string> subjects;
+  while (std::getline(list, row)) {
+    const size_t c0 = row.find(',') + 1;
+    subjects.insert(row.substr(c0, row.find(',', c0) - c0));
+  }
+  EXPECT_GT(subjects.size(), 5u) << "more than the catalogue's five bodies";
+  // Made again from the list (its body columns skipped: the seed draws the bodies again).
+  ASSERT_EQ(gen(t, with({"--scenarios", (t.w() / "a" / "scenarios.csv").string()}), t.w() / "c").status, 0);
+  for (const char* f : {"scenarios.csv", "features.csv"})
+    EXPECT_EQ(test::slurp(t.w() / "a" / f), test::slurp(t.w() / "c" / f)) << f;
+  // The catalogue's subjects: no body columns.
+  ASSERT_EQ(gen(t, {"--count", "5", "--format", "csv"}, t.w() / "d").status, 0);
+  EXPECT_FALSE(test::has(test::slurp(t.w() / "d" / "scenarios.csv"), "stature_mm"));
+  const std::vector<std::pair<std::vector<std::string>, std::string>> bad = {
+      {{"--bodies", "random", "--body-count", "0"}, "--body-count: \"0\" is not between 1 and 255"},
+      {{"--bodies", "random", "--body-count", "256"}, "is not between 1 and 255"},
+      {{"--bodies", "random", "--body-count", "1e3"}, "--body-count"},
+      {{"--bodies", "randomly"}, "--bodies: \"randomly\" is not catalogue or random"},
+      {{"--body-count", "9"}, "--body-count: only applies to random bodies"}};
+  for (const auto& [flags, says] : bad) {
+    std::vector<std::string> a = flags;
+    a.insert(a.end(), {"--count", "3"});
+    const test::Result r = gen(t, a, t.w() / "bad");
+    EXPECT_EQ(r.status, 2) << flags.back();
+    EXPECT_TRUE(test::has(r.err, says)) << flags.back() << ": " << r.err;
+    EXPECT_FALSE(fs::exists(t.w() / "bad")) << "nothing written for " << flags.back();
+  }
+  // A spec file's key is named with its file and line.
+  test::spit(t.w() / "s.toml", "count = 3\n\nbodies = \"everyone\"\n");
+  const test::Result r = gen(t, {"--spec", (t.w() / "s.toml").string()}, t.w() / "bad");
+  EXPECT_NE(r.status, 0);
+  EXPECT_TRUE(test::has(r.err, "s.toml:3: bodies: \"everyone\" is not catalogue or random")) << r.err;
+  EXPECT_FALSE(fs::exists(t.w() / "bad"));
+}
+
+}  // namespace
+}  // namespace portalsim
