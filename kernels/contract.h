@@ -176,7 +176,8 @@ typedef struct {
   PS_I32 phys_gauss; /* the PS_GAUSS_TABLE values of Phi^-1((k + 1/2) / PS_GAUSS_TABLE) in phys */
   /* The IR contact shadow off the body (IR views): per subject, the lowest base image index
    * that is body (warmer than halfway from the room to the skin), then per variant its
-   * shadow against the room, -coupling (room - object), where the object is not on the body. */
+   * shadow against the room, -coupling (room - object), where the object is not on the body,
+   * then per subject the factor of every shadow on it: (its skin - room) / (skin - room). */
   PS_I32 phys_off_body;
   /* The MMW camera's processing: frames averaged (each its own NETD draw), the automatic
    * window (1) or the fixed one (0), and stage_mmw_display's weights of each raw column for

@@ -2,21 +2,33 @@
 // the field is each object's surface dT alone, laid by its IR sprite's coverage over 0 K,
 // against the surface it touches: on the body (a base image index of at least the
 // subject's body_from) the skin (host: PS_PHYS_VARIANTS, -coupling (skin - object)), off
-// it the room (phys_off_body); "heat_spread" then blurs it with the optics kernels. Stage "ir_surface": plus the bare body's surface temperature, the
+// it the room (phys_off_body), scaled to the subject's own skin (shadow_values); "heat_spread" then blurs it with the optics kernels. Stage "ir_surface": plus the bare body's surface temperature, the
 // base image's index read as kelvin through the subject's (gain, offset).
+// A row's layers' shadows for subject s, against the skin (`on`) and the room (`off`): each
+// variant's (layer_values) times the subject's skin above the room over the catalogue's
+// skin's (the object warms towards its carrier's skin; host: the off-body block's last S).
+inline void shadow_values(const Layers* Ly, const PsViewLaunch* L, global const param* phys, const SceneDraw* d, int s,
+                          preal* on, preal* off) {
+  global const param* off_body = phys + L->phys_off_body;
+  layer_values(Ly, phys + PS_PHYS_VARIANTS(L->subjects), phys, d, L->subjects, on);
+  layer_values(Ly, off_body + L->subjects, phys, d, L->subjects, off);
+  const preal skin = (preal)off_body[L->subjects + L->variants + s];
+  for (int k = 0; k < Ly->count; ++k) {
+    on[k] *= skin;
+    off[k] *= skin;
+  }
+}
+
 kernel void stage_contact_shadow(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;
   global preal* dT = (global preal*)field + row0;
-  global const param* shadow = phys + PS_PHYS_VARIANTS(L.subjects);
-  global const param* off_body = phys + L.phys_off_body + L.subjects;
   global const uchar* restrict base = base_row(atlas, bases, subject, &L, i, y);
   const int body_from = (int)phys[L.phys_off_body + subject[i]];
   const SceneDraw scene = scene_draw(phys, seed, index);
   preal on[PS_MAX_LAYERS], off[PS_MAX_LAYERS];
   Layers Ly;
   composite_layers(&Ly, rec, &L, y);
-  layer_values(&Ly, shadow, phys, &scene, L.subjects, on);
-  layer_values(&Ly, off_body, phys, &scene, L.subjects, off);
+  shadow_values(&Ly, &L, phys, &scene, subject[i], on, off);
   for (int x = 0; x < L.width; ++x) dT[x] = lay_values(&Ly, atlas, x, (int)base[x] >= body_from ? on : off, (preal)0);
 }
 

@@ -53,8 +53,6 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
 
   // contact_shadow over each row's span (into T), zero over the rest the row blur reads;
   // then heat_spread along the row (T -> S) as stage_optics_rows, over the span's reach.
-  global const param* shadow = phys + PS_PHYS_VARIANTS(L->subjects);
-  global const param* off_body = phys + L->phys_off_body + L->subjects;
   const int body_from = (int)phys[L->phys_off_body + s];
   global const param* taps = psf_taps(phys, L);
   const SceneDraw scene = scene_draw(phys, (uint2)(L->seed_lo, L->seed_hi), upsample(L->first_hi, L->first_lo) + i);
@@ -62,8 +60,7 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
   for (int y = y_lo; y < y_hi; ++y) {
     Layers Ly;
     composite_layers(&Ly, rec, L, y);
-    layer_values(&Ly, shadow, phys, &scene, L->subjects, on);
-    layer_values(&Ly, off_body, phys, &scene, L->subjects, off);
+    shadow_values(&Ly, L, phys, &scene, s, on, off);
     int a = W, b = 0;
     for (int k = 0; k < Ly.count; ++k) {
       a = min(a, max(Ly.x0[k], 0));

@@ -264,6 +264,38 @@ TEST(Bodies, BothBackendsAgreeOnDrawnAndExtremeBodies) {
   }
 }
 
+// An object warms towards its carrier's own skin, so its IR contact shadow scales with that
+// skin's excess over the room: a plate on a subject of skin 310 K shows (310 - 293) / (306
+// - 293) = 1.31 times the shadow it shows on the catalogue's 306 K, in both backends. The
+// depth is read at the plate's deepest pixel in IR index levels (about 80 deep), so 0.05
+// holds the ratio to a level or two of rounding.
+TEST(Bodies, IrShadowFollowsTheSkin) {
+  Catalogue warm = test::catalogue();
+  warm.subjects[0].skin_temperature = 310;
+  const Catalogue& plain = test::catalogue();
+  const AssetSet warm_assets = build_assets(warm);
+  Scenario bare, plate;
+  plate.objects[1] = static_cast<int16_t>(test::variant_of(plain, "metal-plate"));
+  Plan p = test::physics_plan();
+  p.model.ir_netd = 0;
+  const int ir = plain.sensor_index("ir");
+  const auto depth = [&](const Catalogue& cat, const AssetSet& a, bool reference) {
+    auto backend = reference ? make_reference_backend(cat, a) : make_opencl_backend(cat, a, test::runtime());
+    BatchOutput o;
+    backend->run(test::batch_of({bare, plate}), p, o);
+    const std::vector<uint8_t>& px = o.views[ir].pixels;
+    const size_t n = o.views[ir].pixels_per_image();
+    int deepest = 0;
+    for (size_t k = 0; k < n; ++k) deepest = std::max(deepest, int(px[k]) - int(px[n + k]));
+    return deepest;
+  };
+  for (bool reference : {false, true}) {
+    const int d_warm = depth(warm, warm_assets, reference), d_plain = depth(plain, test::assets(), reference);
+    EXPECT_GT(d_plain, 40) << "a deep shadow to compare";
+    EXPECT_NEAR(double(d_warm) / d_plain, (310.0 - 293) / (306 - 293), 0.05) << (reference ? "reference" : "kernels");
+  }
+}
+
 TEST(Bodies, CatalogueKeysAndBadValues) {
   const std::string text = default_text();
   const Catalogue c = parse_catalogue(

@@ -276,8 +276,8 @@ extern const SinkKind scenario_list_kind{
     .meaning =
         [](std::string_view, int regions, int) {
           return "the scenario list: subject, the object in each of the " + std::to_string(regions) +
-                 " regions, the label (and each object's random transform, each knob drawn per scenario, and with "
-                 "random bodies each row's body as drawn); generate --scenarios makes the data set again from it";
+                 " regions, the label (and each object's random transform); generate --scenarios makes the data set "
+                 "again from it";
         }};
 
 namespace {

@@ -160,6 +160,12 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     for (size_t subj = 0; subj < cat.subjects.size(); ++subj)
       off_body.push_back(std::ceil((body_from - pc.ir_index_min_k) / per_index));
     off_body.insert(off_body.end(), off_body_shadow.begin(), off_body_shadow.end());
+    // Each subject's shadows scale with its skin above the room: every shadow above is
+    // -coupling (skin - room) times a factor of the material and the worn time.
+    for (const Subject& subj : cat.subjects) {
+      const double span = pc.skin_temperature - pc.room_temperature;
+      off_body.push_back(span == 0 ? 1.0 : (pc.skin_temperature_of(subj) - pc.room_temperature) / span);
+    }
     t.off_body = append(off_body);
     if (scene_drawn) p[PS_PHYS_SCENE] = append(scene);
     return t;

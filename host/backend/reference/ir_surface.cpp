@@ -1,15 +1,19 @@
+#include <cmath>
+
 #include "backend/reference/stages.h"
 
 namespace portalsim::reference {
 
-// The clothing surface over an object is pulled towards the object's physical temperature:
-// by ir_coupling of the object's shortfall below the skin.
-double contact_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant) {
-  const PhysicsConfig& pc = cat.physics;
-  return -pc.ir_coupling * (pc.skin_temperature - worn_temperature(cat, m, variant));
-}
-
 namespace {
+
+// The object on this subject has warmed from the room towards the subject's own skin for
+// worn_minutes, with its material's time constant.
+double worn_on(const Catalogue& cat, const ModelSettings& m, int variant, const Subject& subject) {
+  const PhysicsConfig& pc = cat.physics;
+  const double skin = pc.skin_temperature_of(subject);
+  const Material& mat = cat.materials.at(cat.object_of(variant).material_id);
+  return skin - (skin - pc.room_temperature) * std::exp(-m.worn_minutes / mat.warm_minutes);
+}
 
 // The bare surface's temperature at (x, y): the subject's base image index read linearly
 // as kelvin.
@@ -20,12 +24,18 @@ double base_kelvin(const ViewScene& vs, int x, int y) {
 }
 
 // Where the object lies off the body, the surface it touches is the room's.
-double off_body_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant) {
+double off_body_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant, const Subject& subject) {
   const PhysicsConfig& pc = cat.physics;
-  return -pc.ir_coupling * (pc.room_temperature - worn_temperature(cat, m, variant));
+  return -pc.ir_coupling * (pc.room_temperature - worn_on(cat, m, variant, subject));
 }
 
 }  // namespace
+
+// The clothing surface over an object is pulled towards the object's physical temperature:
+// by ir_coupling of the object's shortfall below the subject's skin.
+double contact_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant, const Subject& subject) {
+  return -cat.physics.ir_coupling * (cat.physics.skin_temperature_of(subject) - worn_on(cat, m, variant, subject));
+}
 
 // The shadow field alone (0 K where no object lies), objects in region order by their IR
 // sprites' coverage, as radiometry lays them: v = c dT + (1 - c) v; dT against the skin
@@ -37,10 +47,10 @@ void contact_shadow(const ViewScene& vs, Field& f) {
   f.v.assign(vs.sensor.pixels(), 0.0);
   Field off = f;
   lay_objects(vs, f, 1.0, [](const ViewScene& s, const Placed& p, int, int) {
-    return contact_shadow_kelvin(s.cat, s.model, p.variant);
+    return contact_shadow_kelvin(s.cat, s.model, p.variant, s.cat.subjects[s.scenario.subject]);
   });
   lay_objects(vs, off, 1.0, [](const ViewScene& s, const Placed& p, int, int) {
-    return off_body_shadow_kelvin(s.cat, s.model, p.variant);
+    return off_body_shadow_kelvin(s.cat, s.model, p.variant, s.cat.subjects[s.scenario.subject]);
   });
   const PhysicsConfig& pc = vs.cat.physics;
   for (int y = 0; y < f.height; ++y)

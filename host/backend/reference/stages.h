@@ -87,8 +87,9 @@ PORTALSIM_STAGES(PORTALSIM_DECLARE_STAGE)
 // The physics model's quantities, from the catalogue and the knobs.
 double body_temperature(const Catalogue& cat, const ModelSettings& m, const Subject& s);  // bare body under clothing, K
 double worn_temperature(const Catalogue& cat, const ModelSettings& m, int variant);  // physical, K, warmed on the body
-double object_temperature(const Catalogue& cat, const ModelSettings& m, int variant);     // apparent, under clothing
-double contact_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant);  // IR surface dT, full cover
+double object_temperature(const Catalogue& cat, const ModelSettings& m, int variant);  // apparent, under clothing
+double contact_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant,
+                             const Subject& subject);               // IR surface dT on this subject, full cover
 double ir_spread_pixels(const Catalogue& cat, const Sensor& view);  // heat spreading's sigma in IR view pixels
 void gaussian_blur(Field& f, double sigma);                         // separable, edges held; sigma in pixels
 double psf_fwhm_pixels(const Catalogue& cat, const Sensor& view);   // the Airy core's FWHM in view pixels
