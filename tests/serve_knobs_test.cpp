@@ -26,6 +26,7 @@ TEST(ServeKnobs, ListHasEveryKnobOfTheRegistryWithItsDeclaration) {
     EXPECT_EQ(e["max"].get<double>(), k.max) << k.key;
     EXPECT_EQ(e["choices"].get<std::vector<std::string>>(), k.choices) << k.key;
     EXPECT_EQ(e["fidelity"].get<bool>(), k.fidelity) << k.key;
+    EXPECT_EQ(e["drawable"].get<bool>(), k.drawn >= 0) << k.key;
     EXPECT_EQ(e["default"], knob_text(k.get(standard))) << k.key;
     EXPECT_EQ(e["help"], k.help);
     // The default, set back through the knob, is accepted and changes nothing.

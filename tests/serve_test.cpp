@@ -123,6 +123,47 @@ TEST_F(ServeShortSubject, HitBoxesFollowTheSubjectsHeight) {
   }
 }
 
+// serve --bodies random: the page lists the drawn bodies with their draw, renders any of
+// them, and its Generate draws the same bodies (the body seed passed on).
+class ServeRandomBodies : public Serve {
+ protected:
+  std::vector<std::string> extra_args() override {
+    return {"--bodies", "random", "--body-count", "6", "--body-seed", "3", "--seed", "99"};
+  }
+};
+
+TEST_F(ServeRandomBodies, ListsRendersAndGeneratesTheDrawnBodies) {
+  auto cat = client().Get("/api/catalogue");
+  ASSERT_TRUE(cat);
+  const json j = json::parse(cat->body);
+  ASSERT_EQ(j["subjects"].size(), 6u);
+  EXPECT_EQ(j["subjects"][5], "body-006");
+  ASSERT_EQ(j["subject_notes"].size(), 6u);
+  EXPECT_NE(j["subject_notes"][0].get<std::string>().find(" m, arms-"), std::string::npos) << j["subject_notes"];
+  for (const json& r : j["regions"]) EXPECT_EQ(r["places"].size(), 6u);
+  auto r1 = post("/api/render", {{"objects", kGun}, {"subject", 1}}),
+       r6 = post("/api/render", {{"objects", kGun}, {"subject", 6}});
+  ASSERT_TRUE(r1 && r6);
+  ASSERT_EQ(r6->status, 200) << r6->body;
+  EXPECT_NE(json::parse(r1->body)["upper"], json::parse(r6->body)["upper"]) << "two bodies, two images";
+  auto g = post("/api/generate", {{"objects", kGun}, {"subject", 6}, {"name", "bodies"}, {"count", 20}});
+  ASSERT_TRUE(g);
+  ASSERT_EQ(g->status, 200) << g->body;
+  json s;
+  portalsim::test::wait_until(
+      [&] {
+        auto st = client().Get("/api/generate");
+        s = st ? json::parse(st->body) : json();
+        return s.value("state", "") != "running";
+      },
+      120, 50);
+  ASSERT_EQ(s["state"], "done") << s.dump();
+  const std::string list = slurp(root() / "bodies" / "scenarios.csv");
+  EXPECT_NE(list.find(",stature_mm,"), std::string::npos) << "the run's bodies are the drawn ones";
+  const json manifest = json::parse(slurp(root() / "bodies" / "manifest.json"));
+  EXPECT_EQ(manifest["spec"]["body_seed"], "3") << "the server's bodies, not the page's seed's";
+}
+
 TEST_F(Serve, RenderGivesTheThesisGunExample) {
   auto r = post("/api/render", {{"objects", kGun}, {"rule", "gun"}});
   ASSERT_TRUE(r);

@@ -5,8 +5,11 @@
 #include <cstdio>
 #include <thread>
 
+#include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "io/input_file.h"
+#include "scene/bodies.h"
 #include "serve/server.h"
 
 namespace portalsim::cli {
@@ -15,8 +18,25 @@ namespace {
 struct ServeCmd {
   CommonOptions common;
   ServeOptions serve;
+  std::string bodies = "catalogue", body_count, body_seed;
   CLI::App* app = nullptr;
 };
+
+// The page's subjects: the catalogue's, or random bodies drawn once for the server's life.
+RunSpec bodies_spec(const ServeCmd& o) {
+  RunSpec spec;
+  spec.bodies = o.bodies;
+  if (!o.body_count.empty()) {
+    const uint64_t n = io::parse_u64(o.body_count, "--body-count");
+    if (n < 1 || n > kMaxRandomBodies)
+      throw InputError("--body-count: \"" + o.body_count + "\" is not between 1 and " +
+                       std::to_string(kMaxRandomBodies));
+    spec.body_count = static_cast<int>(n);
+  }
+  if (!o.body_seed.empty()) spec.body_seed = io::parse_u64(o.body_seed, "--body-seed");
+  spec.validate();  // names the flags: --bodies, --body-count, --body-seed
+  return spec;
+}
 
 int serve(ServeCmd& o) {
   // SIGINT/SIGTERM stop the server cleanly (its scratch folder is removed): every thread
@@ -26,7 +46,10 @@ int serve(ServeCmd& o) {
   sigaddset(&stop_signals, SIGINT);
   sigaddset(&stop_signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
-  Session s = open_session(o.common);
+  const RunSpec bodies = bodies_spec(o);
+  Session s;
+  open_catalogue(s, o.common, &bodies);
+  open_backend(s, o.common);
   char self[4096];
   const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
   o.serve.self = n > 0 ? std::string(self, static_cast<size_t>(n)) : std::string("portalsim");
@@ -34,6 +57,11 @@ int serve(ServeCmd& o) {
     CLI::Option* opt = o.app->get_option_no_throw(flag);
     if (opt && opt->count() > 0) o.serve.session.insert(o.serve.session.end(), {flag, opt->as<std::string>()});
   }
+  // Its Generate draws the same bodies, whatever the page's seed.
+  if (bodies.random_bodies())
+    o.serve.session.insert(o.serve.session.end(),
+                           {"--bodies", "random", "--body-count", std::to_string(bodies.random_bodies()), "--body-seed",
+                            std::to_string(bodies.bodies_seed())});
   Server server(s.catalogue, s.assets, *s.backend, o.serve);
   const int port = server.bind();
   std::printf("portalsim serve: http://%s:%d/ (root %s)\n", o.serve.bind.c_str(), port, o.serve.root.c_str());
@@ -58,6 +86,11 @@ std::function<int()> add_serve(CLI::App& app) {
   sub->add_option("--port", o->serve.port, "TCP port (default 8080; 0 = any free port)");
   sub->add_option("--bind", o->serve.bind, "address to listen on (default 127.0.0.1, loopback only)");
   sub->add_option("--root", o->serve.root, "folder that Save and Generate write under (default: current folder)");
+  sub->add_option("--bodies", o->bodies,
+                  "the page's subjects: catalogue (its own), or random: bodies drawn from the ANSUR II survey's "
+                  "statistics (docs/model/bodies.md)");
+  sub->add_option("--body-count", o->body_count, "how many random bodies, 1 .. 255 (default 64)");
+  sub->add_option("--body-seed", o->body_seed, "the seed the random bodies are drawn from (default 0)");
   o->app = sub;
   return [o] { return serve(*o); };
 }

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 
 #include "scene/philox.h"
 
@@ -145,6 +147,19 @@ Subject draw_body(const Catalogue& cat, uint64_t seed, int k, DrawnBody* drawn) 
   b.drawn = row;
   if (drawn) *drawn = d;
   return b;
+}
+
+std::string body_summary(const Subject& s) {
+  if (s.drawn.empty()) return "";
+  // The record's fields: sex, stature_mm, ..., pose (kBodyColumns).
+  std::vector<std::string> f;
+  size_t at = 0;
+  for (size_t comma; (comma = s.drawn.find(',', at)) != std::string::npos; at = comma + 1)
+    f.push_back(s.drawn.substr(at, comma - at));
+  f.push_back(s.drawn.substr(at));
+  char stature[32];
+  std::snprintf(stature, sizeof stature, "%.2f m", std::atof(f[1].c_str()) / 1000);
+  return f[0] + ", " + stature + ", " + f[7];
 }
 
 void use_random_bodies(Catalogue& cat, uint64_t seed, int count) {

@@ -3,6 +3,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "scene/catalogue.h"
@@ -28,6 +29,9 @@ inline constexpr std::array<const char*, 11> kBodyColumns{
 
 // Whether the catalogue's subjects are drawn bodies (use_random_bodies).
 inline bool drawn_bodies(const Catalogue& cat) { return !cat.subjects.empty() && !cat.subjects[0].drawn.empty(); }
+
+// A drawn body in a few words ("female, 1.62 m, arms-raised"); empty for the catalogue's.
+std::string body_summary(const Subject& s);
 
 // Body k (0-based) of a run: a pure function of (seed, k) on the counter generator's
 // PS_STREAM_BODIES stream, whatever the run's count, batch or shard. `cat` gives the

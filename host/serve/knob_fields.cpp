@@ -47,6 +47,7 @@ nlohmann::json knob_list() {
                     {"values", k.values()},
                     {"default", knob_text(k.get(defaults))},
                     {"fidelity", k.fidelity},
+                    {"drawable", k.drawn >= 0},  // takes A..B, drawn per scenario
                     {"group", physics ? "physics" : "both"}});
   }
   return list;

@@ -22,6 +22,7 @@
 #include "base/sizes.h"
 #include "io/input_file.h"
 #include "plan/knobs.h"
+#include "scene/bodies.h"
 #include "serve/knob_fields.h"
 #include "serve/one_scenario.h"
 #include "serve/request.h"
@@ -380,7 +381,11 @@ struct Server::Impl {
                             {"side", side_name(v.side)},
                             {"size", {v.width, v.height}}});
     j["subjects"] = json::array();
-    for (const Subject& sub : c.subjects) j["subjects"].push_back(sub.name);
+    j["subject_notes"] = json::array();  // a random body's draw, for the page's list
+    for (const Subject& sub : c.subjects) {
+      j["subjects"].push_back(sub.name);
+      j["subject_notes"].push_back(body_summary(sub));
+    }
     j["regions"] = json::array();
     for (size_t k = 0; k < c.regions.size(); ++k) {
       const Region& r = c.regions[k];

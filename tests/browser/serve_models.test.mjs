@@ -85,6 +85,16 @@ await withPage(binary, root, { width: 1400, height: 1300 }, async ({ page, url }
   await after(() => page.$eval("#knob-netd", (e) => { e.value = "3"; e.dispatchEvent(new Event("change")); }));
   check((await page.$eval("#error", (e) => e.textContent)) === "", "the message goes when the value is good");
 
+  // A knob that may be drawn per scenario takes A..B (Generate's data set draws it); a
+  // reversed range is refused with the flag's message.
+  check((await page.$eval("#knob-netd", (e) => e.type)) === "text", "--netd is a text field: a number or A..B");
+  await after(() => page.$eval("#knob-netd", (e) => { e.value = "1..4"; e.dispatchEvent(new Event("change")); }));
+  check((await page.$eval("#error", (e) => e.textContent)) === "", "a range renders");
+  await page.$eval("#knob-netd", (e) => { e.value = "4..1"; e.dispatchEvent(new Event("change")); });
+  await page.waitForFunction(() => document.getElementById("error").textContent.includes("reversed"),
+    { timeout: 60000 });
+  await after(() => page.$eval("#knob-netd", (e) => { e.value = "3"; e.dispatchEvent(new Event("change")); }));
+
   // Side by side: one scenario, both models, each with simulate's zones.
   check(await page.$eval("#compare-views", (e) => e.hidden), "side by side starts hidden");
   await after(() => page.click("#side-by-side"));

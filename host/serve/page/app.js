@@ -23,7 +23,8 @@ function settings() {
 }
 
 // One control per knob of the registry (/api/knobs), by its kind: a checkbox for on/off,
-// a list for a choice, a number field within the knob's range, text for WxH and A..B.
+// a list for a choice, a number field within the knob's range, text for WxH and A..B (and
+// for a knob that may be drawn per scenario).
 function knobControl(k) {
   let c;
   if ((k.fidelity && k.choices.length) || k.kind === "choice") {
@@ -37,7 +38,10 @@ function knobControl(k) {
     c.checked = k.default === "on";
   } else {
     c = document.createElement("input");
-    if (k.kind === "integer" || k.kind === "number") {
+    if (k.drawable) {  // a number, or A..B drawn per scenario (Generate's data set varies it)
+      c.type = "text";
+      c.placeholder = k.min + " .. " + k.max + ", or A..B";
+    } else if (k.kind === "integer" || k.kind === "number") {
       c.type = "number";
       c.min = k.min; c.max = k.max; c.step = k.kind === "integer" ? "1" : "any";
     }
@@ -152,7 +156,10 @@ async function init() {
   buildViews();
   knobs = await (await fetch("/api/knobs")).json();
   knobs.forEach(knobControl);
-  cat.subjects.forEach((s, i) => option($("subject"), i + 1, (i + 1) + " " + s));
+  cat.subjects.forEach((s, i) => {
+    const note = cat.subject_notes[i];
+    option($("subject"), i + 1, (i + 1) + " " + s + (note ? " (" + note + ")" : ""));
+  });
   cat.tiers.forEach((t) => option($("tier"), t));
   $("tier").value = "standard";
   cat.objects.forEach((o) => option($("tool"), o));
