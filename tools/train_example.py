@@ -25,19 +25,11 @@ from torch import nn
 from torch.utils.data import DataLoader
 
 from portalsim.torch import H5Dataset, StreamDataset
+from transfer_cnn import model  # the one network, which portalsim transfer --classifiers cnn trains too
 
 # The stream's scenarios: a balanced gun set, as the data.h5 example's generate command.
 STREAM = dict(rule="gun", balance=True, what="images", views=("upper", "lower"))
 TEST_START = 10**9
-
-
-def model(channels):
-    return nn.Sequential(
-        nn.AvgPool2d(4),
-        nn.Conv2d(channels, 16, 5, padding=2), nn.ReLU(), nn.MaxPool2d(2),
-        nn.Conv2d(16, 32, 3, padding=1), nn.ReLU(), nn.MaxPool2d(2),
-        nn.Conv2d(32, 32, 3, padding=1), nn.ReLU(), nn.AdaptiveMaxPool2d(1),
-        nn.Flatten(), nn.Linear(32, 2))
 
 
 def loaders(a):

@@ -63,10 +63,9 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
-void run_plot_script(std::string_view script, const std::string& dir, const std::vector<std::string>& args,
-                     const std::string& what, bool offers_no_plot) {
+bool run_python_script(std::string_view script, const std::string& dir, const std::vector<std::string>& args) {
   namespace fs = std::filesystem;
-  const std::string path = (fs::path(dir) / ".plot.py").string();
+  const std::string path = (fs::path(dir) / ".script.py").string();
   write_text_atomic(path, std::string(script));
   std::string cmd = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   cmd += " " + shell_quote(path);
@@ -74,7 +73,12 @@ void run_plot_script(std::string_view script, const std::string& dir, const std:
   const int rc = std::system(cmd.c_str());
   std::error_code ec;
   fs::remove(path, ec);
-  if (rc != 0)
+  return rc == 0;
+}
+
+void run_plot_script(std::string_view script, const std::string& dir, const std::vector<std::string>& args,
+                     const std::string& what, bool offers_no_plot) {
+  if (!run_python_script(script, dir, args))
     throw OutputError(what + ": the plot failed (python3 with matplotlib is needed" +
                       (offers_no_plot ? "; or --no-plot)" : ")"));
 }

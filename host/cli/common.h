@@ -59,10 +59,12 @@ void print_paths(const Backend& backend, const Plan& plan);
 // `s` as one word for /bin/sh, whatever it holds ('...' with each ' as '\'').
 std::string shell_quote(const std::string& s);
 
-// Runs an embedded Python script (the plots' matplotlib) with Debian's /usr/bin/python3,
-// whose matplotlib it is, where it exists: written into `dir` as .plot.py, run with `args`
-// (each one word, however named), then removed. Throws OutputError naming `what` if it fails,
-// and --no-plot where the command has it.
+// Runs an embedded Python script with Debian's /usr/bin/python3 (whose matplotlib and torch
+// it is) where it exists: written into `dir` as .script.py, run with `args` (each one word,
+// however named), then removed. Whether it exited 0.
+bool run_python_script(std::string_view script, const std::string& dir, const std::vector<std::string>& args);
+// The same for a plot: throws OutputError naming `what` if it fails, and --no-plot where the
+// command has it.
 void run_plot_script(std::string_view script, const std::string& dir, const std::vector<std::string>& args,
                      const std::string& what, bool offers_no_plot = true);
 

@@ -19,17 +19,23 @@
 #include "cli/learning_sets.h"
 #include "cli/validate_stats.h"
 #include "cli/weka.h"
+#include "io/input_file.h"
 #include "schedule/pipeline.h"
 #include "schedule/run_spec.h"
 #include "sink/staging.h"
 
-namespace portalsim::cli {
+namespace portalsim {
+namespace embedded {
+extern const std::string_view transfer_cnn;
+}
+
+namespace cli {
 
 namespace {
 
 namespace fs = std::filesystem;
 
-// The classifiers by their flag name: WEKA's class and the report's name.
+// The classifiers by their flag name: WEKA's class (none for the CNN) and the report's name.
 struct Classifier {
   const char* key;
   const char* weka_class;
@@ -37,12 +43,13 @@ struct Classifier {
 };
 constexpr Classifier kClassifiers[] = {{"j48", "weka.classifiers.trees.J48", "J48"},
                                        {"svm", "weka.classifiers.functions.SMO", "SMO"},
-                                       {"mlp", "weka.classifiers.functions.MultilayerPerceptron", "MLP"}};
+                                       {"mlp", "weka.classifiers.functions.MultilayerPerceptron", "MLP"},
+                                       {"cnn", nullptr, "CNN"}};
 
 struct Options {
   std::string train, out, classifiers = "j48,svm", catalogue;
   std::vector<std::string> tests;
-  int block = 10;
+  int block = 10, cnn_steps = 300;
   double max_loss = 3.0;
 };
 
@@ -64,21 +71,32 @@ bool good_name(const std::string& n) {
   });
 }
 
-Set make_set(const std::string& name, const std::string& source, const std::string& flag) {
+// `images`: the CNN is among the classifiers, so a spec's set is made with its MMW views
+// (data.h5) and any other set must be a data.h5 that holds them.
+Set make_set(const std::string& name, const std::string& source, const std::string& flag, bool images) {
   Set s{.name = name, .source = source, .spec = nullptr, .table = {}};
   if (source.empty()) throw InputError(flag + ": " + name + ": no data set given");
   if (is_spec(source)) {
     // Read now: a bad spec stops the command before anything is made.
     s.spec = std::make_unique<RunSpec>();
     read_spec_file(source, *s.spec);
-    s.spec->what = "features";
-    s.spec->formats = {"arff"};
+    s.spec->what = images ? "both" : "features";
+    s.spec->formats = images ? std::vector<std::string>{"arff", "h5"} : std::vector<std::string>{"arff"};
     s.spec->validate();
   } else {
     std::error_code ec;
     if (!fs::exists(source, ec)) throw InputError(flag + ": " + source + ": no such file or folder");
+    if (images && fs::path(source).extension() != ".h5")
+      throw InputError(flag + ": " + source +
+                       ": the CNN needs the MMW views: give a run spec (.toml) or a data.h5 "
+                       "with images");
   }
   return s;
+}
+
+// The set's data.h5 for the CNN: the one made here for a spec, else the set itself.
+std::string images_of(const Set& s, const std::string& made) {
+  return s.spec ? (fs::path(made) / s.name / "data.h5").string() : s.source;
 }
 
 std::string percent(double fraction) {
@@ -94,12 +112,14 @@ int run_transfer(const Options& o) {
     const auto it = std::find_if(std::begin(kClassifiers), std::end(kClassifiers),
                                  [&](const Classifier& k) { return lower(c) == k.key; });
     if (it == std::end(kClassifiers))
-      throw InputError("--classifiers: unknown classifier '" + c + "' (j48, svm or mlp)");
+      throw InputError("--classifiers: unknown classifier '" + c + "' (j48, svm, mlp or cnn)");
     if (std::find(chosen.begin(), chosen.end(), &*it) == chosen.end()) chosen.push_back(&*it);
   }
-  if (chosen.empty()) throw InputError("--classifiers: none given (j48, svm or mlp)");
+  if (chosen.empty()) throw InputError("--classifiers: none given (j48, svm, mlp or cnn)");
+  const bool cnn = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return !c->weka_class; });
+  const bool weka = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return c->weka_class; });
   std::vector<Set> sets;
-  sets.push_back(make_set("train", o.train, "--train"));
+  sets.push_back(make_set("train", o.train, "--train", cnn));
   std::set<std::string> names{"train"};
   for (const std::string& t : o.tests) {
     const size_t eq = t.find('=');
@@ -108,17 +128,17 @@ int run_transfer(const Options& o) {
     if (!good_name(name))
       throw InputError("--test: '" + name + "' is not a name (letters, digits, '-', '_', '.'; at most 64)");
     if (!names.insert(name).second) throw InputError("--test: the name '" + name + "' is given twice");
-    sets.push_back(make_set(name, t.substr(eq + 1), "--test"));
+    sets.push_back(make_set(name, t.substr(eq + 1), "--test", cnn));
   }
   if (sets.size() < 2) throw InputError("--test: at least one test set is needed (NAME=SET)");
-  if (const auto missing = weka_missing()) throw EnvironmentError("transfer: " + *missing);
+  if (const auto missing = weka_missing(); weka && missing) throw EnvironmentError("transfer: " + *missing);
 
   const WorkDir scratch;
   StagedFolder folder(o.out);
   // The specs' sets, made here and kept under sets/.
   const bool any_spec = std::any_of(sets.begin(), sets.end(), [](const Set& s) { return s.spec != nullptr; });
+  const std::string made = any_spec ? folder.path("sets") : std::string();
   if (any_spec) {
-    const std::string made = folder.path("sets");
     fs::create_directories(made);
     CommonOptions co;
     co.catalogue = o.catalogue;
@@ -169,7 +189,25 @@ int run_transfer(const Options& o) {
                            {"interval", "95%: Wilson (accuracy), Newcombe's hybrid score (loss)"}};
   std::vector<std::vector<long>> correct(chosen.size(), std::vector<long>(sets.size(), 0));
   std::string why;
-  for (size_t c = 0; c < chosen.size(); ++c)
+  for (size_t c = 0; c < chosen.size(); ++c) {
+    if (!chosen[c]->weka_class) {  // the CNN, on the sets' MMW views
+      const std::string scores = (fs::path(scratch.path) / "cnn.json").string();
+      std::vector<std::string> args{scores, "--steps", std::to_string(o.cnn_steps)};
+      for (const Set& s : sets) args.push_back(images_of(s, made));
+      if (!run_python_script(embedded::transfer_cnn, scratch.path, args))
+        throw EnvironmentError(
+            "transfer: the CNN failed (Debian's python3-torch, python3-h5py and python3-numpy are needed; its "
+            "message is above)");
+      const nlohmann::json j = nlohmann::json::parse(io::read_text_file(scores, "CNN scores", io::Bom::refuse));
+      for (size_t k = 1; k < sets.size(); ++k) {
+        correct[c][k] = j.at("correct").at(k - 1).get<long>();
+        if (j.at("n").at(k - 1).get<size_t>() != sets[k].table.rows.size())
+          throw InputError(images_of(sets[k], made) + ": its images and its feature table differ in count");
+        std::fprintf(stderr, "transfer: CNN on %s: %s%%\n", sets[k].name.c_str(),
+                     percent(double(correct[c][k]) / static_cast<double>(sets[k].table.rows.size())).c_str());
+      }
+      continue;
+    }
     for (size_t k = 1; k < sets.size(); ++k) {
       const auto s = weka_score(chosen[c]->weka_class, arff[0], arff[k], 0, 1, why);
       if (!s) throw EnvironmentError(std::string("WEKA ") + chosen[c]->name + ": " + why);
@@ -178,6 +216,7 @@ int run_transfer(const Options& o) {
       std::fprintf(stderr, "transfer: %s on %s: %s%%\n", chosen[c]->name, sets[k].name.c_str(),
                    percent(double(correct[c][k]) / n).c_str());
     }
+  }
 
   std::ostringstream md;
   md << "# portalsim transfer\n\nTrained on `" << sets[0].source << "` (" << sets[0].table.rows.size() << " instances, "
@@ -250,7 +289,11 @@ std::function<int()> add_transfer(CLI::App& app) {
                   "measured against")
       ->required();
   cmd->add_option("--out", o->out, "Folder for report.md, report.json and the specs' sets")->required();
-  cmd->add_option("--classifiers", o->classifiers, "Comma-separated: j48, svm, mlp (default j48,svm)");
+  cmd->add_option("--classifiers", o->classifiers,
+                  "Comma-separated: j48, svm, mlp (WEKA, on the features) and cnn (tools/train_example.py's small "
+                  "CNN on the MMW views; python3-torch) (default j48,svm)");
+  cmd->add_option("--cnn-steps", o->cnn_steps, "Training steps of the CNN, batches of 32 (default 300)")
+      ->check(CLI::Range(1, 1000000));
   cmd->add_option("--catalogue", o->catalogue, "Catalogue TOML for the specs and folders (default: built-in)");
   cmd->add_option("--block", o->block, "Block side for folders turned into tables (default 10)")
       ->check(CLI::Range(1, 65536));
@@ -259,4 +302,5 @@ std::function<int()> add_transfer(CLI::App& app) {
   return [o]() { return run_transfer(*o); };
 }
 
-}  // namespace portalsim::cli
+}  // namespace cli
+}  // namespace portalsim
