@@ -386,6 +386,27 @@ TEST(Bodies, GenerateRecordsEachRowsBody) {
     EXPECT_TRUE(test::has(r.err, says)) << flags.back() << ": " << r.err;
     EXPECT_FALSE(fs::exists(t.w() / "bad")) << "nothing written for " << flags.back();
   }
+  // simulate draws the same bodies: body 7 of body seed 3 as generate renders it from a list.
+  test::spit(t.w() / "one.csv",
+             "subject,region1,region2,region3,region4,region5,region6,region7,region8,region9,region10,region11,"
+             "region12,region13\n7,none,gun,none,none,none,none,none,none,none,none,none,none,none\n");
+  const std::vector<std::string> bodies = {"--model",      "physics", "--bodies",    "random",
+                                           "--body-count", "8",       "--body-seed", "3"};
+  std::vector<std::string> listed = bodies;
+  listed.insert(listed.end(), {"--what", "images", "--scenarios", (t.w() / "one.csv").string()});
+  ASSERT_EQ(gen(t, listed, t.w() / "listed").status, 0);
+  std::vector<std::string> sim = {"simulate", "none", "gun", "--subject", "7", "--out", (t.w() / "sim").string()};
+  sim.insert(sim.end(), bodies.begin(), bodies.end());
+  const test::Result s = test::finish(test::start(t.cap(), sim), 120);
+  ASSERT_EQ(s.status, 0) << test::describe(s);
+  for (const char* f : {"upper.png", "lower.png", "ir.png"})
+    EXPECT_EQ(test::slurp(t.w() / "sim" / f), test::slurp(t.w() / "listed" / "images" / "00000000" / f)) << f;
+  const test::Result s9 =
+      test::finish(test::start(t.cap(), {"simulate", "none", "gun", "--subject", "9", "--bodies", "random",
+                                         "--body-count", "8", "--out", (t.w() / "sim9").string()}),
+                   120);
+  EXPECT_EQ(s9.status, 2);
+  EXPECT_TRUE(test::has(s9.err, "--subject: 9 is out of range (1 to 8)")) << s9.err;
   // A spec file's key is named with its file and line.
   test::spit(t.w() / "s.toml", "count = 3\n\nbodies = \"everyone\"\n");
   const test::Result r = gen(t, {"--spec", (t.w() / "s.toml").string()}, t.w() / "bad");

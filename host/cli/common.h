@@ -50,6 +50,15 @@ Session open_session(const CommonOptions& o);
 // place of the catalogue's subjects.
 void open_catalogue(Session& s, const CommonOptions& o, const RunSpec* spec = nullptr);
 void open_backend(Session& s, const CommonOptions& o);
+// The flags that choose the subjects of a command without a run spec (simulate, serve):
+// the catalogue's, or random bodies (--bodies random, --body-count, --body-seed; default 0).
+struct BodyOptions {
+  std::string bodies = "catalogue", count, seed;
+};
+void add_body_options(CLI::App& app, BodyOptions& o);
+// Them as a spec for open_catalogue; checked, errors naming the flags.
+RunSpec bodies_spec(const BodyOptions& o);
+
 // The bodies a generate folder was made with, as a spec for open_catalogue: its manifest's
 // random bodies and seed (the catalogue's subjects where it has none, or no manifest).
 RunSpec bodies_of_folder(const std::string& dir);

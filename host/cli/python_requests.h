@@ -26,12 +26,13 @@ void check_generate(const RunSpec& spec, const Catalogue& cat);
 
 struct SimulateRequest {
   CommonOptions common;
+  RunSpec bodies;  // the subjects: --bodies, --body-count, --body-seed (open_catalogue's spec)
   Scenario scene;
   Plan plan;  // the model and fidelity, as simulate runs them
 };
 
 // `args` as simulate's (objects, then flags); the scenario and plan are made when `cat` is
-// given (the catalogue `common` names, opened by the caller). Throws as parse_generate.
+// given (the catalogue `common` and `bodies` name, opened by the caller). Throws as parse_generate.
 SimulateRequest parse_simulate(const std::vector<std::string>& args, const Catalogue* cat);
 
 }  // namespace portalsim::cli

@@ -8,7 +8,6 @@
 #include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "io/input_file.h"
 #include "scene/bodies.h"
 #include "serve/server.h"
 
@@ -18,25 +17,9 @@ namespace {
 struct ServeCmd {
   CommonOptions common;
   ServeOptions serve;
-  std::string bodies = "catalogue", body_count, body_seed;
+  BodyOptions body;
   CLI::App* app = nullptr;
 };
-
-// The page's subjects: the catalogue's, or random bodies drawn once for the server's life.
-RunSpec bodies_spec(const ServeCmd& o) {
-  RunSpec spec;
-  spec.bodies = o.bodies;
-  if (!o.body_count.empty()) {
-    const uint64_t n = io::parse_u64(o.body_count, "--body-count");
-    if (n < 1 || n > kMaxRandomBodies)
-      throw InputError("--body-count: \"" + o.body_count + "\" is not between 1 and " +
-                       std::to_string(kMaxRandomBodies));
-    spec.body_count = static_cast<int>(n);
-  }
-  if (!o.body_seed.empty()) spec.body_seed = io::parse_u64(o.body_seed, "--body-seed");
-  spec.validate();  // names the flags: --bodies, --body-count, --body-seed
-  return spec;
-}
 
 int serve(ServeCmd& o) {
   // SIGINT/SIGTERM stop the server cleanly (its scratch folder is removed): every thread
@@ -46,7 +29,7 @@ int serve(ServeCmd& o) {
   sigaddset(&stop_signals, SIGINT);
   sigaddset(&stop_signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
-  const RunSpec bodies = bodies_spec(o);
+  const RunSpec bodies = bodies_spec(o.body);
   Session s;
   open_catalogue(s, o.common, &bodies);
   open_backend(s, o.common);
@@ -86,11 +69,7 @@ std::function<int()> add_serve(CLI::App& app) {
   sub->add_option("--port", o->serve.port, "TCP port (default 8080; 0 = any free port)");
   sub->add_option("--bind", o->serve.bind, "address to listen on (default 127.0.0.1, loopback only)");
   sub->add_option("--root", o->serve.root, "folder that Save and Generate write under (default: current folder)");
-  sub->add_option("--bodies", o->bodies,
-                  "the page's subjects: catalogue (its own), or random: bodies drawn from the ANSUR II survey's "
-                  "statistics (docs/model/bodies.md)");
-  sub->add_option("--body-count", o->body_count, "how many random bodies, 1 .. 255 (default 64)");
-  sub->add_option("--body-seed", o->body_seed, "the seed the random bodies are drawn from (default 0)");
+  add_body_options(*sub, o->body);
   o->app = sub;
   return [o] { return serve(*o); };
 }

@@ -15,6 +15,7 @@ namespace portalsim::cli {
 namespace {
 struct SimulateOptions {
   CommonOptions common;
+  BodyOptions body;
   int subject = 1;
   std::string rule, threat, out = "portalsim-out", image_format = "png";
   std::vector<std::string> objects;
@@ -40,7 +41,8 @@ Plan simulate_plan(const SimulateOptions& o, const Catalogue& cat) {
 int simulate(SimulateOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   Session s;
-  open_catalogue(s, o.common);
+  const RunSpec bodies = bodies_spec(o.body);
+  open_catalogue(s, o.common, &bodies);
   const Catalogue& cat = s.catalogue;
 
   // Everything the user gave is checked before any backend work or any file is written.
@@ -75,7 +77,9 @@ void add_simulate_options(CLI::App* sub, SimulateOptions* o) {
   sub->add_option("objects", o->objects,
                   "objects for the catalogue's regions in order, 1..13 in the built-in one (none = empty region; gun:v "
                   "= vertical variant)");
-  sub->add_option("--subject", o->subject, "subject 1..5 (base images and base metal values)");
+  sub->add_option("--subject", o->subject,
+                  "subject 1..5 (base images and base metal values), or a random body's number");
+  add_body_options(*sub, o->body);
   sub->add_option("--rule", o->rule, "threat rule, e.g. gun or 'iron-rod&metal-plate'");
   sub->add_option("--threat", o->threat, "label the scenario yes or no")->check(CLI::IsMember({"yes", "no"}));
   sub->add_option("--out", o->out, "output folder (default portalsim-out)");
@@ -102,6 +106,7 @@ SimulateRequest parse_simulate(const std::vector<std::string>& args, const Catal
   parse_args(app, args);
   SimulateRequest r;
   r.common = o.common;
+  r.bodies = bodies_spec(o.body);
   if (cat) {
     r.scene = make_scenario(*cat, ScenarioInputs{o.subject, o.objects, o.rule, o.threat});
     r.plan = simulate_plan(o, *cat);

@@ -379,7 +379,8 @@ py::dict simulate(const std::vector<std::string>& args) {
   {
     py::gil_scoped_release nogil;
     cli::Session s;
-    cli::open_catalogue(s, cli::parse_simulate(args, nullptr).common);
+    const cli::SimulateRequest flags = cli::parse_simulate(args, nullptr);
+    cli::open_catalogue(s, flags.common, &flags.bodies);
     const cli::SimulateRequest req = cli::parse_simulate(args, &s.catalogue);
     open_backend_here(s, req.common);
     Plan plan = req.plan;
