@@ -100,25 +100,27 @@ void open_backend(Session& s, const CommonOptions& o) {
   s.backend_seconds = since(t0);
 }
 
-void add_body_options(CLI::App& app, BodyOptions& o) {
+void add_body_options(CLI::App& app, BodyOptions& o, const std::string& seed_default) {
   app.add_option("--bodies", o.bodies,
-                 "the subjects: catalogue (its own), or random: bodies drawn from the ANSUR II survey's statistics "
-                 "(docs/model/bodies.md)");
+                 "the subjects: catalogue (its own), or random: bodies drawn from the ANSUR II survey's statistics, "
+                 "each with its own pose and skin, in place of them (docs/model/bodies.md)");
   app.add_option("--body-count", o.count,
                  "how many random bodies, 1 .. " + std::to_string(kMaxRandomBodies) + " (default " +
                      std::to_string(kDefaultRandomBodies) + ")");
-  app.add_option("--body-seed", o.seed, "the seed the random bodies are drawn from (default 0)");
+  app.add_option("--body-seed", o.seed, "the seed the random bodies are drawn from (default " + seed_default + ")");
+}
+
+int parse_body_count(const std::string& text) {
+  const uint64_t n = io::parse_u64(text, "--body-count");
+  if (n < 1 || n > kMaxRandomBodies)
+    throw InputError("--body-count: \"" + text + "\" is not between 1 and " + std::to_string(kMaxRandomBodies));
+  return static_cast<int>(n);
 }
 
 RunSpec bodies_spec(const BodyOptions& o) {
   RunSpec spec;
   spec.bodies = o.bodies;
-  if (!o.count.empty()) {
-    const uint64_t n = io::parse_u64(o.count, "--body-count");
-    if (n < 1 || n > kMaxRandomBodies)
-      throw InputError("--body-count: \"" + o.count + "\" is not between 1 and " + std::to_string(kMaxRandomBodies));
-    spec.body_count = static_cast<int>(n);
-  }
+  if (!o.count.empty()) spec.body_count = parse_body_count(o.count);
   if (!o.seed.empty()) spec.body_seed = io::parse_u64(o.seed, "--body-seed");
   spec.validate();  // names the flags: --bodies, --body-count, --body-seed
   return spec;

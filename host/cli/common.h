@@ -50,12 +50,16 @@ Session open_session(const CommonOptions& o);
 // place of the catalogue's subjects.
 void open_catalogue(Session& s, const CommonOptions& o, const RunSpec* spec = nullptr);
 void open_backend(Session& s, const CommonOptions& o);
-// The flags that choose the subjects of a command without a run spec (simulate, serve):
-// the catalogue's, or random bodies (--bodies random, --body-count, --body-seed; default 0).
+// The flags that choose a command's subjects: the catalogue's, or random bodies (--bodies
+// random, --body-count, --body-seed). A run spec's commands read them into the spec
+// (spec_flags.cpp); simulate and serve through bodies_spec.
 struct BodyOptions {
   std::string bodies = "catalogue", count, seed;
 };
-void add_body_options(CLI::App& app, BodyOptions& o);
+// `seed_default` says what --body-seed defaults to.
+void add_body_options(CLI::App& app, BodyOptions& o, const std::string& seed_default = "0");
+// --body-count's value, checked: 1 .. kMaxRandomBodies.
+int parse_body_count(const std::string& text);
 // Them as a spec for open_catalogue; checked, errors naming the flags.
 RunSpec bodies_spec(const BodyOptions& o);
 

@@ -5,10 +5,8 @@
 #include <cstdio>
 #include <thread>
 
-#include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "scene/bodies.h"
 #include "serve/server.h"
 
 namespace portalsim::cli {

@@ -16,14 +16,7 @@ void add_spec_flags(CLI::App* sub, SpecFlags* o, bool outputs) {
   sub->add_option("--pool", o->pool, "objects to draw from, comma-separated (default: all)");
   sub->add_option("--objects", o->objects, "objects per scenario, MIN..MAX (default 0..4)");
   sub->add_option("--subjects", o->subjects, "subjects to draw from, e.g. 1,2,5 (default: all)");
-  sub->add_option("--bodies", o->spec.bodies,
-                  "catalogue: the catalogue's subjects; random: bodies drawn from the seed out of the ANSUR II "
-                  "survey's statistics, each with its own pose and skin, in place of them");
-  sub->add_option("--body-seed", o->body_seed,
-                  "the seed random bodies are drawn from (default: --seed): the same bodies with other scenarios");
-  sub->add_option("--body-count", o->body_count,
-                  "how many random bodies a run draws, 1 .. " + std::to_string(kMaxRandomBodies) + " (default " +
-                      std::to_string(kDefaultRandomBodies) + ")");
+  add_body_options(*sub, o->body, "--seed; give it apart to keep the bodies over other scenarios");
   sub->add_flag("--balance", o->spec.balance, "equal classes: even indices threats, odd not");
   if (outputs) {
     sub->add_option("--what", o->spec.what, "features, images or both (default features)");
@@ -75,15 +68,9 @@ RunSpec build_spec(SpecFlags& o) {
       spec.subjects.push_back(std::stoi(s));
     }
   }
-  if (given("--bodies")) spec.bodies = o.spec.bodies;
-  if (given("--body-seed")) spec.body_seed = io::parse_u64(o.body_seed, "--body-seed");
-  if (given("--body-count")) {
-    const uint64_t n = io::parse_u64(o.body_count, "--body-count");
-    if (n < 1 || n > kMaxRandomBodies)
-      throw InputError("--body-count: \"" + o.body_count + "\" is not between 1 and " +
-                       std::to_string(kMaxRandomBodies));
-    spec.body_count = static_cast<int>(n);
-  }
+  if (given("--bodies")) spec.bodies = o.body.bodies;
+  if (given("--body-seed")) spec.body_seed = io::parse_u64(o.body.seed, "--body-seed");
+  if (given("--body-count")) spec.body_count = parse_body_count(o.body.count);
   if (given("--balance")) spec.balance = o.spec.balance;
   if (given("--what")) spec.what = o.spec.what;
   if (given("--format")) spec.formats = split_list(o.formats);

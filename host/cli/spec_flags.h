@@ -14,7 +14,8 @@ namespace portalsim::cli {
 struct SpecFlags {
   CommonOptions common;
   RunSpec spec;
-  std::string count, spec_file, objects, pool, subjects, body_count, body_seed, formats, png_level;
+  std::string count, spec_file, objects, pool, subjects, formats, png_level;
+  BodyOptions body;  // --bodies, --body-count, --body-seed
   std::map<std::string, std::string> knobs;
   CLI::App* app = nullptr;
 };

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -149,17 +150,22 @@ int run_transfer(const Options& o) {
     open_backend(session, co);
     PipelineOptions popt;
     popt.progress = false;
+    // Sets of random bodies draw theirs from their body seed: one session per (body seed,
+    // count), which the sets that share them share (the training bodies tested again).
+    std::map<std::pair<uint64_t, int>, Session> drawn;
     for (Set& s : sets) {
       if (!s.spec) continue;
       const std::string dir = (fs::path(made) / s.name).string();
-      // A set of random bodies draws its own from its seed.
-      Session own;
+      Session* use = &session;
       if (s.spec->random_bodies()) {
-        open_catalogue(own, co, s.spec.get());
-        open_backend(own, co);
+        const auto [it, fresh] = drawn.try_emplace({s.spec->bodies_seed(), s.spec->random_bodies()});
+        if (fresh) {
+          open_catalogue(it->second, co, s.spec.get());
+          open_backend(it->second, co);
+        }
+        use = &it->second;
       }
-      const Session& use = s.spec->random_bodies() ? own : session;
-      run_pipeline(*s.spec, use.catalogue, use.assets, *use.backend, dir, popt);
+      run_pipeline(*s.spec, use->catalogue, use->assets, *use->backend, dir, popt);
       std::fprintf(stderr, "transfer: %s: %llu scenarios from %s\n", s.name.c_str(),
                    static_cast<unsigned long long>(s.spec->count), s.source.c_str());
       s.table = read_arff((fs::path(dir) / "features.arff").string());

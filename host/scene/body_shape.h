@@ -54,25 +54,28 @@ constexpr BodyRange kSkinEmissivityRange{0.1, 0.9}, kSkinTemperatureRange{300.0,
 // head, in field rows.
 constexpr double kBodyFloorRow = 400.0, kBodyHipRow = 212.0, kBodyTopRow = -66.0;
 
+// The 1.0 body's legs (floor to hip joints) in field rows, and the scale of the rest of the
+// stature where the legs scale by `leg_length`: what keeps the stature.
+constexpr double kBodyLegRows = kBodyFloorRow - kBodyHipRow;
+inline double trunk_scale(const BodyShape& b) {
+  return 1.0 + (1.0 - b.leg_length) * kBodyLegRows / (kBodyHipRow - kBodyTopRow);
+}
+
 // The row a point of the body at body row `y` (the 1.0 body's) is drawn at: heights above
 // the floor scale by `height`, the legs' part of them also by `leg_length` and the rest by
-// what keeps the stature.
+// trunk_scale.
 inline double drawn_row(const BodyShape& b, double y) {
   if (b.leg_length == 1.0) return kBodyFloorRow - (kBodyFloorRow - y) * b.height;
-  const double legs = kBodyFloorRow - kBodyHipRow, rest = kBodyHipRow - kBodyTopRow;
-  const double trunk = 1.0 + (1.0 - b.leg_length) * legs / rest;
-  const double c = kBodyFloorRow - y;
-  const double drawn = c <= legs ? b.leg_length * c : b.leg_length * legs + trunk * (c - legs);
+  const double c = kBodyFloorRow - y, legs = kBodyLegRows;
+  const double drawn = c <= legs ? b.leg_length * c : b.leg_length * legs + trunk_scale(b) * (c - legs);
   return kBodyFloorRow - drawn * b.height;
 }
 
 // Its inverse: the body row drawn at field row `y`.
 inline double body_row(const BodyShape& b, double y) {
   if (b.leg_length == 1.0) return b.height == 1.0 ? y : kBodyFloorRow - (kBodyFloorRow - y) / b.height;
-  const double legs = kBodyFloorRow - kBodyHipRow, rest = kBodyHipRow - kBodyTopRow;
-  const double trunk = 1.0 + (1.0 - b.leg_length) * legs / rest;
-  const double e = (kBodyFloorRow - y) / b.height;
-  const double c = e <= b.leg_length * legs ? e / b.leg_length : legs + (e - b.leg_length * legs) / trunk;
+  const double e = (kBodyFloorRow - y) / b.height, legs = kBodyLegRows;
+  const double c = e <= b.leg_length * legs ? e / b.leg_length : legs + (e - b.leg_length * legs) / trunk_scale(b);
   return kBodyFloorRow - c;
 }
 

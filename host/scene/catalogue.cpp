@@ -469,8 +469,8 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
       }
     }
     // Objects move with the stature and the legs; an image file's body would not.
-    for (const char* key : {"height", "leg_length"})
-      if (t.get(key) && rd.number(t, key, f, 0, 2) != 1.0 && !s.images.empty())
+    for (const auto& [key, value] : {std::pair{"height", b.height}, std::pair{"leg_length", b.leg_length}})
+      if (value != 1.0 && !s.images.empty())
         rd.fail(t.get(key), f + "." + key,
                 "only a procedural body can be drawn at another height; this subject names image files (images)");
     cat.subjects.push_back(std::move(s));

@@ -162,8 +162,8 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     off_body.insert(off_body.end(), off_body_shadow.begin(), off_body_shadow.end());
     // Each subject's shadows scale with its skin above the room: every shadow above is
     // -coupling (skin - room) times a factor of the material and the worn time.
+    const double span = pc.skin_temperature - pc.room_temperature;
     for (const Subject& subj : cat.subjects) {
-      const double span = pc.skin_temperature - pc.room_temperature;
       off_body.push_back(span == 0 ? 1.0 : (pc.skin_temperature_of(subj) - pc.room_temperature) / span);
     }
     t.off_body = append(off_body);

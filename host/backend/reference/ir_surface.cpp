@@ -1,19 +1,8 @@
-#include <cmath>
-
 #include "backend/reference/stages.h"
 
 namespace portalsim::reference {
 
 namespace {
-
-// The object on this subject has warmed from the room towards the subject's own skin for
-// worn_minutes, with its material's time constant.
-double worn_on(const Catalogue& cat, const ModelSettings& m, int variant, const Subject& subject) {
-  const PhysicsConfig& pc = cat.physics;
-  const double skin = pc.skin_temperature_of(subject);
-  const Material& mat = cat.materials.at(cat.object_of(variant).material_id);
-  return skin - (skin - pc.room_temperature) * std::exp(-m.worn_minutes / mat.warm_minutes);
-}
 
 // The bare surface's temperature at (x, y): the subject's base image index read linearly
 // as kelvin.
@@ -26,15 +15,16 @@ double base_kelvin(const ViewScene& vs, int x, int y) {
 // Where the object lies off the body, the surface it touches is the room's.
 double off_body_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant, const Subject& subject) {
   const PhysicsConfig& pc = cat.physics;
-  return -pc.ir_coupling * (pc.room_temperature - worn_on(cat, m, variant, subject));
+  return -pc.ir_coupling * (pc.room_temperature - worn_temperature(cat, m, variant, pc.skin_temperature_of(subject)));
 }
 
 }  // namespace
 
 // The clothing surface over an object is pulled towards the object's physical temperature:
-// by ir_coupling of the object's shortfall below the subject's skin.
+// by ir_coupling of the object's shortfall below the subject's skin, which it warms towards.
 double contact_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant, const Subject& subject) {
-  return -cat.physics.ir_coupling * (cat.physics.skin_temperature_of(subject) - worn_on(cat, m, variant, subject));
+  const double skin = cat.physics.skin_temperature_of(subject);
+  return -cat.physics.ir_coupling * (skin - worn_temperature(cat, m, variant, skin));
 }
 
 // The shadow field alone (0 K where no object lies), objects in region order by their IR

@@ -21,18 +21,19 @@ double body_temperature(const Catalogue& cat, const ModelSettings& m, const Subj
   return under_clothing(pc, m, pc.skin_emissivity_of(subject), pc.skin_temperature_of(subject));
 }
 
-// The object has warmed from the room towards the skin for worn_minutes, with its
+// The object has warmed from the room towards the skin it lies on for worn_minutes, with its
 // material's time constant.
-double worn_temperature(const Catalogue& cat, const ModelSettings& m, int variant) {
+double worn_temperature(const Catalogue& cat, const ModelSettings& m, int variant, double skin) {
   const PhysicsConfig& pc = cat.physics;
   const Material& mat = cat.materials.at(cat.object_of(variant).material_id);
-  return pc.skin_temperature -
-         (pc.skin_temperature - pc.room_temperature) * std::exp(-m.worn_minutes / mat.warm_minutes);
+  return skin - (skin - pc.room_temperature) * std::exp(-m.worn_minutes / mat.warm_minutes);
 }
 
+// In MMW the object warms towards the catalogue's skin (docs/model/bodies.md).
 double object_temperature(const Catalogue& cat, const ModelSettings& m, int variant) {
   const Material& mat = cat.materials.at(cat.object_of(variant).material_id);
-  return under_clothing(cat.physics, m, mat.emissivity, worn_temperature(cat, m, variant));
+  return under_clothing(cat.physics, m, mat.emissivity,
+                        worn_temperature(cat, m, variant, cat.physics.skin_temperature));
 }
 
 // The subject's base image in kelvin: its background gray is the room behind the subject,

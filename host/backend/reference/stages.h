@@ -86,7 +86,8 @@ PORTALSIM_STAGES(PORTALSIM_DECLARE_STAGE)
 
 // The physics model's quantities, from the catalogue and the knobs.
 double body_temperature(const Catalogue& cat, const ModelSettings& m, const Subject& s);  // bare body under clothing, K
-double worn_temperature(const Catalogue& cat, const ModelSettings& m, int variant);  // physical, K, warmed on the body
+double worn_temperature(const Catalogue& cat, const ModelSettings& m, int variant,
+                        double skin);  // physical, K, warmed on skin of this temperature
 double object_temperature(const Catalogue& cat, const ModelSettings& m, int variant);  // apparent, under clothing
 double contact_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant,
                              const Subject& subject);               // IR surface dT on this subject, full cover
