@@ -124,10 +124,7 @@ Subject draw_body(const Catalogue& cat, uint64_t seed, int k, DrawnBody* drawn) 
   // temperature above the room (150 at the catalogue's skin, as subject-1), the IR index
   // moves with the skin's kelvin on the catalogue's index map.
   const Subject unit;
-  const auto seen = [&](double e, double t) {
-    return pc.clothing_transmission * (e * t + (1 - e) * pc.room_temperature) +
-           (1 - pc.clothing_transmission) * pc.clothing_temperature;
-  };
+  const auto seen = [&](double e, double t) { return pc.seen_through_clothing(e, t, pc.room_temperature); };
   const double g0 = pc.base_background_gray, room = pc.background_temperature;
   const double level = g0 + (unit.mmw_level - g0) * (seen(b.skin_emissivity, b.skin_temperature) - room) /
                                 (seen(pc.skin_emissivity, pc.skin_temperature) - room);

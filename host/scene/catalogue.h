@@ -77,6 +77,13 @@ struct PhysicsConfig {
   double ir_index_min_k = 290.5, ir_index_max_k = 308.9;
   double ir_coupling = 0.8, ir_spread_mm = 10.0;
   double ir_display_min = 290.5, ir_display_max = 308.9;
+  // What a surface of emissivity e at physical temperature t shows the MMW camera through
+  // the clothing, the scene reflecting `illumination` (docs/model/physics-mmw.md). The
+  // kernels' tables and the drawn bodies' gray levels read it; the reference has its own.
+  double seen_through_clothing(double e, double t, double illumination) const {
+    return clothing_transmission * (e * t + (1 - e) * illumination) +
+           (1 - clothing_transmission) * clothing_temperature;
+  }
   // A subject's own skin where it gives one, else the values above.
   double skin_emissivity_of(const Subject& s) const {
     return s.skin_emissivity > 0 ? s.skin_emissivity : skin_emissivity;

@@ -63,10 +63,7 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   const Sensor& s = cat.sensors[view];
   const PhysicsConfig& pc = cat.physics;
   const bool ir = s.camera == Camera::ir;
-  const auto seen = [&](double e, double t) {
-    return pc.clothing_transmission * (e * t + (1 - e) * m.illumination) +
-           (1 - pc.clothing_transmission) * pc.clothing_temperature;
-  };
+  const auto seen = [&](double e, double t) { return pc.seen_through_clothing(e, t, m.illumination); };
   PhysicsTables t;
   std::vector<double>& p = t.values;
   p.assign(PS_PHYS_SUBJECTS, 0.0);
