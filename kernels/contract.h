@@ -86,6 +86,9 @@
 #define PS_DRAWN_ILLUMINATION 5u
 #define PS_DRAWN_WORN_MINUTES 6u
 #define PS_DRAWN_KNOBS 7
+/* The outfit of a run whose clothing is drawn (--clothing): its class from word 0, its
+ * outfit in the class from word 1 (PS_PHYS_CLOTHING). Not a numeric knob, so past PS_DRAWN_KNOBS. */
+#define PS_DRAWN_CLOTHING 7u
 /* physics: frame k >= 1 of the MMW camera's integration draws its NETD from stream
  * PS_STREAM_FRAME_NOISE + k (frame 0 from PS_STREAM_RAW_NOISE); element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_FRAME_NOISE 32u
@@ -213,7 +216,24 @@ typedef struct {
  * and exp(-worn_lo / tau) (PS_SCENE_*), then (MMW) each subject's bare raw grid's change over
  * the illumination's range (kernels/radiometry.cl, scene_draw). */
 #define PS_PHYS_SCENE 8
-#define PS_PHYS_SUBJECTS 9
+/* Where the clothing is drawn per scenario (--clothing), the offset of the clothing block (0:
+ * the catalogue's clothing): its classes C, each outfit's stride, the offset of the MMW gray
+ * grids (0 for IR), then per class its first outfit, then per class its outfits' count
+ * (PS_CLOTHING_*), then each outfit's entry (PS_OUTFIT_*): its factor of every IR shadow, the
+ * offset in the entry of its scene moves, then each subject's (gain, offset) and each
+ * variant's value as at PS_PHYS_SUBJECTS, and where the scene block is, each subject's and
+ * variant's moves as at its PS_SCENE_SUBJECTS. The gray grids (MMW): each subject's base
+ * image's gray through the raw grid's weights, so that its bare grid is gain G + offset (each
+ * raw cell's weights sum to 1; kernels/physics_raw.cl). */
+#define PS_PHYS_CLOTHING 9
+#define PS_PHYS_SUBJECTS 10
+#define PS_CLOTHING_CLASSES 0
+#define PS_CLOTHING_STRIDE 1
+#define PS_CLOTHING_GRIDS 2
+#define PS_CLOTHING_FIRST 3 /* kernels/shared.h: PS_CLOTHING_OUTFITS */
+#define PS_OUTFIT_SHADOW 0
+#define PS_OUTFIT_MOVES 1
+#define PS_OUTFIT_HEAD 2
 #define PS_SCENE_SUBJECTS 3 /* kernels/shared.h: PS_SCENE_VARIANTS, PS_SCENE_BARE */
 
 /* A camera view's placement record per scenario, written by place_view and read by

@@ -6,13 +6,14 @@
 // base image's index read as kelvin through the subject's (gain, offset).
 // A row's layers' shadows for subject s, against the skin (`on`) and the room (`off`): each
 // variant's (layer_values) times the subject's skin above the room over the catalogue's
-// skin's (the object warms towards its carrier's skin; host: the off-body block's last S).
+// skin's (the object warms towards its carrier's skin; host: the off-body block's last S),
+// times the outfit's factor (its insulation over the catalogue clothing's).
 inline void shadow_values(const Layers* Ly, const PsViewLaunch* L, global const param* phys, const SceneDraw* d, int s,
                           preal* on, preal* off) {
   global const param* off_body = phys + L->phys_off_body;
-  layer_values(Ly, phys + PS_PHYS_VARIANTS(L->subjects), phys, d, L->subjects, on);
-  layer_values(Ly, off_body + L->subjects, phys, d, L->subjects, off);
-  const preal skin = (preal)off_body[L->subjects + L->variants + s];
+  layer_values(Ly, variant_values(d, L->subjects), d, L->subjects, on);
+  layer_values(Ly, off_body + L->subjects, d, L->subjects, off);
+  const preal skin = (preal)off_body[L->subjects + L->variants + s] * d->shadow;
   for (int k = 0; k < Ly->count; ++k) {
     on[k] *= skin;
     off[k] *= skin;
@@ -36,8 +37,9 @@ kernel void stage_ir_surface(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;
   global const uchar* restrict base = base_row(atlas, bases, subject, &L, i, y);
   global preal* restrict T = (global preal*)field + row0;
-  const int s = subject[i];
-  const preal gain = (preal)phys[PS_PHYS_SUBJECTS + 2 * s], offset = (preal)phys[PS_PHYS_SUBJECTS + 2 * s + 1];
+  const SceneDraw scene = scene_draw(phys, seed, index);
+  preal gain, offset;
+  subject_kelvin(&scene, subject[i], &gain, &offset);
   for (int x = 0; x < L.width; ++x) T[x] += gain * (preal)base[x] + offset;
 }
 

@@ -41,7 +41,9 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
   global int* span_a = (global int*)(S + H * W);
   global int* span_b = span_a + H;
   const int s = subject[i];
-  const preal gain = (preal)phys[PS_PHYS_SUBJECTS + 2 * s], offset = (preal)phys[PS_PHYS_SUBJECTS + 2 * s + 1];
+  const SceneDraw scene = scene_draw(phys, (uint2)(L->seed_lo, L->seed_hi), upsample(L->first_hi, L->first_lo) + i);
+  preal gain, offset;
+  subject_kelvin(&scene, s, &gain, &offset);
 
   // The rows the objects can touch.
   int y_lo = H, y_hi = 0;
@@ -55,7 +57,6 @@ inline void ir_surface_view(uint i, const PsViewLaunch* L, global const uchar* a
   // then heat_spread along the row (T -> S) as stage_optics_rows, over the span's reach.
   const int body_from = (int)phys[L->phys_off_body + s];
   global const param* taps = psf_taps(phys, L);
-  const SceneDraw scene = scene_draw(phys, (uint2)(L->seed_lo, L->seed_hi), upsample(L->first_hi, L->first_lo) + i);
   preal on[PS_MAX_LAYERS], off[PS_MAX_LAYERS];
   for (int y = y_lo; y < y_hi; ++y) {
     Layers Ly;

@@ -42,9 +42,16 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   global preal* restrict d = acc + RW;
   const int s = subject[i];
   global const param* bare = phys + L.phys_base + (size_t)s * cells;
-  // The scenario's illumination moves the bare grid along its change (PS_SCENE_BARE).
+  // The scenario's illumination moves the bare grid along its change (PS_SCENE_BARE); its
+  // outfit makes it from its gray grid (PS_CLOTHING_GRIDS): gain G + offset, every raw cell's
+  // weights summing to 1.
   const SceneDraw scene = scene_draw(phys, seed, index);
-  if (scene.at == 0) {
+  preal gain, offset, lv[PS_MAX_LAYERS];
+  subject_kelvin(&scene, s, &gain, &offset);
+  if (scene.outfit >= 0) {
+    global const param* gray = phys + (int)phys[(int)phys[PS_PHYS_CLOTHING] + PS_CLOTHING_GRIDS] + (size_t)s * cells;
+    for (int k = 0; k < cells; ++k) r[k] = gain * (preal)gray[k] + offset;
+  } else if (scene.at == 0) {
     for (int k = 0; k < cells; ++k) r[k] = (preal)bare[k];
   } else {
     global const param* moved = phys + scene.at + PS_SCENE_BARE(L.subjects, L.variants) + (size_t)s * cells;
@@ -58,9 +65,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     y_lo = min(y_lo, max(rows.x, 0));
     y_hi = max(y_hi, min(rows.y, H));
   }
-  preal gain, offset, lv[PS_MAX_LAYERS];
-  subject_kelvin(phys, &scene, s, L.subjects, &gain, &offset);
-  global const param* object_t = phys + PS_PHYS_VARIANTS(L.subjects);
+  global const param* object_t = variant_values(&scene, L.subjects);
   global const param* wx = phys + L.phys_wx;
   global const param* wy = phys + L.phys_wy;
   global const param* cband = phys + L.phys_cband;
@@ -69,7 +74,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     Layers Ly;
     composite_layers(&Ly, rec, &L, y);
     if (Ly.count == 0) continue;
-    layer_values(&Ly, object_t, phys, &scene, L.subjects, lv);
+    layer_values(&Ly, object_t, &scene, L.subjects, lv);
     int x_lo = W, x_hi = 0;
     for (int k = 0; k < Ly.count; ++k) {
       x_lo = min(x_lo, max(Ly.x0[k], 0));

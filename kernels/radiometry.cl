@@ -3,13 +3,18 @@
 // in region order, covers it by its sprite's coverage c: v = c T_object + (1 - c) v, where
 // T_object is the variant's apparent temperature under clothing (host: PS_PHYS_VARIANTS).
 
-// The illumination and worn time of a scenario where drawn per scenario (PS_PHYS_SCENE; host:
-// illumination_at, worn_minutes_at): at, the scene block's offset (0: neither drawn); t, the
-// illumination's place in its range (uniform24 of PS_DRAWN_ILLUMINATION's word 0); w, the
-// worn time in minutes.
+// The illumination, worn time and outfit of a scenario where drawn per scenario (PS_PHYS_SCENE,
+// PS_PHYS_CLOTHING; host: illumination_at, worn_minutes_at, outfit_at): at, the scene
+// block's offset (0: neither drawn); t, the illumination's place in its range (uniform24 of
+// PS_DRAWN_ILLUMINATION's word 0); w, the worn time in minutes; outfit, the outfit's index
+// (-1: the catalogue's clothing); head, each subject's (gain, offset) then each variant's
+// value under it; moves, each subject's then each variant's moves with the scene; shadow,
+// its factor of every IR shadow.
 typedef struct {
-  int at;
-  preal t, w;
+  int at, outfit;
+  preal t, w, shadow;
+  global const param* head;
+  global const param* moves;
 } SceneDraw;
 
 inline SceneDraw scene_draw(global const param* phys, uint2 seed, ulong index) {
@@ -17,6 +22,22 @@ inline SceneDraw scene_draw(global const param* phys, uint2 seed, ulong index) {
   d.at = (int)phys[PS_PHYS_SCENE];
   d.t = 0;
   d.w = 0;
+  d.outfit = -1;
+  d.shadow = 1;
+  d.head = phys + PS_PHYS_SUBJECTS;
+  d.moves = phys + d.at + PS_SCENE_SUBJECTS;
+  const int clothing = (int)phys[PS_PHYS_CLOTHING];
+  if (clothing != 0) {
+    global const param* c = phys + clothing;
+    const uint classes = (uint)c[PS_CLOTHING_CLASSES];
+    const uint2 w = draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_CLOTHING).xy;
+    const uint k = below(w.x, classes);
+    d.outfit = (int)c[PS_CLOTHING_FIRST + k] + (int)below(w.y, (uint)c[PS_CLOTHING_FIRST + classes + k]);
+    global const param* e = c + PS_CLOTHING_OUTFITS(classes) + (size_t)d.outfit * (size_t)c[PS_CLOTHING_STRIDE];
+    d.shadow = (preal)e[PS_OUTFIT_SHADOW];
+    d.head = e + PS_OUTFIT_HEAD;
+    d.moves = e + (int)e[PS_OUTFIT_MOVES];
+  }
   if (d.at == 0) return d;
   global const param* b = phys + d.at;
   if (b[0] != 0) d.t = (preal)uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_ILLUMINATION).x);
@@ -24,25 +45,27 @@ inline SceneDraw scene_draw(global const param* phys, uint2 seed, ulong index) {
   return d;
 }
 
-// Subject s's (gain, offset) in the scenario: the view's, moved with the illumination.
-inline void subject_kelvin(global const param* phys, const SceneDraw* d, int s, int subjects, preal* gain,
-                           preal* offset) {
-  *gain = (preal)phys[PS_PHYS_SUBJECTS + 2 * s];
-  *offset = (preal)phys[PS_PHYS_SUBJECTS + 2 * s + 1];
+// Subject s's (gain, offset) in the scenario: the view's (under its outfit), moved with the
+// illumination.
+inline void subject_kelvin(const SceneDraw* d, int s, preal* gain, preal* offset) {
+  *gain = (preal)d->head[2 * s];
+  *offset = (preal)d->head[2 * s + 1];
   if (d->at == 0) return;
-  global const param* b = phys + d->at + PS_SCENE_SUBJECTS + 2 * s;
-  *gain += (preal)b[0] * d->t;
-  *offset += (preal)b[1] * d->t;
+  *gain += (preal)d->moves[2 * s] * d->t;
+  *offset += (preal)d->moves[2 * s + 1] * d->t;
 }
+
+// Each variant's value in the scenario's outfit (PS_PHYS_VARIANTS where the clothing is the
+// catalogue's).
+inline global const param* variant_values(const SceneDraw* d, int subjects) { return d->head + 2 * subjects; }
 
 // Each of a row's layers' value in the scenario: its variant's in `value`, moved where the
 // illumination or the worn time is drawn.
-inline void layer_values(const Layers* Ly, global const param* value, global const param* phys, const SceneDraw* d,
-                         int subjects, preal* lv) {
+inline void layer_values(const Layers* Ly, global const param* value, const SceneDraw* d, int subjects, preal* lv) {
   for (int k = 0; k < Ly->count; ++k) {
     lv[k] = (preal)value[Ly->variant[k]];
     if (d->at == 0) continue;
-    global const param* v = phys + d->at + PS_SCENE_VARIANTS(subjects) + 4 * Ly->variant[k];
+    global const param* v = d->moves + 2 * subjects + 4 * Ly->variant[k];
     lv[k] += (preal)v[0] * d->t + (preal)v[1] * (exp(-d->w * (preal)v[2]) - (preal)v[3]);
   }
 }
@@ -73,9 +96,9 @@ kernel void stage_radiometry(VIEW_STAGE_ARGS) {
   const int s = subject[i];
   const SceneDraw scene = scene_draw(phys, seed, index);
   preal gain, offset, lv[PS_MAX_LAYERS];
-  subject_kelvin(phys, &scene, s, L.subjects, &gain, &offset);
+  subject_kelvin(&scene, s, &gain, &offset);
   Layers Ly;
   composite_layers(&Ly, rec, &L, y);
-  layer_values(&Ly, phys + PS_PHYS_VARIANTS(L.subjects), phys, &scene, L.subjects, lv);
+  layer_values(&Ly, variant_values(&scene, L.subjects), &scene, L.subjects, lv);
   for (int x = 0; x < L.width; ++x) T[x] = lay_values(&Ly, atlas, x, lv, gain * (preal)base[x] + offset);
 }

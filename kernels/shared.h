@@ -48,5 +48,7 @@
 /* The scene block's per-variant entries and bare grids' changes (PS_PHYS_SCENE). */
 #define PS_SCENE_VARIANTS(S) (PS_SCENE_SUBJECTS + 2 * (S))
 #define PS_SCENE_BARE(S, V) (PS_SCENE_VARIANTS(S) + 4 * (V))
+/* The clothing block's first outfit entry, after C classes' first outfits and counts. */
+#define PS_CLOTHING_OUTFITS(C) (PS_CLOTHING_FIRST + 2 * (C))
 
 #endif

@@ -476,18 +476,6 @@ TEST(DrawnKnobs, EachKnobAtTheEndsOfItsBoundsIsTheReferences) {
   EXPECT_EQ(drawable, size_t{PS_DRAWN_KNOBS});
 }
 
-std::vector<std::vector<std::string>> csv_rows(const fs::path& p) {
-  std::ifstream in(p);
-  std::vector<std::vector<std::string>> rows;
-  for (std::string line; std::getline(in, line);) {
-    std::vector<std::string> f;
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
-    rows.push_back(f);
-  }
-  return rows;
-}
-
 test::Result gen(const test::TempDir& t, std::vector<std::string> args, const fs::path& out) {
   const bool listed = std::find(args.begin(), args.end(), "--scenarios") != args.end();
   args.insert(args.begin(), "generate");
@@ -512,7 +500,7 @@ TEST(DrawnKnobs, EachScenariosDrawIsRecordedAndAFixedRangeKeepsTheBytes) {
       0);
   for (const char* f : {"scenarios.csv", "features.csv", "data.h5"})
     EXPECT_EQ(test::slurp(t.w() / "a" / f), test::slurp(t.w() / "b" / f)) << f;
-  const auto rows = csv_rows(t.w() / "a" / "scenarios.csv");
+  const auto rows = test::csv_cells(t.w() / "a" / "scenarios.csv");
   ASSERT_EQ(rows.size(), 41u);
   const auto col = std::find(rows[0].begin(), rows[0].end(), "metal_noise");
   ASSERT_NE(col, rows[0].end());

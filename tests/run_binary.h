@@ -99,6 +99,19 @@ inline std::string slurp(const std::filesystem::path& p) {
   return s.str();
 }
 
+// A CSV file's rows, each split at every comma (no quoting: portalsim's tables have none).
+inline std::vector<std::vector<std::string>> csv_cells(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+    rows.push_back(f);
+  }
+  return rows;
+}
+
 // A run folder's .portalsim/checkpoint.json "next" (-1 when absent or unreadable).
 inline long long checkpoint_next(const std::filesystem::path& dir) {
   std::error_code ec;

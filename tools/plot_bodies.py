@@ -2,13 +2,15 @@
 """Draws a contact sheet of random bodies (`--bodies random`): each body's MMW views and IR.
 
   /usr/bin/python3 tools/plot_bodies.py PORTALSIM OUT.png [--count 32] [--seed 1] [--model physics]
+                                       [--clothing catalogue|random|none|shirt|sweater|jacket|coat]
 
 PORTALSIM is the built binary. The tool runs `portalsim generate --bodies random
 --body-count COUNT --scenarios LIST --what images`, one listed scenario per body, each
 carrying a few objects (a gun, a phone, a metal plate, a belt buckle, an iron rod by turns),
 and draws for each body the two MMW views stacked (the whole body, floor at the bottom) and
 the IR view beside them, titled with the body as scenarios.csv records it: sex, stature,
-pose. Needs Debian's python3-matplotlib and python3-numpy.
+pose, and with --clothing other than the catalogue's, the outfit each drew
+(docs/model/clothing.md). Needs Debian's python3-matplotlib and python3-numpy.
 """
 import argparse
 import csv
@@ -43,6 +45,7 @@ def main():
     ap.add_argument("--seed", default="1")
     ap.add_argument("--model", default="physics")
     ap.add_argument("--columns", type=int, default=8)
+    ap.add_argument("--clothing", default="catalogue")
     a = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = pathlib.Path(tmp)
@@ -56,7 +59,8 @@ def main():
         listing.write_text("\n".join(rows) + "\n")
         out = tmp / "run"
         subprocess.run([a.portalsim, "generate", "--bodies", "random", "--body-count", str(a.count), "--seed", a.seed,
-                        "--model", a.model, "--scenarios", str(listing), "--what", "images", "--quiet", "--out",
+                        "--model", a.model, "--clothing", a.clothing, "--scenarios", str(listing), "--what", "images",
+                        "--quiet", "--out",
                         str(out)], check=True, stdout=subprocess.DEVNULL)
         with open(out / "scenarios.csv", newline="") as f:
             bodies = list(csv.DictReader(f))
@@ -77,8 +81,12 @@ def main():
             sex = "F" if body["sex"] == "female" else "M"
             title = (f"{k + 1}: {sex} {float(body['stature_mm']) / 1000:.2f} m\n{body['pose']}, "
                      f"e {float(body['skin_emissivity']):.2f}")
-            axes[r, 2 * c].set_title(title, fontsize=7, loc="left")
-        fig.suptitle(f"{a.count} random bodies (--bodies random, seed {a.seed}, --model {a.model}): "
+            if "clothing" in body:  # "shirt:cotton+sweater:wool" -> "cotton shirt, wool sweater"
+                layers = [p.split(":") for p in body["clothing"].split("+")] if body["clothing"] != "none" else []
+                title += "\n" + (", ".join(f"{f} {g}" for g, f in layers) or "no clothing")
+            axes[r, 2 * c].set_title(title, fontsize=7 if a.clothing == "catalogue" else 6, loc="left")
+        dressed = "" if a.clothing == "catalogue" else f", --clothing {a.clothing}"
+        fig.suptitle(f"{a.count} random bodies (--bodies random, seed {a.seed}, --model {a.model}{dressed}): "
                      "MMW upper over lower, and IR", fontsize=11)
         fig.savefig(a.out, dpi=64, bbox_inches="tight")
 

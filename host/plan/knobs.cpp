@@ -141,6 +141,17 @@ std::vector<Knob> declare() {
           "physics: how long the objects have been carried; they warm from the room towards the skin",
           [](Plan& p, double v) { p.model.worn_minutes = v; }, [](const Plan& p) { return p.model.worn_minutes; }),
       PS_DRAWN_WORN_MINUTES));
+  {
+    Knob c = choice(
+        "clothing", "catalogue", {kClothingNames.begin(), kClothingNames.end()},
+        "physics: what the subjects wear: the catalogue's one clothing, or per scenario an outfit of layers of "
+        "sourced fabrics (docs/model/clothing.md): random (none, shirt, sweater, jacket or coat, each alike), or "
+        "one of those, its fabrics drawn",
+        false, true, [](Plan& p, double v) { p.model.clothing = static_cast<Clothing>(v); },
+        [](const Plan& p) { return kClothingNames[static_cast<size_t>(p.model.clothing)]; });
+    c.omit_default = true;
+    k.push_back(std::move(c));
+  }
   // The MMW camera's own processing (docs/model/physics-mmw.md).
   k.push_back(drawable(
       integer(
@@ -418,6 +429,10 @@ void check_knobs(const Plan& plan) {
       if (!std::isfinite(v) || v < k.min || v > k.max)
         throw InputError(k.flag() + ": " + format_number(v) + " must be a finite number between " + k.values());
   }
+  // The thesis model composites gray levels: it has no clothing to draw.
+  if (plan.model.model == Model::thesis && plan.model.clothing != Clothing::catalogue)
+    throw InputError(std::string("--clothing: ") + kClothingNames[static_cast<size_t>(plan.model.clothing)] +
+                     " applies to the physics model (--model physics); the thesis model has the catalogue's clothing");
 }
 
 std::string knob_text(const nlohmann::json& value) {

@@ -28,6 +28,9 @@ struct Knob {
   std::string help{};
   bool fidelity = false;  // overrides the tier (its default comes from the tier)
   bool identity = true;   // part of a data set's identity (checked on --resume)
+  // Left out of a manifest's spec at its default: a knob added after data sets were made,
+  // which keep their identity (and bytes) where it is not used.
+  bool omit_default = false;
   // Sets the knob from a checked value: the number, 0/1 for on_off, the choice's index, or
   // width * 65536 + height for a grid ("WxH").
   std::function<void(Plan&, double)> set{};

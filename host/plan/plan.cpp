@@ -60,6 +60,14 @@ double pixel_noise_at(const ModelSettings& m, uint64_t index) {
   return m.drawn[PS_DRAWN_PIXEL_NOISE].varies() ? drawn_real(m, PS_DRAWN_PIXEL_NOISE, index) : m.pixel_sigma;
 }
 
+int outfit_at(const ModelSettings& m, uint64_t index) {
+  if (m.clothing == Clothing::catalogue) return -1;
+  const OutfitTable& t = outfit_table(m.clothing);
+  const Philox4 q = draw(m.seed, index, kStreamKnobDraw, PS_DRAWN_CLOTHING);
+  const uint32_t k = below(q[0], static_cast<uint32_t>(t.class_first.size()));
+  return t.class_first[k] + static_cast<int>(below(q[1], static_cast<uint32_t>(t.class_count[k])));
+}
+
 double worn_minutes_at(const ModelSettings& m, uint64_t index) {
   return m.drawn[PS_DRAWN_WORN_MINUTES].varies() ? drawn_real(m, PS_DRAWN_WORN_MINUTES, index) : m.worn_minutes;
 }
@@ -73,6 +81,7 @@ ModelSettings ModelSettings::at_scenario(uint64_t index) const {
   m.frames = frames_at(*this, index);
   m.illumination = illumination_at(*this, index);
   m.worn_minutes = worn_minutes_at(*this, index);
+  m.outfit = outfit_at(*this, index);
   m.drawn = {};
   return m;
 }

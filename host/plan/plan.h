@@ -8,6 +8,7 @@
 
 #include "assets/procedural.h"
 #include "scene/catalogue.h"
+#include "scene/clothing.h"
 #include "scene/scene.h"
 
 namespace portalsim {
@@ -56,6 +57,11 @@ struct ModelSettings {
   int raw_width{}, raw_height{};  // the MMW camera's raw grid over each view
   double worn_minutes{};          // how long the objects have been carried (their temperature)
   double ir_netd{};               // K rms: IR sensor noise per pixel
+  // The clothing (docs/model/clothing.md): the catalogue's, or outfits drawn per scenario
+  // (outfit_at); at_scenario resolves the scenario's outfit, an index into
+  // outfit_table(clothing) (-1: the catalogue's clothing).
+  Clothing clothing{};
+  int outfit = -1;
   // The MMW camera's own processing (docs/model/physics-mmw.md, "The camera's defaults"):
   // raw frames at 10 Hz averaged, each with its own NETD draw (the default 10: one second,
   // the body 5+ times the noise in both views); the display window, fixed [window_lo,
@@ -110,6 +116,11 @@ int frames_at(const ModelSettings& m, uint64_t index);
 // PS_DRAWN_ILLUMINATION and PS_DRAWN_WORN_MINUTES. kernels/radiometry.cl's scene_draw.
 double illumination_at(const ModelSettings& m, uint64_t index);
 double worn_minutes_at(const ModelSettings& m, uint64_t index);
+// Scenario `index`'s outfit, an index into outfit_table(m.clothing), -1 for the catalogue's
+// clothing: its class below(word 0, classes), then its outfit in the class below(word 1,
+// the class's outfits), of PS_STREAM_KNOB_DRAW element PS_DRAWN_CLOTHING. kernels/radiometry.cl's
+// scene_draw draws the same.
+int outfit_at(const ModelSettings& m, uint64_t index);
 // Scenario `index`'s pixel noise sigma (the knob pixel_noise, gray levels), as ir_netd_at,
 // element PS_DRAWN_PIXEL_NOISE. kernels/sensor_noise.cl's pixel_sigma_of.
 double pixel_noise_at(const ModelSettings& m, uint64_t index);

@@ -15,6 +15,7 @@
 #include "io/input_file.h"
 #include "io/table_fields.h"
 #include "scene/bodies.h"
+#include "scene/clothing.h"
 
 namespace portalsim {
 
@@ -75,9 +76,11 @@ ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, c
                std::any_of(kDrawnKnobKeys.begin(), kDrawnKnobKeys.end(),
                            [&](const char* k) { return normalise_name(k) == h; }) ||
                std::any_of(kBodyColumns.begin(), kBodyColumns.end(),
+                           [&](const char* k) { return normalise_name(k) == h; }) ||
+               std::any_of(kClothingColumns.begin(), kClothingColumns.end(),
                            [&](const char* k) { return normalise_name(k) == h; })) {
-      // A drawn knob's or body's column records the run's draw; a run draws it again from
-      // its seed.
+      // A drawn knob's, body's or outfit's column records the run's draw; a run draws it
+      // again from its seed.
     } else if (
         int t = 0, tr = 0; [&] {
           for (t = 0; t < 3; ++t)

@@ -97,6 +97,11 @@ std::string tensor_meaning(const std::string& name, const Portal& portal) {
       {"region_rotation", "per region: the object's angle in degrees, counter-clockwise (0 where empty)"},
       {"region_scale", "per region: the object's scale factor (1 where empty)"},
       {"region_flip", "per region: 1 where the object is mirrored left to right"},
+      {"clothing_outfit",
+       "per scenario: its outfit's index in the run's outfit table (docs/model/clothing.md; "
+       "scenarios.csv names it)"},
+      {"clothing_transmission", "per scenario: its outfit's power transmission at 94 GHz"},
+      {"clothing_clo", "per scenario: its outfit's thermal insulation, clo"},
   };
   if (const auto it = m.find(name); it != m.end()) return it->second;
   if (name.starts_with("param_"))

@@ -40,7 +40,10 @@ nlohmann::json RunSpec::to_json() const {
   // noise_draw is absent at Box-Muller, as before it existed: standard and exact runs keep
   // their identity and bytes; the fast tier's (Irwin-Hall) names it.
   for (const Knob& k : portalsim::knobs())
-    if (k.identity && !(k.key == "noise_draw" && p.fidelity.draw == NoiseDraw::box_muller)) j[k.key] = k.get(p);
+    if (k.identity && !(k.key == "noise_draw" && p.fidelity.draw == NoiseDraw::box_muller)) {
+      nlohmann::json v = k.get(p);
+      if (!(k.omit_default && v == nlohmann::json(k.def))) j[k.key] = std::move(v);
+    }
   return j;
 }
 

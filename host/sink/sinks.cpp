@@ -125,6 +125,8 @@ class ScenarioListSink final : public Sink {
         if (ctx.model.drawn[e].varies()) h += std::string(",") + kDrawnKnobKeys[e];
       if (drawn_bodies(*ctx.cat))
         for (const char* c : kBodyColumns) h += std::string(",") + c;
+      if (ctx.model.clothing != Clothing::catalogue)
+        for (const char* c : kClothingColumns) h += std::string(",") + c;
       file_.append(h + ",label\n");
     }
     for (size_t v = 0; v < ctx.cat->variant_list.size(); ++v)
@@ -174,6 +176,19 @@ class ScenarioListSink final : public Sink {
       if (!ctx_.cat->subjects[scenes.subject[i]].drawn.empty()) {
         s += ',';
         s += ctx_.cat->subjects[scenes.subject[i]].drawn;
+      }
+      if (ctx_.model.clothing != Clothing::catalogue) {
+        // The outfit (plan.h, outfit_at), then its transmission and clo, shortest exact text.
+        const Outfit& o = outfit_table(ctx_.model.clothing)
+                              .outfits[static_cast<size_t>(outfit_at(ctx_.model, scenes.first_index + i))];
+        s += ',';
+        s += o.name();
+        for (const double v : {o.transmission(), o.clo()}) {
+          char buf[32];
+          const auto res = std::to_chars(buf, buf + sizeof buf, v);
+          s += ',';
+          s.append(buf, res.ptr);
+        }
       }
       s += scenes.label[i] == 1 ? ",yes\n" : ",no\n";
     }

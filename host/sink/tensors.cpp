@@ -228,6 +228,28 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
               }
               return std::string_view(dst, (hi - lo) * sizeof(double));
             });
+    // The outfit drawn per scenario (plan.h, outfit_at), as scenarios.csv records it.
+    if (ctx.model.clothing != Clothing::catalogue) {
+      add("clothing_outfit", TensorType::i16, {},
+          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+            for (size_t i = lo; i < hi; ++i) {
+              const int16_t v = static_cast<int16_t>(outfit_at(model, b.first_index + i));
+              std::memcpy(dst + (i - lo) * sizeof v, &v, sizeof v);
+            }
+            return std::string_view(dst, (hi - lo) * sizeof(int16_t));
+          });
+      for (const bool transmission : {true, false})
+        add(transmission ? "clothing_transmission" : "clothing_clo", TensorType::f64, {},
+            [model, transmission](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+              const OutfitTable& t = outfit_table(model.clothing);
+              for (size_t i = lo; i < hi; ++i) {
+                const Outfit& o = t.outfits[static_cast<size_t>(outfit_at(model, b.first_index + i))];
+                const double v = transmission ? o.transmission() : o.clo();
+                std::memcpy(dst + (i - lo) * sizeof v, &v, sizeof v);
+              }
+              return std::string_view(dst, (hi - lo) * sizeof(double));
+            });
+    }
   }
   return columns;
 }

@@ -52,6 +52,33 @@ void axis_weights(int size, int raw, const double* taps, int radius, std::vector
   }
 }
 
+// An outfit's physics as the tables take it: its MMW transmission tc and emission E at 94
+// GHz (what reaches the camera of a surface's X is tc X + E), and the fraction g of the skin's
+// excess over the room that reaches its surface (IR). Layer k, innermost first, passes
+// t_k = 10^(-dB/10) and emits (1 - t_k) T_k at the temperature halfway through it along the
+// chain of resistances skin -> layers -> room (docs/model/clothing.md).
+struct OutfitPhysics {
+  double tc = 1, emission = 0, surface = 1;
+};
+OutfitPhysics outfit_physics(const PhysicsConfig& pc, const Outfit& o) {
+  double total = kSurfaceResistance;
+  for (const Layer& l : o.layers) total += kGarments[l.garment].clo * kClo;
+  OutfitPhysics r;
+  double inside = 0;
+  for (const Layer& l : o.layers) {
+    const Garment& g = kGarments[l.garment];
+    const double t = std::pow(10.0, -kFabrics[l.fabric].db_per_mm * g.thickness_mm / 10.0);
+    const double R = g.clo * kClo;
+    const double temperature =
+        pc.skin_temperature - (pc.skin_temperature - pc.room_temperature) * (inside + R / 2) / total;
+    inside += R;
+    r.emission = t * r.emission + (1 - t) * temperature;
+    r.tc *= t;
+  }
+  r.surface = kSurfaceResistance / total;
+  return r;
+}
+
 }  // namespace
 
 size_t mmw_display_scratch(const Sensor& s, int raw_width, int raw_height) {
@@ -85,23 +112,31 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     p[PS_PHYS_FRAMES_HI] = noise.frames_hi;
     p[PS_PHYS_FRAMES_AS_ONE] = noise.as_one;
   }
-  // Per subject, its base image's value to kelvin: the IR index map, or the MMW's gray
-  // between the room behind and the bare body.
-  for (const Subject& subj : cat.subjects) {
-    const double body = seen(pc.skin_emissivity_of(subj), pc.skin_temperature_of(subj));
-    const double gain = ir ? (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0
-                           : (body - pc.background_temperature) / (subj.mmw_level - pc.base_background_gray);
-    p.push_back(gain);
-    p.push_back(ir ? pc.ir_index_min_k : pc.background_temperature - gain * pc.base_background_gray);
-  }
-  // Per variant: the IR surface's contact shadow (and, for phys_off_body, the same against
-  // the room), or the MMW apparent temperature.
+  // Per subject, its base image's value to kelvin: the IR index map (under an outfit, its
+  // surface's share g of the excess over the room), or the MMW's gray between the room behind
+  // and the bare body under the clothing. Per variant: the IR surface's contact shadow, or the
+  // MMW apparent temperature. `seen_as` is the clothing's (e, T) -> apparent temperature.
+  const auto head = [&](std::vector<double>& out, const auto& seen_as, double g) {
+    for (const Subject& subj : cat.subjects) {
+      const double body = seen_as(pc.skin_emissivity_of(subj), pc.skin_temperature_of(subj));
+      const double gain = ir ? (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0
+                             : (body - pc.background_temperature) / (subj.mmw_level - pc.base_background_gray);
+      const double offset = ir ? pc.ir_index_min_k : pc.background_temperature - gain * pc.base_background_gray;
+      out.push_back(g * gain);
+      out.push_back(g * offset + (1 - g) * (ir ? pc.room_temperature : 0.0));
+    }
+    for (size_t v = 0; v < cat.variant_list.size(); ++v) {
+      const Material& mat = cat.materials.at(cat.object_of(static_cast<int>(v)).material_id);
+      const double worn = worn_temperature(pc, mat, m.worn_minutes);
+      out.push_back(ir ? -pc.ir_coupling * (pc.skin_temperature - worn) : seen_as(mat.emissivity, worn));
+    }
+  };
+  head(p, seen, 1.0);
+  // For phys_off_body: each variant's IR shadow against the room.
   std::vector<double> off_body_shadow;
-  for (size_t v = 0; v < cat.variant_list.size(); ++v) {
+  for (size_t v = 0; ir && v < cat.variant_list.size(); ++v) {
     const Material& mat = cat.materials.at(cat.object_of(static_cast<int>(v)).material_id);
-    const double worn = worn_temperature(pc, mat, m.worn_minutes);
-    p.push_back(ir ? -pc.ir_coupling * (pc.skin_temperature - worn) : seen(mat.emissivity, worn));
-    if (ir) off_body_shadow.push_back(-pc.ir_coupling * (pc.room_temperature - worn));
+    off_body_shadow.push_back(-pc.ir_coupling * (pc.room_temperature - worn_temperature(pc, mat, m.worn_minutes)));
   }
   // MMW: the Airy core's FWHM, 1.02 lambda / D at the range, in this view's pixels, as a
   // Gaussian of that FWHM. IR: ir_spread_mm over the view's pixel (as wide as an MMW view).
@@ -126,26 +161,49 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   const bool scene_drawn = ill.varies() || worn.varies();
   const double ill_span = ill.varies() ? ill.hi - ill.lo : 0.0;
   std::vector<double> scene;
-  if (scene_drawn) {
-    scene = {ill.varies() ? 1.0 : 0.0, m.worn_minutes, worn.varies() ? worn.hi : m.worn_minutes};
+  // The moves of each subject and variant under clothing of MMW transmission tc.
+  const auto moves = [&](std::vector<double>& out, double tc) {
     // The bare body's apparent temperature moves by tc (1 - e_skin) per kelvin of illumination.
     for (const Subject& subj : cat.subjects) {
-      const double body_span = ir ? 0.0 : pc.clothing_transmission * (1 - pc.skin_emissivity_of(subj)) * ill_span;
+      const double body_span = ir ? 0.0 : tc * (1 - pc.skin_emissivity_of(subj)) * ill_span;
       const double dgain = ir ? 0.0 : body_span / (subj.mmw_level - pc.base_background_gray);
-      scene.push_back(dgain);
-      scene.push_back(-dgain * pc.base_background_gray);
+      out.push_back(dgain);
+      out.push_back(-dgain * pc.base_background_gray);
     }
     for (size_t v = 0; v < cat.variant_list.size(); ++v) {
       const Material& mat = cat.materials.at(cat.object_of(static_cast<int>(v)).material_id);
       // worn = skin - (skin - room) exp(-worn / tau): the IR shadow (against skin or room)
       // moves by -coupling (skin - room) per unit of it, the MMW value by -tc e (skin - room).
-      const double per_decay =
-          ir ? -pc.ir_coupling * (pc.skin_temperature - pc.room_temperature)
-             : -pc.clothing_transmission * mat.emissivity * (pc.skin_temperature - pc.room_temperature);
-      scene.push_back(ir ? 0.0 : pc.clothing_transmission * (1 - mat.emissivity) * ill_span);
-      scene.push_back(per_decay);
-      scene.push_back(1.0 / mat.warm_minutes);
-      scene.push_back(std::exp(-m.worn_minutes / mat.warm_minutes));
+      const double per_decay = ir ? -pc.ir_coupling * (pc.skin_temperature - pc.room_temperature)
+                                  : -tc * mat.emissivity * (pc.skin_temperature - pc.room_temperature);
+      out.push_back(ir ? 0.0 : tc * (1 - mat.emissivity) * ill_span);
+      out.push_back(per_decay);
+      out.push_back(1.0 / mat.warm_minutes);
+      out.push_back(std::exp(-m.worn_minutes / mat.warm_minutes));
+    }
+  };
+  if (scene_drawn) {
+    scene = {ill.varies() ? 1.0 : 0.0, m.worn_minutes, worn.varies() ? worn.hi : m.worn_minutes};
+    moves(scene, pc.clothing_transmission);
+  }
+  // Where the clothing is drawn per scenario, the clothing block (PS_PHYS_CLOTHING): each
+  // outfit's entries as above, under its layers instead of the catalogue's clothing.
+  const OutfitTable& outfits = outfit_table(m.clothing);
+  std::vector<double> clothing;
+  if (!outfits.outfits.empty()) {
+    const size_t C = outfits.class_first.size(), S = cat.subjects.size(), V = cat.variant_list.size();
+    const size_t stride = PS_OUTFIT_HEAD + 2 * S + V + (scene_drawn ? 2 * S + 4 * V : 0);
+    clothing = {double(C), double(stride), 0.0};
+    for (int f : outfits.class_first) clothing.push_back(f);
+    for (int n : outfits.class_count) clothing.push_back(n);
+    for (const Outfit& o : outfits.outfits) {
+      const OutfitPhysics op = outfit_physics(pc, o);
+      clothing.push_back(ir ? op.surface / pc.ir_coupling : 1.0);
+      clothing.push_back(double(PS_OUTFIT_HEAD + 2 * S + V));
+      head(
+          clothing, [&](double e, double t) { return op.tc * (e * t + (1 - e) * m.illumination) + op.emission; },
+          ir ? op.surface : 1.0);
+      if (scene_drawn) moves(clothing, op.tc);
     }
   }
   if (ir) {
@@ -165,6 +223,7 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     }
     t.off_body = append(off_body);
     if (scene_drawn) p[PS_PHYS_SCENE] = append(scene);
+    if (!clothing.empty()) p[PS_PHYS_CLOTHING] = append(clothing);
     return t;
   }
   // The MMW raw-grid path's tables (kernels/physics_raw.cl).
@@ -204,6 +263,13 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     const std::vector<double> moved = bare_grids(&scene[PS_SCENE_SUBJECTS]);
     scene.insert(scene.end(), moved.begin(), moved.end());
     p[PS_PHYS_SCENE] = append(scene);
+  }
+  if (!clothing.empty()) {
+    // The gray grids: each subject's bare grid at (gain, offset) (1, 0).
+    std::vector<double> unit(2 * cat.subjects.size(), 0.0);
+    for (size_t k = 0; k < cat.subjects.size(); ++k) unit[2 * k] = 1;
+    clothing[PS_CLOTHING_GRIDS] = append(bare_grids(unit.data()));
+    p[PS_PHYS_CLOTHING] = append(clothing);
   }
   return t;
 }

@@ -12,10 +12,16 @@ double base_kelvin(const ViewScene& vs, int x, int y) {
   return pc.ir_index_min_k + (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0 * base.at(x, y);
 }
 
+// How much of an object's shortfall reaches the clothing surface: the catalogue's
+// ir_coupling, or under an outfit its surface's share.
+double coupling(const Catalogue& cat, const ModelSettings& m) {
+  return m.outfit < 0 ? cat.physics.ir_coupling : outfit_surface_share(m);
+}
+
 // Where the object lies off the body, the surface it touches is the room's.
 double off_body_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant, const Subject& subject) {
   const PhysicsConfig& pc = cat.physics;
-  return -pc.ir_coupling * (pc.room_temperature - worn_temperature(cat, m, variant, pc.skin_temperature_of(subject)));
+  return -coupling(cat, m) * (pc.room_temperature - worn_temperature(cat, m, variant, pc.skin_temperature_of(subject)));
 }
 
 }  // namespace
@@ -24,7 +30,7 @@ double off_body_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int 
 // by ir_coupling of the object's shortfall below the subject's skin, which it warms towards.
 double contact_shadow_kelvin(const Catalogue& cat, const ModelSettings& m, int variant, const Subject& subject) {
   const double skin = cat.physics.skin_temperature_of(subject);
-  return -cat.physics.ir_coupling * (skin - worn_temperature(cat, m, variant, skin));
+  return -coupling(cat, m) * (skin - worn_temperature(cat, m, variant, skin));
 }
 
 // The shadow field alone (0 K where no object lies), objects in region order by their IR
@@ -49,10 +55,15 @@ void contact_shadow(const ViewScene& vs, Field& f) {
 }
 
 // The bare body's surface temperature, its base image's index read linearly as kelvin,
-// added to the (spread) shadow.
+// added to the (spread) shadow. Under an outfit the base image is the bare skin's, and the
+// outfit's surface keeps its share of that above the room.
 void ir_surface(const ViewScene& vs, Field& f) {
+  const double room = vs.cat.physics.room_temperature;
+  const bool dressed = vs.model.outfit >= 0;
+  const double share = dressed ? outfit_surface_share(vs.model) : 1.0;
   for (int y = 0; y < f.height; ++y)
-    for (int x = 0; x < f.width; ++x) f.at(x, y) += base_kelvin(vs, x, y);
+    for (int x = 0; x < f.width; ++x)
+      f.at(x, y) += dressed ? room + share * (base_kelvin(vs, x, y) - room) : base_kelvin(vs, x, y);
 }
 
 }  // namespace portalsim::reference

@@ -7,14 +7,46 @@ namespace portalsim::reference {
 namespace {
 
 // What a surface of emissivity e at physical temperature t shows the camera under
-// clothing: it emits e t and reflects the illumination, (1 - e) T_ill; the clothing passes
-// a fraction tc of that and emits its own (1 - tc) T_clothing.
+// clothing: it emits e t and reflects the illumination, (1 - e) T_ill; the catalogue's
+// clothing passes a fraction tc of that and emits its own (1 - tc) T_clothing. Under an
+// outfit, each layer from the skin outwards does the same at its own transmission and
+// temperature (outfit_layers).
 double under_clothing(const PhysicsConfig& pc, const ModelSettings& m, double e, double t) {
-  const double surface = e * t + (1.0 - e) * m.illumination;
-  return pc.clothing_transmission * surface + (1.0 - pc.clothing_transmission) * pc.clothing_temperature;
+  double seen = e * t + (1.0 - e) * m.illumination;
+  if (m.outfit < 0) return pc.clothing_transmission * seen + (1.0 - pc.clothing_transmission) * pc.clothing_temperature;
+  for (const LayerSeen& layer : outfit_layers(pc, m))
+    seen = layer.transmission * seen + (1.0 - layer.transmission) * layer.temperature;
+  return seen;
 }
 
 }  // namespace
+
+// Heat flows from the skin through each layer's resistance (clo) and the surface's to the
+// room: the same flux through each, so each resistance takes its share of the drop. A layer
+// stands at the temperature at its middle; it passes 10^(-dB / 10) of the power at 94 GHz.
+std::vector<LayerSeen> outfit_layers(const PhysicsConfig& pc, const ModelSettings& m) {
+  const Outfit& outfit = outfit_table(m.clothing).outfits.at(static_cast<size_t>(m.outfit));
+  double resistance = kSurfaceResistance;
+  for (const Layer& l : outfit.layers) resistance += kGarments[l.garment].clo * kClo;
+  const double flux = (pc.skin_temperature - pc.room_temperature) / resistance;  // W / m^2
+  std::vector<LayerSeen> out;
+  double inner = pc.skin_temperature;  // the layer's inner face
+  for (const Layer& l : outfit.layers) {
+    const Garment& g = kGarments[l.garment];
+    const double drop = flux * g.clo * kClo;
+    const double db = kFabrics[l.fabric].db_per_mm * g.thickness_mm;
+    out.push_back({std::pow(10.0, -db / 10.0), inner - drop / 2});
+    inner -= drop;
+  }
+  return out;
+}
+
+double outfit_surface_share(const ModelSettings& m) {
+  double clothed = 0;
+  for (const Layer& l : outfit_table(m.clothing).outfits.at(static_cast<size_t>(m.outfit)).layers)
+    clothed += kGarments[l.garment].clo * kClo;
+  return kSurfaceResistance / (kSurfaceResistance + clothed);
+}
 
 double body_temperature(const Catalogue& cat, const ModelSettings& m, const Subject& subject) {
   const PhysicsConfig& pc = cat.physics;

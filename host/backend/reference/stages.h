@@ -85,6 +85,14 @@ PORTALSIM_STAGES(PORTALSIM_DECLARE_STAGE)
 #undef PORTALSIM_DECLARE_STAGE
 
 // The physics model's quantities, from the catalogue and the knobs.
+// The scenario's outfit (m.outfit >= 0), innermost layer first: what each layer passes at
+// 94 GHz and its temperature, K.
+struct LayerSeen {
+  double transmission, temperature;
+};
+std::vector<LayerSeen> outfit_layers(const PhysicsConfig& pc, const ModelSettings& m);
+// The share of the skin's excess over the room that reaches the outfit's surface (IR).
+double outfit_surface_share(const ModelSettings& m);
 double body_temperature(const Catalogue& cat, const ModelSettings& m, const Subject& s);  // bare body under clothing, K
 double worn_temperature(const Catalogue& cat, const ModelSettings& m, int variant,
                         double skin);  // physical, K, warmed on skin of this temperature

@@ -44,10 +44,11 @@ class PhysicsRawFeatures final : public FeaturePath {
                          !m.window_auto && m.display_filter == DisplayFilter::bilinear && m.smooth == 0;
     if (!plan_ok || !physics_raw_path().applies(plan, sensor)) return {};
     // Tables where objects stand at their places and their values are the run's (no drawn
-    // illumination or worn time), and while the pairs' index (subjects x (variants x
-    // regions)^2) stays small.
+    // illumination, worn time or clothing), and while the pairs' index (subjects x (variants
+    // x regions)^2) stays small.
     const size_t combos = d_.cat.variant_list.size() * d_.cat.regions.size();
-    const bool scene_drawn = m.drawn[PS_DRAWN_ILLUMINATION].varies() || m.drawn[PS_DRAWN_WORN_MINUTES].varies();
+    const bool scene_drawn = m.drawn[PS_DRAWN_ILLUMINATION].varies() || m.drawn[PS_DRAWN_WORN_MINUTES].varies() ||
+                             m.clothing != Clothing::catalogue;
     if (plan.model.jitter <= 0 && !plan.model.transforms() && !scene_drawn &&
         d_.cat.subjects.size() * combos * combos <= kMaxTabulatedPairs)
       return {.runs = true, .variant = kTabulated, .variant_name = "tabulated"};
