@@ -1394,8 +1394,9 @@ TEST(PortalCounts, TwentyRegionsAndThirtyThreeZonesMatchTheReference) {
   EXPECT_EQ(w->cat.sensors[5].name, "back_ir");
   EXPECT_EQ(w->cat.sensors[5].side, Side::back);
   EXPECT_EQ(w->cat.sensors[2].raw, (std::array<int, 2>{24, 24})) << "the back MMW camera's own raw grid";
-  // Random crowds, then every region filled on each subject.
-  std::vector<Scenario> scenes = coverage(w->cat, 24, 10, false);
+  // Random crowds (a quarter under the sanitizers, test::kSanitized, like the other parity
+  // tests' random scenarios), then every region filled on each subject.
+  std::vector<Scenario> scenes = coverage(w->cat, test::kSanitized ? 6 : 24, 10, false);
   for (int s = 0; s < 5; ++s) scenes.push_back(crowded(w->cat, s, static_cast<size_t>(2 * s)));
   const SceneBatch batch = test::batch_of(scenes, 700, w->cat.region_count());
   expect_parity(*w, batch, model(161, true), "20 regions, pattern noise");
