@@ -334,12 +334,7 @@ TEST(Bodies, CatalogueKeysAndBadValues) {
 // generate --bodies random: scenarios.csv records each row's body, the run's bytes do not
 // depend on the batch, a scenario list of it makes the same data again, and bad values are
 // refused before anything is written.
-test::Result gen(const test::TempDir& t, std::vector<std::string> args, const fs::path& out) {
-  args.insert(args.begin(), "generate");
-  for (const char* a : {"--quiet", "--out"}) args.push_back(a);
-  args.push_back(out.string());
-  return test::finish(test::start(t.cap(), args), 300);
-}
+using test::generate;
 
 TEST(Bodies, GenerateRecordsEachRowsBody) {
   test::TempDir t;
@@ -350,9 +345,9 @@ TEST(Bodies, GenerateRecordsEachRowsBody) {
     a.insert(a.end(), more.begin(), more.end());
     return a;
   };
-  const test::Result a = gen(t, with({"--count", "120", "--batch", "7"}), t.w() / "a");
+  const test::Result a = generate(t, with({"--count", "120", "--batch", "7"}), t.w() / "a");
   ASSERT_EQ(a.status, 0) << test::describe(a);
-  ASSERT_EQ(gen(t, with({"--count", "120", "--batch", "64", "--threads", "1"}), t.w() / "b").status, 0);
+  ASSERT_EQ(generate(t, with({"--count", "120", "--batch", "64", "--threads", "1"}), t.w() / "b").status, 0);
   for (const char* f : {"scenarios.csv", "features.csv", "images/00000037/upper.png", "images/00000101/ir.png"})
     EXPECT_EQ(test::slurp(t.w() / "a" / f), test::slurp(t.w() / "b" / f)) << f;
   std::istringstream list(test::slurp(t.w() / "a" / "scenarios.csv"));
@@ -366,11 +361,11 @@ TEST(Bodies, GenerateRecordsEachRowsBody) {
   }
   EXPECT_GT(subjects.size(), 5u) << "more than the catalogue's five bodies";
   // Made again from the list (its body columns skipped: the seed draws the bodies again).
-  ASSERT_EQ(gen(t, with({"--scenarios", (t.w() / "a" / "scenarios.csv").string()}), t.w() / "c").status, 0);
+  ASSERT_EQ(generate(t, with({"--scenarios", (t.w() / "a" / "scenarios.csv").string()}), t.w() / "c").status, 0);
   for (const char* f : {"scenarios.csv", "features.csv"})
     EXPECT_EQ(test::slurp(t.w() / "a" / f), test::slurp(t.w() / "c" / f)) << f;
   // The catalogue's subjects: no body columns.
-  ASSERT_EQ(gen(t, {"--count", "5", "--format", "csv"}, t.w() / "d").status, 0);
+  ASSERT_EQ(generate(t, {"--count", "5", "--format", "csv"}, t.w() / "d").status, 0);
   EXPECT_FALSE(test::has(test::slurp(t.w() / "d" / "scenarios.csv"), "stature_mm"));
   const std::vector<std::pair<std::vector<std::string>, std::string>> bad = {
       {{"--bodies", "random", "--body-count", "0"}, "--body-count: \"0\" is not between 1 and 255"},
@@ -381,7 +376,7 @@ TEST(Bodies, GenerateRecordsEachRowsBody) {
   for (const auto& [flags, says] : bad) {
     std::vector<std::string> a = flags;
     a.insert(a.end(), {"--count", "3"});
-    const test::Result r = gen(t, a, t.w() / "bad");
+    const test::Result r = generate(t, a, t.w() / "bad");
     EXPECT_EQ(r.status, 2) << flags.back();
     EXPECT_TRUE(test::has(r.err, says)) << flags.back() << ": " << r.err;
     EXPECT_FALSE(fs::exists(t.w() / "bad")) << "nothing written for " << flags.back();
@@ -394,7 +389,7 @@ TEST(Bodies, GenerateRecordsEachRowsBody) {
                                            "--body-count", "8",       "--body-seed", "3"};
   std::vector<std::string> listed = bodies;
   listed.insert(listed.end(), {"--what", "images", "--scenarios", (t.w() / "one.csv").string()});
-  ASSERT_EQ(gen(t, listed, t.w() / "listed").status, 0);
+  ASSERT_EQ(generate(t, listed, t.w() / "listed").status, 0);
   std::vector<std::string> sim = {"simulate", "none", "gun", "--subject", "7", "--out", (t.w() / "sim").string()};
   sim.insert(sim.end(), bodies.begin(), bodies.end());
   const test::Result s = test::finish(test::start(t.cap(), sim), 120);
@@ -409,7 +404,7 @@ TEST(Bodies, GenerateRecordsEachRowsBody) {
   EXPECT_TRUE(test::has(s9.err, "--subject: 9 is out of range (1 to 8)")) << s9.err;
   // A spec file's key is named with its file and line.
   test::spit(t.w() / "s.toml", "count = 3\n\nbodies = \"everyone\"\n");
-  const test::Result r = gen(t, {"--spec", (t.w() / "s.toml").string()}, t.w() / "bad");
+  const test::Result r = generate(t, {"--spec", (t.w() / "s.toml").string()}, t.w() / "bad");
   EXPECT_NE(r.status, 0);
   EXPECT_TRUE(test::has(r.err, "s.toml:3: bodies: \"everyone\" is not catalogue or random")) << r.err;
   EXPECT_FALSE(fs::exists(t.w() / "bad"));

@@ -186,10 +186,8 @@ TEST(Clothing, ThickerClothingShowsLess) {
 }
 
 test::Result gen(const test::TempDir& t, std::vector<std::string> args, const fs::path& out) {
-  args.insert(args.begin(), "generate");
-  for (const char* a : {"--count", "40", "--seed", "9", "--quiet", "--out"}) args.push_back(a);
-  args.push_back(out.string());
-  return test::finish(test::start(t.cap(), args), 300);
+  args.insert(args.end(), {"--count", "40", "--seed", "9"});
+  return test::generate(t, args, out);
 }
 
 // Each row records its outfit (as outfit_at draws it), the same for any batch; the list
@@ -228,11 +226,8 @@ TEST(Clothing, EachRowsOutfitIsRecorded) {
   EXPECT_NE(test::slurp(t.w() / "a" / "manifest.json").find("\"clothing\": \"random\""), std::string::npos);
   // The list re-runs: its outfit columns are read as the record they are.
   std::vector<std::string> c_args = physics;
-  c_args.insert(c_args.end(), {"--scenarios", (t.w() / "a" / "scenarios.csv").string()});
-  c_args.insert(c_args.begin(), "generate");
-  for (const char* x : {"--seed", "9", "--quiet", "--out"}) c_args.push_back(x);
-  c_args.push_back((t.w() / "c").string());
-  ASSERT_EQ(test::finish(test::start(t.cap(), c_args), 300).status, 0);
+  c_args.insert(c_args.end(), {"--scenarios", (t.w() / "a" / "scenarios.csv").string(), "--seed", "9"});
+  ASSERT_EQ(test::generate(t, c_args, t.w() / "c").status, 0);
   EXPECT_EQ(test::slurp(t.w() / "a" / "scenarios.csv"), test::slurp(t.w() / "c" / "scenarios.csv"));
   // The catalogue's clothing: no clothing key in the manifest, no clothing columns.
   ASSERT_EQ(gen(t, {"--model", "physics"}, t.w() / "d").status, 0);

@@ -477,12 +477,9 @@ TEST(DrawnKnobs, EachKnobAtTheEndsOfItsBoundsIsTheReferences) {
 }
 
 test::Result gen(const test::TempDir& t, std::vector<std::string> args, const fs::path& out) {
-  const bool listed = std::find(args.begin(), args.end(), "--scenarios") != args.end();
-  args.insert(args.begin(), "generate");
-  if (!listed) args.insert(args.end(), {"--count", "40"});
-  for (const char* a : {"--seed", "9", "--quiet", "--out"}) args.push_back(a);
-  args.push_back(out.string());
-  return test::finish(test::start(t.cap(), args), 300);
+  if (std::find(args.begin(), args.end(), "--scenarios") == args.end()) args.insert(args.end(), {"--count", "40"});
+  args.insert(args.end(), {"--seed", "9"});
+  return test::generate(t, args, out);
 }
 
 TEST(DrawnKnobs, EachScenariosDrawIsRecordedAndAFixedRangeKeepsTheBytes) {

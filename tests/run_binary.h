@@ -226,6 +226,14 @@ inline Result finish(const Running& r, int limit_s = 120) {
   return res;
 }
 
+// `portalsim generate ARGS --quiet --out OUT`, run to its end (up to 300 s).
+inline Result generate(const TempDir& t, std::vector<std::string> args, const std::filesystem::path& out) {
+  args.insert(args.begin(), "generate");
+  for (const char* a : {"--quiet", "--out"}) args.push_back(a);
+  args.push_back(out.string());
+  return finish(start(t.cap(), args), 300);
+}
+
 // True once the started run has ended (without reaping it).
 inline bool has_ended(const Running& r) {
   siginfo_t info{};

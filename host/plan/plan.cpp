@@ -68,6 +68,10 @@ int outfit_at(const ModelSettings& m, uint64_t index) {
   return t.class_first[k] + static_cast<int>(below(q[1], static_cast<uint32_t>(t.class_count[k])));
 }
 
+const Outfit& outfit_of(const ModelSettings& m, uint64_t index) {
+  return outfit_table(m.clothing).outfits.at(static_cast<size_t>(outfit_at(m, index)));
+}
+
 double worn_minutes_at(const ModelSettings& m, uint64_t index) {
   return m.drawn[PS_DRAWN_WORN_MINUTES].varies() ? drawn_real(m, PS_DRAWN_WORN_MINUTES, index) : m.worn_minutes;
 }

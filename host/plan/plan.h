@@ -121,6 +121,8 @@ double worn_minutes_at(const ModelSettings& m, uint64_t index);
 // the class's outfits), of PS_STREAM_KNOB_DRAW element PS_DRAWN_CLOTHING. kernels/radiometry.cl's
 // scene_draw draws the same.
 int outfit_at(const ModelSettings& m, uint64_t index);
+// That outfit itself, for a run whose clothing is drawn (m.clothing not the catalogue's).
+const Outfit& outfit_of(const ModelSettings& m, uint64_t index);
 // Scenario `index`'s pixel noise sigma (the knob pixel_noise, gray levels), as ir_netd_at,
 // element PS_DRAWN_PIXEL_NOISE. kernels/sensor_noise.cl's pixel_sigma_of.
 double pixel_noise_at(const ModelSettings& m, uint64_t index);

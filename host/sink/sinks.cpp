@@ -179,8 +179,7 @@ class ScenarioListSink final : public Sink {
       }
       if (ctx_.model.clothing != Clothing::catalogue) {
         // The outfit (plan.h, outfit_at), then its transmission and clo, shortest exact text.
-        const Outfit& o = outfit_table(ctx_.model.clothing)
-                              .outfits[static_cast<size_t>(outfit_at(ctx_.model, scenes.first_index + i))];
+        const Outfit& o = outfit_of(ctx_.model, scenes.first_index + i);
         s += ',';
         s += o.name();
         for (const double v : {o.transmission(), o.clo()}) {

@@ -241,9 +241,8 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
       for (const bool transmission : {true, false})
         add(transmission ? "clothing_transmission" : "clothing_clo", TensorType::f64, {},
             [model, transmission](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
-              const OutfitTable& t = outfit_table(model.clothing);
               for (size_t i = lo; i < hi; ++i) {
-                const Outfit& o = t.outfits[static_cast<size_t>(outfit_at(model, b.first_index + i))];
+                const Outfit& o = outfit_of(model, b.first_index + i);
                 const double v = transmission ? o.transmission() : o.clo();
                 std::memcpy(dst + (i - lo) * sizeof v, &v, sizeof v);
               }

@@ -61,8 +61,7 @@ struct OutfitPhysics {
   double tc = 1, emission = 0, surface = 1;
 };
 OutfitPhysics outfit_physics(const PhysicsConfig& pc, const Outfit& o) {
-  double total = kSurfaceResistance;
-  for (const Layer& l : o.layers) total += kGarments[l.garment].clo * kClo;
+  const double total = kSurfaceResistance + o.clo() * kClo;
   OutfitPhysics r;
   double inside = 0;
   for (const Layer& l : o.layers) {
@@ -132,12 +131,6 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     }
   };
   head(p, seen, 1.0);
-  // For phys_off_body: each variant's IR shadow against the room.
-  std::vector<double> off_body_shadow;
-  for (size_t v = 0; ir && v < cat.variant_list.size(); ++v) {
-    const Material& mat = cat.materials.at(cat.object_of(static_cast<int>(v)).material_id);
-    off_body_shadow.push_back(-pc.ir_coupling * (pc.room_temperature - worn_temperature(pc, mat, m.worn_minutes)));
-  }
   // MMW: the Airy core's FWHM, 1.02 lambda / D at the range, in this view's pixels, as a
   // Gaussian of that FWHM. IR: ir_spread_mm over the view's pixel (as wide as an MMW view).
   const double span_m = 2.0 * pc.range_m * std::tan(pc.fov_rad / 2.0);
@@ -214,7 +207,11 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     const double body_from = (pc.room_temperature + pc.skin_temperature) / 2;
     for (size_t subj = 0; subj < cat.subjects.size(); ++subj)
       off_body.push_back(std::ceil((body_from - pc.ir_index_min_k) / per_index));
-    off_body.insert(off_body.end(), off_body_shadow.begin(), off_body_shadow.end());
+    // Each variant's shadow against the room.
+    for (size_t v = 0; v < cat.variant_list.size(); ++v) {
+      const Material& mat = cat.materials.at(cat.object_of(static_cast<int>(v)).material_id);
+      off_body.push_back(-pc.ir_coupling * (pc.room_temperature - worn_temperature(pc, mat, m.worn_minutes)));
+    }
     // Each subject's shadows scale with its skin above the room: every shadow above is
     // -coupling (skin - room) times a factor of the material and the worn time.
     const double span = pc.skin_temperature - pc.room_temperature;

@@ -19,13 +19,18 @@ double under_clothing(const PhysicsConfig& pc, const ModelSettings& m, double e,
   return seen;
 }
 
+// The scenario's outfit (m.outfit, as at_scenario resolved it).
+const Outfit& worn_outfit(const ModelSettings& m) {
+  return outfit_table(m.clothing).outfits.at(static_cast<size_t>(m.outfit));
+}
+
 }  // namespace
 
 // Heat flows from the skin through each layer's resistance (clo) and the surface's to the
 // room: the same flux through each, so each resistance takes its share of the drop. A layer
 // stands at the temperature at its middle; it passes 10^(-dB / 10) of the power at 94 GHz.
 std::vector<LayerSeen> outfit_layers(const PhysicsConfig& pc, const ModelSettings& m) {
-  const Outfit& outfit = outfit_table(m.clothing).outfits.at(static_cast<size_t>(m.outfit));
+  const Outfit& outfit = worn_outfit(m);
   double resistance = kSurfaceResistance;
   for (const Layer& l : outfit.layers) resistance += kGarments[l.garment].clo * kClo;
   const double flux = (pc.skin_temperature - pc.room_temperature) / resistance;  // W / m^2
@@ -43,8 +48,7 @@ std::vector<LayerSeen> outfit_layers(const PhysicsConfig& pc, const ModelSetting
 
 double outfit_surface_share(const ModelSettings& m) {
   double clothed = 0;
-  for (const Layer& l : outfit_table(m.clothing).outfits.at(static_cast<size_t>(m.outfit)).layers)
-    clothed += kGarments[l.garment].clo * kClo;
+  for (const Layer& l : worn_outfit(m).layers) clothed += kGarments[l.garment].clo * kClo;
   return kSurfaceResistance / (kSurfaceResistance + clothed);
 }
 
