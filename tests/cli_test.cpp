@@ -930,14 +930,18 @@ TEST(CliCatalogueCmd, ListsObjectsAndRegions) {
   const std::vector<std::string> objects = section(r.out, "objects");
   const std::vector<std::string> subjects = section(r.out, "subjects:");
   EXPECT_EQ(regions.size(), 13u);
-  EXPECT_EQ(objects.size(), 12u);
+  EXPECT_EQ(objects.size(), 31u);
   EXPECT_EQ(subjects.size(), 5u);
-  for (const char* name : {"gun", "iron-handle", "iron-rod", "compact-disk", "metal-strip", "metal-plate", "pendant",
-                           "iron-pipe", "belt-buckle", "ceramic-plate", "cement-tile", "mobile-phone"})
-    EXPECT_TRUE(
-        std::any_of(objects.begin(), objects.end(),
-                    [&](const std::string& l) { return split(l.substr(l.find_first_not_of(' ')), ' ')[0] == name; }))
-        << name << " is not listed";
+  // "  * gun ..." for the default pool's objects, "    knife-chef ..." for the rest.
+  std::vector<std::string> in_default;
+  for (const std::string& l : objects)
+    if (l.size() > 2 && l[2] == '*') in_default.push_back(split(l.substr(4), ' ')[0]);
+  EXPECT_EQ(in_default, (std::vector<std::string>{"gun", "iron-handle", "iron-rod", "compact-disk", "metal-strip",
+                                                  "metal-plate", "pendant", "iron-pipe", "belt-buckle", "ceramic-plate",
+                                                  "cement-tile", "mobile-phone"}));
+  EXPECT_TRUE(std::any_of(objects.begin(), objects.end(), [](const std::string& l) {
+    return l.rfind("    knife-chef ", 0) == 0 && has(l, " large   threat  knife ");
+  })) << "knife-chef's line names its metal, class and family";
   EXPECT_TRUE(has(r.out, "left-chest"));
   EXPECT_TRUE(has(r.out, "camera views: upper mmw 200x200; lower mmw 200x200; ir ir 100x200; alpha 0.9"));
   EXPECT_TRUE(names_in(t.w()).empty()) << "listing writes nothing";
@@ -980,10 +984,10 @@ TEST(CliCatalogueCmd, ImagesWritesEveryImage) {
   }
   EXPECT_EQ(subject_images, 5 * 3) << "5 subjects x (MMW upper, MMW lower, IR)";
   EXPECT_EQ(noise, 5);
-  // 12 objects, gun and iron-rod with two drawings: 14 drawings, each an MMW and an IR sprite.
-  EXPECT_EQ(sprites, 14 * 2);
+  // 31 objects, 11 of them with two drawings: 42 drawings, each an MMW and an IR sprite.
+  EXPECT_EQ(sprites, 42 * 2);
   for (const char* n : {"subject1_upper.png", "subject5_ir.png", "gun_h_mmw.png", "gun_v_ir.png", "iron-handle_mmw.png",
-                        "mobile-phone_ir.png"})
+                        "mobile-phone_ir.png", "knife-chef_v_mmw.png", "glasses_ir.png"})
     EXPECT_TRUE(std::find(names.begin(), names.end(), n) != names.end()) << n << " missing";
   EXPECT_EQ(names_in(t.w()), (std::vector<std::string>{"images"}));
 }

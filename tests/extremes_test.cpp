@@ -750,12 +750,11 @@ void black_and_white(uint8_t base, uint8_t sprite) {
   const std::string iv = write_gray(t.path(), "sprite-ir-v-" + s + ".png", 15, 20, sprite);
   std::string text = default_text();
   for (int k = 1; k <= 5; ++k) text = add_after_name(text, "subject-" + std::to_string(k), subject_images(up, up, ir));
-  for (const char* o : {"gun", "iron-rod"})
-    text = add_after_name(
-        text, o, "mmw_h = \"" + sh + "\"\nmmw_v = \"" + sv + "\"\nir_h = \"" + ih + "\"\nir_v = \"" + iv + "\"\n");
-  for (const char* o : {"iron-handle", "compact-disk", "metal-strip", "metal-plate", "pendant", "iron-pipe",
-                        "belt-buckle", "ceramic-plate", "cement-tile", "mobile-phone"})
-    text = add_after_name(text, o, "mmw = \"" + sh + "\"\nir = \"" + ih + "\"\n");
+  for (const Object& o : test::catalogue().objects)  // every object's drawings are files
+    text = add_after_name(text, o.name,
+                          o.variants.size() == 2 ? "mmw_h = \"" + sh + "\"\nmmw_v = \"" + sv + "\"\nir_h = \"" + ih +
+                                                       "\"\nir_v = \"" + iv + "\"\n"
+                                                 : "mmw = \"" + sh + "\"\nir = \"" + ih + "\"\n");
   auto w = make_world(text, t.str());
   for (const auto& views : w->assets.bases)
     for (const Image& img : views)

@@ -320,14 +320,16 @@ TEST(MetalMap, CleanTesterAtTheCoilsPlaneReadsAsTheScenario) {
   evaluate::MetalMapSettings s = small("gun");
   const evaluate::MetalWalks w = evaluate::metal_map_walks(cat, s);
   const opencl::MetalResponses r = opencl::metal_responses(*test::runtime(), cat, w.objects, w.probes);
-  const size_t cells = w.walks - cat.subjects.size() * 4 * kBuiltinRegions;  // the map's walks; four benign items
+  // The map's walks, then the clean testers: every standard benign item (the catalogue has
+  // all eight, docs/model/objects.md) in every region of every subject.
+  const size_t cells = w.walks - cat.subjects.size() * evaluate::kBenignItems.size() * kBuiltinRegions;
   const size_t at0 = static_cast<size_t>(std::lround(s.walk * s.sample_rate / s.speed));
   ASSERT_EQ(w.probes[(cells * w.samples + at0) * PS_MP_LEN + PS_MP_Y], 0.0);
   ModelSettings m;
   m.model = Model::physics;
   int checked = 0;
   for (size_t subject = 0; subject < cat.subjects.size(); ++subject)
-    for (const char* item : {"belt-buckle", "mobile-phone", "pendant", "compact-disk"})
+    for (const char* item : evaluate::kBenignItems)
       for (int region = 0; region < kBuiltinRegions; ++region, ++checked) {
         Scenario sc;
         sc.subject = static_cast<int>(subject);

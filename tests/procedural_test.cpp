@@ -11,8 +11,9 @@
 namespace portalsim::procedural {
 namespace {
 
-const std::vector<std::string> kShapes = {"gun",     "handle", "rod",    "disk", "strip", "plate",
-                                          "pendant", "pipe",   "buckle", "tile", "slab",  "phone"};
+const std::vector<std::string> kShapes = {"gun",   "handle", "rod",   "disk",    "strip",  "plate", "pendant",
+                                          "pipe",  "buckle", "tile",  "slab",    "phone",  "knife", "keys",
+                                          "coins", "wallet", "watch", "glasses", "bottle", "sheet"};
 
 // Catalogue sizes of the horizontal drawings.
 struct Size {
@@ -30,6 +31,14 @@ Size catalogue_size(const std::string& s) {
   if (s == "buckle") return {26, 18};
   if (s == "tile") return {28, 28};
   if (s == "slab") return {32, 32};
+  if (s == "knife") return {54, 8};
+  if (s == "keys") return {20, 13};
+  if (s == "coins") return {13, 10};
+  if (s == "wallet") return {25, 20};
+  if (s == "watch") return {24, 10};
+  if (s == "glasses") return {32, 12};
+  if (s == "bottle") return {46, 15};
+  if (s == "sheet") return {45, 34};
   return {18, 32};  // phone
 }
 
@@ -55,7 +64,7 @@ TEST(ProceduralTest, TheDeclaredShapesAreExactlyTheDrawnOnes) {
     EXPECT_TRUE(is_procedural_shape(s)) << s;
     EXPECT_NO_THROW(sprite(s, false, 40, 20, 200)) << s;
   }
-  for (const char* s : {"", "Gun", "GUN", "knife", "disc", "gun ", "pistol"}) {
+  for (const char* s : {"", "Gun", "GUN", "sword", "disc", "gun ", "pistol"}) {
     EXPECT_FALSE(is_procedural_shape(s)) << s;
     EXPECT_THROW(sprite(s, false, 40, 20, 200), std::invalid_argument) << s;
   }
@@ -120,7 +129,7 @@ TEST(ProceduralTest, SpritesHaveCleanOutsideAndSoftEdges) {
       EXPECT_GT(opaque, 0) << s;
       EXPECT_GT(partial, 0) << s << ": no anti-aliased edge";
       // Boxy shapes fill their box up to slightly rounded corners.
-      if (s != "tile" && s != "plate" && s != "rod" && s != "strip" && s != "pipe") {
+      if (s != "tile" && s != "plate" && s != "rod" && s != "strip" && s != "pipe" && s != "wallet" && s != "sheet") {
         EXPECT_GT(clear, 0) << s;
       }
     }
@@ -434,7 +443,7 @@ TEST(ProceduralTest, InvalidArgumentsThrow) {
   EXPECT_THROW(ir_body(b, 100, 0), std::invalid_argument);
   EXPECT_THROW(sprite("gun", false, 0, 10, 100), std::invalid_argument);
   EXPECT_THROW(sprite("gun", true, 10, -3, 100), std::invalid_argument);
-  EXPECT_THROW(sprite("knife", false, 10, 10, 100), std::invalid_argument);
+  EXPECT_THROW(sprite("sword", false, 10, 10, 100), std::invalid_argument);
   EXPECT_THROW(sprite("", false, 10, 10, 100), std::invalid_argument);
   EXPECT_THROW(noise_pattern(-1, 64), std::invalid_argument);
   EXPECT_THROW(noise_pattern(kProceduralNoisePatterns, 64), std::invalid_argument);

@@ -78,18 +78,27 @@ inline std::string with_view_line(std::string text, const std::string& view, con
   return text;
 }
 
-// Every variant in every region (one object per scenario, rotating subjects), then random
-// crowds of up to `max_objects` (random_scenario from k = 0) until there are `n`.
+// Every variant of the default pool's objects in every region, every other variant in
+// three regions spread over the views (one object per scenario, rotating subjects), then
+// random crowds of up to `max_objects` (random_scenario from k = 0) until there are `n`.
+// The objects outside the default pool take the same code paths as the thesis's 12 (a
+// sprite each); three regions apiece keep the singles at 266 rather than 546.
 inline std::vector<Scenario> coverage(const Catalogue& c, size_t n, int max_objects, bool singles = true) {
   std::vector<Scenario> v;
+  const int R = c.region_count();
   if (singles)
-    for (size_t var = 0; var < c.variant_list.size(); ++var)
-      for (int r = 0; r < c.region_count(); ++r) {
+    for (size_t var = 0; var < c.variant_list.size(); ++var) {
+      const bool every =
+          std::find(c.default_pool.begin(), c.default_pool.end(), c.variant_list[var].object) != c.default_pool.end();
+      for (int r = 0; r < R; ++r) {
+        const int at = static_cast<int>(var) % R;
+        if (!every && r != at && r != (at + 4) % R && r != (at + 9) % R) continue;
         Scenario s;
         s.subject = static_cast<int>((var + r) % c.subjects.size());
         s.objects[r] = static_cast<int16_t>(var);
         v.push_back(s);
       }
+    }
   for (uint64_t k = 0; v.size() < n; ++k) v.push_back(random_scenario(c, k, max_objects));
   return v;
 }

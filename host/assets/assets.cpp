@@ -114,22 +114,31 @@ AssetSet build_assets(const Catalogue& cat) {
   });
   // Each sprite set's drawings keep the objects' physical size: a catalogue size is in field
   // units, scaled by the set's view pixels per unit. A file is its camera's drawing as given.
-  for (const SpriteSet& set : cat.sprite_sets) {
-    std::vector<Image>& out = a.sprites.emplace_back();
+  // Drawn on every thread (each drawing stands alone), files one at a time as the bases are.
+  const size_t V = cat.variant_list.size();
+  for (size_t set = 0; set < cat.sprite_sets.size(); ++set) a.sprites.emplace_back(V);
+  const auto draw_sprite = [&](size_t job) {
+    const SpriteSet& set = cat.sprite_sets[job / V];
+    const size_t v = job % V;
     const bool ir = set.camera == Camera::ir;
-    for (size_t v = 0; v < cat.variant_list.size(); ++v) {
-      const Object& o = cat.object_of(static_cast<int>(v));
-      const Variant& var = cat.variant(static_cast<int>(v));
-      const bool vertical = var.code == "v";
-      const int w = vertical ? o.height : o.width, h = vertical ? o.width : o.height;
-      const int sw = std::max(1, static_cast<int>(std::lround(w * set.scale_x)));
-      const int sh = std::max(1, static_cast<int>(std::lround(h * set.scale_y)));
-      const ImageSource& file = ir ? var.ir : var.mmw;
-      Image sp = !file.path.empty() ? (ir ? to_temperature(load(file), a.palette, true) : to_gray(load(file), true))
-                                    : procedural::sprite(o.shape, vertical, sw, sh, ir ? o.ir_level : o.mmw_level);
-      out.push_back(set.mirrored ? mirrored(sp) : std::move(sp));
-    }
-  }
+    const Object& o = cat.object_of(static_cast<int>(v));
+    const Variant& var = cat.variant(static_cast<int>(v));
+    const bool vertical = var.code == "v";
+    const int w = vertical ? o.height : o.width, h = vertical ? o.width : o.height;
+    const int sw = std::max(1, static_cast<int>(std::lround(w * set.scale_x)));
+    const int sh = std::max(1, static_cast<int>(std::lround(h * set.scale_y)));
+    const ImageSource& file = ir ? var.ir : var.mmw;
+    Image sp = !file.path.empty() ? (ir ? to_temperature(load(file), a.palette, true) : to_gray(load(file), true))
+                                  : procedural::sprite(o.shape, vertical, sw, sh, ir ? o.ir_level : o.mmw_level);
+    a.sprites[job / V][v] = set.mirrored ? mirrored(sp) : std::move(sp);
+  };
+  const bool sprite_files = std::any_of(cat.objects.begin(), cat.objects.end(), [](const Object& o) {
+    return std::any_of(o.variants.begin(), o.variants.end(),
+                       [](const Variant& v) { return !v.mmw.path.empty() || !v.ir.path.empty(); });
+  });
+  parallel_for(cat.sprite_sets.size() * V, sprite_files ? 1 : default_threads(), [&](size_t begin, size_t end) {
+    for (size_t job = begin; job < end; ++job) draw_sprite(job);
+  });
   for (size_t k = 0; k < cat.noise.size(); ++k) {
     const NoisePattern& p = cat.noise[k];
     a.noise.push_back(p.image.path.empty() ? procedural::noise_pattern(static_cast<int>(k), ic.noise_size)

@@ -673,6 +673,188 @@ class Phone : public Shape {
   }
 };
 
+// A knife lying blade right, edge down: a rounded handle with two rivets, a bolster, and a
+// blade whose spine runs straight to a drop point while the edge sweeps up to it.
+class Knife : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override {
+    const double handle = sd_rect(p, 0.0, 0.20 * h_, 0.40 * w_, 0.84 * h_, 0.30 * h_);
+    const double bolster = sd_rect(p, 0.38 * w_, 0.10 * h_, 0.44 * w_, 0.94 * h_, 0.05 * m_);
+    const double blade =
+        sd_polygon(p, {at(0.43, 0.06), at(0.84, 0.06), at(1.0, 0.32), at(0.91, 0.66), at(0.72, 0.90), at(0.43, 0.95)});
+    return std::min({handle, bolster, blade});
+  }
+  double shade(P p) const override {
+    const double u = p.x / w_, v = p.y / h_;
+    double s;
+    if (u < 0.38) {  // handle: darker scales, two bright rivets
+      s = -16.0 + 4.0 * value_noise(p.x / 3.0, p.y / 3.0, 81);
+      for (double ru : {0.10, 0.28})
+        if (sd_circle(p, at(ru, 0.52), std::max(0.5, 0.12 * h_)) < 0.0) s += 26.0;
+    } else if (u < 0.44) {  // bolster
+      s = 10.0;
+    } else {  // blade: bright flat, the edge's grind a darker band, a sheen along the spine
+      s = 6.0 + 14.0 * std::max(0.0, 1.0 - std::fabs(v - 0.16) / 0.12);
+      if (v > 0.68 - 0.3 * clamp01((u - 0.7) / 0.3)) s -= 10.0;
+    }
+    return s + rim(sd(p), 0.6, 8.0) + 1.5 * grain(p, 82);
+  }
+};
+
+// A bunch of keys: a split ring on the left and three keys fanning out from it.
+class Keys : public Shape {
+ public:
+  Keys(double w, double h) : Shape(w, h) {
+    ring_ = at(0.16, 0.50);
+    ring_r_ = std::max(1.0, 0.26 * h_);
+    for (int k = 0; k < 3; ++k) {
+      head_[k] = at(0.40, 0.24 + 0.26 * k);
+      tip_[k] = at(0.97, 0.12 + 0.38 * k);
+    }
+  }
+  double sd(P p) const override {
+    const double t = std::max(0.45, 0.07 * h_);
+    double d = std::fabs(sd_circle(p, ring_, ring_r_)) - t;
+    for (int k = 0; k < 3; ++k) {
+      d = std::min(d, sd_circle(p, head_[k], std::max(0.8, 0.17 * h_)));
+      d = std::min(d, sd_capsule(p, head_[k], tip_[k], std::max(0.5, 0.07 * h_)));
+    }
+    return d;
+  }
+  double shade(P p) const override {
+    double s = 6.0;
+    for (int k = 0; k < 3; ++k)
+      if (sd_circle(p, head_[k], std::max(0.8, 0.17 * h_)) < 0.0) s = 12.0 - 6.0 * k;  // heads of three metals
+    return s + rim(sd(p), 0.5, 10.0) + 2.0 * grain(p, 91);
+  }
+
+ private:
+  P ring_, head_[3], tip_[3];
+  double ring_r_;
+};
+
+// A few coins, overlapping: raised rims and a relief in each face.
+class Coins : public Shape {
+ public:
+  Coins(double w, double h) : Shape(w, h) {
+    r_ = 0.30 * m_;
+    c_[0] = at(0.30, 0.36);
+    c_[1] = at(0.68, 0.40);
+    c_[2] = at(0.46, 0.68);
+  }
+  double sd(P p) const override {
+    return std::min({sd_circle(p, c_[0], r_), sd_circle(p, c_[1], r_), sd_circle(p, c_[2], r_)});
+  }
+  double shade(P p) const override {
+    for (int k = 2; k >= 0; --k) {  // the last coin lies on top
+      const double d = sd_circle(p, c_[k], r_);
+      if (d < 0.0) {
+        double s = 4.0 * k - 4.0 + 10.0 * value_noise(p.x / 1.5, p.y / 1.5, 101 + k);
+        if (-d < std::max(0.5, 0.15 * r_)) s += 14.0;  // rim
+        return s;
+      }
+    }
+    return 0.0;
+  }
+
+ private:
+  P c_[3];
+  double r_;
+};
+
+// A folded wallet: a rounded leather case with the fold down its middle, stitching along
+// its edge and the bulge of cards.
+class Wallet : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override { return sd_rect(p, 0, 0, w_, h_, 0.12 * m_); }
+  double shade(P p) const override {
+    const double d = sd(p), u = p.x / w_;
+    double s = 6.0 * fbm(p.x / 2.5, p.y / 2.5, 111) + 2.0 * grain(p, 112);  // grain of the leather
+    if (std::fabs(u - 0.5) < 0.03) s -= 14.0;                               // the fold
+    const double inset = std::max(1.0, 0.1 * m_);
+    if (std::fabs(-d - inset) < 0.35 && wave((p.x + p.y) / 1.6) > 0.5) s -= 10.0;  // stitching
+    s += 8.0 * std::max(0.0, 1.0 - std::fabs(p.y / h_ - 0.45) / 0.3) * (u > 0.55 ? 1.0 : 0.0);
+    return s + rim(d, 0.8, 10.0);
+  }
+};
+
+// A wristwatch as it lies, strap straight: a round case with a crown, a bracelet of links.
+class Watch : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override {
+    const double strap = sd_rect(p, 0, 0.22 * h_, w_, 0.78 * h_, 0.2 * h_);
+    const double c = sd_circle(p, at(0.5, 0.5), 0.5 * h_);
+    const double crown = sd_rect(p, 0.46 * w_, 0.0, 0.54 * w_, 0.08 * h_, 0.02 * m_);
+    return std::min({strap, c, crown});
+  }
+  double shade(P p) const override {
+    const double dc = sd_circle(p, at(0.5, 0.5), 0.5 * h_);
+    if (dc < 0.0) {
+      if (-dc < std::max(0.6, 0.14 * h_)) return 16.0 + rim(dc, 0.5, 8.0);                            // the bezel
+      return -18.0 + 8.0 * std::max(0.0, 1.0 - std::fabs(p.x - p.y - 0.5 * (w_ - h_)) / (0.2 * h_));  // the glass
+    }
+    return 4.0 + 10.0 * wave(p.x / std::max(1.2, 0.12 * h_)) + rim(sd(p), 0.5, 8.0);  // links
+  }
+};
+
+// Folded glasses: two lenses in thin frames joined by a bridge, the temples folded across
+// their tops.
+class Glasses : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override {
+    const double l = sd_ellipse(p, at(0.26, 0.56), 0.22 * w_, 0.40 * h_);
+    const double r = sd_ellipse(p, at(0.74, 0.56), 0.22 * w_, 0.40 * h_);
+    const double bridge = sd_capsule(p, at(0.46, 0.38), at(0.54, 0.38), std::max(0.45, 0.06 * h_));
+    const double temples = sd_capsule(p, at(0.03, 0.14), at(0.97, 0.14), std::max(0.45, 0.06 * h_));
+    return std::min({l, r, bridge, temples});
+  }
+  double shade(P p) const override {
+    const double l = sd_ellipse(p, at(0.26, 0.56), 0.22 * w_, 0.40 * h_);
+    const double r = sd_ellipse(p, at(0.74, 0.56), 0.22 * w_, 0.40 * h_);
+    const double lens = std::min(l, r), frame = std::max(0.5, 0.09 * h_);
+    if (lens < 0.0 && -lens > frame) return -12.0 + 10.0 * std::max(0.0, 1.0 - std::fabs(p.x / w_ - p.y / h_) / 0.15);
+    return 14.0 + 2.0 * grain(p, 121);  // the frame, the bridge and the temples
+  }
+};
+
+// A drinks bottle lying down: the body, a shoulder, the neck and a ribbed cap on the right.
+class Bottle : public Elongated {
+ public:
+  using Elongated::Elongated;
+  double sd(P p) const override {
+    const P q = horizontal() ? p : P{p.y, p.x};  // along the box's long side
+    const double L = length(), T = horizontal() ? h_ : w_;
+    const double body = sd_rect(q, 0, 0, 0.70 * L, T, 0.25 * T);
+    const double shoulder = sd_round_cone(q, {0.66 * L, 0.5 * T}, {0.86 * L, 0.5 * T}, 0.46 * T, 0.16 * T);
+    const double cap = sd_rect(q, 0.86 * L, 0.30 * T, L, 0.70 * T, 0.05 * T);
+    return std::min({body, shoulder, cap});
+  }
+  double shade(P p) const override {
+    const double a = along(p);
+    double s = cylinder(across(p), -0.3, 0.3);
+    if (a > 0.18 && a < 0.52) s -= 8.0;                                                 // the label
+    if (a > 0.86) s = 6.0 + 8.0 * wave(a * length() / std::max(1.0, 0.05 * length()));  // the cap's ribs
+    return s + rim(sd(p), 0.6, 6.0);
+  }
+};
+
+// A flat sheet in a wrapper: low relief, the wrapper's creases, a band of tape across it.
+class Sheet : public Shape {
+ public:
+  using Shape::Shape;
+  double sd(P p) const override { return sd_rect(p, 0, 0, w_, h_, std::max(0.5, 0.06 * m_)); }
+  double shade(P p) const override {
+    double s = 5.0 * fbm(p.x / 6.0, p.y / 3.0, 131) + 2.0 * grain(p, 132);
+    s -= 8.0 * std::max(0.0, 1.0 - std::fabs(p.x - 0.6 * p.y - 0.3 * w_) / 1.2);  // a crease
+    if (std::fabs(p.x / w_ - 0.5) < 0.08) s += 10.0;                              // tape
+    return s + rim(sd(p), 0.6, 6.0);
+  }
+};
+
 // Shading offset squeezed smoothly into the room between the level and 0 or 255, so bright
 // metals keep their highlights instead of clipping flat.
 double fit_shade(double s, double level) {
@@ -695,6 +877,14 @@ std::unique_ptr<Shape> make_shape(const std::string& name, double w, double h) {
   if (name == "tile") return std::make_unique<Tile>(w, h);
   if (name == "slab") return std::make_unique<Slab>(w, h);
   if (name == "phone") return std::make_unique<Phone>(w, h);
+  if (name == "knife") return std::make_unique<Knife>(w, h);
+  if (name == "keys") return std::make_unique<Keys>(w, h);
+  if (name == "coins") return std::make_unique<Coins>(w, h);
+  if (name == "wallet") return std::make_unique<Wallet>(w, h);
+  if (name == "watch") return std::make_unique<Watch>(w, h);
+  if (name == "glasses") return std::make_unique<Glasses>(w, h);
+  if (name == "bottle") return std::make_unique<Bottle>(w, h);
+  if (name == "sheet") return std::make_unique<Sheet>(w, h);
   return nullptr;
 }
 

@@ -1,4 +1,5 @@
 // portalsim catalogue: what a scenario can name, and the default images to look at.
+#include <algorithm>
 #include <cstdio>
 
 #include "assets/image_io.h"
@@ -39,14 +40,26 @@ int list(CatalogueOptions& o) {
     const int view = first_view(c.sensors, r.id - 1, Camera::mmw);
     std::printf("  %2d  %-15s %s\n", r.id, r.name.c_str(), view < 0 ? "" : c.sensors[view].name.c_str());
   }
-  std::printf("\nobjects (name [variants] metal category: aliases):\n");
-  for (const Object& ob : c.objects) {
+  std::printf("\nobjects (name [variants] metal category, class, family, * in the default pool: aliases):\n");
+  size_t width = 0;
+  for (const Object& ob : c.objects) width = std::max(width, ob.name.size());
+  std::vector<char> in_default(c.objects.size(), 0);
+  for (int k : c.default_pool) in_default[k] = 1;
+  for (size_t i = 0; i < c.objects.size(); ++i) {
+    const Object& ob = c.objects[i];
     std::string vars, aliases;
     for (const Variant& v : ob.variants)
       if (!v.code.empty()) vars += (vars.empty() ? "" : ",") + v.code;
     for (const std::string& a : ob.aliases) aliases += (aliases.empty() ? "" : ", ") + a;
-    std::printf("  %-14s %-6s %-7s %s\n", ob.name.c_str(), vars.empty() ? "" : ("[" + vars + "]").c_str(),
-                c.metal_categories[ob.metal].c_str(), aliases.c_str());
+    char line[512];
+    std::snprintf(line, sizeof line, "  %c %-*s %-6s %-7s %-7s %-8s %s", in_default[i] ? '*' : ' ',
+                  static_cast<int>(std::min<size_t>(width, 64)), ob.name.c_str(),
+                  vars.empty() ? "" : ("[" + vars + "]").c_str(), c.metal_categories[ob.metal].c_str(),
+                  ob.object_class.empty() ? "-" : ob.object_class.c_str(), ob.family.empty() ? "-" : ob.family.c_str(),
+                  aliases.c_str());
+    std::string shown = line;
+    shown.erase(shown.find_last_not_of(' ') + 1);  // no trailing blanks where there are no aliases
+    std::printf("%s\n", shown.c_str());
   }
   if (!o.images.empty()) {
     StagedFolder folder(o.images);

@@ -13,7 +13,9 @@ void add_spec_flags(CLI::App* sub, SpecFlags* o, bool outputs) {
   sub->add_option("--spec", o->spec_file, "TOML spec file; command-line flags override its keys");
   sub->add_option("--count", o->count, "number of scenarios (default 1000)");
   sub->add_option("--rule", o->spec.rule, "threat rule, e.g. gun or 'iron-rod&metal-plate'");
-  sub->add_option("--pool", o->pool, "objects to draw from, comma-separated (default: all)");
+  sub->add_option("--pool", o->pool,
+                  "objects to draw from, comma-separated: names, class:NAME, family:NAME or all (default: the "
+                  "catalogue's default_pool)");
   sub->add_option("--objects", o->objects, "objects per scenario, MIN..MAX (default 0..4)");
   sub->add_option("--subjects", o->subjects, "subjects to draw from, e.g. 1,2,5 (default: all)");
   add_body_options(*sub, o->body, "--seed; give it apart to keep the bodies over other scenarios");

@@ -8,8 +8,9 @@
 
 namespace portalsim {
 
-inline constexpr std::array<std::string_view, 12> kProceduralShapes = {
-    "gun", "handle", "rod", "disk", "strip", "plate", "pendant", "pipe", "buckle", "tile", "slab", "phone"};
+inline constexpr std::array<std::string_view, 20> kProceduralShapes = {
+    "gun",  "handle", "rod",   "disk", "strip", "plate",  "pendant", "pipe",    "buckle", "tile",
+    "slab", "phone",  "knife", "keys", "coins", "wallet", "watch",   "glasses", "bottle", "sheet"};
 
 inline bool is_procedural_shape(std::string_view name) {
   return std::find(kProceduralShapes.begin(), kProceduralShapes.end(), name) != kProceduralShapes.end();

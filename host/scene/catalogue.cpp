@@ -335,9 +335,10 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
                           const std::string& assets_dir) {
   Reader rd{source_name, base_dir, assets_dir};
   const toml::table root = io::parse_toml(text, source_name);
-  io::reject_unknown_keys(
-      root, {"format", "images", "views", "metal", "subjects", "regions", "objects", "noise", "physics", "materials"},
-      source_name, "");
+  io::reject_unknown_keys(root,
+                          {"format", "default_pool", "images", "views", "metal", "subjects", "regions", "objects",
+                           "noise", "physics", "materials"},
+                          source_name, "");
   Catalogue cat;
   cat.source = source_name;
   cat.hash = fnv1a_hex(text);
@@ -535,13 +536,14 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     const toml::table& t = *objects.get(i)->as_table();
     const std::string f = "objects[" + std::to_string(i + 1) + "]";
     io::reject_unknown_keys(t,
-                            {"name", "aliases", "material", "metal", "shape", "size", "mmw_level", "ir_level",
-                             "variants", "mmw", "ir", "mmw_h", "mmw_v", "ir_h", "ir_v", "metal_anisotropy"},
+                            {"name", "aliases", "class", "family", "material", "metal", "shape", "size", "mmw_level",
+                             "ir_level", "variants", "mmw", "ir", "mmw_h", "mmw_v", "ir_h", "ir_v", "metal_anisotropy"},
                             source_name, f);
     Object o;
     o.name = rd.string(t, "name", f);
-    if (normalise_name(o.name).empty() || normalise_name(o.name) == "none")
-      rd.fail(t.get("name"), f + ".name", "\"" + o.name + "\" cannot name an object");
+    for (const char* reserved : {"", "none", "all", "class", "family"})  // words of pools and rules
+      if (normalise_name(o.name) == reserved)
+        rd.fail(t.get("name"), f + ".name", "\"" + o.name + "\" cannot name an object");
     if (const toml::node* an = t.get("aliases")) {
       const toml::array* a = an->as_array();
       if (!a) rd.fail(an, f + ".aliases", "expected an array of strings");
@@ -557,6 +559,13 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
          }()) {
       if (cat.find_object(n) >= 0)
         rd.fail(&t, f + ".name", "\"" + n + "\" already names " + cat.objects[cat.find_object(n)].name);
+    }
+    for (auto [key, into] : {std::pair{"class", &o.object_class}, std::pair{"family", &o.family}}) {
+      *into = rd.string(t, key, f, "");
+      if (t.get(key) && (normalise_name(*into).empty() || into->size() > 64 ||
+                         into->find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-_") != std::string::npos))
+        rd.fail(t.get(key), f + "." + key,
+                "expected a name of a-z, 0-9, '-' and '_' (at most 64), got \"" + *into + "\"");
     }
     o.material = rd.string(t, "material", f, "");
     if (!cat.materials.empty()) {
@@ -621,6 +630,23 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     }
     if (cat.variant_list.size() > 30000) rd.fail(&t, f, "too many object variants (at most 30000)");
     cat.objects.push_back(std::move(o));
+  }
+
+  // default_pool: object names, after the objects it names.
+  if (const toml::node* dp = root.get("default_pool")) {
+    const toml::array* a = dp->as_array();
+    if (!a || a->empty()) rd.fail(dp, "default_pool", "expected a non-empty array of object names");
+    for (size_t k = 0; k < a->size(); ++k) {
+      const std::string pf = "default_pool[" + std::to_string(k + 1) + "]";
+      if (!a->get(k)->is_string()) rd.fail(a->get(k), pf, "expected an object's name");
+      const int o = cat.find_object(a->get(k)->as_string()->get());
+      if (o < 0) rd.fail(a->get(k), pf, "\"" + a->get(k)->as_string()->get() + "\" is not one of the [[objects]]");
+      if (std::find(cat.default_pool.begin(), cat.default_pool.end(), o) != cat.default_pool.end())
+        rd.fail(a->get(k), pf, "\"" + cat.objects[o].name + "\" is listed twice");
+      cat.default_pool.push_back(o);
+    }
+  } else {
+    for (size_t o = 0; o < cat.objects.size(); ++o) cat.default_pool.push_back(static_cast<int>(o));
   }
 
   // [[noise]]

@@ -104,6 +104,9 @@ struct Object {
   int mmw_level = 0, ir_level = 0;
   // --model physics: polarizability along the drawing's long axis over across it (1: isotropic).
   double metal_anisotropy = 1.0;
+  // What rules and pools can name it by (`class:threat`, `family:knife`); empty where the
+  // catalogue gives none (docs/model/objects.md).
+  std::string object_class, family;
   std::vector<Variant> variants;
   int first_variant = 0;  // index of variants[0] in Catalogue::variant_list
 };
@@ -153,6 +156,9 @@ struct Catalogue {
   // influence[category][region][zone]
   std::vector<std::vector<std::vector<int>>> influence;
   std::vector<VariantRef> variant_list;
+  // The objects a run draws from when it names no pool (`default_pool`; every object when
+  // the catalogue gives none).
+  std::vector<int> default_pool;
   std::vector<Sensor> sensors;         // the camera views ([[views]]; scene/sensor.h)
   std::vector<SpriteSet> sprite_sets;  // the objects' drawings the views need
   MetalPhysics metal_physics;

@@ -13,8 +13,7 @@ constexpr uint32_t kMaxAttempts = 4096;  // balanced draws: rejection sampling p
 
 Generator::Generator(const Catalogue& cat, GeneratorSpec spec, uint64_t seed)
     : cat_(cat), spec_(std::move(spec)), seed_(seed) {
-  if (spec_.pool.empty())
-    for (size_t i = 0; i < cat.objects.size(); ++i) spec_.pool.push_back(static_cast<int>(i));
+  if (spec_.pool.empty()) spec_.pool = cat.default_pool;
   if (spec_.subjects.empty())
     for (size_t i = 0; i < cat.subjects.size(); ++i) spec_.subjects.push_back(static_cast<int>(i));
   for (int s : spec_.subjects)

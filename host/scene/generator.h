@@ -11,7 +11,7 @@
 namespace portalsim {
 
 struct GeneratorSpec {
-  std::vector<int> pool;  // object indices to draw from; empty = every object
+  std::vector<int> pool;  // object indices to draw from; empty = the catalogue's default_pool
   int min_objects = 0, max_objects = 4;
   std::vector<int> subjects;  // 0-based; empty = every subject
   std::string rule;           // threat rule; empty = every scenario is "no"

@@ -8,8 +8,9 @@
 namespace portalsim {
 
 struct ThreatRule::Node {
-  enum Kind { any_of, all_of, negate, object, variant } kind = object;
-  int id = 0;  // object index or variant id
+  enum Kind { any_of, all_of, negate, objects, variant } kind = objects;
+  std::vector<char> member;  // objects: by object index, whether it is one the factor names
+  int id = 0;                // variant: its id
   std::vector<std::unique_ptr<Node>> kids;
 
   bool eval(const Catalogue* cat, const Scenario& s) const {
@@ -24,9 +25,9 @@ struct ThreatRule::Node {
         return true;
       case negate:
         return !kids[0]->eval(cat, s);
-      case object:
+      case objects:
         for (int16_t v : s.objects)
-          if (v != kNoObject && cat->variant_list[v].object == id) return true;
+          if (v != kNoObject && member[cat->variant_list[v].object]) return true;
         return false;
       case variant:
         for (int16_t v : s.objects)
@@ -94,6 +95,12 @@ ThreatRule::ThreatRule(const Catalogue& cat, const std::string& text, const std:
       ++p.pos;
     if (p.pos == start) p.fail("expected an object name");
     const std::string token = text.substr(start, p.pos - start);
+    if (is_object_set_token(token)) {
+      auto n = std::make_unique<Node>();
+      n->member.assign(cat.objects.size(), 0);
+      for (int o : parse_object_set(cat, token, where, false)) n->member[o] = 1;
+      return n;
+    }
     const int16_t v = parse_object_token(cat, token, where);
     if (v == kNoObject) p.fail("\"none\" cannot be part of a rule");
     auto n = std::make_unique<Node>();
@@ -101,8 +108,8 @@ ThreatRule::ThreatRule(const Catalogue& cat, const std::string& text, const std:
       n->kind = Node::variant;
       n->id = v;
     } else {
-      n->kind = Node::object;
-      n->id = cat.variant_list[v].object;
+      n->member.assign(cat.objects.size(), 0);
+      n->member[cat.variant_list[v].object] = 1;
     }
     return n;
   };

@@ -2,7 +2,8 @@
 //   rule   := term ('|' term)*        any term holds
 //   term   := factor ('&' factor)*    all factors hold (thesis 5.1.2: two or more objects)
 //   factor := '!' factor | '(' rule ')' | object[:variant]   present anywhere on the body
-// Examples: "gun" (5.1.1), "iron-rod&metal-plate" (5.1.2), "gun|iron-rod&metal-plate".
+//           | class:NAME | family:NAME                        any object of that class or family
+// Examples: "gun" (5.1.1), "iron-rod&metal-plate" (5.1.2), "gun|iron-rod&metal-plate", "class:threat".
 #pragma once
 #include <memory>
 #include <string>

@@ -67,6 +67,13 @@ struct SceneBatch {
 // catalogue's regions), "none" for an empty region, "name:v" / "name:h" for a variant.
 // `where` prefixes errors (e.g. "argument 3" or "scenes.csv:12: region3").
 int16_t parse_object_token(const Catalogue& cat, const std::string& token, const std::string& where);
+// The objects a pool or rule token names (docs/model/objects.md): "class:NAME" (every
+// object of that class), "family:NAME", "all" (with `allow_all`), or one object's name or
+// alias; in catalogue order. Throws InputError naming `where` for a name nothing carries.
+std::vector<int> parse_object_set(const Catalogue& cat, const std::string& token, const std::string& where,
+                                  bool allow_all);
+// Whether `token` names a class or family ("class:..." or "family:...", any case).
+bool is_object_set_token(const std::string& token);
 // The tokens of simulate's positional argument `objects`: errors start "objects: region N"
 // (the command line names the argument, so that an unknown object there is a usage error).
 Scenario parse_object_list(const Catalogue& cat, const std::vector<std::string>& tokens);

@@ -263,12 +263,20 @@ void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
 
 GeneratorSpec generator_spec(const RunSpec& spec, const Catalogue& cat) {
   GeneratorSpec g;
-  for (const std::string& name : spec.pool) {
-    const int o = cat.find_object(name);
-    if (o < 0) throw InputError(spec.where("pool") + ": unknown object \"" + name + "\"");
-    for (int p : g.pool)
-      if (p == o) throw InputError(spec.where("pool") + ": \"" + name + "\" is listed twice");
-    g.pool.push_back(o);
+  // The union of what the entries name, each object where it first appears (the order
+  // the draws index); an object named twice by its own name is a slip and refused.
+  std::vector<char> in_pool(cat.objects.size(), 0), named(cat.objects.size(), 0);
+  for (const std::string& token : spec.pool) {
+    const std::vector<int> set = parse_object_set(cat, token, spec.where("pool"), true);
+    if (set.size() == 1 && !is_object_set_token(token) && normalise_name(token) != "all") {
+      if (named[set[0]]) throw InputError(spec.where("pool") + ": \"" + token + "\" is listed twice");
+      named[set[0]] = 1;
+    }
+    for (int o : set)
+      if (!in_pool[o]) {
+        in_pool[o] = 1;
+        g.pool.push_back(o);
+      }
   }
   g.min_objects = spec.min_objects;
   g.max_objects = spec.max_objects;

@@ -19,7 +19,7 @@ namespace portalsim {
 struct RunSpec {
   uint64_t count = 1000;
   uint64_t seed = 0;
-  std::vector<std::string> pool;  // object names as given; empty = all
+  std::vector<std::string> pool;  // names, class:NAME, family:NAME, all, as given; empty = default_pool
   int min_objects = 0, max_objects = 4;
   std::vector<int> subjects;  // 1-based; empty = all
   // "catalogue": the catalogue's subjects; "random": body_count bodies drawn from the seed

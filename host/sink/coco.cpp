@@ -104,7 +104,11 @@ class CocoSink final : public Sink {
       std::ofstream o(tmp, std::ios::binary | std::ios::trunc);
       json categories = json::array();
       for (size_t c = 0; c < ctx_.cat->objects.size(); ++c)
-        categories.push_back({{"id", c + 1}, {"name", ctx_.cat->objects[c].name}, {"supercategory", "object"}});
+        categories.push_back(
+            {{"id", c + 1},
+             {"name", ctx_.cat->objects[c].name},
+             {"supercategory",
+              ctx_.cat->objects[c].object_class.empty() ? std::string("object") : ctx_.cat->objects[c].object_class}});
       o << "{\"info\":" << opt_.info.dump() << ",\"licenses\":[],\"categories\":" << categories.dump()
         << ",\"images\":[";
       copy(o, dir / kImagesPart);

@@ -598,9 +598,12 @@ class TensorSink final : public Sink {
     a.push_back({"identity", {opt_.identity.dump()}, true});
     a.push_back({"class_names", {"negative", "positive"}, false});
     H5Attribute objects{"object_names", {}, false}, regions{"region_names", {}, false},
-        drawings{"object_drawings", {}, false};
+        drawings{"object_drawings", {}, false}, classes{"object_classes", {}, false},
+        families{"object_families", {}, false};
     for (const Object& o : cat.objects) {
       objects.values.push_back(o.name);
+      classes.values.push_back(o.object_class);
+      families.values.push_back(o.family);
       std::string codes;  // region_orientation indexes these: "h,v", or "" for one drawing
       for (const Variant& v : o.variants) codes += (codes.empty() ? "" : ",") + v.code;
       drawings.values.push_back(codes);
@@ -609,6 +612,8 @@ class TensorSink final : public Sink {
     a.push_back(objects);
     a.push_back(regions);
     a.push_back(drawings);
+    a.push_back(classes);
+    a.push_back(families);
     a.push_back({"region_label_rule", {opt_.rule ? opt_.rule->text() : std::string()}, true});
     return a;
   }

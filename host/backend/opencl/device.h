@@ -36,6 +36,7 @@ struct DeviceBatch {
   size_t n = 0;
   cl::Buffer subject, objects;
   cl_uint2 seed{}, first{};
+  std::vector<char> variants;  // by variant id: carried by a scenario of the batch (PathTables)
 };
 
 }  // namespace portalsim::opencl

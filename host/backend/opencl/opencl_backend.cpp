@@ -45,7 +45,10 @@ class OpenCLBackend final : public Backend {
                   .subject = subject_.at_least(ctx, n),
                   .objects = objects_.at_least(ctx, n * cat_.regions.size() * sizeof(int16_t)),
                   .seed = split(plan.model.seed),
-                  .first = split(batch.first_index)};
+                  .first = split(batch.first_index),
+                  .variants = std::vector<char>(cat_.variant_list.size(), 0)};
+    for (int16_t v : batch.objects)
+      if (v != kNoObject) b.variants[static_cast<size_t>(v)] = 1;
     q.enqueueWriteBuffer(b.subject, CL_FALSE, 0, n, batch.subject.data());
     q.enqueueWriteBuffer(b.objects, CL_FALSE, 0, n * cat_.regions.size() * sizeof(int16_t), batch.objects.data());
 

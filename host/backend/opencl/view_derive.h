@@ -8,6 +8,7 @@
 #include <CL/opencl.hpp>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "assets/assets.h"
 #include "backend/opencl/launch.h"
@@ -19,9 +20,26 @@ namespace portalsim::opencl {
 
 // A features path's tables for a view (paths/*_features.cpp): made by the path on first
 // use, as they need its kernels run, and kept with the view's derivation.
+// Tables per object drawing are made for the drawings the run's batches carry, not the
+// catalogue's every one (a run draws from its pool: 14 of the 42 drawings by default), and
+// made again with the union when a batch brings another; a drawing's entries are the same
+// whichever others are tabulated.
 struct PathTables {
   virtual ~PathTables() = default;
+  std::vector<char> variants;  // by variant id: tabulated
+  bool covers(const std::vector<char>& batch) const {
+    for (size_t v = 0; v < batch.size(); ++v)
+      if (batch[v] && (v >= variants.size() || !variants[v])) return false;
+    return true;
+  }
 };
+// What tables for `batch` cover: the kept tables' drawings and the batch's.
+inline std::vector<char> tabulated_variants(const PathTables* kept, const std::vector<char>& batch) {
+  std::vector<char> v = batch;
+  if (kept)
+    for (size_t k = 0; k < v.size() && k < kept->variants.size(); ++k) v[k] = v[k] || kept->variants[k];
+  return v;
+}
 
 struct ViewDerived {
   ModelSettings model;  // the plan's knobs as this view takes them (ModelSettings::for_view)

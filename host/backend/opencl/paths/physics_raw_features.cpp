@@ -65,8 +65,8 @@ class PhysicsRawFeatures final : public FeaturePath {
     cl_int8 dims{};  // blocks_x, blocks_y, band_x, band_y, regions (RawGridNoise), the first block's column
     cl::Buffer noise, base_features, object_range, object_feature, object_value;
   };
-  Tables& tables(Kernels& K, const Plan& plan, ViewDerived& derived, const FeatureLayout& lay, int slot,
-                 bool tabulated);
+  Tables& tables(Kernels& K, const Plan& plan, ViewDerived& derived, const FeatureLayout& lay, int slot, bool tabulated,
+                 const std::vector<char>& batch_variants);
   // The raw grid of view `view` for batch b (place_view, then physics_raw) into Device::raw.
   void raw_grid(ViewLaunch& v) {
     v.run("place_view", v.batch.n);
@@ -88,7 +88,7 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const Gate& g, c
     // The tables first: making them runs a batch of their own through the same buffers. The
     // raw grid is noise-free: physics_features draws the NETD per feature.
     const std::shared_ptr<ViewDerived> derived = d_.derived(plan, view, true);
-    Tables& t = tables(K, plan, *derived, lay, static_cast<int>(slot), tabulated);
+    Tables& t = tables(K, plan, *derived, lay, static_cast<int>(slot), tabulated, b.variants);
     ViewLaunch v(d_, K, plan, view, b, d_.pooled_only[view].at_least(ctx, 1), false, tabulated, true);
     raw_grid(v);
     const auto& d = t.dims.s;
@@ -135,9 +135,10 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const Gate& g, c
 // the pooling taps, the noise factors and, when `tabulated`, each subject's bare features
 // and each (subject, variant, region)'s change to them, made by physics_raw itself on one
 // scenario per object (so a tabulated scenario differs from its raw grid only in the order
-// of float sums).
+// of float sums), for the drawings the batches so far carried (PathTables).
 PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& plan, ViewDerived& derived,
-                                                       const FeatureLayout& lay, int slot, bool tabulated) {
+                                                       const FeatureLayout& lay, int slot, bool tabulated,
+                                                       const std::vector<char>& batch_variants) {
   const Catalogue& cat = d_.cat;
   const int view = lay.pooled[slot];
   const Sensor& sv = cat.sensors[view];
@@ -146,10 +147,13 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& p
   // The derivation's key holds every knob, so the program variant (precision, fast math)
   // whose arithmetic made them too.
   std::unique_ptr<PathTables>& kept = derived.path_tables;
-  if (auto* t = dynamic_cast<Tables*>(kept.get()); t && t->tabulated == tabulated) return *t;
+  auto* old = dynamic_cast<Tables*>(kept.get());
+  if (old && old->tabulated == tabulated && (!tabulated || old->covers(batch_variants))) return *old;
   auto made = std::make_unique<Tables>();  // kept only once whole
   Tables& t = *made;
   t.tabulated = tabulated;
+  t.variants = tabulated_variants(old && old->tabulated == tabulated ? old : nullptr, batch_variants);
+  const std::vector<char>& want = t.variants;
   cl::Context& ctx = d_.ctx();
   const bool fp64 = K.fp64();
   const RawGridPooling p = raw_grid_pooling(sv, lay, slot, RW, RH);
@@ -186,14 +190,14 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& p
         if (sv.sees(ra) && sv.sees(rb))
           for (int va = 0; va < V; ++va)
             for (int vb = 0; vb < V; ++vb)
-              if (meet(va, ra, vb, rb)) pairs.push_back({va, ra, vb, rb});
+              if (want[va] && want[vb] && meet(va, ra, vb, rb)) pairs.push_back({va, ra, vb, rb});
     for (int s = 0; s < S; ++s) {
       Scenario sc;
       sc.subject = s;
       b.push(sc);
       for (int v = 0; v < V; ++v)
         for (int r = 0; r < R; ++r)
-          if (sv.sees(r)) {
+          if (sv.sees(r) && want[v]) {
             sc.objects.fill(kNoObject);
             sc.objects[r] = static_cast<int16_t>(v);
             b.push(sc);
@@ -210,7 +214,8 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& p
                                   .subject = constant(ctx, b.subject),
                                   .objects = constant(ctx, b.objects),
                                   .seed = {{0, 0}},
-                                  .first = {{0, 0}}};
+                                  .first = {{0, 0}},
+                                  .variants = {}};
     ViewLaunch v(d_, K, plan, view, table_batch, d_.pooled_only[view].at_least(ctx, 1), false, false, true);
     raw_grid(v);
     std::vector<double> raw(N * cells);
@@ -251,7 +256,7 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& p
       for (int v = 0; v < V; ++v)
         for (int r = 0; r < R; ++r) {
           const size_t c = static_cast<size_t>(v) * R + r;
-          if (sv.sees(r)) {
+          if (sv.sees(r) && want[v]) {
             alone[c] = at++;
             entries(s * combos + c, {{alone[c], 1.0}, {bare_at, -1.0}});
           }

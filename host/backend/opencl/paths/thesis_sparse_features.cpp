@@ -42,7 +42,8 @@ class ThesisSparseFeatures final : public FeaturePath {
     bool noise = false;
     cl::Buffer fps, deltas, region_deltas, base_sums, base_means;
   };
-  Tables& tables(Kernels& K, const Plan& plan, ViewDerived& derived, bool noise);
+  Tables& tables(Kernels& K, const Plan& plan, ViewDerived& derived, bool noise,
+                 const std::vector<char>& batch_variants);
   // The tables assume every pooled view has the first one's size (the gate's uniform).
   const Sensor& pooled_view(const FeatureLayout& lay) const { return d_.cat.sensors[lay.pooled.at(0)]; }
 
@@ -51,12 +52,14 @@ class ThesisSparseFeatures final : public FeaturePath {
 };
 
 ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Plan& plan, ViewDerived& derived,
-                                                           bool noise) {
+                                                           bool noise, const std::vector<char>& batch_variants) {
   // The derivation's key holds every knob, so the program variant whose arithmetic made them.
   std::unique_ptr<PathTables>& kept = derived.path_tables;
-  if (auto* t = dynamic_cast<Tables*>(kept.get()); t && t->noise == noise) return *t;
+  auto* old = dynamic_cast<Tables*>(kept.get());
+  if (old && old->noise == noise && old->covers(batch_variants)) return *old;
   auto made = std::make_unique<Tables>();  // kept only once whole
   Tables& t = *made;
+  t.variants = tabulated_variants(old && old->noise == noise ? old : nullptr, batch_variants);
   const Catalogue& cat = d_.cat;
   const DeviceCatalogue& c = d_.data;
   const ImagesConfig& ic = cat.images;
@@ -96,7 +99,8 @@ ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Pla
         y0 = std::max(y0, 0);
         x1 = std::min(x1, W);
         y1 = std::min(y1, H);
-        if (x0 >= x1 || y0 >= y1) x0 = y0 = x1 = y1 = 0;  // wholly outside: touches nothing
+        // Wholly outside, or a drawing no batch carried yet: touches nothing.
+        if (x0 >= x1 || y0 >= y1 || !t.variants[v]) x0 = y0 = x1 = y1 = 0;
         f[PS_FP_X0] = x0;
         f[PS_FP_Y0] = y0;
         f[PS_FP_X1] = x1;
@@ -170,7 +174,7 @@ void ThesisSparseFeatures::features(Kernels& K, const Plan& plan, const Gate& g,
   const Catalogue& cat = d_.cat;
   const FeatureLayout lay = FeatureLayout::of(cat, plan.model.block);
   const std::shared_ptr<ViewDerived> derived = d_.derived(plan, lay.pooled.at(0));
-  const Tables& t = tables(K, plan, *derived, g.variant == kPatterns);
+  const Tables& t = tables(K, plan, *derived, g.variant == kPatterns, b.variants);
   const DeviceCatalogue& c = d_.data;
   const ImagesConfig& ic = cat.images;
   const Sensor& view = pooled_view(lay);
