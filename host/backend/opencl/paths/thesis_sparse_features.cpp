@@ -141,27 +141,38 @@ ThesisSparseFeatures::Tables& ThesisSparseFeatures::tables(Kernels& K, const Pla
                            .sums = t.base_sums,
                            .means = t.base_means},
           static_cast<size_t>(S) * row_len);
-  enqueue(q, K["footprint_deltas"], K.fp64(),
-          FootprintDeltasArgs{.atlas = c.atlas,
-                              .bases = c.bases,
-                              .fps = t.fps,
-                              .noise_offsets = c.noise_offsets,
-                              .noise_gains = c.noise_gains,
-                              .rects = c.region_rects,
-                              .pooled = c.pooled,
-                              .views = views,
-                              .region_slot = c.region_slot,
-                              .combos = combos,
-                              .subjects = S,
-                              .patterns = P,
-                              .width = W,
-                              .block = block,
-                              .alpha = {ic.alpha},
-                              .tile = N,
-                              .use_noise = noise ? 1 : 0,
-                              .deltas = t.deltas,
-                              .region_deltas = t.region_deltas},
-          static_cast<size_t>(combos));
+  const FootprintDeltasArgs deltas_args{.atlas = c.atlas,
+                                        .bases = c.bases,
+                                        .fps = t.fps,
+                                        .noise_offsets = c.noise_offsets,
+                                        .noise_gains = c.noise_gains,
+                                        .rects = c.region_rects,
+                                        .pooled = c.pooled,
+                                        .views = views,
+                                        .region_slot = c.region_slot,
+                                        .combos = combos,
+                                        .subjects = S,
+                                        .patterns = P,
+                                        .width = W,
+                                        .block = block,
+                                        .alpha = {ic.alpha},
+                                        .tile = N,
+                                        .use_noise = noise ? 1 : 0,
+                                        .deltas = t.deltas,
+                                        .region_deltas = t.region_deltas};
+  // Over the tabulated drawings only, a launch per run of them (combos are variant-major),
+  // so that the work is spread over every thread rather than on the first one's range.
+  const size_t per_variant = static_cast<size_t>(lay.regions) * S * P;
+  for (int v0 = 0; v0 < V;) {
+    if (!t.variants[v0]) {
+      ++v0;
+      continue;
+    }
+    int v1 = v0;
+    while (v1 < V && t.variants[v1]) ++v1;
+    enqueue(q, K["footprint_deltas"], K.fp64(), deltas_args, (v1 - v0) * per_variant, v0 * per_variant);
+    v0 = v1;
+  }
   q.finish();
   t.noise = noise;
   t.patterns = P;
