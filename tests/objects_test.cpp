@@ -9,7 +9,9 @@
 #include <set>
 #include <sstream>
 
+#include "backend/compare.h"
 #include "base/error.h"
+#include "plan/tolerance.h"
 #include "run_binary.h"
 #include "scene/generator.h"
 #include "scene/rules.h"
@@ -177,6 +179,52 @@ TEST(Objects, NonMetalThreatsLeaveTheDetectorAlone) {
     EXPECT_GT(d["knife-chef"], d["knife-paring"]) << static_cast<int>(model);
     EXPECT_GT(d["handgun-large"], d["plastic-handgun"]) << static_cast<int>(model);
   }
+}
+
+// Crowds of every object (random_scenario draws the default pool's): the kernels' images,
+// features and metal are the reference's within each model's tolerance table, in the
+// standard and exact tiers; and the tabulated features path's (physics, fast tier) where
+// the pairs of the new drawings meet.
+TEST(Objects, CrowdsOfEveryObjectAreTheReferences) {
+  const Catalogue& cat = catalogue();
+  GeneratorSpec spec;
+  spec.pool = parse_object_set(cat, "all", "--pool", true);
+  spec.min_objects = 3;
+  spec.max_objects = 8;
+  const Generator gen(cat, spec, 13);
+  std::vector<Scenario> scenes;
+  for (int i = 0; i < (test::kSanitized ? 10 : 40); ++i) scenes.push_back(gen(i));
+  const SceneBatch batch = test::batch_of(scenes, 300);
+  auto ref = make_reference_backend(cat, test::assets());
+  auto ocl = make_opencl_backend(cat, test::assets(), test::runtime());
+  for (Model model : {Model::thesis, Model::physics})
+    for (Tier tier : {Tier::standard, Tier::exact}) {
+      SCOPED_TRACE(std::string(model == Model::physics ? "physics " : "thesis ") + tier_name(tier));
+      Plan plan = model == Model::physics ? test::physics_plan(6) : Plan{};
+      plan.fidelity = tier_fidelity(tier);
+      BatchOutput r, k;
+      ref->run(batch, plan, r);
+      ocl->run(batch, plan, k);
+      EXPECT_EQ(check_tolerance(compare_outputs(k, r), model_tolerance(model, tier)), "");
+    }
+  // Features only in the fast tier, noise-free and in a window no scene leaves (as
+  // Clothing.OutfitsAreTheReferencesOnEveryPath): the tables' sums against the reference's.
+  Plan fast = test::physics_plan(6);
+  fast.fidelity = tier_fidelity(Tier::fast);
+  fast.model.netd = 0;
+  fast.model.ir_netd = 0;
+  fast.model.window_lo = 250;
+  fast.model.window_hi = 340;
+  Plan features = fast;
+  features.images = 0;
+  const std::vector<std::string> paths = ocl->paths(features);
+  ASSERT_NE(std::find(paths.begin(), paths.end(), "features: physics_raw_features (tabulated)"), paths.end());
+  BatchOutput r, k;
+  ref->run(batch, fast, r);
+  ocl->run(batch, features, k);
+  const OutputDiff d = compare_outputs(k, r);
+  ASSERT_TRUE(d.features_only);
+  EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, Tier::fast)), "");
 }
 
 // The features paths tabulate the drawings their batches carry, and tabulate again with

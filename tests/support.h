@@ -43,15 +43,28 @@ inline std::shared_ptr<OpenCLRuntime> runtime() {
 
 // Scenario k of a test set: every subject, 0 to `max_objects` objects in random regions
 // with random variants, all drawn from the counter generator (stream 99).
+// The drawings random_scenario draws from: the default pool's objects' (the thesis's 12 in
+// the built-in catalogue; every object in a catalogue without default_pool). The other
+// drawings take the same code paths with other sprites; coverage() places each of them.
+inline std::vector<int16_t> default_pool_variants(const Catalogue& cat) {
+  std::vector<int16_t> v;
+  for (size_t k = 0; k < cat.variant_list.size(); ++k)
+    if (std::find(cat.default_pool.begin(), cat.default_pool.end(), cat.variant_list[k].object) !=
+        cat.default_pool.end())
+      v.push_back(static_cast<int16_t>(k));
+  return v;
+}
+
 inline Scenario random_scenario(const Catalogue& cat, uint64_t k, int max_objects = 13) {
   Scenario s;
+  const std::vector<int16_t> drawings = default_pool_variants(cat);
   const Philox4 r = draw(12345, k, 99, 0);
   s.subject = static_cast<int>(below(r[0], static_cast<uint32_t>(cat.subjects.size())));
   const int count = static_cast<int>(below(r[1], static_cast<uint32_t>(max_objects + 1)));
   for (int j = 0; j < count; ++j) {
     const Philox4 q = draw(12345, k, 99, 1 + j);
     const int region = static_cast<int>(below(q[0], static_cast<uint32_t>(cat.region_count())));
-    s.objects[region] = static_cast<int16_t>(below(q[1], static_cast<uint32_t>(cat.variant_list.size())));
+    s.objects[region] = drawings[below(q[1], static_cast<uint32_t>(drawings.size()))];
   }
   s.label = static_cast<int>(r[2] & 1);
   return s;
