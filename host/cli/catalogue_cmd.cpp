@@ -1,6 +1,7 @@
 // portalsim catalogue: what a scenario can name, and the default images to look at.
 #include <algorithm>
 #include <cstdio>
+#include <string>
 
 #include "assets/image_io.h"
 #include "cli/commands.h"
@@ -51,13 +52,16 @@ int list(CatalogueOptions& o) {
     for (const Variant& v : ob.variants)
       if (!v.code.empty()) vars += (vars.empty() ? "" : ",") + v.code;
     for (const std::string& a : ob.aliases) aliases += (aliases.empty() ? "" : ", ") + a;
-    char line[512];
-    std::snprintf(line, sizeof line, "  %c %-*s %-6s %-7s %-7s %-8s %s", in_default[i] ? '*' : ' ',
-                  static_cast<int>(std::min<size_t>(width, 64)), ob.name.c_str(),
-                  vars.empty() ? "" : ("[" + vars + "]").c_str(), c.metal_categories[ob.metal].c_str(),
-                  ob.object_class.empty() ? "-" : ob.object_class.c_str(), ob.family.empty() ? "-" : ob.family.c_str(),
-                  aliases.c_str());
-    std::string shown = line;
+    // Left-aligned columns as printf's %-Ns gives them (never cut), then the aliases.
+    const auto pad = [](std::string text, size_t n) {
+      if (text.size() < n) text.resize(n, ' ');
+      return text;
+    };
+    std::string shown = std::string("  ") + (in_default[i] ? '*' : ' ') + ' ' +
+                        pad(ob.name, std::min<size_t>(width, 64)) + ' ' + pad(vars.empty() ? "" : "[" + vars + "]", 6) +
+                        ' ' + pad(c.metal_categories[ob.metal], 7) + ' ' +
+                        pad(ob.object_class.empty() ? "-" : ob.object_class, 7) + ' ' +
+                        pad(ob.family.empty() ? "-" : ob.family, 8) + ' ' + aliases;
     shown.erase(shown.find_last_not_of(' ') + 1);  // no trailing blanks where there are no aliases
     std::printf("%s\n", shown.c_str());
   }

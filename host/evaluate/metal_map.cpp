@@ -183,11 +183,8 @@ std::string text(double v) {
 void check_metal_map(const Catalogue& cat, const MetalMapSettings& s) {
   if (!cat.metal_physics.present)
     throw InputError("--metal-map: the catalogue has no [metal.physics] section (the coil model the map needs)");
-  if (cat.find_object(s.object) < 0) {
-    std::string known;
-    for (const Object& o : cat.objects) known += (known.empty() ? "" : ", ") + o.name;
-    throw InputError("--metal-map: unknown object '" + s.object + "' (the catalogue has " + known + ")");
-  }
+  if (cat.find_object(s.object) < 0)
+    throw InputError("--metal-map: unknown object '" + s.object + "' (the catalogue has " + cat.object_names() + ")");
   auto finite_positive = [](double v) { return std::isfinite(v) && v > 0; };
   if (!finite_positive(s.grid_step))
     throw InputError("--grid-step: must be a number of metres above 0, not " + text(s.grid_step));

@@ -320,6 +320,12 @@ std::string Catalogue::variant_name(int variant_id) const {
   return v.code.empty() ? o.name : o.name + ":" + v.code;
 }
 
+std::string Catalogue::object_names() const {
+  std::string names;
+  for (const Object& o : objects) names += (names.empty() ? "" : ", ") + o.name;
+  return names;
+}
+
 int Catalogue::find_object(std::string_view name) const {
   const std::string key = normalise_name(name);
   if (key.empty()) return -1;

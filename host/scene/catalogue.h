@@ -184,6 +184,8 @@ struct Catalogue {
   std::array<double, 2> long_side(int variant_id) const;
   // The metal model's scale: the field's height is [metal.physics] body_height.
   double metres_per_field_unit() const { return metal_physics.body_height / kFieldHeight; }
+  // Every object's name, comma-separated in catalogue order: what messages list as known.
+  std::string object_names() const;
   // "gun:v" for display; "gun" where the object has one drawing.
   std::string variant_name(int variant_id) const;
   // Finds an object by name or alias, ignoring case and punctuation ("Iron Rod",

@@ -22,9 +22,7 @@ int16_t parse_object_token(const Catalogue& cat, const std::string& token, const
   }
   const int obj = cat.find_object(name);
   if (obj < 0) {
-    std::string known;
-    for (const Object& o : cat.objects) known += (known.empty() ? "" : ", ") + o.name;
-    throw InputError(where + ": unknown object \"" + name + "\" (known: " + known + ", none)");
+    throw InputError(where + ": unknown object \"" + name + "\" (known: " + cat.object_names() + ", none)");
   }
   const Object& o = cat.objects[obj];
   if (code.empty()) return static_cast<int16_t>(o.first_variant);
@@ -53,12 +51,9 @@ std::vector<int> parse_object_set(const Catalogue& cat, const std::string& token
   }
   if (!is_object_set_token(token)) {
     const int o = cat.find_object(token);
-    if (o < 0) {
-      std::string known;
-      for (const Object& ob : cat.objects) known += (known.empty() ? "" : ", ") + ob.name;
-      throw InputError(where + ": unknown object \"" + token + "\" (known: " + known +
+    if (o < 0)
+      throw InputError(where + ": unknown object \"" + token + "\" (known: " + cat.object_names() +
                        (allow_all ? "; or all, class:NAME, family:NAME)" : "; or class:NAME, family:NAME)"));
-    }
     return {o};
   }
   const size_t colon = token.find(':');
