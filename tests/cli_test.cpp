@@ -653,7 +653,7 @@ struct TmpfsRun {
 TmpfsRun run_on_tmpfs(const TempDir& t, const std::string& size, bool read_only, const std::string& prepare,
                       const Args& args) {
   const fs::path mnt = t.w() / "mnt";
-  std::string cmd = quoted(PORTALSIM_BINARY);
+  std::string cmd = quoted(portalsim::test::kBinary);
   for (const std::string& a : args) {
     cmd += ' ';  // appended apart: g++ 12 warns (-Wrestrict) on " " + std::string&&
     cmd += quoted(a);

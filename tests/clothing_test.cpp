@@ -21,7 +21,7 @@ using test::assets;
 using test::catalogue;
 // The image tests' scenarios; under the sanitizers (support.h, kSanitized), whose fp64
 // reference loops run several times slower, a quarter of them.
-constexpr size_t kScenes = test::kSanitized ? 12 : 48;
+const size_t kScenes = test::kSanitized ? 12 : 48;
 
 Plan clothed_plan(const std::string& clothing, Tier tier, bool fused) {
   Plan plan = test::physics_plan(53);

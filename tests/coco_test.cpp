@@ -41,7 +41,7 @@ portalsim::test::Result run(const portalsim::test::TempDir& t, Args args, const 
                             const std::string& command = "generate") {
   args.insert(args.begin(), command);
   args.insert(args.end(), {"--out", out.string(), "--quiet"});
-  return portalsim::test::finish(portalsim::test::start_program(t.cap(), PORTALSIM_BINARY, args), 300);
+  return portalsim::test::finish(portalsim::test::start_program(t.cap(), portalsim::test::kBinary, args), 300);
 }
 
 void ExpectOk(const portalsim::test::Result& r) {
@@ -281,7 +281,8 @@ TEST(Coco, ResumeAfterKill9IsExact) {
     Args victim_args{"generate"};
     victim_args.insert(victim_args.end(), spec.begin(), spec.end());
     victim_args.insert(victim_args.end(), {"--batch", "50", "--out", dir.string(), "--quiet"});
-    const portalsim::test::Running victim = portalsim::test::start_program(t.cap(), PORTALSIM_BINARY, victim_args);
+    const portalsim::test::Running victim =
+        portalsim::test::start_program(t.cap(), portalsim::test::kBinary, victim_args);
     ASSERT_GT(victim.pid, 0);
     const portalsim::test::Killed k = portalsim::test::kill_mid_run(victim, dir, 200);
     ASSERT_TRUE(k.result.signaled) << "the run ended before it could be killed: "
@@ -306,7 +307,7 @@ TEST(Coco, MergeRefusesAnnotationsNamingThem) {
   ExpectOk(run(t, plus(s, {"--shard", "1/2"}), t.w() / "p1"));
   const portalsim::test::Result r = portalsim::test::finish(
       portalsim::test::start_program(
-          t.cap(), PORTALSIM_BINARY,
+          t.cap(), portalsim::test::kBinary,
           {"merge", (t.w() / "p0").string(), (t.w() / "p1").string(), "--out", (t.w() / "m").string()}),
       120);
   EXPECT_TRUE(r.exited && r.status != 0) << portalsim::test::describe(r);

@@ -20,7 +20,7 @@ namespace {
 namespace fs = std::filesystem;
 // The image tests' scenarios; under the sanitizers (support.h, kSanitized), whose fp64
 // reference loops run several times slower, a quarter of them.
-constexpr size_t kScenes = test::kSanitized ? 10 : 40;
+const size_t kScenes = test::kSanitized ? 10 : 40;
 using test::assets;
 using test::catalogue;
 

@@ -79,7 +79,7 @@ Started start_program(const GenTempDir& t, const std::string& program, const Arg
   return portalsim::test::start_program(t.cap(), program, args);
 }
 
-Started start_ps(const GenTempDir& t, const Args& args) { return start_program(t, PORTALSIM_BINARY, args); }
+Started start_ps(const GenTempDir& t, const Args& args) { return start_program(t, portalsim::test::kBinary, args); }
 
 // Signals a started run, never anything else (a failed start has no pid: kill(-1) would hit
 // every process we may signal).

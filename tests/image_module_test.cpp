@@ -32,17 +32,17 @@ bool loads_openimageio(const Result& r) { return has(r.err, "file=libOpenImageIO
 
 TEST(ImageModule, LoadedOnlyWhenAnImageFileIsReadOrWrittenOtherThanPng) {
   TempDir t;
-  const Result version = run_traced(t, PORTALSIM_BINARY, {"--version"});
+  const Result version = run_traced(t, portalsim::test::kBinary, {"--version"});
   ASSERT_TRUE(version.exited && version.status == 0) << describe(version);
   EXPECT_FALSE(loads_openimageio(version)) << describe(version);
   EXPECT_FALSE(has(version.err, kModule)) << describe(version);
 
-  const Result png = run_traced(t, PORTALSIM_BINARY, simulate_gun(t.w() / "png", "png"));
+  const Result png = run_traced(t, portalsim::test::kBinary, simulate_gun(t.w() / "png", "png"));
   ASSERT_TRUE(png.exited && png.status == 0) << describe(png);
   EXPECT_TRUE(fs::exists(t.w() / "png" / "upper.png"));
   EXPECT_FALSE(loads_openimageio(png)) << describe(png);
 
-  const Result jpg = run_traced(t, PORTALSIM_BINARY, simulate_gun(t.w() / "jpg", "jpg"));
+  const Result jpg = run_traced(t, portalsim::test::kBinary, simulate_gun(t.w() / "jpg", "jpg"));
   ASSERT_TRUE(jpg.exited && jpg.status == 0) << describe(jpg);
   EXPECT_TRUE(fs::exists(t.w() / "jpg" / "upper.jpg"));
   EXPECT_TRUE(has(jpg.err, kModule)) << describe(jpg);
@@ -55,7 +55,7 @@ TEST(ImageModule, FoundFromAnInstalledBin) {
   TempDir t;
   const fs::path prefix = t.w() / "prefix";
   const Result install = finish(start_program(t.cap(), "/usr/bin/cmake",
-                                              {"--install", fs::path(PORTALSIM_BINARY).parent_path().string(),
+                                              {"--install", fs::path(portalsim::test::kBinary).parent_path().string(),
                                                "--component", "cli", "--prefix", prefix.string()}));
   ASSERT_TRUE(install.exited && install.status == 0) << describe(install);
   const fs::path installed = prefix / "bin" / "portalsim";
@@ -76,7 +76,7 @@ TEST(ImageModule, MissingIsAnEnvironmentErrorNamingWhereItLooked) {
   TempDir t;
   const fs::path alone = t.w() / "alone" / "bin" / "portalsim";
   fs::create_directories(alone.parent_path());
-  fs::copy_file(PORTALSIM_BINARY, alone);
+  fs::copy_file(portalsim::test::kBinary, alone);
   const Result png = finish(start_program(t.cap(), alone.string(), simulate_gun(t.w() / "png", "png")));
   EXPECT_TRUE(png.exited && png.status == 0) << describe(png);
   const Result jpg = finish(start_program(t.cap(), alone.string(), simulate_gun(t.w() / "jpg", "jpg")));

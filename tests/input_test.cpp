@@ -472,7 +472,7 @@ TEST(Environment, NoOpenClPlatformSaysSoAndNamesTheReferenceBackend) {
   TempDir t;
   const Result r = portalsim::test::finish(portalsim::test::start_program(
       t.cap(), "/usr/bin/env",
-      {"OCL_ICD_VENDORS=/nonexistent", PORTALSIM_BINARY, "simulate", "gun", "--out", (t.w() / "o").string()}));
+      {"OCL_ICD_VENDORS=/nonexistent", portalsim::test::kBinary, "simulate", "gun", "--out", (t.w() / "o").string()}));
   SCOPED_TRACE(describe(r));
   EXPECT_TRUE(r.exited && r.status == 5) << "5: the OpenCL environment";
   EXPECT_TRUE(has(r.err, "no OpenCL platform found")) << "not clGetPlatformIDs";
@@ -484,8 +484,8 @@ TEST(Environment, WithoutOpenClTheReferenceBackendStillRuns) {
   TempDir t;
   const Result r = portalsim::test::finish(
       portalsim::test::start_program(t.cap(), "/usr/bin/env",
-                                     {"OCL_ICD_VENDORS=/nonexistent", PORTALSIM_BINARY, "simulate", "gun", "--backend",
-                                      "reference", "--out", (t.w() / "o").string()}));
+                                     {"OCL_ICD_VENDORS=/nonexistent", portalsim::test::kBinary, "simulate", "gun",
+                                      "--backend", "reference", "--out", (t.w() / "o").string()}));
   SCOPED_TRACE(describe(r));
   EXPECT_TRUE(r.exited && r.status == 0);
   EXPECT_TRUE(fs::exists(t.w() / "o" / "upper.png"));
@@ -494,7 +494,8 @@ TEST(Environment, WithoutOpenClTheReferenceBackendStillRuns) {
 TEST(Environment, AnUnknownDeviceIsAUsageError) {
   TempDir t;
   const Result r = portalsim::test::finish(portalsim::test::start_program(
-      t.cap(), PORTALSIM_BINARY, {"simulate", "gun", "--device", "no-such-device", "--out", (t.w() / "o").string()}));
+      t.cap(), portalsim::test::kBinary,
+      {"simulate", "gun", "--device", "no-such-device", "--out", (t.w() / "o").string()}));
   SCOPED_TRACE(describe(r));
   EXPECT_TRUE(r.exited && r.status == 2);
   EXPECT_TRUE(has(r.err, "--device: no OpenCL device matches"));
@@ -504,7 +505,7 @@ TEST(Environment, AnUnknownDeviceIsAUsageError) {
 TEST(Environment, ReadOnlyPoclCacheIsNamed) {
   TempDir t;
   const fs::path cache = t.w() / "cache";
-  const std::string cmd = "POCL_CACHE_DIR=" + portalsim::test::quoted(cache.string()) + " " + PORTALSIM_BINARY +
+  const std::string cmd = "POCL_CACHE_DIR=" + portalsim::test::quoted(cache.string()) + " " + portalsim::test::kBinary +
                           " simulate gun --out " + portalsim::test::quoted((t.w() / "o").string());
   const Result r = portalsim::test::run_on_tmpfs(t.cap(), cache, "1m", true, cmd);
   SCOPED_TRACE(describe(r));
@@ -518,7 +519,7 @@ TEST(Environment, ReadOnlyPoclCacheIsNamed) {
 TEST(Environment, MissingPoclCacheOnAReadOnlyFileSystemIsNamed) {
   TempDir t;
   const fs::path mount = t.w() / "ro", cache = mount / "pocl";
-  const std::string cmd = "POCL_CACHE_DIR=" + portalsim::test::quoted(cache.string()) + " " + PORTALSIM_BINARY +
+  const std::string cmd = "POCL_CACHE_DIR=" + portalsim::test::quoted(cache.string()) + " " + portalsim::test::kBinary +
                           " simulate gun --out " + portalsim::test::quoted((t.w() / "o").string());
   const Result r = portalsim::test::run_on_tmpfs(t.cap(), mount, "1m", true, cmd);
   SCOPED_TRACE(describe(r));

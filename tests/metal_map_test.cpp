@@ -432,7 +432,7 @@ TEST(MetalMapCommand, BadInputNamesTheFlagAndWritesNothing) {
 TEST(MetalMapCommand, ReadOnlyOutputLeavesNothing) {
   TempDir t;
   const fs::path mnt = t.w() / "mnt", out = mnt / "map";
-  std::string cmd = test::quoted(PORTALSIM_BINARY);
+  std::string cmd = test::quoted(portalsim::test::kBinary);
   for (const std::string& a : map_args(out, {"--no-plot"})) {
     cmd += ' ';
     cmd += test::quoted(a);

@@ -255,9 +255,9 @@ TEST(OpenCLRuntime, APoclCacheThatIsAFileIsNamed) {
   test::TempDir t;
   const fs::path cache = t.w() / "cache";
   test::spit(cache, "not a folder\n");
-  const test::Result r = test::finish(test::start_program(
-      t.cap(), "/usr/bin/env",
-      {"POCL_CACHE_DIR=" + cache.string(), PORTALSIM_BINARY, "simulate", "gun", "--out", (t.w() / "o").string()}));
+  const test::Result r = test::finish(test::start_program(t.cap(), "/usr/bin/env",
+                                                          {"POCL_CACHE_DIR=" + cache.string(), portalsim::test::kBinary,
+                                                           "simulate", "gun", "--out", (t.w() / "o").string()}));
   SCOPED_TRACE(test::describe(r));
   EXPECT_TRUE(r.exited && r.status == 5) << "5: the OpenCL environment";
   EXPECT_NE(r.err.find("PoCL's kernel cache, " + cache.string()), std::string::npos);
@@ -276,8 +276,8 @@ TEST(OpenCLRuntime, KernelProgramFromTheEnvironmentIsTheOneBuilt) {
   test::spit(t.w() / "broken.cl", program + "\nthis is not OpenCL\n");
   const auto simulate = [&](const fs::path& file, const std::string& out) {
     return test::finish(test::start_program(t.cap(), "/usr/bin/env",
-                                            {"PORTALSIM_KERNEL_PROGRAM=" + file.string(), PORTALSIM_BINARY, "simulate",
-                                             "gun", "--out", (t.w() / out).string()}));
+                                            {"PORTALSIM_KERNEL_PROGRAM=" + file.string(), portalsim::test::kBinary,
+                                             "simulate", "gun", "--out", (t.w() / out).string()}));
   };
   const test::Result same = simulate(t.w() / "same.cl", "same");
   EXPECT_TRUE(same.exited && same.status == 0) << test::describe(same);

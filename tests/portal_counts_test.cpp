@@ -25,7 +25,7 @@ std::string first_line(const fs::path& p) {
 }
 
 test::Result run(const test::TempDir& t, std::vector<std::string> args) {
-  return test::finish(test::start_program(t.cap(), PORTALSIM_BINARY, args), 300);
+  return test::finish(test::start_program(t.cap(), portalsim::test::kBinary, args), 300);
 }
 
 std::vector<std::string> spec_args() {

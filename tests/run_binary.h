@@ -20,19 +20,11 @@
 #include <thread>
 #include <vector>
 
+#include "build_config.h"
+
 extern char** environ;
 
-// How many times slower the build under test runs than a Release build: CMakeLists.txt
-// sets it for the sanitizer build (PORTALSIM_SANITIZE).
-#ifndef PORTALSIM_TIME_SCALE
-#define PORTALSIM_TIME_SCALE 1
-#endif
-
 namespace portalsim::test {
-
-// Every limit on how long a child may run is a hang detector, never a speed check; each
-// is multiplied by this factor, so that a slower build cannot miss one.
-inline constexpr int kTimeScale = PORTALSIM_TIME_SCALE;
 
 // Polls `done` every poll_ms until it holds (true) or `limit_s` (scaled) passed (false).
 template <class Done>
@@ -165,7 +157,7 @@ inline Running start_program(const std::filesystem::path& cap, const std::string
   r.err_path = cap / (std::string("run") + std::to_string(n) + ".stderr");
   std::vector<std::string> argv_s{program};
   argv_s.insert(argv_s.end(), args.begin(), args.end());
-  r.command = program == PORTALSIM_BINARY ? "portalsim" : program;
+  r.command = program == kBinary ? "portalsim" : program;
   for (const std::string& a : args) {
     r.command += ' ';
     r.command += quoted(a);
@@ -191,7 +183,7 @@ inline Running start_program(const std::filesystem::path& cap, const std::string
 
 // The same for portalsim itself.
 inline Running start(const std::filesystem::path& cap, const std::vector<std::string>& args) {
-  return start_program(cap, PORTALSIM_BINARY, args);
+  return start_program(cap, kBinary, args);
 }
 
 // Waits for a started run (at most limit_s, scaled, then kills that one child) and collects

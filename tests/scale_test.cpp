@@ -26,7 +26,7 @@ Result ps(const TempDir& t, const Args& args) { return finish(start(t.cap(), arg
 Running start_mpi(const TempDir& t, int ranks, const Args& args) {
   return start_program(
       t.cap(), kMpirun,
-      cat({"--oversubscribe", "--allow-run-as-root", "-np", std::to_string(ranks), PORTALSIM_BINARY}, args));
+      cat({"--oversubscribe", "--allow-run-as-root", "-np", std::to_string(ranks), portalsim::test::kBinary}, args));
 }
 
 Args gen(const Args& spec, const fs::path& out) { return cat(cat({"generate"}, spec), {"--out", out.string()}); }

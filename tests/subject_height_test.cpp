@@ -206,7 +206,7 @@ TEST(SubjectHeight, ObjectsStayOnTheirBodyPart) {
 TEST(SubjectHeight, BothBackendsAgreeAndMetalFollows) {
   const Catalogue cat = heights_catalogue({0.86, 0.93, 1.0, 1.08, 1.15});
   const AssetSet a = build_assets(cat);
-  const SceneBatch batch = test::batch_of(test::coverage(cat, cat.variant_list.size() * kBuiltinRegions + 120, 8));
+  const SceneBatch batch = test::batch_of(test::parity_set(cat, cat.variant_list.size() * kBuiltinRegions + 120, 8));
   auto ref = make_reference_backend(cat, a);
   auto cl = make_opencl_backend(cat, a, test::runtime());
   for (Model model : {Model::thesis, Model::physics}) {

@@ -11,6 +11,7 @@
 #include "assets/assets.h"
 #include "backend/backend.h"
 #include "backend/opencl/opencl_backend.h"
+#include "build_config.h"
 #include "plan/plan.h"
 #include "scene/catalogue.h"
 #include "scene/philox.h"
@@ -116,17 +117,6 @@ inline std::vector<Scenario> coverage(const Catalogue& c, size_t n, int max_obje
   return v;
 }
 
-// .ci/run's second pass builds the tests with AddressSanitizer and UndefinedBehaviorSanitizer
-// (PORTALSIM_SANITIZE), where the fp64 reference's loops run several times slower. The
-// sanitizers check the host C++, which a few scenarios walk through as many do: the parity
-// tests whose time is those loops take every fourth scenario of their set there, which
-// keeps its mix of single objects and crowds (the Release pass, .ci/run's first, runs them
-// whole).
-#ifdef PORTALSIM_SANITIZED
-inline constexpr bool kSanitized = true;
-#else
-inline constexpr bool kSanitized = false;
-#endif
 // coverage(c, n, max_objects), or under the sanitizers every fourth of its scenarios.
 inline std::vector<Scenario> parity_set(const Catalogue& c, size_t n, int max_objects) {
   std::vector<Scenario> all = coverage(c, n, max_objects);

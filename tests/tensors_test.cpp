@@ -43,7 +43,7 @@ Args plus(Args a, const Args& more) {
 portalsim::test::Result run(const portalsim::test::TempDir& t, Args args, const fs::path& out) {
   args.insert(args.begin(), "generate");
   args.insert(args.end(), {"--out", out.string(), "--quiet"});
-  return portalsim::test::finish(portalsim::test::start_program(t.cap(), PORTALSIM_BINARY, args), 300);
+  return portalsim::test::finish(portalsim::test::start_program(t.cap(), portalsim::test::kBinary, args), 300);
 }
 
 void ExpectOk(const portalsim::test::Result& r) {
@@ -357,7 +357,8 @@ portalsim::test::Result kill_then_resume(portalsim::test::TempDir& t, const Args
   Args victim_args{"generate"};
   victim_args.insert(victim_args.end(), spec.begin(), spec.end());
   victim_args.insert(victim_args.end(), {"--batch", "100", "--out", dir.string(), "--quiet"});
-  const portalsim::test::Running victim = portalsim::test::start_program(t.cap(), PORTALSIM_BINARY, victim_args);
+  const portalsim::test::Running victim =
+      portalsim::test::start_program(t.cap(), portalsim::test::kBinary, victim_args);
   EXPECT_GT(victim.pid, 0);
   const portalsim::test::Killed k = portalsim::test::kill_mid_run(victim, dir, 300);
   EXPECT_TRUE(k.result.signaled) << "the run ended before it could be killed: " << portalsim::test::describe(k.result);

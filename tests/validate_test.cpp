@@ -502,7 +502,7 @@ TEST(Validate, BadInputGetsAMessageAndNoReport) {
   // No java on PATH: the run stops with a message instead of a report.
   const auto r = finish(portalsim::test::start_program(
       d / "cap", "/usr/bin/env",
-      {"PATH=/nonexistent", PORTALSIM_BINARY, "validate", "--sim", (d / "ok.arff").string(), "--real",
+      {"PATH=/nonexistent", portalsim::test::kBinary, "validate", "--sim", (d / "ok.arff").string(), "--real",
        (d / "ok.arff").string(), "--out", (d / "out").string(), "--folds", "5"}));
   EXPECT_TRUE(r.exited && r.status == 5) << portalsim::test::describe(r);  // 5: the machine's environment
   EXPECT_NE(r.err.find("java not found"), std::string::npos) << r.err;
