@@ -85,10 +85,14 @@
 #define PS_DRAWN_FRAMES 4u
 #define PS_DRAWN_ILLUMINATION 5u
 #define PS_DRAWN_WORN_MINUTES 6u
-#define PS_DRAWN_KNOBS 7
 /* The outfit of a run whose clothing is drawn (--clothing): its class from word 0, its
- * outfit in the class from word 1 (PS_PHYS_CLOTHING). Not a numeric knob, so past PS_DRAWN_KNOBS. */
+ * outfit in the class from word 1 (PS_PHYS_CLOTHING). Not a numeric knob (host/scene/scene.h
+ * lists the numeric ones). */
 #define PS_DRAWN_CLOTHING 7u
+/* physics: the MMW display window's ends (--window L1..L2/H1..H2), each drawn from its range. */
+#define PS_DRAWN_WINDOW_LO 8u
+#define PS_DRAWN_WINDOW_HI 9u
+#define PS_DRAWN_KNOBS 10 /* elements 0 .. PS_DRAWN_KNOBS - 1 */
 /* physics: frame k >= 1 of the MMW camera's integration draws its NETD from stream
  * PS_STREAM_FRAME_NOISE + k (frame 0 from PS_STREAM_RAW_NOISE); element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_FRAME_NOISE 32u
@@ -98,6 +102,10 @@
 #define PS_WINDOW_LOW_PERMILLE 10
 #define PS_WINDOW_HIGH_PERMILLE 990
 #define PS_WINDOW_MIN_SPAN 1.0
+/* PsViewLaunch.window_auto: the fixed window, the automatic one, or its ends drawn per scenario. */
+#define PS_WINDOW_FIXED 0
+#define PS_WINDOW_AUTO 1
+#define PS_WINDOW_DRAWN 2
 #define PS_PIXEL_NOISE_VIEW_SHIFT 28 /* element bit where a view's index starts */
 /* The physics model's table Gaussians (docs/model/determinism.md): a cell's Gaussian is
  * the top PS_GAUSS_BITS bits of a 16-bit half of a draw's word, k, taken to
@@ -182,8 +190,8 @@ typedef struct {
    * shadow against the room, -coupling (room - object), where the object is not on the body,
    * then per subject the factor of every shadow on it: (its skin - room) / (skin - room). */
   PS_I32 phys_off_body;
-  /* The MMW camera's processing: frames averaged (each its own NETD draw), the automatic
-   * window (1) or the fixed one (0), and stage_mmw_display's weights of each raw column for
+  /* The MMW camera's processing: frames averaged (each its own NETD draw), the window
+   * (PS_WINDOW_FIXED, _AUTO or _DRAWN), and stage_mmw_display's weights of each raw column for
    * each view column (raw_width rows of display_stride, zero past width), the first and last
    * raw column of each run of 16 view columns (2 per run), the weights of each raw row for
    * each view row (height rows of raw_height), and each view row's first and last raw row. */
@@ -226,7 +234,11 @@ typedef struct {
  * image's gray through the raw grid's weights, so that its bare grid is gain G + offset (each
  * raw cell's weights sum to 1; kernels/physics_raw.cl). */
 #define PS_PHYS_CLOTHING 9
-#define PS_PHYS_SUBJECTS 10
+/* MMW: the display window's ends drawn per scenario (PS_WINDOW_DRAWN): the upper ends of their
+ * ranges (the lower ends are PS_PHYS_WINDOW_MIN and PS_PHYS_WINDOW_MAX); the window's ends where fixed. */
+#define PS_PHYS_WINDOW_MIN_HI 10
+#define PS_PHYS_WINDOW_MAX_HI 11
+#define PS_PHYS_SUBJECTS 12
 #define PS_CLOTHING_CLASSES 0
 #define PS_CLOTHING_STRIDE 1
 #define PS_CLOTHING_GRIDS 2

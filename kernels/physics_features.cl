@@ -6,7 +6,8 @@
 // variant, region), its entries [x, y)),
 // or else its weighted sum of the raw cells physics_raw wrote; then the NETD's noise drawn
 // in feature space (Ly Z Lx^T for the blocks, B z + Lr z_r for the regions); then the
-// window, clamped to 0..255: the mean of its unrounded, unclamped pixels.
+// window (the scenario's, where its ends are drawn), clamped to 0..255: the mean of its
+// unrounded, unclamped pixels.
 //   dims: blocks_x, blocks_y, band_x, band_y, regions (RawGridNoise), the block columns' first.
 //   noise: dx, dy (per block, raw_grid_pooling.h), region_blocks, region_own.
 //   work space per scenario (PS_FEATURE_SPACE): the features, band_x zeros, Z (blocks_y x
@@ -112,8 +113,14 @@ FEATURE_NOISE(private)
     if (sd > 0)                                                                                                \
       feature_noise_##SPACE(acc, z, w, dims, noise, sd, (uint2)(L->seed_lo, L->seed_hi),                       \
                             upsample(L->first_hi, L->first_lo) + i, L->view, phys + L->phys_gauss);            \
-    const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];                                                          \
-    const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);                                   \
+    preal lo = (preal)phys[PS_PHYS_WINDOW_MIN], hi = (preal)phys[PS_PHYS_WINDOW_MAX];                          \
+    if (L->window_auto == PS_WINDOW_DRAWN) { /* the scenario's window (stage_window's draws) */               \
+      const uint2 seed = (uint2)(L->seed_lo, L->seed_hi);                                                      \
+      const ulong index = upsample(L->first_hi, L->first_lo) + i;                                              \
+      lo = knob_draw(lo, (preal)phys[PS_PHYS_WINDOW_MIN_HI], seed, index, PS_DRAWN_WINDOW_LO);                 \
+      hi = knob_draw(hi, (preal)phys[PS_PHYS_WINDOW_MAX_HI], seed, index, PS_DRAWN_WINDOW_HI);                 \
+    }                                                                                                          \
+    const preal scale = (preal)255 / (hi - lo);                                                                \
     global float* restrict fb = row + dims.s5; /* the blocks' columns are contiguous */                        \
     for (int f = 0; f < blocks; ++f) fb[f] = clamp((float)((acc[f] - lo) * scale), 0.0f, 255.0f);              \
     for (int f = blocks; f < count; ++f) row[columns[f]] = clamp((float)((acc[f] - lo) * scale), 0.0f, 255.0f); \

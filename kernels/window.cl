@@ -1,9 +1,11 @@
-// Stage "window" (physics model): the MMW camera's automatic window. The raw grid's
-// PS_WINDOW_LOW_PERMILLE and PS_WINDOW_HIGH_PERMILLE order statistics (the 1st and 99th
-// percentiles; at least PS_WINDOW_MIN_SPAN kelvin apart) are put on the fixed window's
-// ends, so that stage_mmw_display shows them as gray 0 and 255, as a camera's automatic
-// gain does per frame. The fixed window (L.window_auto 0) leaves the grid. One work-item
-// per scenario; the order statistics come from a copy in scratch, by Hoare's selection.
+// Stage "window" (physics model): the MMW camera's automatic window, or its ends drawn per
+// scenario. The raw grid's PS_WINDOW_LOW_PERMILLE and PS_WINDOW_HIGH_PERMILLE order
+// statistics (the 1st and 99th percentiles; at least PS_WINDOW_MIN_SPAN kelvin apart), or
+// the scenario's drawn ends (PS_WINDOW_DRAWN: each uniform over its range, knob_draw), are
+// put on the fixed window's ends, so that stage_mmw_display shows them as gray 0 and 255, as
+// a camera's automatic gain does per frame. The fixed window (PS_WINDOW_FIXED) leaves the
+// grid. One work-item per scenario; the order statistics come from a copy in scratch, by
+// Hoare's selection.
 inline preal select_rank(global preal* restrict a, int n, int k) {
   int lo = 0, hi = n - 1;
   while (lo < hi) {
@@ -35,12 +37,20 @@ kernel void stage_window(VIEW_STAGE_ARGS) {
       (void)objects, (void)alpha, (void)sigma, (void)records, (void)field, (void)out;
   const int cells = L.raw_width * L.raw_height;
   global preal* restrict r = (global preal*)raw + (size_t)i * cells;
-  global preal* restrict a = (global preal*)scratch + (size_t)i * cells;
-  for (int k = 0; k < cells; ++k) a[k] = r[k];
-  const preal lo = select_rank(a, cells, PS_WINDOW_RANK(PS_WINDOW_LOW_PERMILLE, cells));
-  const preal hi = fmax(select_rank(a, cells, PS_WINDOW_RANK(PS_WINDOW_HIGH_PERMILLE, cells)),
-                        lo + (preal)PS_WINDOW_MIN_SPAN);
   const preal w0 = (preal)phys[PS_PHYS_WINDOW_MIN];
+  preal lo, hi;
+  if (L.window_auto == PS_WINDOW_DRAWN) {
+    const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
+    const ulong index = upsample(L.first_hi, L.first_lo) + i;
+    lo = knob_draw(w0, (preal)phys[PS_PHYS_WINDOW_MIN_HI], seed, index, PS_DRAWN_WINDOW_LO);
+    hi = knob_draw((preal)phys[PS_PHYS_WINDOW_MAX], (preal)phys[PS_PHYS_WINDOW_MAX_HI], seed, index,
+                   PS_DRAWN_WINDOW_HI);
+  } else {
+    global preal* restrict a = (global preal*)scratch + (size_t)i * cells;
+    for (int k = 0; k < cells; ++k) a[k] = r[k];
+    lo = select_rank(a, cells, PS_WINDOW_RANK(PS_WINDOW_LOW_PERMILLE, cells));
+    hi = fmax(select_rank(a, cells, PS_WINDOW_RANK(PS_WINDOW_HIGH_PERMILLE, cells)), lo + (preal)PS_WINDOW_MIN_SPAN);
+  }
   const preal gain = ((preal)phys[PS_PHYS_WINDOW_MAX] - w0) / (hi - lo);
   for (int k = 0; k < cells; ++k) r[k] = w0 + (r[k] - lo) * gain;
 }

@@ -473,7 +473,133 @@ TEST(DrawnKnobs, EachKnobAtTheEndsOfItsBoundsIsTheReferences) {
     ocl->run(batch, whole, k);
     EXPECT_EQ(check_tolerance(compare_outputs(k, r), model_tolerance(model, Tier::standard)), "");
   }
-  EXPECT_EQ(drawable, size_t{PS_DRAWN_KNOBS});
+  // Every number the knob draw stream's elements draw belongs to a knob: one of these, or an
+  // end of a range knob whose ends are drawn (the window, its own test below).
+  size_t ends = 0, numbers = 0;
+  for (const Knob& knob : knobs()) ends += knob.drawn_ends[0] >= 0 ? 2 : 0;
+  for (const char* key : kDrawnKnobKeys) numbers += *key != 0;
+  EXPECT_EQ(drawable + ends, numbers);
+}
+
+// The MMW display window's ends drawn per scenario (--window L1..L2/H1..H2: window_lo_at,
+// window_hi_at; kernels/window.cl puts the scenario's ends on the range's low ends before
+// the display, the reference shows each scenario through its own window): the kernels' MMW
+// images are the reference's within the MMW camera's parity tolerance (1 gray level, at most
+// 0.5% off by one) in every tier, fused and as the chain of stage kernels, and at the knob's
+// bounds; each scenario's image is the one its window gives when fixed; IR and metal move
+// not; the features-only run leaves the tables for the pooled images.
+TEST(DrawnKnobs, WindowEndsDrawnPerScenarioAreTheReferencesOnEveryPath) {
+  std::vector<Scenario> scenes;
+  for (size_t k = 0; k < kScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
+  const SceneBatch batch = test::batch_of(scenes, 1700);
+  auto ref = make_reference_backend(catalogue(), assets());
+  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  const auto plan_of = [](const std::string& window, bool fused, Tier tier) {
+    Plan plan = test::physics_plan(61);
+    plan.fidelity = tier_fidelity(tier);
+    plan.fidelity.fused = fused;
+    set_knob(plan, *find_knob("window"), window, "--window");
+    return plan;
+  };
+  const size_t upper = static_cast<size_t>(catalogue().sensor_index("upper"));
+  const auto mmw_within = [](const OutputDiff& d) {
+    EXPECT_GT(d.mmw.pixels, 0u);
+    EXPECT_LE(d.mmw.max_abs, 1);
+    EXPECT_LE(d.mmw.share_differing, 0.005);
+    EXPECT_EQ(d.metal_exact, 1.0);
+  };
+  for (Tier tier : {Tier::standard, Tier::exact, Tier::fast})
+    for (bool fused : {true, false}) {
+      SCOPED_TRACE(std::string(tier_name(tier)) + (fused ? " fused" : " stage chain"));
+      const Plan drawn = plan_of("285..292/300..306", fused, tier);
+      BatchOutput r, k;
+      ref->run(batch, drawn, r);
+      ocl->run(batch, drawn, k);
+      mmw_within(compare_outputs(k, r));
+      // The IR views and the metal are the fixed window's run's, to the byte.
+      BatchOutput fixed;
+      ocl->run(batch, plan_of("285..300", fused, tier), fixed);
+      EXPECT_EQ(k.metal, fixed.metal);
+      for (size_t v = 0; v < k.views.size(); ++v) {
+        if (catalogue().sensors[v].camera == Camera::ir) {
+          EXPECT_EQ(k.views[v].pixels, fixed.views[v].pixels) << v;
+        }
+      }
+      EXPECT_NE(k.views[upper].pixels, fixed.views[upper].pixels);
+    }
+  {
+    // Ranges of one value are that window, to the byte.
+    BatchOutput one, fixed;
+    ocl->run(batch, plan_of("290..290/302..302", true, Tier::standard), one);
+    ocl->run(batch, plan_of("290..302", true, Tier::standard), fixed);
+    for (size_t v = 0; v < one.views.size(); ++v) EXPECT_EQ(one.views[v].pixels, fixed.views[v].pixels) << v;
+    EXPECT_EQ(find_knob("window")->get(plan_of("290..290/302..302", true, Tier::standard)), "290..302");
+    EXPECT_EQ(find_knob("window")->get(plan_of("285..292/302", true, Tier::standard)), "285..292/302");
+  }
+  {
+    // Each scenario's image is its window's, fixed, on a batch of that scenario alone.
+    const Plan drawn = plan_of("280..295/297..320", true, Tier::standard);
+    BatchOutput k;
+    ocl->run(batch, drawn, k);
+    for (size_t i : {size_t{0}, size_t{3}, batch.size() - 1}) {
+      const uint64_t index = batch.first_index + i;
+      const std::string own =
+          std::to_string(window_lo_at(drawn.model, index)) + ".." + std::to_string(window_hi_at(drawn.model, index));
+      SCOPED_TRACE("scenario " + std::to_string(index) + ", window " + own);
+      BatchOutput alone;
+      ocl->run(test::batch_of({scenes[i]}, index), plan_of(own, true, Tier::standard), alone);
+      const ViewImages &a = k.views[upper], &b = alone.views[upper];
+      int worst = 0;
+      for (size_t p = 0; p < a.pixels_per_image(); ++p) worst = std::max(worst, std::abs(a.of(i)[p] - b.of(0)[p]));
+      EXPECT_LE(worst, 1);  // the decimal text of the window's ends, rounded at the 6th place
+    }
+  }
+  {
+    // The knob's bounds: a window from 0..1 to 999..1000 K, and one as narrow as they allow.
+    for (const char* window : {"0..1/999..1000", "0..999/999.5..1000"}) {
+      SCOPED_TRACE(window);
+      const Plan drawn = plan_of(window, true, Tier::standard);
+      BatchOutput r, k;
+      ref->run(batch, drawn, r);
+      ocl->run(batch, drawn, k);
+      mmw_within(compare_outputs(k, r));
+    }
+  }
+  // Features only: the raw-grid path, which applies each scenario's window to its sums in
+  // kelvin (tabulated, and untabulated where jitter moves the objects), and leaves the
+  // pixels' clipping out: a window no body reaches. Noise-free: the path draws its noise in
+  // feature space, the reference per raw pixel.
+  for (const double jitter : {0.0, 4.0}) {
+    Plan with_images = plan_of("240..250/345..360", true, Tier::fast);
+    with_images.model.jitter = jitter;
+    with_images.model.netd = 0;
+    Plan features = with_images;
+    features.images = 0;
+    ASSERT_EQ(test::features_path(*ocl, features), "physics_raw_features");
+    const std::vector<std::string> paths = ocl->paths(features);
+    const std::string variant = jitter > 0 ? "untabulated" : "tabulated";
+    EXPECT_NE(std::find(paths.begin(), paths.end(), "features: physics_raw_features (" + variant + ")"), paths.end());
+    BatchOutput r, k, fixed;
+    ref->run(batch, with_images, r);
+    ocl->run(batch, features, k);
+    const OutputDiff d = compare_outputs(k, r);
+    ASSERT_TRUE(d.features_only);
+    EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, Tier::fast)), "") << variant;
+    Plan fixed_plan = plan_of("240..345", true, Tier::fast);
+    fixed_plan.model.jitter = jitter;
+    fixed_plan.model.netd = 0;
+    fixed_plan.images = 0;
+    ocl->run(batch, fixed_plan, fixed);
+    EXPECT_NE(k.features, fixed.features) << variant;
+  }
+  Plan features = plan_of("285..292/300..306", true, Tier::fast);
+  // Each end's draws stay in its range.
+  for (uint64_t i = 0; i < 2000; ++i) {
+    EXPECT_GE(window_lo_at(features.model, i), 285.0);
+    EXPECT_LT(window_lo_at(features.model, i), 292.0);
+    EXPECT_GE(window_hi_at(features.model, i), 300.0);
+    EXPECT_LT(window_hi_at(features.model, i), 306.0);
+  }
 }
 
 test::Result gen(const test::TempDir& t, std::vector<std::string> args, const fs::path& out) {
@@ -519,6 +645,35 @@ TEST(DrawnKnobs, EachScenariosDrawIsRecordedAndAFixedRangeKeepsTheBytes) {
   EXPECT_EQ(test::slurp(t.w() / "a" / "scenarios.csv"), test::slurp(t.w() / "c" / "scenarios.csv"));
 }
 
+// The window's drawn ends: a column each in scenarios.csv (the run's window_lo_at and
+// window_hi_at), float64 datasets in data.h5, the manifest's window as given.
+TEST(DrawnKnobs, WindowEndsDrawnAreRecorded) {
+  test::TempDir t;
+  const test::Result a =
+      gen(t, {"--model", "physics", "--window", "285..292/300..306", "--what", "features", "--format", "csv,h5"},
+          t.w() / "a");
+  ASSERT_EQ(a.status, 0) << test::describe(a);
+  const auto rows = test::csv_cells(t.w() / "a" / "scenarios.csv");
+  ASSERT_EQ(rows.size(), 41u);
+  Plan plan = test::physics_plan(9);
+  set_knob(plan, *find_knob("window"), "285..292/300..306", "--window");
+  for (const char* key : {"window_lo", "window_hi"}) {
+    const auto col = std::find(rows[0].begin(), rows[0].end(), key);
+    ASSERT_NE(col, rows[0].end()) << key;
+    const size_t c = static_cast<size_t>(col - rows[0].begin());
+    for (size_t i = 1; i < rows.size(); ++i) {
+      const double want =
+          std::string(key) == "window_lo" ? window_lo_at(plan.model, i - 1) : window_hi_at(plan.model, i - 1);
+      EXPECT_EQ(std::stod(rows[i][c]), want) << key << " " << i;
+    }
+  }
+  std::set<std::string> params;
+  for (const H5Dataset& d : read_h5_layout((t.w() / "a" / "data.h5").string()).datasets)
+    if (d.type == TensorType::f64) params.insert(d.name);
+  EXPECT_TRUE(params.count("param_window_lo") && params.count("param_window_hi"));
+  EXPECT_NE(test::slurp(t.w() / "a" / "manifest.json").find("\"window\": \"285..292/300..306\""), std::string::npos);
+}
+
 TEST(DrawnKnobs, BadRangesAreRefusedNamingTheFlagOrTheLine) {
   test::TempDir t;
   const std::vector<std::pair<std::string, std::string>> flags = {
@@ -534,12 +689,34 @@ TEST(DrawnKnobs, BadRangesAreRefusedNamingTheFlagOrTheLine) {
     EXPECT_NE(r.err.find(says), std::string::npos) << value << ": " << r.err;
     EXPECT_FALSE(fs::exists(t.w() / "o")) << value;
   }
+  const std::vector<std::pair<std::string, std::string>> windows = {
+      {"292..285/300..306", "--window (L1..L2 of L1..L2/H1..H2): \"292..285\" is reversed"},
+      {"285..301/300..306", "--window: \"285..301/300..306\": the low end's range must lie below the high end's"},
+      {"285..292/300..1200", "--window (H1..H2 of L1..L2/H1..H2): \"300..1200\" must be finite and within 0 .. 1000"},
+      {"nan/300", "--window (L1..L2 of L1..L2/H1..H2): \"nan\" must be finite"},
+      {"285..292/", "--window (H1..H2 of L1..L2/H1..H2): \"\" is not a number or a range A..B"},
+      {"auto/300", "--window (L1..L2 of L1..L2/H1..H2): \"auto\" is not a number"},
+  };
+  for (const auto& [value, says] : windows) {
+    const test::Result r = gen(t, {"--model", "physics", "--window", value}, t.w() / "o");
+    EXPECT_EQ(r.status, 2) << value;
+    EXPECT_NE(r.err.find(says), std::string::npos) << value << ": " << r.err;
+    EXPECT_FALSE(fs::exists(t.w() / "o")) << value;
+  }
   test::spit(t.w() / "spec.toml", "count = 10\nmetal_noise = \"9..2\"\n");
   const test::Result r = test::finish(
       test::start(t.cap(), {"generate", "--spec", (t.w() / "spec.toml").string(), "--out", (t.w() / "s").string()}),
       120);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("spec.toml:2: metal_noise: \"9..2\" is reversed"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(t.w() / "s"));
+  test::spit(t.w() / "window.toml", "count = 10\nmodel = \"physics\"\nwindow = \"285..301/300..306\"\n");
+  const test::Result w = test::finish(
+      test::start(t.cap(), {"generate", "--spec", (t.w() / "window.toml").string(), "--out", (t.w() / "s").string()}),
+      120);
+  EXPECT_NE(w.status, 0);
+  EXPECT_NE(w.err.find("window.toml:3: window: \"285..301/300..306\": the low end's range"), std::string::npos)
+      << w.err;
   EXPECT_FALSE(fs::exists(t.w() / "s"));
 }
 

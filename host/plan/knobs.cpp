@@ -172,7 +172,16 @@ std::vector<Knob> declare() {
         },
         [](const Plan& p) { return std::pair(p.model.window_lo, p.model.window_hi); });
     w.word = "auto";
-    w.get = [get = w.get](const Plan& p) -> nlohmann::json { return p.model.window_auto ? "auto" : get(p); };
+    w.drawn_ends = {PS_DRAWN_WINDOW_LO, PS_DRAWN_WINDOW_HI};
+    w.get = [get = w.get](const Plan& p) -> nlohmann::json {
+      if (p.model.window_auto) return "auto";
+      if (!p.model.window_drawn()) return get(p);
+      const auto end = [](const DrawnRange& d, double fixed) {
+        return d.varies() ? format_number(d.lo) + ".." + format_number(d.hi) : format_number(fixed);
+      };
+      return end(p.model.drawn[PS_DRAWN_WINDOW_LO], p.model.window_lo) + "/" +
+             end(p.model.drawn[PS_DRAWN_WINDOW_HI], p.model.window_hi);
+    };
     k.push_back(std::move(w));
   }
   k.push_back(choice(
@@ -311,7 +320,8 @@ std::string Knob::values() const {
     return "WxH, each " + format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit);
   if (kind == KnobKind::range)
     return (word.empty() ? std::string("X or A..B") : word + " or A..B") + ", each " + format_number(min) + " .. " +
-           format_number(max) + (unit.empty() ? "" : " " + unit);
+           format_number(max) + (unit.empty() ? "" : " " + unit) +
+           (drawn_ends[0] >= 0 ? ", or L1..L2/H1..H2 drawn per scenario" : "");
   if (kind == KnobKind::integer || kind == KnobKind::number)
     return format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit) +
            (drawn >= 0 ? ", or A..B drawn per scenario" : "");
@@ -345,6 +355,32 @@ double knob_number(const Knob& knob, const std::string& text, const std::string&
     throw InputError(where + ": \"" + text + "\" must be a finite number between " + knob.values());
   }
   return v;
+}
+
+// "L1..L2/H1..H2" of a range knob whose ends are drawn (Knob::drawn_ends), `slash` the
+// position of '/': each end a number or a range within the knob's bounds, the low end's
+// range wholly below the high end's, so that every scenario's range is open.
+void set_drawn_ends(Plan& plan, const Knob& knob, const std::string& text, size_t slash, const std::string& where) {
+  std::array<DrawnRange, 2> ends;
+  for (int k = 0; k < 2; ++k) {
+    const std::string part = k == 0 ? text.substr(0, slash) : text.substr(slash + 1);
+    const std::string what = where + " (" + (k == 0 ? "L1..L2" : "H1..H2") + " of L1..L2/H1..H2)";
+    const size_t dots = part.find("..");
+    double a = 0, b = 0;
+    if (dots == std::string::npos ? !parse_number(part, a)
+                                  : !parse_number(part.substr(0, dots), a) || !parse_number(part.substr(dots + 2), b))
+      throw InputError(what + ": \"" + part + "\" is not a number or a range A..B");
+    if (dots == std::string::npos) b = a;
+    if (!std::isfinite(a) || !std::isfinite(b) || a < knob.min || b > knob.max)
+      throw InputError(what + ": \"" + part + "\" must be finite and within " + format_number(knob.min) + " .. " +
+                       format_number(knob.max));
+    if (a > b) throw InputError(what + ": \"" + part + "\" is reversed: A..B needs A <= B");
+    ends[k] = {a, b};
+  }
+  if (ends[0].hi >= ends[1].lo)
+    throw InputError(where + ": \"" + text + "\": the low end's range must lie below the high end's (L2 < H1)");
+  knob.set_range(plan, ends[0].lo, ends[1].lo);
+  for (int k = 0; k < 2; ++k) plan.model.drawn[static_cast<size_t>(knob.drawn_ends[k])] = ends[k];
 }
 
 }  // namespace
@@ -384,6 +420,13 @@ void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::
       break;
     }
     case KnobKind::range: {
+      if (knob.drawn_ends[0] >= 0) {
+        for (const int e : knob.drawn_ends) plan.model.drawn[static_cast<size_t>(e)] = {};
+        if (const size_t slash = text.find('/'); slash != std::string::npos) {
+          set_drawn_ends(plan, knob, text, slash, where);
+          return;
+        }
+      }
       if (!knob.word.empty() && text == knob.word) {
         knob.set_range(plan, std::nan(""), std::nan(""));
         return;

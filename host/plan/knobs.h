@@ -2,6 +2,7 @@
 // values it takes, its default and its help. The command-line flags, the spec-file keys,
 // the checks, the manifest entries and the knob table of docs/reference/knobs.md all come from this list.
 #pragma once
+#include <array>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -47,6 +48,10 @@ struct Knob {
   // "A..B" (A <= B, each within its range) then sets ModelSettings::drawn and the field to A;
   // get gives "A..B" back where A < B.
   int drawn = -1;
+  // A range knob whose ends may each be drawn per scenario (the window): the PS_DRAWN_*
+  // elements of its A and B ends, or -1. "L1..L2/H1..H2" (each end a number or a range,
+  // L2 < H1) sets ModelSettings::drawn and the range to L1..H1; get gives it back so.
+  std::array<int, 2> drawn_ends{-1, -1};
 
   std::string flag() const;
   // "0 .. 1000 gray levels", "on, off", "fp32, fp64, fixed16", "X or A..B, each 0.1 .. 10".

@@ -72,6 +72,14 @@ const Outfit& outfit_of(const ModelSettings& m, uint64_t index) {
   return outfit_table(m.clothing).outfits.at(static_cast<size_t>(outfit_at(m, index)));
 }
 
+double window_lo_at(const ModelSettings& m, uint64_t index) {
+  return m.drawn[PS_DRAWN_WINDOW_LO].varies() ? drawn_real(m, PS_DRAWN_WINDOW_LO, index) : m.window_lo;
+}
+
+double window_hi_at(const ModelSettings& m, uint64_t index) {
+  return m.drawn[PS_DRAWN_WINDOW_HI].varies() ? drawn_real(m, PS_DRAWN_WINDOW_HI, index) : m.window_hi;
+}
+
 double worn_minutes_at(const ModelSettings& m, uint64_t index) {
   return m.drawn[PS_DRAWN_WORN_MINUTES].varies() ? drawn_real(m, PS_DRAWN_WORN_MINUTES, index) : m.worn_minutes;
 }
@@ -85,6 +93,8 @@ ModelSettings ModelSettings::at_scenario(uint64_t index) const {
   m.frames = frames_at(*this, index);
   m.illumination = illumination_at(*this, index);
   m.worn_minutes = worn_minutes_at(*this, index);
+  m.window_lo = window_lo_at(*this, index);
+  m.window_hi = window_hi_at(*this, index);
   m.outfit = outfit_at(*this, index);
   m.drawn = {};
   return m;
@@ -106,6 +116,10 @@ double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index) {
       return illumination_at(m, index);
     case PS_DRAWN_WORN_MINUTES:
       return worn_minutes_at(m, index);
+    case PS_DRAWN_WINDOW_LO:
+      return window_lo_at(m, index);
+    case PS_DRAWN_WINDOW_HI:
+      return window_hi_at(m, index);
   }
   throw std::logic_error("no drawn knob " + std::to_string(element));
 }

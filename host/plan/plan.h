@@ -67,8 +67,9 @@ struct ModelSettings {
   // the body 5+ times the noise in both views); the display window, fixed [window_lo,
   // window_hi] kelvin (the default 290..302: room 293 K and body 298.6 K well inside it,
   // 3 sigma of noise unclipped) or set per image from the raw grid's 1st and 99th
-  // percentiles (window_auto); the interpolation from the raw grid to the view, and a
-  // Gaussian of `smooth` view pixels.
+  // percentiles (window_auto), or each end drawn per scenario (window_drawn: drawn's
+  // PS_DRAWN_WINDOW_LO and _HI, window_lo and window_hi holding their ranges' low ends); the
+  // interpolation from the raw grid to the view, and a Gaussian of `smooth` view pixels.
   int frames{};
   bool window_auto{};
   double window_lo{}, window_hi{};
@@ -89,6 +90,7 @@ struct ModelSettings {
   double pixel_sigma_hi() const {
     return drawn[PS_DRAWN_PIXEL_NOISE].varies() ? drawn[PS_DRAWN_PIXEL_NOISE].hi : pixel_sigma;
   }
+  bool window_drawn() const { return drawn[PS_DRAWN_WINDOW_LO].varies() || drawn[PS_DRAWN_WINDOW_HI].varies(); }
   bool transforms() const { return rotate_lo != 0 || rotate_hi != 0 || scale_lo != 1 || scale_hi != 1 || flip; }
   bool moves_sprites() const { return bilinear || jitter > 0 || transforms(); }
 };
@@ -116,6 +118,10 @@ int frames_at(const ModelSettings& m, uint64_t index);
 // PS_DRAWN_ILLUMINATION and PS_DRAWN_WORN_MINUTES. kernels/radiometry.cl's scene_draw.
 double illumination_at(const ModelSettings& m, uint64_t index);
 double worn_minutes_at(const ModelSettings& m, uint64_t index);
+// Scenario `index`'s MMW display window's ends (K), as ir_netd_at, elements
+// PS_DRAWN_WINDOW_LO and PS_DRAWN_WINDOW_HI. kernels/window.cl's stage_window draws the same.
+double window_lo_at(const ModelSettings& m, uint64_t index);
+double window_hi_at(const ModelSettings& m, uint64_t index);
 // Scenario `index`'s outfit, an index into outfit_table(m.clothing), -1 for the catalogue's
 // clothing: its class below(word 0, classes), then its outfit in the class below(word 1,
 // the class's outfits), of PS_STREAM_KNOB_DRAW element PS_DRAWN_CLOTHING. kernels/radiometry.cl's

@@ -74,7 +74,7 @@ ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, c
       col_region_[r - 1] = static_cast<int>(c);
     } else if (h == "index" ||
                std::any_of(kDrawnKnobKeys.begin(), kDrawnKnobKeys.end(),
-                           [&](const char* k) { return normalise_name(k) == h; }) ||
+                           [&](const char* k) { return *k && normalise_name(k) == h; }) ||
                std::any_of(kBodyColumns.begin(), kBodyColumns.end(),
                            [&](const char* k) { return normalise_name(k) == h; }) ||
                std::any_of(kClothingColumns.begin(), kClothingColumns.end(),

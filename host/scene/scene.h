@@ -11,11 +11,13 @@ namespace portalsim {
 
 constexpr int16_t kNoObject = -1;
 
-// The keys of the knobs a run may draw per scenario, by their PS_DRAWN_* element: each is
-// its knob's key (plan/knobs.cpp checks) and, where drawn, a column of scenarios.csv and
-// data.h5's param_<key>.
+// The keys of the numbers a run may draw per scenario, by their PS_DRAWN_* element: each is
+// its knob's key, or for the window's ends (--window L1..L2/H1..H2) the knob's key and the
+// end (plan/knobs.cpp checks), and, where drawn, a column of scenarios.csv and data.h5's
+// param_<key>. PS_DRAWN_CLOTHING's element draws an outfit, no number: its key is empty.
 inline constexpr std::array<const char*, PS_DRAWN_KNOBS> kDrawnKnobKeys = {
-    "metal_noise", "ir_netd", "pixel_noise", "netd", "frames", "illumination", "worn_minutes"};
+    "metal_noise",  "ir_netd", "pixel_noise", "netd",     "frames", "illumination",
+    "worn_minutes", "",        "window_lo",   "window_hi"};
 
 struct Scenario {
   int subject = 0;  // 0-based

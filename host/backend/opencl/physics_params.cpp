@@ -96,6 +96,10 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   p[PS_PHYS_BACKGROUND] = pc.background_temperature;
   p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : m.window_lo;
   p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : m.window_hi;
+  // The window's ends drawn per scenario (stage_window): their ranges' upper ends.
+  const DrawnRange &window_lo = m.drawn[PS_DRAWN_WINDOW_LO], &window_hi = m.drawn[PS_DRAWN_WINDOW_HI];
+  p[PS_PHYS_WINDOW_MIN_HI] = !ir && window_lo.varies() ? window_lo.hi : p[PS_PHYS_WINDOW_MIN];
+  p[PS_PHYS_WINDOW_MAX_HI] = !ir && window_hi.varies() ? window_hi.hi : p[PS_PHYS_WINDOW_MAX];
   // The view's NETD, and its range and the frames' where drawn per scenario (mmw_noise_of,
   // ir_netd_of).
   if (ir) {

@@ -44,7 +44,7 @@ PsViewLaunch settings(const Catalogue& cat, const Plan& plan, const ModelSetting
   L.raw_width = m.raw_width;
   L.raw_height = m.raw_height;
   L.frames = kernel_frames(plan, m);
-  L.window_auto = m.window_auto;
+  L.window_auto = m.window_auto ? PS_WINDOW_AUTO : m.window_drawn() ? PS_WINDOW_DRAWN : PS_WINDOW_FIXED;
   L.subjects = static_cast<int32_t>(cat.subjects.size());
   return L;
 }

@@ -1,7 +1,7 @@
 // The physics model's MMW view path: physics_raw (kernels/physics_raw.cl) makes each
 // scenario's raw grid straight from the placement records, radiometry, optics, sampling
-// and NETD together; stage_window sets the automatic window where the plan has it, and
-// stage_mmw_display then shows it.
+// and NETD together; stage_window sets the automatic window, or the scenario's drawn one,
+// where the plan has it, and stage_mmw_display then shows it.
 #include "backend/opencl/paths/paths.h"
 
 namespace portalsim::opencl {
@@ -15,16 +15,17 @@ class PhysicsRaw final : public ViewPath {
     static const std::vector<std::string> stages = {"radiometry", "optics", "sample", "netd", "window", "mmw_display"};
     return stages;
   }
-  enum Variant { kFixedWindow, kAutoWindow };
+  enum Variant { kFixedWindow, kAutoWindow, kDrawnWindow };
   Gate gate(const Plan& plan, const Sensor& sensor) const override {
     if (!plan.fidelity.fused || sensor.chain_for(plan.model.model) != chain()) return {};
     if (plan.model.window_auto) return {.runs = true, .variant = kAutoWindow, .variant_name = "automatic window"};
+    if (plan.model.window_drawn()) return {.runs = true, .variant = kDrawnWindow, .variant_name = "drawn window"};
     return {.runs = true, .variant = kFixedWindow, .variant_name = "fixed window"};
   }
   bool uses_field() const override { return false; }
   void render(ViewLaunch& v, const Gate& g) const override {
     run_raw_grid(v);
-    if (g.variant == kAutoWindow) v.run("stage_window", v.batch.n);
+    if (g.variant != kFixedWindow) v.run("stage_window", v.batch.n);
     v.run("stage_mmw_display", v.batch.n);
   }
 };

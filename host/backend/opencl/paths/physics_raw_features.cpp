@@ -35,8 +35,9 @@ class PhysicsRawFeatures final : public FeaturePath {
   enum Variant { kUntabulated, kTabulated };
   // Features only, physics model, sparse pooling, the block-mean noise model (the raw grid
   // leaves single pixels' rounding and clipping out), fused, and physics_raw's chain on the
-  // view. The tables fold the bilinear interpolation and a fixed window into each feature,
-  // so the automatic window, the bicubic filter and smoothing take the dense path.
+  // view. The tables fold the bilinear interpolation into each feature, in kelvin, and the
+  // kernel then applies the window, fixed or the scenario's drawn one; the automatic window
+  // (from each raw grid's percentiles), the bicubic filter and smoothing take the dense path.
   Gate gate(const Plan& plan, const Sensor& sensor) const override {
     const ModelSettings& m = plan.model;
     const bool plan_ok = plan.features && plan.images == 0 && m.model == Model::physics &&
