@@ -114,12 +114,8 @@ FEATURE_NOISE(private)
       feature_noise_##SPACE(acc, z, w, dims, noise, sd, (uint2)(L->seed_lo, L->seed_hi),                       \
                             upsample(L->first_hi, L->first_lo) + i, L->view, phys + L->phys_gauss);            \
     preal lo = (preal)phys[PS_PHYS_WINDOW_MIN], hi = (preal)phys[PS_PHYS_WINDOW_MAX];                          \
-    if (L->window_auto == PS_WINDOW_DRAWN) { /* the scenario's window (stage_window's draws) */               \
-      const uint2 seed = (uint2)(L->seed_lo, L->seed_hi);                                                      \
-      const ulong index = upsample(L->first_hi, L->first_lo) + i;                                              \
-      lo = knob_draw(lo, (preal)phys[PS_PHYS_WINDOW_MIN_HI], seed, index, PS_DRAWN_WINDOW_LO);                 \
-      hi = knob_draw(hi, (preal)phys[PS_PHYS_WINDOW_MAX_HI], seed, index, PS_DRAWN_WINDOW_HI);                 \
-    }                                                                                                          \
+    if (L->window_auto == PS_WINDOW_DRAWN) /* the scenario's window, as stage_window draws it */              \
+      drawn_window(phys, (uint2)(L->seed_lo, L->seed_hi), upsample(L->first_hi, L->first_lo) + i, &lo, &hi);  \
     const preal scale = (preal)255 / (hi - lo);                                                                \
     global float* restrict fb = row + dims.s5; /* the blocks' columns are contiguous */                        \
     for (int f = 0; f < blocks; ++f) fb[f] = clamp((float)((acc[f] - lo) * scale), 0.0f, 255.0f);              \

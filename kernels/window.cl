@@ -1,11 +1,18 @@
 // Stage "window" (physics model): the MMW camera's automatic window, or its ends drawn per
 // scenario. The raw grid's PS_WINDOW_LOW_PERMILLE and PS_WINDOW_HIGH_PERMILLE order
 // statistics (the 1st and 99th percentiles; at least PS_WINDOW_MIN_SPAN kelvin apart), or
-// the scenario's drawn ends (PS_WINDOW_DRAWN: each uniform over its range, knob_draw), are
+// the scenario's drawn ends (PS_WINDOW_DRAWN: drawn_window), are
 // put on the fixed window's ends, so that stage_mmw_display shows them as gray 0 and 255, as
 // a camera's automatic gain does per frame. The fixed window (PS_WINDOW_FIXED) leaves the
 // grid. One work-item per scenario; the order statistics come from a copy in scratch, by
 // Hoare's selection.
+// Scenario `index`'s drawn window ends (PS_WINDOW_DRAWN; host: window_lo_at, window_hi_at),
+// each uniform over its range: from PS_PHYS_WINDOW_MIN to _MIN_HI, and _MAX to _MAX_HI.
+inline void drawn_window(global const param* phys, uint2 seed, ulong index, preal* lo, preal* hi) {
+  *lo = knob_draw((preal)phys[PS_PHYS_WINDOW_MIN], (preal)phys[PS_PHYS_WINDOW_MIN_HI], seed, index, PS_DRAWN_WINDOW_LO);
+  *hi = knob_draw((preal)phys[PS_PHYS_WINDOW_MAX], (preal)phys[PS_PHYS_WINDOW_MAX_HI], seed, index, PS_DRAWN_WINDOW_HI);
+}
+
 inline preal select_rank(global preal* restrict a, int n, int k) {
   int lo = 0, hi = n - 1;
   while (lo < hi) {
@@ -40,11 +47,7 @@ kernel void stage_window(VIEW_STAGE_ARGS) {
   const preal w0 = (preal)phys[PS_PHYS_WINDOW_MIN];
   preal lo, hi;
   if (L.window_auto == PS_WINDOW_DRAWN) {
-    const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
-    const ulong index = upsample(L.first_hi, L.first_lo) + i;
-    lo = knob_draw(w0, (preal)phys[PS_PHYS_WINDOW_MIN_HI], seed, index, PS_DRAWN_WINDOW_LO);
-    hi = knob_draw((preal)phys[PS_PHYS_WINDOW_MAX], (preal)phys[PS_PHYS_WINDOW_MAX_HI], seed, index,
-                   PS_DRAWN_WINDOW_HI);
+    drawn_window(phys, (uint2)(L.seed_lo, L.seed_hi), upsample(L.first_hi, L.first_lo) + i, &lo, &hi);
   } else {
     global preal* restrict a = (global preal*)scratch + (size_t)i * cells;
     for (int k = 0; k < cells; ++k) a[k] = r[k];

@@ -108,6 +108,25 @@ Knob drawable(Knob k, unsigned element) {
   return k;
 }
 
+// `k`, a range knob, with its ends drawn per scenario where given L1..L2/H1..H2
+// (Knob::drawn_ends): elements `lo` and `hi`, keyed as the knob's key and _lo, _hi. A fixed
+// end's drawn range is that one value.
+Knob drawable_ends(Knob k, unsigned lo, unsigned hi) {
+  if (hi >= kDrawnKnobKeys.size() || k.key + "_lo" != kDrawnKnobKeys[lo] || k.key + "_hi" != kDrawnKnobKeys[hi])
+    throw std::logic_error("knob " + k.key + ": not drawn ends " + std::to_string(lo) + ", " + std::to_string(hi) +
+                           " (scene.h)");
+  k.drawn_ends = {static_cast<int>(lo), static_cast<int>(hi)};
+  k.get = [get = std::move(k.get), lo, hi](const Plan& p) -> nlohmann::json {
+    const DrawnRange &a = p.model.drawn[lo], &b = p.model.drawn[hi];
+    if (!a.varies() && !b.varies()) return get(p);
+    const auto end = [](const DrawnRange& d) {
+      return d.varies() ? format_number(d.lo) + ".." + format_number(d.hi) : format_number(d.lo);
+    };
+    return end(a) + "/" + end(b);
+  };
+  return k;
+}
+
 std::vector<Knob> declare() {
   std::vector<Knob> k;
   // The sensor model (docs/model/thesis.md); defaults are the thesis's.
@@ -172,17 +191,8 @@ std::vector<Knob> declare() {
         },
         [](const Plan& p) { return std::pair(p.model.window_lo, p.model.window_hi); });
     w.word = "auto";
-    w.drawn_ends = {PS_DRAWN_WINDOW_LO, PS_DRAWN_WINDOW_HI};
-    w.get = [get = w.get](const Plan& p) -> nlohmann::json {
-      if (p.model.window_auto) return "auto";
-      if (!p.model.window_drawn()) return get(p);
-      const auto end = [](const DrawnRange& d, double fixed) {
-        return d.varies() ? format_number(d.lo) + ".." + format_number(d.hi) : format_number(fixed);
-      };
-      return end(p.model.drawn[PS_DRAWN_WINDOW_LO], p.model.window_lo) + "/" +
-             end(p.model.drawn[PS_DRAWN_WINDOW_HI], p.model.window_hi);
-    };
-    k.push_back(std::move(w));
+    w.get = [get = w.get](const Plan& p) -> nlohmann::json { return p.model.window_auto ? "auto" : get(p); };
+    k.push_back(drawable_ends(std::move(w), PS_DRAWN_WINDOW_LO, PS_DRAWN_WINDOW_HI));
   }
   k.push_back(choice(
       "display_filter", "bilinear", {"bilinear", "bicubic"},
