@@ -27,6 +27,8 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 constexpr int kCount = 40;
+// The timed passes' least length: the report's rates are not what these tests hold.
+constexpr double kTimedSeconds = 0.05;
 const std::vector<std::string> kRowNames = {"reference", "exact", "standard", "fast"};
 
 const json& row(const json& report, const std::string& model, const std::string& name) {
@@ -220,9 +222,12 @@ TEST(TradeoffModels, BothModelsByDefault) {
   test::TempDir t;
   const fs::path out = t.w() / "trade";
   const test::Result r =
-      test::finish(test::start(t.cap(), {"tradeoff", "--count", std::to_string(kCount), "--out", out.string()}), 600);
+      test::finish(test::start(t.cap(), {"tradeoff", "--count", std::to_string(kCount), "--timed-seconds",
+                                         std::to_string(kTimedSeconds), "--out", out.string()}),
+                   600);
   ASSERT_TRUE(r.exited && r.status == 0) << test::describe(r);
   const json report = json::parse(test::slurp(out / "tradeoff.json"));
+  EXPECT_EQ(report["timed_seconds"].get<double>(), kTimedSeconds);
   {
     SCOPED_TRACE("every model has its reference and every tier");
     every_model_has_its_reference_and_every_tier(report, out);
@@ -249,8 +254,8 @@ TEST(TradeoffModelsOption, SelectsOneModel) {
   test::spit(cat, test::with_view_line(test::slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "catalogue.toml"),
                                        "upper", "raw = [24, 24]\n"));
   const test::Result r =
-      test::finish(test::start(t.cap(), {"tradeoff", "--count", "10", "--models", "physics", "--no-classifier",
-                                         "--catalogue", cat.string(), "--out", out.string()}),
+      test::finish(test::start(t.cap(), {"tradeoff", "--count", "10", "--timed-seconds", "0", "--models", "physics",
+                                         "--no-classifier", "--catalogue", cat.string(), "--out", out.string()}),
                    600);
   ASSERT_TRUE(r.exited && r.status == 0) << test::describe(r);
   const json report = json::parse(test::slurp(out / "tradeoff.json"));
@@ -275,6 +280,7 @@ TEST(TradeoffModelsOption, NoPlotWritesTheTablesWithoutThePlot) {
                                       600);
   ASSERT_TRUE(r.exited && r.status == 0) << test::describe(r);
   EXPECT_EQ(json::parse(test::slurp(out / "tradeoff.json"))["rows"].size(), 4u);
+  EXPECT_EQ(json::parse(test::slurp(out / "tradeoff.json"))["timed_seconds"].get<double>(), 0.3) << "the default";
   EXPECT_TRUE(fs::is_regular_file(out / "tradeoff.csv"));
   EXPECT_FALSE(fs::exists(out / "tradeoff.png"));
 }
@@ -287,6 +293,15 @@ TEST(TradeoffModelsOption, BadListsAreRejectedBeforeAnythingIsWritten) {
     const test::Result r = test::finish(test::start(t.cap(), {"tradeoff", "--models", models, "--out", out.string()}));
     EXPECT_TRUE(r.exited && r.status != 0) << test::describe(r);
     EXPECT_NE(r.err.find("--models"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  for (const std::string seconds : {"-0.1", "60.5", "nan", "inf"}) {
+    SCOPED_TRACE(seconds);
+    const fs::path out = t.w() / "trade";
+    const test::Result r =
+        test::finish(test::start(t.cap(), {"tradeoff", "--timed-seconds", seconds, "--out", out.string()}));
+    EXPECT_TRUE(r.exited && r.status != 0) << test::describe(r);
+    EXPECT_NE(r.err.find("--timed-seconds"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
   }
 }

@@ -47,6 +47,7 @@ struct TradeoffOptions {
   std::string models = "thesis,physics";
   bool classifier = true;
   bool plot = true;
+  double timed_seconds = 0.3;  // each timed pass's least length
 };
 
 Plan images_plan(const ModelSettings& m) {
@@ -189,6 +190,8 @@ void put_distribution(json& r, const std::vector<double>& draws) {
 int tradeoff(TradeoffOptions& o) {
   if (o.count < 10 || o.count > 1000000) throw InputError("--count: must be between 10 and 1000000");
   if (o.out.empty()) throw InputError("--out: empty folder name");
+  if (!(o.timed_seconds >= 0 && o.timed_seconds <= 60))  // NaN fails too
+    throw InputError("--timed-seconds: must be a number of seconds between 0 and 60");
   const std::vector<Model> models = parse_models(o.models);
   Session s;
   open_catalogue(s, o.common);
@@ -380,8 +383,8 @@ int tradeoff(TradeoffOptions& o) {
       auto cl = make_opencl_backend(cat, s.assets, rt);
       Plan ip = images_plan(model), fp = features_plan(model);
       ip.fidelity = fp.fidelity = f;
-      const Timed img = run_timed(*cl, batch, ip, 1024, 0.3);
-      const Timed feat = run_timed(*cl, batch, fp, 16384, 0.3);
+      const Timed img = run_timed(*cl, batch, ip, 1024, o.timed_seconds);
+      const Timed feat = run_timed(*cl, batch, fp, 16384, o.timed_seconds);
       put_distribution(rows.emplace_back(), opencl::noise_draws(*rt, f, opencl::KernelCounts::of(cat), m, model.seed, 0,
                                                                 draw_scenarios, kDrawCells));
       const bool images_own_features = o.classifier && img.out.features != feat.out.features;
@@ -399,6 +402,7 @@ int tradeoff(TradeoffOptions& o) {
   report["pixel_noise"] = base.pixel_sigma;
   report["pattern_noise"] = base.pattern_noise;
   report["block"] = base.block;
+  report["timed_seconds"] = o.timed_seconds;
   report["models"] = json::array();
   for (Model m : models) report["models"].push_back(model_name(m));
   report["physics"] = {{"netd_k", base.netd},
@@ -470,6 +474,9 @@ std::function<int()> add_tradeoff(CLI::App& app) {
   sub->add_option("--pixel-noise", o->model.pixel_sigma, "per-pixel sensor noise sigma (default 2)");
   sub->add_option("--block", o->model.block, "feature block side (default 10)");
   sub->add_option("--models", o->models, "sensor models to measure, comma-separated (default thesis,physics)");
+  sub->add_option(
+      "--timed-seconds", o->timed_seconds,
+      "each tier's three timed passes run at least this long (default 0.3; shorter: quicker, noisier rates)");
   sub->add_flag("!--no-classifier", o->classifier, "skip WEKA J48 (faster)");
   sub->add_flag("!--no-plot", o->plot, "skip tradeoff.png (needs no python3 with matplotlib)");
   return [o] { return tradeoff(*o); };
