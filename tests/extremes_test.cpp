@@ -191,11 +191,7 @@ std::string first_subject_only(const std::string& text) {
 
 class TempDir {
  public:
-  TempDir() {
-    char tmpl[] = "/tmp/portalsim-extremes-XXXXXX";
-    if (!::mkdtemp(tmpl)) throw std::runtime_error(std::string("mkdtemp: ") + std::strerror(errno));
-    root_ = tmpl;
-  }
+  TempDir() { root_ = test::make_temp_dir("portalsim-extremes"); }
   TempDir(const TempDir&) = delete;
   TempDir& operator=(const TempDir&) = delete;
   ~TempDir() {

@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -37,14 +38,21 @@ bool wait_until(Done done, int limit_s, int poll_ms = 2) {
   }
 }
 
-// A fresh folder under /tmp for one test: w/ is the test's workspace, cap/ holds the captured
-// stdout and stderr of every run (kept apart so that w/ shows only what portalsim wrote).
+// A new folder named `prefix` and six random characters under $TMPDIR, else /tmp, as
+// Python's tempfile and mktemp choose (the Python suites and the scripts' folders).
+inline std::filesystem::path make_temp_dir(const std::string& prefix) {
+  const char* dir = std::getenv("TMPDIR");
+  std::string tmpl = std::string(dir && *dir ? dir : "/tmp") + "/" + prefix + "-XXXXXX";
+  if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp " + tmpl + ": " + std::strerror(errno));
+  return tmpl;
+}
+
+// A fresh folder (make_temp_dir) for one test: w/ is the test's workspace, cap/ holds the
+// captured stdout and stderr of every run (kept apart so that w/ shows only what portalsim wrote).
 class TempDir {
  public:
   TempDir() {
-    char tmpl[] = "/tmp/portalsim-test-XXXXXX";
-    if (!::mkdtemp(tmpl)) throw std::runtime_error(std::string("mkdtemp: ") + std::strerror(errno));
-    root_ = tmpl;
+    root_ = make_temp_dir("portalsim-test");
     std::filesystem::create_directory(root_ / "w");
     std::filesystem::create_directory(root_ / "cap");
   }

@@ -28,9 +28,7 @@ const std::vector<std::string> kGun{"none", "none", "none", "gun"};
 class Serve : public ::testing::Test {
  protected:
   void SetUp() override {
-    char tmpl[] = "/tmp/portalsim-serve-test-XXXXXX";
-    ASSERT_NE(::mkdtemp(tmpl), nullptr);
-    tmp_ = tmpl;
+    tmp_ = portalsim::test::make_temp_dir("portalsim-serve-test");
     fs::create_directories(tmp_ / "root");
     fs::create_directories(tmp_ / "cap");
     std::vector<std::string> args{"serve", "--port", "0", "--root", (tmp_ / "root").string()};

@@ -21,11 +21,7 @@ using portalsim::test::slurp;
 using portalsim::test::spit;
 using portalsim::test::start;
 
-fs::path fresh_dir() {
-  char tmpl[] = "/tmp/portalsim-validate-XXXXXX";
-  if (!::mkdtemp(tmpl)) throw std::runtime_error("mkdtemp failed");
-  return tmpl;
-}
+fs::path fresh_dir() { return portalsim::test::make_temp_dir("portalsim-validate"); }
 
 // Two attributes; `a` separates the classes unless `shuffled`, then labels are random.
 std::string table(int n, unsigned seed, bool shuffled) {
