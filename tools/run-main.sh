@@ -30,7 +30,11 @@ for case in "${cases[@]}"; do
   pids+=($!)
 done
 for i in "${!cases[@]}"; do
-  wait "${pids[i]}" || { echo "run-main.sh: WEKA's J48 failed on out/${cases[i]}/features.arff" >&2; exit 1; }
+  if ! wait "${pids[i]}"; then
+    echo "run-main.sh: WEKA's J48 failed on out/${cases[i]}/features.arff" >&2
+    kill "${pids[@]}" 2>/dev/null || true
+    exit 1
+  fi
   echo "== WEKA J48, 10-fold cross-validation, out/${cases[i]}/features.arff"
   grep -A2 "Stratified cross-validation" "out/${cases[i]}/j48.txt" | tail -1
 done
