@@ -15,11 +15,14 @@
 //   phys:    the physics model's parameters (kernels/shared.h, PS_PHYS_*)
 //   raw:     physics: the MMW raw grid, n * raw_height * raw_width
 //   scratch: physics: a second field, for stages that cannot work in place
+//   indices: each scenario's global index where the batch is not contiguous, else null
+//            (scenario_index)
 #define VIEW_STAGE_ARGS                                                                                          \
   global const uchar *atlas, global const int *bases, global const int4 *sprites, global const int2 *places,     \
       global const int *noise_offsets, global const float *noise_gains, global const uchar *subject,             \
       global const short *objects, PsViewLaunch L, param alpha, param sigma, param sigma_hi, global int *records,                 \
-      global real *field, global uchar *out, global const param *phys, global real *raw, global real *scratch
+      global real *field, global uchar *out, global const param *phys, global real *raw, global real *scratch, \
+      global const ulong *indices
 
 // The scenario and image row of a work-item (one per (scenario, row)).
 #define VIEW_STAGE_ROW                                           \
@@ -28,7 +31,7 @@
   const int y = (int)(gid % (size_t)L.height);                   \
   if (i >= L.n) return;                                          \
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);              \
-  const ulong index = upsample(L.first_hi, L.first_lo) + i;      \
+  const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);      \
   global const int* rec = records + (size_t)i * PS_REC_LEN;      \
   const size_t row0 = ((size_t)i * L.height + y) * L.width;      \
   (void)seed;                                                    \
@@ -39,7 +42,7 @@
   const uint i = (uint)get_global_id(0);                     \
   if (i >= L.n) return;                                      \
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);          \
-  const ulong index = upsample(L.first_hi, L.first_lo) + i;  \
+  const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);  \
   (void)seed;                                                \
   (void)index
 
@@ -51,7 +54,7 @@
   const int j = (int)(gid % (size_t)L.raw_height);                                      \
   if (i >= L.n) return;                                                                 \
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);                                     \
-  const ulong index = upsample(L.first_hi, L.first_lo) + i;                             \
+  const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);                             \
   global preal* r = (global preal*)raw + ((size_t)i * L.raw_height + j) * L.raw_width;  \
   (void)seed;                                                                           \
   (void)index
@@ -141,7 +144,7 @@ kernel void place_view(VIEW_STAGE_ARGS) {
   if (i >= L.n) return;
   (void)atlas, (void)bases, (void)alpha, (void)sigma, (void)field, (void)out, (void)phys, (void)raw, (void)scratch;
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
-  const ulong index = upsample(L.first_hi, L.first_lo) + i;
+  const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);
   global const short* objs = objects + (size_t)i * PS_REGIONS;
   global int* rec = records + (size_t)i * PS_REC_LEN;
   rec[PS_REC_PATTERN] = (L.flags & PS_FLAG_PATTERN_NOISE)

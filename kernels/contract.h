@@ -92,7 +92,11 @@
 /* physics: the MMW display window's ends (--window L1..L2/H1..H2), each drawn from its range. */
 #define PS_DRAWN_WINDOW_LO 8u
 #define PS_DRAWN_WINDOW_HI 9u
-#define PS_DRAWN_KNOBS 10 /* elements 0 .. PS_DRAWN_KNOBS - 1 */
+/* physics: the MMW raw grid of a run given a list of grids (--mmw-raw 24x24,28x28): the
+ * grid below(word 0, grids) of the list. The host draws it and runs each grid's scenarios
+ * together (an index table, kernels/philox.cl's scenario_index); not a numeric knob. */
+#define PS_DRAWN_MMW_RAW 10u
+#define PS_DRAWN_KNOBS 11 /* elements 0 .. PS_DRAWN_KNOBS - 1 */
 /* physics: frame k >= 1 of the MMW camera's integration draws its NETD from stream
  * PS_STREAM_FRAME_NOISE + k (frame 0 from PS_STREAM_RAW_NOISE); element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_FRAME_NOISE 32u

@@ -19,6 +19,13 @@ inline uint4 draw(uint2 seed, ulong index, uint stream, uint element) {
   return philox4x32_10((uint4)(element, stream, (uint)index, (uint)(index >> 32)), seed);
 }
 
+// The global index of a batch's scenario i: the batch's first index plus i, or where the
+// batch is not contiguous (a run whose raw grid is drawn runs each grid's scenarios
+// together), its index table's entry; a null table is a contiguous batch.
+inline ulong scenario_index(global const ulong* indices, uint first_lo, uint first_hi, uint i) {
+  return indices ? indices[i] : upsample(first_hi, first_lo) + i;
+}
+
 inline float uniform24(uint r) { return (float)(r >> 8) * (1.0f / 16777216.0f); }
 inline uint below(uint r, uint n) { return mul_hi(r, n); }
 

@@ -78,7 +78,7 @@ FEATURE_NOISE(private)
                                     global const uchar* subject, global const short* objects,                    \
                                     global const param* base_features, global const int2* object_range,           \
                                     global const int* object_feature, global const param* object_value,          \
-                                    preal sd, int8 dims, global const param* noise) {                           \
+                                    preal sd, int8 dims, global const param* noise, ulong index) {                           \
     const int blocks = dims.s0 * dims.s1;                                                                      \
     global const int* rec = records + (size_t)i * PS_REC_LEN;                                                  \
     if (physics_tabulated(rec, L)) {                                                                           \
@@ -112,10 +112,10 @@ FEATURE_NOISE(private)
     }                                                                                                          \
     if (sd > 0)                                                                                                \
       feature_noise_##SPACE(acc, z, w, dims, noise, sd, (uint2)(L->seed_lo, L->seed_hi),                       \
-                            upsample(L->first_hi, L->first_lo) + i, L->view, phys + L->phys_gauss);            \
+                            index, L->view, phys + L->phys_gauss);            \
     preal lo = (preal)phys[PS_PHYS_WINDOW_MIN], hi = (preal)phys[PS_PHYS_WINDOW_MAX];                          \
     if (L->window_auto == PS_WINDOW_DRAWN) /* the scenario's window, as stage_window draws it */              \
-      drawn_window(phys, (uint2)(L->seed_lo, L->seed_hi), upsample(L->first_hi, L->first_lo) + i, &lo, &hi);  \
+      drawn_window(phys, (uint2)(L->seed_lo, L->seed_hi), index, &lo, &hi);  \
     const preal scale = (preal)255 / (hi - lo);                                                                \
     global float* restrict fb = row + dims.s5; /* the blocks' columns are contiguous */                        \
     for (int f = 0; f < blocks; ++f) fb[f] = clamp((float)((acc[f] - lo) * scale), 0.0f, 255.0f);              \
@@ -131,16 +131,17 @@ kernel void physics_features(global const preal* raw, global const int* first, g
                              global const param* base_features, global const int2* object_range,
                              global const int* object_feature, global const param* object_value, param netd_lo,
                              param netd_hi, int2 frames, int8 dims, global const param* noise,
-                             global preal* scratch) {
+                             global preal* scratch, global const ulong* indices) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
+  const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);
   // The NETD over the frames' mean: netd_lo where neither is drawn (the host's NETD /
   // sqrt(frames)), else the scenario's draw (kernels/netd.cl).
   int one;
   const preal sd = netd_hi <= netd_lo && frames.y <= frames.x
                        ? (preal)netd_lo
                        : mmw_noise_drawn((preal)netd_lo, (preal)netd_hi, frames.x, frames.y, true,
-                                         (uint2)(L.seed_lo, L.seed_hi), upsample(L.first_hi, L.first_lo) + i, &one);
+                                         (uint2)(L.seed_lo, L.seed_hi), index, &one);
   global float* row = features + (size_t)i * row_len;
   const int band_x = dims.s2, band_y = dims.s3, zlen = dims.s0 * dims.s1 + dims.s4;
   const int space = PS_FEATURE_SPACE(dims.s0, dims.s1, band_x, band_y, dims.s4);
@@ -149,12 +150,12 @@ kernel void physics_features(global const preal* raw, global const int* first, g
     view_features_private(work, work + count + band_x, work + count + band_x + zlen + band_y * dims.s0, row, i, &L,
                           raw, first, cells,
                           weights, columns, count, raw_cells, phys, records, subject, objects, base_features,
-                          object_range, object_feature, object_value, sd, dims, noise);
+                          object_range, object_feature, object_value, sd, dims, noise, index);
   } else {
     global preal* work = scratch + (size_t)(i - get_global_offset(0)) * space;  // a launch per chunk
     view_features_global(work, work + count + band_x, work + count + band_x + zlen + band_y * dims.s0, row, i, &L,
                          raw, first, cells,
                          weights, columns, count, raw_cells, phys, records, subject, objects, base_features,
-                         object_range, object_feature, object_value, sd, dims, noise);
+                         object_range, object_feature, object_value, sd, dims, noise, index);
   }
 }

@@ -32,7 +32,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   (void)bases, (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha,
       (void)sigma, (void)field, (void)out;
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
-  const ulong index = upsample(L.first_hi, L.first_lo) + i;
+  const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);
   global const int* rec = records + (size_t)i * PS_REC_LEN;
   if (physics_tabulated(rec, &L)) return;  // physics_features sums its tables instead
   const int W = L.width, H = L.height, RW = L.raw_width, RH = L.raw_height, cells = RW * RH;

@@ -115,10 +115,11 @@ inline int blocks_meet(const int* a, const int* b) {
 
 // Each scenario's noise pattern (under pattern noise), apart from features_sparse so that
 // PoCL runs the generator across the work-items of a group, in vector registers.
-kernel void sparse_patterns(uint n, int P, uint2 seed, uint2 first, global int* patterns) {
+kernel void sparse_patterns(uint n, int P, uint2 seed, uint2 first, global const ulong* indices,
+                              global int* patterns) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
-  patterns[i] = (int)below(draw(seed, upsample(first.y, first.x) + i, PS_STREAM_NOISE_PATTERN, 0u).x, (uint)P);
+  patterns[i] = (int)below(draw(seed, scenario_index(indices, first.x, first.y, i), PS_STREAM_NOISE_PATTERN, 0u).x, (uint)P);
 }
 
 #if defined(VECTOR_RENDER)
@@ -332,10 +333,10 @@ kernel void features_sparse(global const uchar* restrict atlas, global const int
 // are not modelled; tradeoff measures what that costs. One work-item per scenario.
 kernel void analytic_noise(global float* features, global const int4* rects, global const int4* grids, uint n,
                            int block, int npooled, int row_len, float sigma_lo, float sigma_hi, uint2 seed,
-                           uint2 first) {
+                           uint2 first, global const ulong* indices) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
-  const ulong index = upsample(first.y, first.x) + i;
+  const ulong index = scenario_index(indices, first.x, first.y, i);
   // The scenario's sigma: the knob's, or its draw (kernels/sensor_noise.cl).
   const float sigma = knob_draw(sigma_lo, sigma_hi, seed, index, PS_DRAWN_PIXEL_NOISE);
   // grids: per pooled view (width, height, blocks across, first column); the regions follow.

@@ -324,7 +324,7 @@ kernel void render_view(VIEW_STAGE_ARGS) {
   if (i >= L.n) return;
   (void)sprites, (void)places, (void)objects, (void)field, (void)phys, (void)raw, (void)scratch;
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
-  const ulong index = upsample(L.first_hi, L.first_lo) + i;
+  const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);
   global const int* rec = records + (size_t)i * PS_REC_LEN;
   const int W = L.width, H = L.height;
   global const uchar* base = base_row(atlas, bases, subject, &L, i, 0);

@@ -47,7 +47,7 @@ kernel void stage_window(VIEW_STAGE_ARGS) {
   const preal w0 = (preal)phys[PS_PHYS_WINDOW_MIN];
   preal lo, hi;
   if (L.window_auto == PS_WINDOW_DRAWN) {
-    drawn_window(phys, (uint2)(L.seed_lo, L.seed_hi), upsample(L.first_hi, L.first_lo) + i, &lo, &hi);
+    drawn_window(phys, (uint2)(L.seed_lo, L.seed_hi), scenario_index(indices, L.first_lo, L.first_hi, i), &lo, &hi);
   } else {
     global preal* restrict a = (global preal*)scratch + (size_t)i * cells;
     for (int k = 0; k < cells; ++k) a[k] = r[k];

@@ -19,9 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::assets;
 using test::catalogue;
-// The image tests' scenarios; under the sanitizers (support.h, kSanitized), whose fp64
-// reference loops run several times slower, a quarter of them.
-const size_t kScenes = test::kSanitized ? 12 : 48;
+using test::kImageScenes;
 
 Plan clothed_plan(const std::string& clothing, Tier tier, bool fused) {
   Plan plan = test::physics_plan(53);
@@ -72,7 +70,7 @@ TEST(Clothing, OutfitsAreDrawnByClassThenFabric) {
 // path (untabulated: it leaves its tables) within the tolerance table's.
 TEST(Clothing, OutfitsAreTheReferencesOnEveryPath) {
   std::vector<Scenario> scenes;
-  for (size_t k = 0; k < kScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
+  for (size_t k = 0; k < kImageScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
   const SceneBatch batch = test::batch_of(scenes, 700);
   auto ref = make_reference_backend(catalogue(), assets());
   auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
@@ -125,7 +123,7 @@ TEST(Clothing, OutfitsAreTheReferencesOnEveryPath) {
 // hold the kernels to the reference as above.
 TEST(Clothing, TheLightestAndHeaviestOutfitsAreTheReferences) {
   std::vector<Scenario> scenes;
-  for (size_t k = 0; k < kScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), 3000 + k, 6));
+  for (size_t k = 0; k < kImageScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), 3000 + k, 6));
   const SceneBatch batch = test::batch_of(scenes, 0);
   auto ref = make_reference_backend(catalogue(), assets());
   auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
@@ -248,10 +246,7 @@ TEST(Clothing, BadValuesAreRefusedNamingTheFlagOrTheLine) {
     EXPECT_NE(r.err.find(says), std::string::npos) << says << ": " << r.err;
     EXPECT_FALSE(fs::exists(t.w() / "o")) << says;
   }
-  test::spit(t.w() / "spec.toml", "count = 10\nmodel = \"physics\"\nclothing = \"kilt\"\n");
-  const test::Result r = test::finish(
-      test::start(t.cap(), {"generate", "--spec", (t.w() / "spec.toml").string(), "--out", (t.w() / "s").string()}),
-      120);
+  const test::Result r = test::generate_spec(t, "count = 10\nmodel = \"physics\"\nclothing = \"kilt\"\n", t.w() / "s");
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("spec.toml:3: clothing"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(t.w() / "s"));

@@ -703,20 +703,14 @@ TEST(DrawnKnobs, BadRangesAreRefusedNamingTheFlagOrTheLine) {
     EXPECT_NE(r.err.find(says), std::string::npos) << value << ": " << r.err;
     EXPECT_FALSE(fs::exists(t.w() / "o")) << value;
   }
-  test::spit(t.w() / "spec.toml", "count = 10\nmetal_noise = \"9..2\"\n");
-  const test::Result r = test::finish(
-      test::start(t.cap(), {"generate", "--spec", (t.w() / "spec.toml").string(), "--out", (t.w() / "s").string()}),
-      120);
+  const test::Result r = test::generate_spec(t, "count = 10\nmetal_noise = \"9..2\"\n", t.w() / "s");
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("spec.toml:2: metal_noise: \"9..2\" is reversed"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(t.w() / "s"));
-  test::spit(t.w() / "window.toml", "count = 10\nmodel = \"physics\"\nwindow = \"285..301/300..306\"\n");
-  const test::Result w = test::finish(
-      test::start(t.cap(), {"generate", "--spec", (t.w() / "window.toml").string(), "--out", (t.w() / "s").string()}),
-      120);
+  const test::Result w =
+      test::generate_spec(t, "count = 10\nmodel = \"physics\"\nwindow = \"285..301/300..306\"\n", t.w() / "s");
   EXPECT_NE(w.status, 0);
-  EXPECT_NE(w.err.find("window.toml:3: window: \"285..301/300..306\": the low end's range"), std::string::npos)
-      << w.err;
+  EXPECT_NE(w.err.find("spec.toml:3: window: \"285..301/300..306\": the low end's range"), std::string::npos) << w.err;
   EXPECT_FALSE(fs::exists(t.w() / "s"));
 }
 

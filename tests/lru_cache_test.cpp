@@ -39,5 +39,18 @@ TEST(LruCache, AThousandKnobSettingsKeepTheSizeBoundedAndTheLatestValid) {
   for (int i = 992; i < 1000; ++i) EXPECT_TRUE(cache.contains("knobs=" + std::to_string(i))) << i;
 }
 
+// reserve() grows the capacity for what is used by turns (each raw grid's part of a batch)
+// and never shrinks it.
+TEST(LruCache, ReserveHoldsMoreAndNeverLess) {
+  LruCache<int, int> cache(2);
+  cache.reserve(5);
+  EXPECT_EQ(cache.capacity(), 5u);
+  for (int round = 0; round < 2; ++round)
+    for (int k = 0; k < 5; ++k) cache[k] += 1;
+  for (int k = 0; k < 5; ++k) EXPECT_EQ(cache[k], 2) << k << " was dropped and made again";
+  cache.reserve(3);
+  EXPECT_EQ(cache.capacity(), 5u);
+}
+
 }  // namespace
 }  // namespace portalsim

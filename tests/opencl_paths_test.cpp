@@ -210,6 +210,33 @@ TEST(OpenCLPaths, ViewDerivationsAreBoundedAndKeepWhatIsInUse) {
   EXPECT_EQ(derived(plan, 0)->model.netd, plan.model.netd);
 }
 
+// A run whose raw grid is drawn from a list of the most grids uses every grid's derivations
+// in every batch (each grid's part, images and the features path's noise-free ones): the
+// cache holds them all, so none is made again batch after batch.
+TEST(OpenCLPaths, ViewDerivationsHoldEveryDrawnGridsPart) {
+  const Catalogue& cat = catalogue();
+  opencl::ViewDerivations derived(cat, assets(), test::runtime()->context());
+  derived.hold_parts(kMaxRawGrids);
+  Plan plan = test::physics_plan();
+  std::vector<std::shared_ptr<opencl::ViewDerived>> made;
+  for (int round = 0; round < 2; ++round) {
+    size_t k = 0;
+    for (int g = 1; g <= static_cast<int>(kMaxRawGrids); ++g) {
+      plan.model.raw_width = plan.model.raw_height = 10 + g;
+      for (int view = 0; view < static_cast<int>(cat.sensors.size()); ++view)
+        for (const bool noise_free : {false, true}) {
+          const std::shared_ptr<opencl::ViewDerived> d = derived(plan, view, noise_free);
+          if (round == 0)
+            made.push_back(d);
+          else
+            EXPECT_EQ(d.get(), made[k].get()) << "grid " << g << " view " << view << " made again";
+          ++k;
+        }
+    }
+  }
+  EXPECT_LE(derived.size(), derived.capacity());
+}
+
 // After more knob settings than the cache holds, a backend gives the first setting's bytes
 // again: images (the physics parameter tables) and features-only runs (the sparse tables).
 TEST(OpenCLPaths, ARunAfterTheCacheDroppedItsTablesGivesTheSameBytes) {

@@ -234,6 +234,14 @@ inline Result generate(const TempDir& t, std::vector<std::string> args, const st
   return finish(start(t.cap(), args), 300);
 }
 
+// `portalsim generate --spec SPEC --out OUT`, SPEC a file holding `toml` (up to 120 s): a
+// spec file's errors name its line and key.
+inline Result generate_spec(const TempDir& t, const std::string& toml, const std::filesystem::path& out) {
+  const std::filesystem::path spec = t.w() / "spec.toml";
+  spit(spec, toml);
+  return finish(start(t.cap(), {"generate", "--spec", spec.string(), "--out", out.string()}), 120);
+}
+
 // True once the started run has ended (without reaping it).
 inline bool has_ended(const Running& r) {
   siginfo_t info{};

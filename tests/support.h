@@ -117,6 +117,10 @@ inline std::vector<Scenario> coverage(const Catalogue& c, size_t n, int max_obje
   return v;
 }
 
+// The scenarios of an image test that runs the fp64 reference over several plans; under
+// the sanitizers, whose reference loops run several times slower, a quarter of them.
+inline const size_t kImageScenes = kSanitized ? 12 : 48;
+
 // coverage(c, n, max_objects), or under the sanitizers every fourth of its scenarios.
 inline std::vector<Scenario> parity_set(const Catalogue& c, size_t n, int max_objects) {
   std::vector<Scenario> all = coverage(c, n, max_objects);

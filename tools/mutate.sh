@@ -30,7 +30,7 @@ build=$(realpath -m "${1:-build}")
 list=$(realpath "${2:-tools/mutations.txt}")
 # Cheap first: known answers and golden examples, then the parity suites, then the rest.
 # (gtest runs a filter's tests in link order, so a filter is a stage.)
-filters=${PORTALSIM_MUTATE_TESTS:-'Golden*:Philox*:Parity*:SparseFeatures*:Stages* Physics*:Metal* IrPhysics*:Camera.KernelsMatchTheReference Camera*:OpenCLPaths*:Extreme*:Baseline*:SubjectHeight*:RandomisedObjects*:Bodies*:Clothing*'}
+filters=${PORTALSIM_MUTATE_TESTS:-'Golden*:Philox*:Parity*:SparseFeatures*:Stages* Physics*:Metal* IrPhysics*:Camera.KernelsMatchTheReference Camera*:OpenCLPaths*:Extreme*:Baseline*:SubjectHeight*:RandomisedObjects*:Bodies*:Clothing*:RawGridDrawn*'}
 py=/usr/bin/python3
 work=$(realpath -m "${PORTALSIM_MUTATE_WORK:-$build/mutate}")
 mkdir -p "$work"

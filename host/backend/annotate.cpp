@@ -502,7 +502,7 @@ void Annotator::operator()(const ModelSettings& model, const SceneBatch& batch, 
         uint8_t* scr = scratch[k].data();
         size_t m = 0;
         if (moves) {
-          moved = reference::view_scene(cat, assets, model, static_cast<int>(k), s, batch.first_index + i).placed;
+          moved = reference::view_scene(cat, assets, model, static_cast<int>(k), s, batch.index_of(i)).placed;
           moved_at.clear();
           for (const reference::Placed& pl : moved)
             moved_at.emplace_back(pl, runs[k][pl.variant], model, W, sensor.height);

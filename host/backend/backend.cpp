@@ -1,5 +1,6 @@
 #include "backend/backend.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "base/parallel.h"
@@ -37,6 +38,21 @@ const ViewImages& BatchOutput::view(std::string_view name) const {
   for (const ViewImages& v : views)
     if (v.name == name) return v;
   throw std::out_of_range("no camera view is called \"" + std::string(name) + "\"");
+}
+
+void place_rows(BatchOutput& all, const BatchOutput& part, const std::vector<size_t>& rows) {
+  if (rows.size() != part.n) throw std::logic_error("place_rows: the rows are not the part's scenarios");
+  const auto place = [&](std::vector<uint8_t>& to, const std::vector<uint8_t>& from, size_t per) {
+    for (size_t j = 0; j < rows.size(); ++j) std::copy_n(from.begin() + j * per, per, to.begin() + rows[j] * per);
+  };
+  for (size_t k = 0; k < part.views.size(); ++k)
+    if (!part.views[k].empty()) place(all.views[k].pixels, part.views[k].pixels, part.views[k].pixels_per_image());
+  if (!part.metal.empty()) place(all.metal, part.metal, static_cast<size_t>(part.layout.zones));
+  if (!part.features.empty()) {
+    const size_t per = static_cast<size_t>(part.layout.image_features());
+    for (size_t j = 0; j < rows.size(); ++j)
+      std::copy_n(part.features.begin() + j * per, per, all.features.begin() + rows[j] * per);
+  }
 }
 
 void append_output(BatchOutput& all, const BatchOutput& part) {

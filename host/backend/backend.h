@@ -49,6 +49,9 @@ void prepare_output(BatchOutput& out, const Catalogue& cat, const Plan& plan, si
 
 // Appends `part`'s scenarios to `all` (same catalogue and plan).
 void append_output(BatchOutput& all, const BatchOutput& part);
+// Puts `part`'s scenario j at row rows[j] of `all` (sized for the whole batch, the same
+// layout): its images, metal zones and features; annotations are left to the caller.
+void place_rows(BatchOutput& all, const BatchOutput& part, const std::vector<size_t>& rows);
 
 class Backend {
  public:

@@ -33,6 +33,9 @@ class LruCache {
     return it->second.first;
   }
   size_t size() const { return entries_.size(); }
+  size_t capacity() const { return capacity_; }
+  // Keeps at least `capacity` entries from now on (never fewer than before).
+  void reserve(size_t capacity) { capacity_ = std::max(capacity_, capacity); }
   bool contains(const Key& key) const { return entries_.count(key) != 0; }
 
  private:

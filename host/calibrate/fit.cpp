@@ -443,6 +443,7 @@ ModelSettings fitted_model(const ModelSettings& model, const CameraFit& fit) {
   m.netd = fit.netd;
   m.raw_width = fit.raw_w;
   m.raw_height = fit.raw_h;
+  m.raw_grids.clear();  // the fitted grid, not a list drawn from
   // The camera the fit assumes: one frame, the fitted fixed window, bilinear, unsmoothed.
   m.frames = 1;
   m.window_auto = false;

@@ -1,5 +1,6 @@
 #include "plan/knobs.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -152,8 +153,23 @@ std::vector<Knob> declare() {
       [](Plan& p, double v) {
         p.model.raw_width = static_cast<int>(v) / 65536;
         p.model.raw_height = static_cast<int>(v) % 65536;
+        p.model.raw_grids.clear();
       },
-      [](const Plan& p) { return std::to_string(p.model.raw_width) + "x" + std::to_string(p.model.raw_height); }));
+      [](const Plan& p) {
+        if (!p.model.raw_grid_drawn())
+          return std::to_string(p.model.raw_width) + "x" + std::to_string(p.model.raw_height);
+        std::string list;
+        for (const auto& [w, h] : p.model.raw_grids) {
+          if (!list.empty()) list += ',';
+          list.append(std::to_string(w)).append(1, 'x').append(std::to_string(h));
+        }
+        return list;
+      }));
+  k.back().set_list = [](Plan& p, const std::vector<double>& grids) {
+    p.model.raw_grids.clear();
+    for (const double v : grids)
+      p.model.raw_grids.push_back({static_cast<int>(v) / 65536, static_cast<int>(v) % 65536});
+  };
   k.push_back(drawable(
       number(
           "worn_minutes", "5", 0, 1440, "minutes",
@@ -327,7 +343,8 @@ std::string Knob::flag() const {
 
 std::string Knob::values() const {
   if (kind == KnobKind::grid)
-    return "WxH, each " + format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit);
+    return "WxH, each " + format_number(min) + " .. " + format_number(max) + (unit.empty() ? "" : " " + unit) +
+           (set_list ? ", or WxH,WxH,... one drawn per scenario" : "");
   if (kind == KnobKind::range)
     return (word.empty() ? std::string("X or A..B") : word + " or A..B") + ", each " + format_number(min) + " .. " +
            format_number(max) + (unit.empty() ? "" : " " + unit) +
@@ -393,6 +410,41 @@ void set_drawn_ends(Plan& plan, const Knob& knob, const std::string& text, size_
   for (int k = 0; k < 2; ++k) plan.model.drawn[static_cast<size_t>(knob.drawn_ends[k])] = ends[k];
 }
 
+// "WxH" of a grid knob, as Knob::set takes it (width * 65536 + height).
+double grid_value(const Knob& knob, const std::string& text, const std::string& where) {
+  const size_t x = text.find('x');
+  double w = 0, h = 0;
+  if (x == std::string::npos || !parse_number(text.substr(0, x), w) || !parse_number(text.substr(x + 1), h) ||
+      w != std::floor(w) || h != std::floor(h) || text.find_first_of(".eE+-") != std::string::npos)
+    throw InputError(where + ": \"" + text + "\" is not WxH (two whole numbers, such as 28x28)");
+  if (w < knob.min || w > knob.max || h < knob.min || h > knob.max)
+    throw InputError(where + ": " + text + " is out of range [" + knob.values() + "]");
+  return w * 65536 + h;
+}
+
+// "WxH,WxH,..." of a grid knob drawn per scenario (Knob::set_list): at most kMaxRawGrids
+// grids, none twice; the first is set as the knob's value.
+void set_grid_list(Plan& plan, const Knob& knob, const std::string& text, const std::string& where) {
+  std::vector<double> grids;
+  size_t at = 0;
+  while (true) {
+    const size_t comma = text.find(',', at);
+    const std::string part = text.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
+    const std::string what = where + " (grid " + std::to_string(grids.size() + 1) + " of the list)";
+    if (part.empty()) throw InputError(what + ": empty; the list is WxH,WxH,... (such as 24x24,28x28)");
+    const double v = grid_value(knob, part, what);
+    if (std::find(grids.begin(), grids.end(), v) != grids.end())
+      throw InputError(what + ": " + part + " is listed twice");
+    grids.push_back(v);
+    if (grids.size() > kMaxRawGrids)
+      throw InputError(where + ": \"" + text + "\" lists more than " + std::to_string(kMaxRawGrids) + " grids");
+    if (comma == std::string::npos) break;
+    at = comma + 1;
+  }
+  knob.set(plan, grids[0]);
+  knob.set_list(plan, grids);
+}
+
 }  // namespace
 
 void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::string& where) {
@@ -419,14 +471,11 @@ void set_knob(Plan& plan, const Knob& knob, const std::string& text, const std::
       v = text == "on";
       break;
     case KnobKind::grid: {
-      const size_t x = text.find('x');
-      double w = 0, h = 0;
-      if (x == std::string::npos || !parse_number(text.substr(0, x), w) || !parse_number(text.substr(x + 1), h) ||
-          w != std::floor(w) || h != std::floor(h) || text.find_first_of(".eE+-") != std::string::npos)
-        throw InputError(where + ": \"" + text + "\" is not WxH (two whole numbers, such as 28x28)");
-      if (w < knob.min || w > knob.max || h < knob.min || h > knob.max)
-        throw InputError(where + ": " + text + " is out of range [" + knob.values() + "]");
-      v = w * 65536 + h;
+      if (knob.set_list && text.find(',') != std::string::npos) {
+        set_grid_list(plan, knob, text, where);
+        return;
+      }
+      v = grid_value(knob, text, where);
       break;
     }
     case KnobKind::range: {
@@ -482,7 +531,11 @@ void check_knobs(const Plan& plan) {
       if (!std::isfinite(v) || v < k.min || v > k.max)
         throw InputError(k.flag() + ": " + format_number(v) + " must be a finite number between " + k.values());
   }
-  // The thesis model composites gray levels: it has no clothing to draw.
+  // The thesis model composites gray levels: it has no raw grid or clothing to draw.
+  if (plan.model.model == Model::thesis && plan.model.raw_grid_drawn())
+    throw InputError(
+        "--mmw-raw: a list of grids applies to the physics model (--model physics); the thesis model "
+        "has no raw grid");
   if (plan.model.model == Model::thesis && plan.model.clothing != Clothing::catalogue)
     throw InputError(std::string("--clothing: ") + kClothingNames[static_cast<size_t>(plan.model.clothing)] +
                      " applies to the physics model (--model physics); the thesis model has the catalogue's clothing");

@@ -52,6 +52,9 @@ struct Knob {
   // elements of its A and B ends, or -1. "L1..L2/H1..H2" (each end a number or a range,
   // L2 < H1) sets ModelSettings::drawn and the range to L1..H1; get gives it back so.
   std::array<int, 2> drawn_ends{-1, -1};
+  // A grid knob that may be drawn per scenario from a list ("WxH,WxH,..."): sets the list,
+  // each grid as set takes it, after set has set the first; null where the grid is one.
+  std::function<void(Plan&, const std::vector<double>&)> set_list{};
 
   std::string flag() const;
   // "0 .. 1000 gray levels", "on, off", "fp32, fp64, fixed16", "X or A..B, each 0.1 .. 10".

@@ -84,8 +84,19 @@ double worn_minutes_at(const ModelSettings& m, uint64_t index) {
   return m.drawn[PS_DRAWN_WORN_MINUTES].varies() ? drawn_real(m, PS_DRAWN_WORN_MINUTES, index) : m.worn_minutes;
 }
 
+std::array<int, 2> raw_grid_at(const ModelSettings& m, uint64_t index) {
+  if (!m.raw_grid_drawn()) return {m.raw_width, m.raw_height};
+  const uint32_t k =
+      below(draw(m.seed, index, kStreamKnobDraw, PS_DRAWN_MMW_RAW)[0], static_cast<uint32_t>(m.raw_grids.size()));
+  return m.raw_grids[k];
+}
+
 ModelSettings ModelSettings::at_scenario(uint64_t index) const {
   ModelSettings m = *this;
+  const std::array<int, 2> raw = raw_grid_at(*this, index);
+  m.raw_width = raw[0];
+  m.raw_height = raw[1];
+  m.raw_grids.clear();
   m.metal_noise = metal_noise_at(*this, index);
   m.pixel_sigma = pixel_noise_at(*this, index);
   m.ir_netd = ir_netd_at(*this, index);
@@ -171,9 +182,10 @@ ModelSettings ModelSettings::for_view(const Sensor& s) const {
   ModelSettings m = *this;
   if (s.netd) (s.camera == Camera::ir ? m.ir_netd : m.netd) = *s.netd;
   if (s.netd) m.drawn[s.camera == Camera::ir ? PS_DRAWN_IR_NETD : PS_DRAWN_NETD] = {};  // its own, never drawn
-  if (s.raw) {
+  if (s.raw) {                                                                          // its own, never drawn
     m.raw_width = (*s.raw)[0];
     m.raw_height = (*s.raw)[1];
+    m.raw_grids.clear();
   }
   return m;
 }
@@ -223,11 +235,13 @@ void validate(const Plan& plan, const Catalogue& cat) {
       throw InputError("--model physics: subject " + s.name + "'s mmw_level equals physics.base_background_gray (" +
                        std::to_string(s.mmw_level) + "), so its base image cannot be read as kelvin");
   // A view with a raw grid of its own was checked against its size when the catalogue was read.
+  std::vector<std::array<int, 2>> grids = plan.model.raw_grids;
+  if (grids.empty()) grids.push_back({plan.model.raw_width, plan.model.raw_height});
   for (const Sensor& s : cat.sensors)
-    if (s.camera == Camera::mmw && !s.raw && (plan.model.raw_width > s.width || plan.model.raw_height > s.height))
-      throw InputError("--mmw-raw: " + std::to_string(plan.model.raw_width) + "x" +
-                       std::to_string(plan.model.raw_height) + " is finer than the " + s.name + " view (" +
-                       std::to_string(s.width) + "x" + std::to_string(s.height) + ")");
+    for (const auto& [w, h] : grids)
+      if (s.camera == Camera::mmw && !s.raw && (w > s.width || h > s.height))
+        throw InputError("--mmw-raw: " + std::to_string(w) + "x" + std::to_string(h) + " is finer than the " + s.name +
+                         " view (" + std::to_string(s.width) + "x" + std::to_string(s.height) + ")");
 }
 
 }  // namespace portalsim

@@ -55,8 +55,12 @@ struct ModelSettings {
   double illumination{};          // K: what the body and objects reflect (the room, indoors)
   double netd{};                  // K rms: MMW sensor noise per raw pixel
   int raw_width{}, raw_height{};  // the MMW camera's raw grid over each view
-  double worn_minutes{};          // how long the objects have been carried (their temperature)
-  double ir_netd{};               // K rms: IR sensor noise per pixel
+  // The raw grids a run draws from (--mmw-raw 24x24,28x28; docs/model/drawn-knobs.md), each
+  // {width, height}, raw_width x raw_height the first; empty where the grid is fixed. Each
+  // scenario's is raw_grid_at's; a backend runs each grid's scenarios together.
+  std::vector<std::array<int, 2>> raw_grids;
+  double worn_minutes{};  // how long the objects have been carried (their temperature)
+  double ir_netd{};       // K rms: IR sensor noise per pixel
   // The clothing (docs/model/clothing.md): the catalogue's, or outfits drawn per scenario
   // (outfit_at); at_scenario resolves the scenario's outfit, an index into
   // outfit_table(clothing) (-1: the catalogue's clothing).
@@ -90,6 +94,7 @@ struct ModelSettings {
   double pixel_sigma_hi() const {
     return drawn[PS_DRAWN_PIXEL_NOISE].varies() ? drawn[PS_DRAWN_PIXEL_NOISE].hi : pixel_sigma;
   }
+  bool raw_grid_drawn() const { return raw_grids.size() > 1; }
   bool window_drawn() const { return drawn[PS_DRAWN_WINDOW_LO].varies() || drawn[PS_DRAWN_WINDOW_HI].varies(); }
   bool transforms() const { return rotate_lo != 0 || rotate_hi != 0 || scale_lo != 1 || scale_hi != 1 || flip; }
   bool moves_sprites() const { return bilinear || jitter > 0 || transforms(); }
@@ -132,6 +137,12 @@ const Outfit& outfit_of(const ModelSettings& m, uint64_t index);
 // Scenario `index`'s pixel noise sigma (the knob pixel_noise, gray levels), as ir_netd_at,
 // element PS_DRAWN_PIXEL_NOISE. kernels/sensor_noise.cl's pixel_sigma_of.
 double pixel_noise_at(const ModelSettings& m, uint64_t index);
+// The most raw grids a list may hold (--mmw-raw WxH,WxH,...): each is a part of every batch.
+constexpr size_t kMaxRawGrids = 16;
+// Scenario `index`'s MMW raw grid, {width, height}: the run's, or where a list is drawn
+// (ModelSettings::raw_grids) its entry below(word 0, size) of PS_STREAM_KNOB_DRAW element
+// PS_DRAWN_MMW_RAW. The OpenCL backend runs each grid's scenarios as a batch of their own.
+std::array<int, 2> raw_grid_at(const ModelSettings& m, uint64_t index);
 // Scenario `index`'s value of the drawn knob `element` (PS_DRAWN_*), as its *_at gives it.
 double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index);
 

@@ -78,6 +78,8 @@ ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, c
                std::any_of(kBodyColumns.begin(), kBodyColumns.end(),
                            [&](const char* k) { return normalise_name(k) == h; }) ||
                std::any_of(kClothingColumns.begin(), kClothingColumns.end(),
+                           [&](const char* k) { return normalise_name(k) == h; }) ||
+               std::any_of(kRawGridColumns.begin(), kRawGridColumns.end(),
                            [&](const char* k) { return normalise_name(k) == h; })) {
       // A drawn knob's, body's or outfit's column records the run's draw; a run draws it
       // again from its seed.

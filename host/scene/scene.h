@@ -14,10 +14,14 @@ constexpr int16_t kNoObject = -1;
 // The keys of the numbers a run may draw per scenario, by their PS_DRAWN_* element: each is
 // its knob's key, or for the window's ends (--window L1..L2/H1..H2) the knob's key and the
 // end (plan/knobs.cpp checks), and, where drawn, a column of scenarios.csv and data.h5's
-// param_<key>. PS_DRAWN_CLOTHING's element draws an outfit, no number: its key is empty.
+// param_<key>. PS_DRAWN_CLOTHING's element draws an outfit and PS_DRAWN_MMW_RAW's a raw
+// grid, no number: their keys are empty (each has columns of its own).
 inline constexpr std::array<const char*, PS_DRAWN_KNOBS> kDrawnKnobKeys = {
-    "metal_noise",  "ir_netd", "pixel_noise", "netd",     "frames", "illumination",
-    "worn_minutes", "",        "window_lo",   "window_hi"};
+    "metal_noise",  "ir_netd", "pixel_noise", "netd",      "frames", "illumination",
+    "worn_minutes", "",        "window_lo",   "window_hi", ""};
+// The columns of scenarios.csv and data.h5 that record a scenario's MMW raw grid where a run
+// draws it from a list (raw_grid_at, plan.h).
+inline constexpr std::array<const char*, 2> kRawGridColumns{"mmw_raw_width", "mmw_raw_height"};
 
 struct Scenario {
   int subject = 0;  // 0-based
@@ -35,18 +39,23 @@ struct ObjectTransform {
   bool operator==(const ObjectTransform&) const = default;
 };
 
-// n scenarios with global indices first_index .. first_index + n - 1. The index, not the
-// position in the batch, feeds the random generator, so results never depend on batching.
+// n scenarios with global indices first_index .. first_index + n - 1, or where `indices` is
+// not empty, those (a backend's part of a batch: scenarios of one drawn raw grid). The index,
+// not the position in the batch, feeds the random generator, so results never depend on
+// batching.
 struct SceneBatch {
   explicit SceneBatch(int regions) : regions(regions) {}
   int regions;  // the catalogue's regions: the stride of `objects`
   uint64_t first_index = 0;
-  std::vector<uint8_t> subject;  // n
-  std::vector<int16_t> objects;  // n * regions, region-major within a scenario
-  std::vector<uint8_t> label;    // n
+  std::vector<uint64_t> indices;  // empty, or n: each scenario's index
+  std::vector<uint8_t> subject;   // n
+  std::vector<int16_t> objects;   // n * regions, region-major within a scenario
+  std::vector<uint8_t> label;     // n
 
   size_t size() const { return subject.size(); }
+  uint64_t index_of(size_t i) const { return indices.empty() ? first_index + i : indices[i]; }
   void clear() {
+    indices.clear();
     subject.clear();
     objects.clear();
     label.clear();

@@ -102,6 +102,8 @@ std::string tensor_meaning(const std::string& name, const Portal& portal) {
        "scenarios.csv names it)"},
       {"clothing_transmission", "per scenario: its outfit's power transmission at 94 GHz"},
       {"clothing_clo", "per scenario: its outfit's thermal insulation, clo"},
+      {"mmw_raw_width", "per scenario: the MMW camera's raw grid, cells across (drawn from the run's --mmw-raw list)"},
+      {"mmw_raw_height", "per scenario: the MMW camera's raw grid, cells down (drawn from the run's --mmw-raw list)"},
   };
   if (const auto it = m.find(name); it != m.end()) return it->second;
   if (name.starts_with("param_"))

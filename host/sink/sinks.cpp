@@ -123,6 +123,8 @@ class ScenarioListSink final : public Sink {
           for (int r = 1; r <= R; ++r) h += what + std::to_string(r);
       for (unsigned e = 0; e < kDrawnKnobKeys.size(); ++e)
         if (ctx.model.drawn[e].varies()) h += std::string(",") + kDrawnKnobKeys[e];
+      if (ctx.model.raw_grid_drawn())
+        for (const char* c : kRawGridColumns) h += std::string(",") + c;
       if (drawn_bodies(*ctx.cat))
         for (const char* c : kBodyColumns) h += std::string(",") + c;
       if (ctx.model.clothing != Clothing::catalogue)
@@ -173,6 +175,10 @@ class ScenarioListSink final : public Sink {
           s += ',';
           s.append(buf, res.ptr);
         }
+      if (ctx_.model.raw_grid_drawn()) {
+        const std::array<int, 2> g = raw_grid_at(ctx_.model, scenes.first_index + i);
+        s += ',' + std::to_string(g[0]) + ',' + std::to_string(g[1]);
+      }
       if (!ctx_.cat->subjects[scenes.subject[i]].drawn.empty()) {
         s += ',';
         s += ctx_.cat->subjects[scenes.subject[i]].drawn;

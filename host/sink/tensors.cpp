@@ -228,6 +228,17 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
               }
               return std::string_view(dst, (hi - lo) * sizeof(double));
             });
+    // The raw grid drawn per scenario (plan.h, raw_grid_at), as scenarios.csv records it.
+    if (ctx.model.raw_grid_drawn())
+      for (size_t side = 0; side < kRawGridColumns.size(); ++side)
+        add(kRawGridColumns[side], TensorType::i16, {},
+            [model, side](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+              for (size_t i = lo; i < hi; ++i) {
+                const int16_t v = static_cast<int16_t>(raw_grid_at(model, b.first_index + i)[side]);
+                std::memcpy(dst + (i - lo) * sizeof v, &v, sizeof v);
+              }
+              return std::string_view(dst, (hi - lo) * sizeof(int16_t));
+            });
     // The outfit drawn per scenario (plan.h, outfit_at), as scenarios.csv records it.
     if (ctx.model.clothing != Clothing::catalogue) {
       add("clothing_outfit", TensorType::i16, {},

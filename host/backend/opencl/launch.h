@@ -76,7 +76,8 @@ inline void check_count(cl::Kernel& k, cl_uint given) {
   X(cl::Buffer, out)           \
   X(cl::Buffer, phys)          \
   X(cl::Buffer, raw)           \
-  X(cl::Buffer, scratch)
+  X(cl::Buffer, scratch)       \
+  X(cl::Buffer, indices)
 PS_KERNEL_ARGS(ViewStageArgs, PS_VIEW_STAGE_ARGS)
 
 // kernels/pool.cl
@@ -115,6 +116,7 @@ PS_KERNEL_ARGS(PoolRegionsArgs, PS_POOL_REGIONS_ARGS)
   X(cl_uint, n)                   \
   X(cl_uint2, seed)               \
   X(cl_uint2, first)              \
+  X(cl::Buffer, indices)          \
   X(cl_int, noise_lo)             \
   X(cl_int, noise_hi)             \
   X(cl::Buffer, out)
@@ -131,6 +133,7 @@ PS_KERNEL_ARGS(MetalZonesArgs, PS_METAL_ZONES_ARGS)
   X(cl_uint, n)                  \
   X(cl_uint2, seed)              \
   X(cl_uint2, first)             \
+  X(cl::Buffer, indices)         \
   X(cl_int, noise_lo)            \
   X(cl_int, noise_hi)            \
   X(cl_double, jitter)           \
@@ -196,6 +199,7 @@ PS_KERNEL_ARGS(FootprintDeltasArgs, PS_FOOTPRINT_DELTAS_ARGS)
   X(cl_int, patterns)              \
   X(cl_uint2, seed)                \
   X(cl_uint2, first)               \
+  X(cl::Buffer, indices)           \
   X(cl::Buffer, out)
 PS_KERNEL_ARGS(SparsePatternsArgs, PS_SPARSE_PATTERNS_ARGS)
 
@@ -243,7 +247,8 @@ PS_KERNEL_ARGS(FeaturesSparseArgs, PS_FEATURES_SPARSE_ARGS)
   X(cl_float, sigma_lo)           \
   X(cl_float, sigma_hi)           \
   X(cl_uint2, seed)               \
-  X(cl_uint2, first)
+  X(cl_uint2, first)              \
+  X(cl::Buffer, indices)
 PS_KERNEL_ARGS(AnalyticNoiseArgs, PS_ANALYTIC_NOISE_ARGS)
 
 // kernels/physics_features.cl
@@ -271,7 +276,8 @@ PS_KERNEL_ARGS(AnalyticNoiseArgs, PS_ANALYTIC_NOISE_ARGS)
   X(cl_int2, frames)                \
   X(cl_int8, dims)                  \
   X(cl::Buffer, noise)              \
-  X(cl::Buffer, scratch)
+  X(cl::Buffer, scratch)            \
+  X(cl::Buffer, indices)
 PS_KERNEL_ARGS(PhysicsFeaturesArgs, PS_PHYSICS_FEATURES_ARGS)
 
 // kernels/noise_draws.cl (portalsim tradeoff's noise samples)

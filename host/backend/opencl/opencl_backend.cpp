@@ -4,6 +4,8 @@
 // The paths are in paths/; docs/dev/architecture.md says how they fit.
 #include "backend/opencl/opencl_backend.h"
 
+#include <algorithm>
+
 #include "backend/opencl/paths/paths.h"
 #include "backend/stages.h"
 
@@ -31,10 +33,82 @@ class OpenCLBackend final : public Backend {
   std::string name() const override { return "opencl"; }
 
   void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) override {
+    if (drawn_grids(plan))
+      run_by_raw_grid(batch, plan, out);
+    else
+      run_part(batch, plan, out, true);
+  }
+
+  // No gate reads the raw grid (RawGridDrawn.NoGateReadsTheGrid), so a run whose grid is
+  // drawn takes its first grid's paths, every part alike.
+  std::vector<std::string> paths(const Plan& plan) const override {
+    const Route r = route(plan, FeatureLayout::of(cat_, plan.model.block));
+    std::vector<std::string> taken;
+    for (size_t k = 0; k < cat_.sensors.size(); ++k)
+      if (r.views[k].path)
+        taken.push_back(cat_.sensors[k].name + ": " + describe(r.views[k].path->name(), r.views[k].gate));
+    if (plan.features)
+      taken.push_back(r.features ? "features: " + describe(r.features->name(), r.features_gate)
+                                 : std::string("features: ") + kPooledFeatures);
+    return taken;
+  }
+
+  std::vector<int> rendered_views(const Plan& plan) const override {
+    const Route r = route(plan, FeatureLayout::of(cat_, plan.model.block));
+    std::vector<int> views;
+    for (size_t k = 0; k < cat_.sensors.size(); ++k)
+      if (r.views[k].path) views.push_back(static_cast<int>(k));
+    return views;
+  }
+
+ private:
+  static bool drawn_grids(const Plan& plan) {
+    return plan.model.model == Model::physics && plan.model.raw_grid_drawn();
+  }
+  // `plan` with its raw grid fixed at `grid`: what a grid's part of a batch runs under.
+  static Plan part_plan(const Plan& plan, const std::array<int, 2>& grid) {
+    Plan one = plan;
+    one.annotations = false;
+    one.model.raw_grids.clear();
+    one.model.raw_width = grid[0];
+    one.model.raw_height = grid[1];
+    return one;
+  }
+
+  // A raw grid drawn per scenario: every kernel of a batch takes one grid's shapes and
+  // tables, so each grid's scenarios run as a part of their own (their indices in a table,
+  // SceneBatch::indices) under the plan with that grid fixed, and their rows are put back in
+  // the batch's order. The annotations do not depend on the grid: made once, for the batch.
+  void run_by_raw_grid(const SceneBatch& batch, const Plan& plan, BatchOutput& out) {
+    const size_t n = batch.size();
+    prepare_output(out, cat_, plan, n);
+    const std::vector<std::array<int, 2>>& grids = plan.model.raw_grids;
+    device_.derived.hold_parts(grids.size());
+    std::vector<std::vector<size_t>> rows(grids.size());
+    for (size_t i = 0; i < n; ++i) {
+      const auto g = std::find(grids.begin(), grids.end(), raw_grid_at(plan.model, batch.index_of(i)));
+      rows[static_cast<size_t>(g - grids.begin())].push_back(i);
+    }
+    for (size_t g = 0; g < grids.size(); ++g) {
+      if (rows[g].empty()) continue;
+      SceneBatch part(batch.regions);
+      part.first_index = batch.index_of(rows[g][0]);
+      for (const size_t i : rows[g]) {
+        part.push(batch.at(i));
+        part.indices.push_back(batch.index_of(i));
+      }
+      run_part(part, part_plan(plan, grids[g]), part_out_, false);
+      place_rows(out, part_out_, rows[g]);
+    }
+    annotations(cat_, assets_, batch, plan, out);
+  }
+
+  // `batch` under `plan`, whose raw grid is one; with_annotations: the plan's annotations too.
+  void run_part(const SceneBatch& batch, const Plan& plan, BatchOutput& out, bool with_annotations) {
     const size_t n = batch.size();
     prepare_output(out, cat_, plan, n);
     if (n == 0) {
-      annotations(cat_, assets_, batch, plan, out);
+      if (with_annotations) annotations(cat_, assets_, batch, plan, out);
       return;
     }
     const FeatureLayout& lay = out.layout;
@@ -46,7 +120,12 @@ class OpenCLBackend final : public Backend {
                   .objects = objects_.at_least(ctx, n * cat_.regions.size() * sizeof(int16_t)),
                   .seed = split(plan.model.seed),
                   .first = split(batch.first_index),
+                  .indices = {},
                   .variants = std::vector<char>(cat_.variant_list.size(), 0)};
+    if (!batch.indices.empty()) {
+      b.indices = indices_.at_least(ctx, n * sizeof(cl_ulong));
+      q.enqueueWriteBuffer(b.indices, CL_FALSE, 0, n * sizeof(cl_ulong), batch.indices.data());
+    }
     for (int16_t v : batch.objects)
       if (v != kNoObject) b.variants[static_cast<size_t>(v)] = 1;
     q.enqueueWriteBuffer(b.subject, CL_FALSE, 0, n, batch.subject.data());
@@ -81,7 +160,7 @@ class OpenCLBackend final : public Backend {
     // The host's boxes and masks while PoCL's threads run what is queued (their outputs
     // are apart); the maps below wait for the kernels.
     q.flush();
-    annotations(cat_, assets_, batch, plan, out);
+    if (with_annotations) annotations(cat_, assets_, batch, plan, out);
     if (plan.features) sync(q, feats, out.features);
     for (size_t k = 0; k < cat_.sensors.size(); ++k)
       if (plan.image(static_cast<int>(k))) sync(q, rendered[k], out.views[k].pixels);
@@ -89,27 +168,6 @@ class OpenCLBackend final : public Backend {
     q.finish();
   }
 
-  std::vector<std::string> paths(const Plan& plan) const override {
-    const Route r = route(plan, FeatureLayout::of(cat_, plan.model.block));
-    std::vector<std::string> taken;
-    for (size_t k = 0; k < cat_.sensors.size(); ++k)
-      if (r.views[k].path)
-        taken.push_back(cat_.sensors[k].name + ": " + describe(r.views[k].path->name(), r.views[k].gate));
-    if (plan.features)
-      taken.push_back(r.features ? "features: " + describe(r.features->name(), r.features_gate)
-                                 : std::string("features: ") + kPooledFeatures);
-    return taken;
-  }
-
-  std::vector<int> rendered_views(const Plan& plan) const override {
-    const Route r = route(plan, FeatureLayout::of(cat_, plan.model.block));
-    std::vector<int> views;
-    for (size_t k = 0; k < cat_.sensors.size(); ++k)
-      if (r.views[k].path) views.push_back(static_cast<int>(k));
-    return views;
-  }
-
- private:
   // Every choice of paths run() makes for `plan`, made here alone: the features path, and
   // for each view that is rendered, its path (null: the view is not rendered).
   struct Route {
@@ -149,7 +207,8 @@ class OpenCLBackend final : public Backend {
   KernelVariants kernels_;
   MetalPath metal_;
   std::vector<std::unique_ptr<FeaturePath>> features_paths_;  // in the order they are tried
-  Grown subject_, objects_;
+  Grown subject_, objects_, indices_;
+  BatchOutput part_out_;  // a raw grid's part of a batch (run_by_raw_grid)
 };
 
 }  // namespace

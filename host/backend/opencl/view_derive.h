@@ -59,7 +59,11 @@ class ViewDerivations {
   // it whole while in use, even where the cache drops it meanwhile.
   std::shared_ptr<ViewDerived> operator()(const Plan& plan, int view, bool noise_free = false);
   size_t size() const { return cache_.size(); }
-  size_t capacity() const { return capacity_; }
+  size_t capacity() const { return cache_.capacity(); }
+  // Room for `parts` plans' derivations used by turns in every batch (a raw grid drawn
+  // from a list of that many: each grid's part has its own), so that none is dropped and
+  // made again batch after batch.
+  void hold_parts(size_t parts) { cache_.reserve(capacity_ * std::max<size_t>(parts, 1)); }
   // What a derivation depends on: every knob, the view, and the parts of the plan
   // outside the registry that the launch settings read.
   static std::string key(const Plan& plan, int view, bool noise_free);

@@ -45,7 +45,8 @@ ViewLaunch::ViewLaunch(Device& d, Kernels& K, const Plan& p, int view, const Dev
                         .out = out,
                         .phys = derived->phys,
                         .raw = raw,
-                        .scratch = scratch};
+                        .scratch = scratch,
+                        .indices = b.indices};
 }
 
 void ViewLaunch::run(std::string_view kernel, size_t items) {

@@ -39,7 +39,7 @@ class ReferenceBackend final : public Backend {
     for (const Sensor& sensor : cat_.sensors) view_model.push_back(plan.model.for_view(sensor));
     for (size_t i = 0; i < n; ++i) {
       const Scenario s = batch.at(i);
-      const uint64_t index = batch.first_index + i;
+      const uint64_t index = batch.index_of(i);
       for (int k = 0; k < views; ++k) {
         const Sensor& sensor = cat_.sensors[k];
         if (!plan.renders(sensor, k)) continue;

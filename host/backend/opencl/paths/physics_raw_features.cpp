@@ -126,7 +126,8 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const Gate& g, c
                                    .frames = {{noise.frames_lo, noise.frames_hi}},
                                    .dims = t.dims,
                                    .noise = t.noise,
-                                   .scratch = scratch};
+                                   .scratch = scratch,
+                                   .indices = b.indices};
     for (size_t at = 0; at < b.n; at += chunk)
       enqueue(d_.queue(), K["physics_features"], K.fp64(), args, std::min(chunk, padded(b.n) - at), at);
   }
@@ -216,6 +217,7 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& p
                                   .objects = constant(ctx, b.objects),
                                   .seed = {{0, 0}},
                                   .first = {{0, 0}},
+                                  .indices = {},
                                   .variants = {}};
     ViewLaunch v(d_, K, plan, view, table_batch, d_.pooled_only[view].at_least(ctx, 1), false, false, true);
     raw_grid(v);

@@ -59,7 +59,8 @@ void block_mean_noise(Device& d, Kernels& K, const Plan& plan, const DeviceBatch
                             .sigma_lo = static_cast<cl_float>(plan.model.pixel_sigma),
                             .sigma_hi = static_cast<cl_float>(plan.model.pixel_sigma_hi()),
                             .seed = b.seed,
-                            .first = b.first},
+                            .first = b.first,
+                            .indices = b.indices},
           b.n);
 }
 

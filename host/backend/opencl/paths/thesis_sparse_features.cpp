@@ -193,8 +193,11 @@ void ThesisSparseFeatures::features(Kernels& K, const Plan& plan, const Gate& g,
   cl::Buffer& patterns = patterns_.at_least(d_.ctx(), b.n * sizeof(cl_int));
   const cl_uint n = static_cast<cl_uint>(b.n);
   if (t.noise)
-    enqueue(q, K["sparse_patterns"], K.fp64(),
-            SparsePatternsArgs{.n = n, .patterns = t.patterns, .seed = b.seed, .first = b.first, .out = patterns}, b.n);
+    enqueue(
+        q, K["sparse_patterns"], K.fp64(),
+        SparsePatternsArgs{
+            .n = n, .patterns = t.patterns, .seed = b.seed, .first = b.first, .indices = b.indices, .out = patterns},
+        b.n);
   enqueue(q, K["features_sparse"], K.fp64(),
           FeaturesSparseArgs{.atlas = c.atlas,
                              .bases = c.bases,
