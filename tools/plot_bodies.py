@@ -3,6 +3,7 @@
 
   /usr/bin/python3 tools/plot_bodies.py PORTALSIM OUT.png [--count 32] [--seed 1] [--model physics]
                                        [--clothing catalogue|random|none|shirt|sweater|jacket|coat]
+                                       [-- GENERATE FLAGS...]
 
 PORTALSIM is the built binary. The tool runs `portalsim generate --bodies random
 --body-count COUNT --scenarios LIST --what images`, one listed scenario per body, each
@@ -10,13 +11,17 @@ carrying a few objects (a gun, a phone, a metal plate, a belt buckle, an iron ro
 and draws for each body the two MMW views stacked (the whole body, floor at the bottom) and
 the IR view beside them, titled with the body as scenarios.csv records it: sex, stature,
 pose, and with --clothing other than the catalogue's, the outfit each drew
-(docs/model/clothing.md). Needs Debian's python3-matplotlib and python3-numpy.
+(docs/model/clothing.md). Flags after `--` go to `generate` as they are: knobs drawn per
+scenario (`-- --mmw-raw 14x14,28x28,40x40 --netd 1..4 --illumination 285..305`) add each
+body's draws to its title (docs/model/drawn-knobs.md). Needs Debian's python3-matplotlib
+and python3-numpy.
 """
 import argparse
 import csv
 import math
 import pathlib
 import subprocess
+import sys
 import tempfile
 
 import matplotlib
@@ -27,6 +32,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 REGIONS = 13
+# The drawn knobs' columns of scenarios.csv a title shows, each as a format of its value.
+DRAWN = [("netd", "NETD {:.1f} K"), ("frames", "{:.0f} fr"), ("illumination", "{:.0f} K room"),
+         ("worn_minutes", "worn {:.0f} min"), ("ir_netd", "IR {:.2f} K")]
+
 # Objects by turns: (region number, object) pairs for body k, k modulo the list.
 CARRIED = [
     [(2, "gun")],
@@ -46,7 +55,10 @@ def main():
     ap.add_argument("--model", default="physics")
     ap.add_argument("--columns", type=int, default=8)
     ap.add_argument("--clothing", default="catalogue")
-    a = ap.parse_args()
+    argv = sys.argv[1:]
+    cut = argv.index("--") if "--" in argv else len(argv)
+    a = ap.parse_args(argv[:cut])
+    extra = argv[cut + 1:]  # flags for portalsim generate
     with tempfile.TemporaryDirectory() as tmp:
         tmp = pathlib.Path(tmp)
         listing = tmp / "list.csv"
@@ -60,7 +72,7 @@ def main():
         out = tmp / "run"
         subprocess.run([a.portalsim, "generate", "--bodies", "random", "--body-count", str(a.count), "--seed", a.seed,
                         "--model", a.model, "--clothing", a.clothing, "--scenarios", str(listing), "--what", "images",
-                        "--quiet", "--out",
+                        "--quiet", *extra, "--out",
                         str(out)], check=True, stdout=subprocess.DEVNULL)
         with open(out / "scenarios.csv", newline="") as f:
             bodies = list(csv.DictReader(f))
@@ -84,8 +96,15 @@ def main():
             if "clothing" in body:  # "shirt:cotton+sweater:wool" -> "cotton shirt, wool sweater"
                 layers = [p.split(":") for p in body["clothing"].split("+")] if body["clothing"] != "none" else []
                 title += "\n" + (", ".join(f"{f} {g}" for g, f in layers) or "no clothing")
-            axes[r, 2 * c].set_title(title, fontsize=7 if a.clothing == "catalogue" else 6, loc="left")
-        dressed = "" if a.clothing == "catalogue" else f", --clothing {a.clothing}"
+            if "mmw_raw_width" in body:
+                title += f"\nraw {body['mmw_raw_width']}x{body['mmw_raw_height']}"
+            drawn = [fmt.format(float(body[key])) for key, fmt in DRAWN if key in body]
+            for k0 in range(0, len(drawn), 2):
+                title += "\n" + ", ".join(drawn[k0:k0 + 2])
+            small = a.clothing != "catalogue" or extra
+            axes[r, 2 * c].set_title(title, fontsize=6 if small else 7, loc="left")
+        dressed = ("" if a.clothing == "catalogue" else f", --clothing {a.clothing}") + "".join(
+            f" {x}" for x in extra)
         fig.suptitle(f"{a.count} random bodies (--bodies random, seed {a.seed}, --model {a.model}{dressed}): "
                      "MMW upper over lower, and IR", fontsize=11)
         fig.savefig(a.out, dpi=64, bbox_inches="tight")
