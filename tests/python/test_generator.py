@@ -18,15 +18,17 @@ CASES = {
     "drawn-metal-noise": dict(what="features", metal_noise="0..9"),
     # The thesis model's pixel noise drawn per scenario: images, features and param_pixel_noise.
     "drawn-pixel-noise": dict(what="both", pixel_noise="0..4"),
-    # The physics camera and scene drawn per scenario: images, features and each param_<knob>.
+    # The physics camera and scene drawn per scenario: images, features, each param_<knob>
+    # and the raw grid's mmw_raw_width and mmw_raw_height.
     "drawn-camera": dict(what="both", model="physics", netd="1..4", frames="1..8", illumination="285..305",
-                         worn_minutes="0..60", ir_netd="0.03..0.1"),
+                         worn_minutes="0..60", ir_netd="0.03..0.1", mmw_raw="14x14,28x28,40x40"),
     # Random bodies drawn from their own seed: images, features and the subject column.
     "random-bodies": dict(what="both", model="physics", bodies="random", body_count=12, body_seed=8),
     "spec-file": dict(spec="scenarios/case1-gun.toml", what="both", seed=5),
     # 20 regions, 33 zones, front and back MMW and IR views (tools/portal_catalogues.py).
+    # The front MMW views' raw grid drawn; the back ones keep their own.
     "portal-20x33": dict(catalogue="tests/portals/portal-20x33.toml", what="images", annotations=True,
-                         model="physics", objects="4..10", rule="gun"),
+                         model="physics", objects="4..10", rule="gun", mmw_raw="12x12,28x28"),
 }
 
 
