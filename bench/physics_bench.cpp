@@ -5,12 +5,16 @@
 // tier's draws and display).
 // The MMW camera's own processing (frames, window, display filter, smoothing), MMW images:
 //   ./build/portalsim_bench --benchmark_filter=MmwCamera --benchmark_repetitions=3
+// The MMW raw grid drawn per scenario from a list against one grid (each grid's scenarios a
+// part of the batch of their own):
+//   ./build/portalsim_bench --benchmark_filter=RawGrid --benchmark_repetitions=5
 // The IR camera alone, and its physics chain cut after each stage:
 //   ./build/portalsim_bench --benchmark_filter='Ir' --benchmark_repetitions=3
 #include <benchmark/benchmark.h>
 
 #include "backend/stages.h"
 #include "fixture.h"
+#include "plan/knobs.h"
 
 namespace portalsim {
 namespace {
@@ -96,6 +100,26 @@ BENCHMARK(BM_MmwCamera)
     ->Args({10, 1, 1, 10, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// Args: what (0 images of every view, standard tier; 1 features only, fast tier), raw grid
+// (0: 14x14, 1: 28x28, 2: 40x40, 3: drawn from 14x14,28x28,40x40).
+void BM_RawGrid(benchmark::State& state) {
+  auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+  Plan p;
+  p.model.model = Model::physics;
+  const bool images = state.range(0) == 0;
+  if (images) {
+    p.features = false;
+  } else {
+    p.fidelity = tier_fidelity(Tier::fast);
+    p.images = 0;
+  }
+  const char* grids[] = {"14x14", "28x28", "40x40", "14x14,28x28,40x40"};
+  set_knob(p, *find_knob("mmw_raw"), grids[state.range(1)], "--mmw-raw");
+  state.SetLabel(std::string(images ? "physics images, " : "physics features, fast, ") + grids[state.range(1)]);
+  bench::time_runs(state, *b, p, images ? 1024 : 8192);
+}
+BENCHMARK(BM_RawGrid)->ArgsProduct({{0, 1}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The IR view's images only. Args: model (0 thesis, 1 physics), IR NETD in mK (physics).
 void BM_IrImages(benchmark::State& state) {
