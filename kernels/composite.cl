@@ -21,7 +21,7 @@
   global const uchar *atlas, global const int *bases, global const int4 *sprites, global const int2 *places,     \
       global const int *noise_offsets, global const float *noise_gains, global const uchar *subject,             \
       global const short *objects, PsViewLaunch L, param alpha, param sigma, param sigma_hi, global int *records,                 \
-      global real *field, global uchar *out, global const param *phys, global real *raw, global real *scratch, \
+      global real *field, global uchar *out, global const param *phys, global real *raw, global real *scratch,   \
       global const ulong *indices
 
 // The scenario and image row of a work-item (one per (scenario, row)).

@@ -30,9 +30,10 @@ inline void bare_surface(global preal* restrict T, global const uchar* restrict 
 // Scenario i's view. Scratch: the row blur, H x W, then each shadow row's blurred span
 // [a, b) as two arrays of H ints (empty: (W, 0)). With display, each part of the field is
 // shown as soon as it is made, while it is in cache.
-inline void ir_surface_view(uint i, ulong index, const PsViewLaunch* L, global const uchar* atlas, global const int* bases,
-                            global const uchar* subject, global const int* records, global real* field,
-                            global uchar* out, global const param* phys, global real* scratch, bool display) {
+inline void ir_surface_view(uint i, ulong index, const PsViewLaunch* L, global const uchar* atlas,
+                            global const int* bases, global const uchar* subject, global const int* records,
+                            global real* field, global uchar* out, global const param* phys, global real* scratch,
+                            bool display) {
   global const int* rec = records + (size_t)i * PS_REC_LEN;
   const int W = L->width, H = L->height, R = L->psf_radius;
   global preal* T = (global preal*)field + (size_t)i * H * W;
@@ -201,7 +202,8 @@ kernel void ir_surface_fused(VIEW_STAGE_ARGS) {
   if (i >= L.n) return;
   (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
       (void)raw;
-  ir_surface_view(i, scenario_index(indices, L.first_lo, L.first_hi, i), &L, atlas, bases, subject, records, field, out, phys, scratch, false);
+  ir_surface_view(i, scenario_index(indices, L.first_lo, L.first_hi, i), &L, atlas, bases, subject, records, field,
+                  out, phys, scratch, false);
 }
 
 kernel void ir_surface_display_fused(VIEW_STAGE_ARGS) {
@@ -209,7 +211,8 @@ kernel void ir_surface_display_fused(VIEW_STAGE_ARGS) {
   if (i >= L.n) return;
   (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
       (void)raw;
-  ir_surface_view(i, scenario_index(indices, L.first_lo, L.first_hi, i), &L, atlas, bases, subject, records, field, out, phys, scratch, true);
+  ir_surface_view(i, scenario_index(indices, L.first_lo, L.first_hi, i), &L, atlas, bases, subject, records, field,
+                  out, phys, scratch, true);
 }
 
 // The whole chain with noise: the surface as ir_surface_fused, then ir_netd and ir_display
@@ -218,7 +221,8 @@ kernel void ir_surface_noise_display_fused(VIEW_STAGE_ARGS) {
   VIEW_STAGE_SCENARIO;
   (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
       (void)raw;
-  ir_surface_view(i, scenario_index(indices, L.first_lo, L.first_hi, i), &L, atlas, bases, subject, records, field, out, phys, scratch, false);
+  ir_surface_view(i, scenario_index(indices, L.first_lo, L.first_hi, i), &L, atlas, bases, subject, records, field,
+                  out, phys, scratch, false);
   const int pixels = L.width * L.height;
   global const preal* T = (global const preal*)field + (size_t)i * pixels;
   global uchar* o = out + (size_t)i * pixels;

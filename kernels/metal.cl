@@ -12,7 +12,8 @@ inline int metal_noise_of(uint2 seed, ulong index, int noise_lo, int noise_hi) {
 
 kernel void metal_zones(global const uchar* influence, global const uchar* variant_category,
                         global const uchar* base_zones, global const uchar* subject, global const short* objects,
-                        uint n, uint2 seed, uint2 first, global const ulong* indices, int noise_lo, int noise_hi, global uchar* out) {
+                        uint n, uint2 seed, uint2 first, global const ulong* indices, int noise_lo, int noise_hi,
+                        global uchar* out) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const ulong index = scenario_index(indices, first.x, first.y, i);

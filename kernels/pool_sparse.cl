@@ -119,7 +119,8 @@ kernel void sparse_patterns(uint n, int P, uint2 seed, uint2 first, global const
                               global int* patterns) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
-  patterns[i] = (int)below(draw(seed, scenario_index(indices, first.x, first.y, i), PS_STREAM_NOISE_PATTERN, 0u).x, (uint)P);
+  const ulong index = scenario_index(indices, first.x, first.y, i);
+  patterns[i] = (int)below(draw(seed, index, PS_STREAM_NOISE_PATTERN, 0u).x, (uint)P);
 }
 
 #if defined(VECTOR_RENDER)
