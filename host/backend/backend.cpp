@@ -42,20 +42,18 @@ const ViewImages& BatchOutput::view(std::string_view name) const {
 
 void place_rows(BatchOutput& all, const BatchOutput& part, const std::vector<size_t>& rows) {
   if (rows.size() != part.n) throw std::logic_error("place_rows: the rows are not the part's scenarios");
+  // Row j of `from` (`per` values a scenario) to row rows[j] of `to`; empty where not asked for.
+  const auto place = [&rows](auto& to, const auto& from, size_t per, size_t j) {
+    if (!from.empty()) std::copy_n(from.begin() + j * per, per, to.begin() + rows[j] * per);
+  };
   // A part's images are most of its bytes (about 100 kB a scenario in the built-in portal):
   // copied on every core, as the kernels made them.
-  const size_t zones = static_cast<size_t>(part.layout.zones),
-               feats = static_cast<size_t>(part.layout.image_features());
   parallel_for(rows.size(), default_threads(), [&](size_t lo, size_t hi) {
     for (size_t j = lo; j < hi; ++j) {
       for (size_t k = 0; k < part.views.size(); ++k)
-        if (!part.views[k].empty()) {
-          const size_t per = part.views[k].pixels_per_image();
-          std::copy_n(part.views[k].pixels.begin() + j * per, per, all.views[k].pixels.begin() + rows[j] * per);
-        }
-      if (!part.metal.empty()) std::copy_n(part.metal.begin() + j * zones, zones, all.metal.begin() + rows[j] * zones);
-      if (!part.features.empty())
-        std::copy_n(part.features.begin() + j * feats, feats, all.features.begin() + rows[j] * feats);
+        place(all.views[k].pixels, part.views[k].pixels, part.views[k].pixels_per_image(), j);
+      place(all.metal, part.metal, static_cast<size_t>(part.layout.zones), j);
+      place(all.features, part.features, static_cast<size_t>(part.layout.image_features()), j);
     }
   });
 }

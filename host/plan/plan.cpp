@@ -182,7 +182,8 @@ ModelSettings ModelSettings::for_view(const Sensor& s) const {
   ModelSettings m = *this;
   if (s.netd) (s.camera == Camera::ir ? m.ir_netd : m.netd) = *s.netd;
   if (s.netd) m.drawn[s.camera == Camera::ir ? PS_DRAWN_IR_NETD : PS_DRAWN_NETD] = {};  // its own, never drawn
-  if (s.raw) {                                                                          // its own, never drawn
+  if (s.raw) {
+    // its own, never drawn
     m.raw_width = (*s.raw)[0];
     m.raw_height = (*s.raw)[1];
     m.raw_grids.clear();

@@ -52,7 +52,7 @@ PsViewLaunch settings(const Catalogue& cat, const Plan& plan, const ModelSetting
 }  // namespace
 
 ViewDerivations::ViewDerivations(const Catalogue& cat, const AssetSet& assets, cl::Context& ctx)
-    : cat_(cat), assets_(assets), ctx_(ctx), capacity_(capacity_for(cat)), cache_(capacity_) {}
+    : cat_(cat), assets_(assets), ctx_(ctx), per_plan_(capacity_for(cat)), cache_(per_plan_) {}
 
 std::string ViewDerivations::key(const Plan& plan, int view, bool noise_free) {
   // images: whether per-pixel noise is drawn pixel by pixel (Plan::pixel_noise_per_pixel);

@@ -63,7 +63,7 @@ class ViewDerivations {
   // Room for `parts` plans' derivations used by turns in every batch (a raw grid drawn
   // from a list of that many: each grid's part has its own), so that none is dropped and
   // made again batch after batch.
-  void hold_parts(size_t parts) { cache_.reserve(capacity_ * std::max<size_t>(parts, 1)); }
+  void hold_parts(size_t parts) { cache_.reserve(per_plan_ * std::max<size_t>(parts, 1)); }
   // What a derivation depends on: every knob, the view, and the parts of the plan
   // outside the registry that the launch settings read.
   static std::string key(const Plan& plan, int view, bool noise_free);
@@ -72,7 +72,7 @@ class ViewDerivations {
   const Catalogue& cat_;
   const AssetSet& assets_;
   cl::Context& ctx_;
-  size_t capacity_;
+  size_t per_plan_;  // room for one plan's derivations, and some: the cache's least capacity
   LruCache<std::string, std::shared_ptr<ViewDerived>> cache_;
 };
 
