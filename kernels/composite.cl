@@ -344,6 +344,11 @@ inline global const uchar* base_row(global const uchar* atlas, global const int*
                                     const PsViewLaunch* L, uint i, int y) {
   return atlas + bases[subject[i] * L->views + L->view] + (size_t)y * L->width;
 }
+// The same row of the base's fold pattern (host: AssetSet::folds), after every subject's bases.
+inline global const uchar* fold_row(global const uchar* atlas, global const int* bases, global const uchar* subject,
+                                    const PsViewLaunch* L, uint i, int y) {
+  return atlas + bases[(L->subjects + subject[i]) * L->views + L->view] + (size_t)y * L->width;
+}
 
 kernel void stage_composite(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;

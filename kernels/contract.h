@@ -96,7 +96,10 @@
  * grid below(word 0, grids) of the list. The host draws it and runs each grid's scenarios
  * together (an index table, kernels/philox.cl's scenario_index); not a numeric knob. */
 #define PS_DRAWN_MMW_RAW 10u
-#define PS_DRAWN_KNOBS 11 /* elements 0 .. PS_DRAWN_KNOBS - 1 */
+/* physics: the share of the outer garment's folds and seams that lies doubled (--clothing-folds,
+ * docs/model/clothing.md), under a drawn outfit. */
+#define PS_DRAWN_CLOTHING_FOLDS 11u
+#define PS_DRAWN_KNOBS 12 /* elements 0 .. PS_DRAWN_KNOBS - 1 */
 /* physics: frame k >= 1 of the MMW camera's integration draws its NETD from stream
  * PS_STREAM_FRAME_NOISE + k (frame 0 from PS_STREAM_RAW_NOISE); element: PS_GAUSS_ELEMENT */
 #define PS_STREAM_FRAME_NOISE 32u
@@ -230,13 +233,17 @@ typedef struct {
 #define PS_PHYS_SCENE 8
 /* Where the clothing is drawn per scenario (--clothing), the offset of the clothing block (0:
  * the catalogue's clothing): its classes C, each outfit's stride, the offset of the MMW gray
- * grids (0 for IR), then per class its first outfit, then per class its outfits' count
- * (PS_CLOTHING_*), then each outfit's entry (PS_OUTFIT_*): its factor of every IR shadow, the
- * offset in the entry of its scene moves, then each subject's (gain, offset) and each
+ * grids (0 for IR), the folds' range (--clothing-folds), the offset of the MMW fold grids (0
+ * where the folds are off or for IR), then per class its first outfit, then per class its
+ * outfits' count (PS_CLOTHING_*), then each outfit's entry (PS_OUTFIT_*): its factor of every IR
+ * shadow, the offset in the entry of its scene moves, its folds' factor k and reference
+ * temperature T (a fold of share m turns a value v into T + (1 + f k m)(v - T)), then each
+ * subject's (gain, offset) and each
  * variant's value as at PS_PHYS_SUBJECTS, and where the scene block is, each subject's and
  * variant's moves as at its PS_SCENE_SUBJECTS. The gray grids (MMW): each subject's base
  * image's gray through the raw grid's weights, so that its bare grid is gain G + offset (each
- * raw cell's weights sum to 1; kernels/physics_raw.cl). */
+ * raw cell's weights sum to 1; kernels/physics_raw.cl). The fold grids (MMW): each subject's
+ * fold share m times its gray, then each subject's m alone, through the same weights. */
 #define PS_PHYS_CLOTHING 9
 /* MMW: the display window's ends drawn per scenario (PS_WINDOW_DRAWN): the upper ends of their
  * ranges (the lower ends are PS_PHYS_WINDOW_MIN and PS_PHYS_WINDOW_MAX); the window's ends where fixed. */
@@ -246,10 +253,15 @@ typedef struct {
 #define PS_CLOTHING_CLASSES 0
 #define PS_CLOTHING_STRIDE 1
 #define PS_CLOTHING_GRIDS 2
-#define PS_CLOTHING_FIRST 3 /* kernels/shared.h: PS_CLOTHING_OUTFITS */
+#define PS_CLOTHING_FOLDS_LO 3
+#define PS_CLOTHING_FOLDS_HI 4
+#define PS_CLOTHING_FOLD_GRIDS 5
+#define PS_CLOTHING_FIRST 6 /* kernels/shared.h: PS_CLOTHING_OUTFITS */
 #define PS_OUTFIT_SHADOW 0
 #define PS_OUTFIT_MOVES 1
-#define PS_OUTFIT_HEAD 2
+#define PS_OUTFIT_FOLD_K 2
+#define PS_OUTFIT_FOLD_T 3
+#define PS_OUTFIT_HEAD 4
 #define PS_SCENE_SUBJECTS 3 /* kernels/shared.h: PS_SCENE_VARIANTS, PS_SCENE_BARE */
 
 /* A camera view's placement record per scenario, written by place_view and read by

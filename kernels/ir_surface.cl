@@ -41,6 +41,7 @@ kernel void stage_ir_surface(VIEW_STAGE_ARGS) {
   preal gain, offset;
   subject_kelvin(&scene, subject[i], &gain, &offset);
   for (int x = 0; x < L.width; ++x) T[x] += gain * (preal)base[x] + offset;
+  fold_values(&scene, fold_row(atlas, bases, subject, &L, i, y), T, L.width);
 }
 
 // Stage "ir_netd": Gaussian noise of the IR NETD (kelvin rms) on every view pixel, a table

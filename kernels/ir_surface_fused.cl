@@ -45,6 +45,9 @@ inline void ir_surface_view(uint i, ulong index, const PsViewLaunch* L, global c
   const SceneDraw scene = scene_draw(phys, (uint2)(L->seed_lo, L->seed_hi), index);
   preal gain, offset;
   subject_kelvin(&scene, s, &gain, &offset);
+  // Folds change every body pixel (after the surface is whole, as stage_ir_surface): the view
+  // is shown at the end then.
+  const bool folds = scene.fold != 0, show = display && !folds;
 
   // The rows the objects can touch.
   int y_lo = H, y_hi = 0;
@@ -106,7 +109,7 @@ inline void ir_surface_view(uint i, ulong index, const PsViewLaunch* L, global c
     }
     if (a >= b && y < H) continue;
     bare_surface(T, base, bare_from * W, y * W, gain, offset, false);
-    if (display) ir_window(T, o, phys, bare_from * W, y * W);
+    if (show) ir_window(T, o, phys, bare_from * W, y * W);
     bare_from = y + 1;
     if (y == H) break;
     global preal* restrict dst = T + (size_t)y * W;
@@ -122,8 +125,11 @@ inline void ir_surface_view(uint i, ulong index, const PsViewLaunch* L, global c
     bare_surface(dst, row_base, 0, a, gain, offset, false);
     bare_surface(dst, row_base, a, b, gain, offset, true);
     bare_surface(dst, row_base, b, W, gain, offset, false);
-    if (display) ir_window(T, o, phys, y * W, (y + 1) * W);
+    if (show) ir_window(T, o, phys, y * W, (y + 1) * W);
   }
+  if (!folds) return;
+  for (int y = 0; y < H; ++y) fold_values(&scene, fold_row(atlas, bases, subject, L, i, y), T + (size_t)y * W, W);
+  if (display) ir_window(T, o, phys, 0, H * W);
 }
 
 // The noisy kelvin as a value of its own, which fast math may not reassociate with the

@@ -29,7 +29,7 @@ inline bool physics_tabulated(global const int* rec, const PsViewLaunch* L) {
 kernel void physics_raw(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
-  (void)bases, (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha,
+  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha,
       (void)sigma, (void)field, (void)out;
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
   const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);
@@ -51,6 +51,15 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   if (scene.outfit >= 0) {
     global const param* gray = phys + (int)phys[(int)phys[PS_PHYS_CLOTHING] + PS_CLOTHING_GRIDS] + (size_t)s * cells;
     for (int k = 0; k < cells; ++k) r[k] = gain * (preal)gray[k] + offset;
+    // Its folds: the fold grids' share-weighted gray A and share B (PS_CLOTHING_FOLD_GRIDS) add
+    // fold (gain A + (offset - fold_t) B), the raw grid of fold m (v - fold_t) over the bare body.
+    if (scene.fold != 0) {
+      const int grids = (int)phys[(int)phys[PS_PHYS_CLOTHING] + PS_CLOTHING_FOLD_GRIDS];
+      global const param* fa = phys + grids + (size_t)s * cells;
+      global const param* fb = fa + (size_t)L.subjects * cells;
+      for (int k = 0; k < cells; ++k)
+        r[k] += scene.fold * (gain * (preal)fa[k] + (offset - scene.fold_t) * (preal)fb[k]);
+    }
   } else if (scene.at == 0) {
     for (int k = 0; k < cells; ++k) r[k] = (preal)bare[k];
   } else {
@@ -85,6 +94,10 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     for (int x = x_lo; x < x_hi; ++x) {
       const preal t0 = gain * (preal)base[x] + offset;
       d[x] = lay_values(&Ly, atlas, x, lv, t0) - t0;
+    }
+    if (scene.fold != 0) {  // the change passes the folds as the bare body does
+      global const uchar* m = fold_row(atlas, bases, subject, &L, i, y);
+      for (int x = x_lo; x < x_hi; ++x) d[x] *= fold_gain(&scene, m[x]);
     }
     // Each raw column's share of the row: its weights (zero outside its band) against
     // the change, as dot products over the span; fp32 builds in 16-lane partial sums.

@@ -9,10 +9,12 @@
 // PS_DRAWN_ILLUMINATION's word 0); w, the worn time in minutes; outfit, the outfit's index
 // (-1: the catalogue's clothing); head, each subject's (gain, offset) then each variant's
 // value under it; moves, each subject's then each variant's moves with the scene; shadow,
-// its factor of every IR shadow.
+// its factor of every IR shadow; fold and fold_t, its folds' f k and T (0: no folds), so that
+// a value v where the fold pattern's share is m turns into fold_t + (1 + fold m)(v - fold_t)
+// (host: clothing_folds_at; PS_OUTFIT_FOLD_K).
 typedef struct {
   int at, outfit;
-  preal t, w, shadow;
+  preal t, w, shadow, fold, fold_t;
   global const param* head;
   global const param* moves;
 } SceneDraw;
@@ -24,6 +26,8 @@ inline SceneDraw scene_draw(global const param* phys, uint2 seed, ulong index) {
   d.w = 0;
   d.outfit = -1;
   d.shadow = 1;
+  d.fold = 0;
+  d.fold_t = 0;
   d.head = phys + PS_PHYS_SUBJECTS;
   d.moves = phys + d.at + PS_SCENE_SUBJECTS;
   const int clothing = (int)phys[PS_PHYS_CLOTHING];
@@ -35,6 +39,12 @@ inline SceneDraw scene_draw(global const param* phys, uint2 seed, ulong index) {
     d.outfit = (int)c[PS_CLOTHING_FIRST + k] + (int)below(w.y, (uint)c[PS_CLOTHING_FIRST + classes + k]);
     global const param* e = c + PS_CLOTHING_OUTFITS(classes) + (size_t)d.outfit * (size_t)c[PS_CLOTHING_STRIDE];
     d.shadow = (preal)e[PS_OUTFIT_SHADOW];
+    if (c[PS_CLOTHING_FOLDS_HI] > 0) {
+      const preal f = knob_draw((preal)c[PS_CLOTHING_FOLDS_LO], (preal)c[PS_CLOTHING_FOLDS_HI], seed, index,
+                                PS_DRAWN_CLOTHING_FOLDS);
+      d.fold = f * (preal)e[PS_OUTFIT_FOLD_K];
+      d.fold_t = (preal)e[PS_OUTFIT_FOLD_T];
+    }
     d.head = e + PS_OUTFIT_HEAD;
     d.moves = e + (int)e[PS_OUTFIT_MOVES];
   }
@@ -89,6 +99,17 @@ inline preal lay_values(const Layers* Ly, global const uchar* atlas, int x, cons
   return v;
 }
 
+// A value's factor where the fold pattern's share is m (0 .. 255): v - fold_t scales by it.
+inline preal fold_gain(const SceneDraw* d, uchar m) {
+  return (preal)1 + d->fold * ((preal)m * ((preal)1 / (preal)255));
+}
+
+// Pixels [0, n) of a row v through the scenario's folds (fold_row's row m); none where it has none.
+inline void fold_values(const SceneDraw* d, global const uchar* restrict m, global preal* restrict v, int n) {
+  if (d->fold == 0) return;
+  for (int x = 0; x < n; ++x) v[x] = d->fold_t + fold_gain(d, m[x]) * (v[x] - d->fold_t);
+}
+
 kernel void stage_radiometry(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;
   global const uchar* base = base_row(atlas, bases, subject, &L, i, y);
@@ -101,4 +122,5 @@ kernel void stage_radiometry(VIEW_STAGE_ARGS) {
   composite_layers(&Ly, rec, &L, y);
   layer_values(&Ly, variant_values(&scene, L.subjects), &scene, L.subjects, lv);
   for (int x = 0; x < L.width; ++x) T[x] = lay_values(&Ly, atlas, x, lv, gain * (preal)base[x] + offset);
+  fold_values(&scene, fold_row(atlas, bases, subject, &L, i, y), T, L.width);
 }

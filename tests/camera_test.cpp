@@ -83,8 +83,7 @@ TEST(Camera, KernelsMatchTheReference) {
       BatchOutput k;
       cl->run(batch, plan, k);
       const OutputDiff d = compare_outputs(k, r);
-      EXPECT_LE(d.mmw.max_abs, 1);
-      EXPECT_LE(d.mmw.share_differing, 0.005);
+      test::expect_camera_parity(d.mmw);
       EXPECT_LE(d.feature_max_abs, 1.0);
     }
   }

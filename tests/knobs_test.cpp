@@ -25,8 +25,10 @@ Other other_value(const Knob& k, const Plan& defaults) {
       const int v = d.get<int>() == static_cast<int>(k.max) ? static_cast<int>(k.min) : static_cast<int>(k.max);
       return {std::to_string(v), std::to_string(v)};
     }
-    case KnobKind::number:
-      return {"2.5", "2.5"};
+    case KnobKind::number: {  // 2.5, or the middle of a range that does not hold it
+      const double v = 2.5 >= k.min && 2.5 <= k.max && d.get<double>() != 2.5 ? 2.5 : (k.min + k.max) / 2;
+      return {knob_text(v), knob_text(v)};
+    }
     case KnobKind::on_off:
       return d.get<bool>() ? Other{"off", "false"} : Other{"on", "true"};
     case KnobKind::grid:

@@ -85,8 +85,7 @@ TEST(Physics, KernelsMatchTheReferenceInEveryTier) {
     // The tolerance table (plan/tolerance.h), and the MMW camera's own: pixels within 1
     // gray level, at most 0.5% of them off by one; metal zones exact.
     EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, c.tier)), "");
-    EXPECT_LE(d.mmw.max_abs, 1);
-    EXPECT_LE(d.mmw.share_differing, 0.005);
+    test::expect_camera_parity(d.mmw);
     EXPECT_EQ(d.metal_exact, 1.0);
   }
 }
@@ -117,10 +116,8 @@ TEST(Physics, FastTierDrawsMatchTheReference) {
     const OutputDiff d = compare_outputs(k, r);
     EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, Tier::fast)), "");
     EXPECT_GT(d.ir.pixels, 0u);
-    EXPECT_LE(d.mmw.max_abs, 1);
-    EXPECT_LE(d.mmw.share_differing, 0.005);
-    EXPECT_LE(d.ir.max_abs, 1);
-    EXPECT_LE(d.ir.share_differing, 0.005);
+    test::expect_camera_parity(d.mmw);
+    test::expect_camera_parity(d.ir);
     EXPECT_NE(k.view("ir").pixels, box_muller.view("ir").pixels) << "the draws must not be the table's";
   }
 }
@@ -386,8 +383,7 @@ TEST(Physics, FastPathMatchesTheChainOfStageKernels) {
       plan.fidelity.fused = false;
       cl->run(batch, plan, staged);
       const OutputDiff d = compare_outputs(fast, staged);
-      EXPECT_LE(d.mmw.max_abs, 1);
-      EXPECT_LE(d.mmw.share_differing, 0.005);
+      test::expect_camera_parity(d.mmw);
     }
 }
 
@@ -707,8 +703,7 @@ TEST(Physics, AutoWindowOnAFlatGridKeepsItsMinimumSpan) {
     make_reference_backend(w.cat, w.assets)->run(batch, plan, r);
     make_opencl_backend(w.cat, w.assets, test::runtime())->run(batch, plan, k);
     const OutputDiff d = compare_outputs(k, r);
-    EXPECT_LE(d.mmw.max_abs, 1);
-    EXPECT_LE(d.mmw.share_differing, 0.005);
+    test::expect_camera_parity(d.mmw);
     const std::vector<uint8_t>& px = k.view("upper").pixels;
     const auto [lo, hi] = std::minmax_element(px.begin(), px.begin() + 200 * 200);
     EXPECT_GT(*hi - *lo, 20) << "the noise must show";

@@ -34,7 +34,8 @@ import numpy as np  # noqa: E402
 REGIONS = 13
 # The drawn knobs' columns of scenarios.csv a title shows, each as a format of its value.
 DRAWN = [("netd", "NETD {:.1f} K"), ("frames", "{:.0f} fr"), ("illumination", "{:.0f} K room"),
-         ("worn_minutes", "worn {:.0f} min"), ("ir_netd", "IR {:.2f} K")]
+         ("worn_minutes", "worn {:.0f} min"), ("ir_netd", "IR {:.2f} K"),
+         ("clothing_folds", "folds {:.2f}")]
 
 # Objects by turns: (region number, object) pairs for body k, k modulo the list.
 CARRIED = [
@@ -78,7 +79,7 @@ def main():
             bodies = list(csv.DictReader(f))
         cols = a.columns
         lines = math.ceil(a.count / cols)
-        fig, axes = plt.subplots(lines, 2 * cols, figsize=(1.55 * 2 * cols, 3.25 * lines),
+        fig, axes = plt.subplots(lines, 2 * cols, squeeze=False, figsize=(1.55 * 2 * cols, 3.25 * lines),
                                  gridspec_kw={"wspace": 0.03, "hspace": 0.28})
         for ax in axes.flat:
             ax.set_axis_off()

@@ -14,6 +14,9 @@ struct AssetSet {
   // Per subject, per camera view (Catalogue::sensors order): 1 channel at the view's size,
   // gray (MMW) or temperature index (IR).
   std::vector<std::vector<Image>> bases;
+  // Per subject, per view, as bases: the outer garment's fold and seam pattern over the
+  // body (procedural::fold_pattern), 0 .. 255 the share where it lies doubled.
+  std::vector<std::vector<Image>> folds;
   // Per sprite set (Catalogue::sprite_sets), per variant id: 2 channels (value, alpha);
   // gray for MMW, temperature indices for IR, at the set's scale, mirrored for back views.
   std::vector<std::vector<Image>> sprites;

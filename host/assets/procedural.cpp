@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <numbers>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -1042,6 +1043,53 @@ Image sprite(const std::string& shape, bool vertical, int width, int height, int
     }
   }
   return img;
+}
+
+Image fold_pattern(const Image& base, const Sensor& view, int body_lo, int body_hi, int texture) {
+  check_size(base.width, base.height, "fold pattern");
+  Image out(base.width, base.height, 1, 0);
+  const uint64_t seed = 0xf01d5ULL + static_cast<uint64_t>(texture);
+  const double phase = 2.0 * std::numbers::pi * hash01(texture, 1, seed);
+  const double per_col = std::abs(view.field_per_col());
+  constexpr double kCreaseEvery = 22.0, kCreaseWidth = 0.3;  // field units; its share of the period
+  constexpr double kSeamIn = 3.0, kSeamWidth = 1.5, kCentreWidth = 2.0, kCentreFrom = 40.0;
+  for (int y = 0; y < base.height; ++y) {
+    const double v = view.field_row(y + 0.5);
+    for (int a = 0; a < base.width;) {
+      const auto body = [&](int x) { return base.at(x, y) >= body_lo && base.at(x, y) <= body_hi; };
+      if (!body(a)) {
+        ++a;
+        continue;
+      }
+      int b = a;
+      while (b < base.width && body(b)) ++b;
+      const double run = (b - a) * per_col, centre = 0.5 * (a + b);
+      for (int x = a; x < b; ++x) {
+        const double u = view.field_col(x + 0.5);
+        // Crease k lies across the body near v = 22 k, bent with a wavelength, height and phase
+        // of its own; each is a band 0.3 of the period wide, of its own depth along it.
+        double m = 0;
+        const int64_t near = static_cast<int64_t>(std::floor(v / kCreaseEvery));
+        for (int64_t k = near - 1; k <= near + 1; ++k) {
+          const auto own = [&](int j) { return hash01(k, j, seed); };
+          const double bend =
+              (2.0 + 3.0 * own(3)) * std::sin(2.0 * std::numbers::pi * (u / (25.0 + 20.0 * own(4)) + own(5)) + phase);
+          const double at = (v + bend) / kCreaseEvery - static_cast<double>(k);
+          if (at < 0 || at >= kCreaseWidth) continue;
+          const double depth = 0.35 + 0.65 * own(2);
+          const double along = 0.5 + 0.5 * std::sin(2.0 * std::numbers::pi * (u / (40.0 + 30.0 * own(6)) + own(7)));
+          const double profile = std::sin(std::numbers::pi * at / kCreaseWidth);
+          m = std::max(m, depth * along * profile * profile);
+        }
+        const double in = std::min(x - a, b - 1 - x) * per_col + 0.5 * per_col;
+        if (run >= 4 * kSeamIn && in >= kSeamIn && in < kSeamIn + kSeamWidth) m = 1;
+        if (run >= kCentreFrom && std::abs(x + 0.5 - centre) * per_col < kCentreWidth / 2) m = 1;
+        out.at(x, y) = static_cast<uint8_t>(std::lround(255.0 * clamp01(m)));
+      }
+      a = b;
+    }
+  }
+  return out;
 }
 
 Image noise_pattern(int k, int size) {

@@ -40,6 +40,14 @@ Image ir_view(const Body& body, const Frame& field, Side side, int width, int he
 Image mmw_body(const Body& body, bool upper, int width, int height);
 Image ir_body(const Body& body, int width, int height);
 
+// The outer garment's folds and seams over a view's body (docs/model/clothing.md): per pixel,
+// the share (0 .. 255) where the garment lies doubled. A body pixel is one whose base value
+// lies in [body_lo, body_hi]. Creases run across the body every 22 field units, wavy, each of
+// its own depth (from `texture`), in field coordinates so that every view of a body shows
+// the same ones; seams run 3 units inside each edge of every run of body pixels along a row
+// (sleeves, trouser legs, the trunk's sides) and down the middle of runs over 40 units wide.
+Image fold_pattern(const Image& base, const Sensor& view, int body_lo, int body_hi, int texture);
+
 // The object outlines of the thesis (section 4.3.1). width/height are the sprite's
 // final size (already swapped for a vertical variant); `vertical` turns the drawing.
 // Returns 2 channels: value (gray for MMW, temperature index for IR) and alpha

@@ -187,6 +187,17 @@ std::vector<Knob> declare() {
     c.omit_default = true;
     k.push_back(std::move(c));
   }
+  {
+    Knob f = drawable(number(
+                          "clothing_folds", "0", 0, 1, "of the fold pattern",
+                          "physics: under a drawn outfit, the share of the outer garment's fold and seam pattern "
+                          "where it lies doubled, in both cameras (docs/model/clothing.md); 0: smooth layers",
+                          [](Plan& p, double v) { p.model.clothing_folds = v; },
+                          [](const Plan& p) { return p.model.clothing_folds; }),
+                      PS_DRAWN_CLOTHING_FOLDS);
+    f.omit_default = true;
+    k.push_back(std::move(f));
+  }
   // The MMW camera's own processing (docs/model/physics-mmw.md).
   k.push_back(drawable(
       integer(
@@ -539,6 +550,12 @@ void check_knobs(const Plan& plan) {
   if (plan.model.model == Model::thesis && plan.model.clothing != Clothing::catalogue)
     throw InputError(std::string("--clothing: ") + kClothingNames[static_cast<size_t>(plan.model.clothing)] +
                      " applies to the physics model (--model physics); the thesis model has the catalogue's clothing");
+  // Folds belong to a drawn outfit's outer garment: the catalogue's clothing has no layers.
+  const DrawnRange& folds = plan.model.drawn[PS_DRAWN_CLOTHING_FOLDS];
+  if ((plan.model.clothing_folds > 0 || folds.varies()) && plan.model.clothing == Clothing::catalogue)
+    throw InputError(
+        "--clothing-folds: folds belong to an outfit's outer garment; give --clothing random (or none, shirt, "
+        "sweater, jacket, coat) with --model physics");
 }
 
 std::string knob_text(const nlohmann::json& value) {

@@ -84,6 +84,10 @@ double worn_minutes_at(const ModelSettings& m, uint64_t index) {
   return m.drawn[PS_DRAWN_WORN_MINUTES].varies() ? drawn_real(m, PS_DRAWN_WORN_MINUTES, index) : m.worn_minutes;
 }
 
+double clothing_folds_at(const ModelSettings& m, uint64_t index) {
+  return m.drawn[PS_DRAWN_CLOTHING_FOLDS].varies() ? drawn_real(m, PS_DRAWN_CLOTHING_FOLDS, index) : m.clothing_folds;
+}
+
 std::array<int, 2> raw_grid_at(const ModelSettings& m, uint64_t index) {
   if (!m.raw_grid_drawn()) return {m.raw_width, m.raw_height};
   const uint32_t k =
@@ -107,6 +111,7 @@ ModelSettings ModelSettings::at_scenario(uint64_t index) const {
   m.window_lo = window_lo_at(*this, index);
   m.window_hi = window_hi_at(*this, index);
   m.outfit = outfit_at(*this, index);
+  m.clothing_folds = clothing_folds_at(*this, index);
   m.drawn = {};
   return m;
 }
@@ -131,6 +136,8 @@ double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index) {
       return window_lo_at(m, index);
     case PS_DRAWN_WINDOW_HI:
       return window_hi_at(m, index);
+    case PS_DRAWN_CLOTHING_FOLDS:
+      return clothing_folds_at(m, index);
   }
   throw std::logic_error("no drawn knob " + std::to_string(element));
 }

@@ -66,6 +66,10 @@ struct ModelSettings {
   // outfit_table(clothing) (-1: the catalogue's clothing).
   Clothing clothing{};
   int outfit = -1;
+  // The outer garment's folds and seams (--clothing-folds): the share of the view's fold
+  // pattern (AssetSet::folds) where it lies doubled, 0 (none) .. 1; each scenario's is
+  // clothing_folds_at's. Only under a drawn outfit.
+  double clothing_folds{};
   // The MMW camera's own processing (docs/model/physics-mmw.md, "The camera's defaults"):
   // raw frames at 10 Hz averaged, each with its own NETD draw (the default 10: one second,
   // the body 5+ times the noise in both views); the display window, fixed [window_lo,
@@ -134,6 +138,9 @@ double window_hi_at(const ModelSettings& m, uint64_t index);
 int outfit_at(const ModelSettings& m, uint64_t index);
 // That outfit itself, for a run whose clothing is drawn (m.clothing not the catalogue's).
 const Outfit& outfit_of(const ModelSettings& m, uint64_t index);
+// Scenario `index`'s folds (the knob clothing_folds), as ir_netd_at, element
+// PS_DRAWN_CLOTHING_FOLDS. kernels/radiometry.cl's scene_draw draws the same.
+double clothing_folds_at(const ModelSettings& m, uint64_t index);
 // Scenario `index`'s pixel noise sigma (the knob pixel_noise, gray levels), as ir_netd_at,
 // element PS_DRAWN_PIXEL_NOISE. kernels/sensor_noise.cl's pixel_sigma_of.
 double pixel_noise_at(const ModelSettings& m, uint64_t index);

@@ -18,7 +18,7 @@ constexpr int16_t kNoObject = -1;
 // grid, no number: their keys are empty (each has columns of its own).
 inline constexpr std::array<const char*, PS_DRAWN_KNOBS> kDrawnKnobKeys = {
     "metal_noise",  "ir_netd", "pixel_noise", "netd",      "frames", "illumination",
-    "worn_minutes", "",        "window_lo",   "window_hi", ""};
+    "worn_minutes", "",        "window_lo",   "window_hi", "",       "clothing_folds"};
 // The columns of scenarios.csv and data.h5 that record a scenario's MMW raw grid where a run
 // draws it from a list (raw_grid_at, plan.h).
 inline constexpr std::array<const char*, 2> kRawGridColumns{"mmw_raw_width", "mmw_raw_height"};

@@ -42,7 +42,7 @@ nlohmann::json RunSpec::to_json() const {
   for (const Knob& k : portalsim::knobs())
     if (k.identity && !(k.key == "noise_draw" && p.fidelity.draw == NoiseDraw::box_muller)) {
       nlohmann::json v = k.get(p);
-      if (!(k.omit_default && v == nlohmann::json(k.def))) j[k.key] = std::move(v);
+      if (!(k.omit_default && knob_text(v) == k.def)) j[k.key] = std::move(v);
     }
   return j;
 }

@@ -24,6 +24,8 @@ CASES = {
                          worn_minutes="0..60", ir_netd="0.03..0.1", mmw_raw="14x14,28x28,40x40"),
     # Random bodies drawn from their own seed: images, features and the subject column.
     "random-bodies": dict(what="both", model="physics", bodies="random", body_count=12, body_seed=8),
+    # Drawn outfits with folds and seams drawn per scenario: param_clothing_folds.
+    "clothing-folds": dict(what="both", model="physics", clothing="random", clothing_folds="0..1"),
     "spec-file": dict(spec="scenarios/case1-gun.toml", what="both", seed=5),
     # 20 regions, 33 zones, front and back MMW and IR views (tools/portal_catalogues.py).
     # The front MMW views' raw grid drawn; the back ones keep their own.

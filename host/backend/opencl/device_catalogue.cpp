@@ -30,7 +30,10 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
   const size_t V = cat.variant_list.size(), views = cat.sensors.size();
   const int R = cat.region_count();
   std::vector<cl_int> base_offsets;
+  // Each subject's base images, then their fold patterns (kernels/composite.cl, fold_row).
   for (const auto& subject_views : assets.bases)
+    for (const Image& img : subject_views) base_offsets.push_back(add(img));
+  for (const auto& subject_views : assets.folds)
     for (const Image& img : subject_views) base_offsets.push_back(add(img));
   // The vector render path's copies (kernels/shared.h, PS_PAD): each sprite row as a
   // value row and a coverage row, each tile row, with neutral pixels on both sides.

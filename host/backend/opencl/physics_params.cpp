@@ -57,8 +57,13 @@ void axis_weights(int size, int raw, const double* taps, int radius, std::vector
 // excess over the room that reaches its surface (IR). Layer k, innermost first, passes
 // t_k = 10^(-dB/10) and emits (1 - t_k) T_k at the temperature halfway through it along the
 // chain of resistances skin -> layers -> room (docs/model/clothing.md).
+// Where the outer garment lies doubled (its folds and seams), a value v turns into
+// T + (1 + k)(v - T): in MMW the garment passes t_outer of v - T_outer again (k = t_outer - 1,
+// T = T_outer); in IR the surface keeps g' / g of its excess over the room (T the room), g' the
+// share with the outer garment's resistance counted twice.
 struct OutfitPhysics {
   double tc = 1, emission = 0, surface = 1;
+  double mmw_fold_k = 0, mmw_fold_t = 0, ir_fold_k = 0;
 };
 OutfitPhysics outfit_physics(const PhysicsConfig& pc, const Outfit& o) {
   const double total = kSurfaceResistance + o.clo() * kClo;
@@ -73,8 +78,13 @@ OutfitPhysics outfit_physics(const PhysicsConfig& pc, const Outfit& o) {
     inside += R;
     r.emission = t * r.emission + (1 - t) * temperature;
     r.tc *= t;
+    r.mmw_fold_k = t - 1;
+    r.mmw_fold_t = temperature;
   }
   r.surface = kSurfaceResistance / total;
+  if (!o.layers.empty())
+    r.ir_fold_k =
+        -kGarments[o.layers.back().garment].clo * kClo / (total + kGarments[o.layers.back().garment].clo * kClo);
   return r;
 }
 
@@ -190,13 +200,16 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   if (!outfits.outfits.empty()) {
     const size_t C = outfits.class_first.size(), S = cat.subjects.size(), V = cat.variant_list.size();
     const size_t stride = PS_OUTFIT_HEAD + 2 * S + V + (scene_drawn ? 2 * S + 4 * V : 0);
-    clothing = {double(C), double(stride), 0.0};
+    const DrawnRange& folds = m.drawn[PS_DRAWN_CLOTHING_FOLDS];
+    clothing = {double(C), double(stride), 0.0, m.clothing_folds, folds.varies() ? folds.hi : m.clothing_folds, 0.0};
     for (int f : outfits.class_first) clothing.push_back(f);
     for (int n : outfits.class_count) clothing.push_back(n);
     for (const Outfit& o : outfits.outfits) {
       const OutfitPhysics op = outfit_physics(pc, o);
       clothing.push_back(ir ? op.surface / pc.ir_coupling : 1.0);
       clothing.push_back(double(PS_OUTFIT_HEAD + 2 * S + V));
+      clothing.push_back(ir ? op.ir_fold_k : op.mmw_fold_k);
+      clothing.push_back(ir ? pc.room_temperature : op.mmw_fold_t);
       head(
           clothing, [&](double e, double t) { return op.tc * (e * t + (1 - e) * m.illumination) + op.emission; },
           ir ? op.surface : 1.0);
@@ -237,18 +250,14 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   t.cband = append(cband);
   t.rband = append(rband);
   t.display = append_display_tables(p, m, W, H, RW, RH);
-  // Each subject's bare raw grid: wy . T . wx^T over its base image in kelvin at the
-  // subject's (gain, offset); with the scene block, also its change over the illumination's
-  // range, the same sums at the change of (gain, offset).
-  const auto bare_grids = [&](const double* gains) {
+  // Each subject's grid of a value per view pixel, wy . T . wx^T, T = value(subject, x, y).
+  const auto grids_of = [&](const auto& value) {
     std::vector<double> bare(cat.subjects.size() * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
     for (size_t subj = 0; subj < cat.subjects.size(); ++subj) {
-      const Image& base = assets.bases[subj][view];
-      const double gain = gains[2 * subj], offset = gains[2 * subj + 1];
       std::fill(rows.begin(), rows.end(), 0.0);
       for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
-          const double kelvin = gain * base.at(x, y) + offset;
+          const double kelvin = value(subj, x, y);
           for (int c = int(cband[2 * x]); c <= int(cband[2 * x + 1]); ++c)
             rows[size_t(y) * RW + c] += wx[size_t(c) * W + x] * kelvin;
         }
@@ -258,6 +267,14 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
           for (int c = 0; c < RW; ++c) out[size_t(r) * RW + c] += wy[size_t(r) * H + y] * rows[size_t(y) * RW + c];
     }
     return bare;
+  };
+  // Each subject's bare raw grid: its base image in kelvin at the subject's (gain, offset);
+  // with the scene block, also its change over the illumination's range, the same sums at the
+  // change of (gain, offset).
+  const auto bare_grids = [&](const double* gains) {
+    return grids_of([&](size_t subj, int x, int y) {
+      return gains[2 * subj] * assets.bases[subj][view].at(x, y) + gains[2 * subj + 1];
+    });
   };
   t.base = append(bare_grids(&p[PS_PHYS_SUBJECTS]));
   if (scene_drawn) {
@@ -270,6 +287,16 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     std::vector<double> unit(2 * cat.subjects.size(), 0.0);
     for (size_t k = 0; k < cat.subjects.size(); ++k) unit[2 * k] = 1;
     clothing[PS_CLOTHING_GRIDS] = append(bare_grids(unit.data()));
+    // The fold grids: each subject's fold share m (0 .. 1) times its gray, then m alone.
+    if (clothing[PS_CLOTHING_FOLDS_HI] > 0) {
+      std::vector<double> folds = grids_of([&](size_t subj, int x, int y) {
+        return assets.folds[subj][view].at(x, y) / 255.0 * assets.bases[subj][view].at(x, y);
+      });
+      const std::vector<double> share =
+          grids_of([&](size_t subj, int x, int y) { return assets.folds[subj][view].at(x, y) / 255.0; });
+      folds.insert(folds.end(), share.begin(), share.end());
+      clothing[PS_CLOTHING_FOLD_GRIDS] = append(folds);
+    }
     p[PS_PHYS_CLOTHING] = append(clothing);
   }
   return t;

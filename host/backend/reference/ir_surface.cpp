@@ -64,6 +64,17 @@ void ir_surface(const ViewScene& vs, Field& f) {
   for (int y = 0; y < f.height; ++y)
     for (int x = 0; x < f.width; ++x)
       f.at(x, y) += dressed ? room + share * (base_kelvin(vs, x, y) - room) : base_kelvin(vs, x, y);
+  // Folds and seams: over the share m of a pixel where the outer garment lies doubled, the
+  // surface keeps the share with its resistance counted twice; the surface (and its shadow)
+  // is the mix of the two.
+  if (!dressed || vs.model.clothing_folds == 0) return;
+  const double doubled = outfit_surface_share(vs.model, true);
+  const Image& folds = vs.assets.folds[vs.scenario.subject][vs.view];
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      const double m = vs.model.clothing_folds * folds.at(x, y) / 255.0;
+      f.at(x, y) = room + ((1 - m) * share + m * doubled) / share * (f.at(x, y) - room);
+    }
 }
 
 }  // namespace portalsim::reference

@@ -46,9 +46,11 @@ std::vector<LayerSeen> outfit_layers(const PhysicsConfig& pc, const ModelSetting
   return out;
 }
 
-double outfit_surface_share(const ModelSettings& m) {
+double outfit_surface_share(const ModelSettings& m, bool outer_doubled) {
   double clothed = 0;
   for (const Layer& l : worn_outfit(m).layers) clothed += kGarments[l.garment].clo * kClo;
+  if (outer_doubled && !worn_outfit(m).layers.empty())
+    clothed += kGarments[worn_outfit(m).layers.back().garment].clo * kClo;
   return kSurfaceResistance / (kSurfaceResistance + clothed);
 }
 
@@ -89,6 +91,18 @@ void radiometry(const ViewScene& vs, Field& f) {
   lay_objects(vs, f, 1.0, [](const ViewScene& s, const Placed& p, int, int) {
     return object_temperature(s.cat, s.model, p.variant);
   });
+  // Folds and seams: over the share m of a pixel where the outer garment lies doubled, what
+  // it shows passes the garment once more (t, emitting (1 - t) at its temperature).
+  if (vs.model.outfit < 0 || vs.model.clothing_folds == 0) return;
+  const std::vector<LayerSeen> layers = outfit_layers(pc, vs.model);
+  if (layers.empty()) return;  // bare skin
+  const LayerSeen outer = layers.back();
+  const Image& folds = vs.assets.folds[vs.scenario.subject][vs.view];
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      const double m = vs.model.clothing_folds * folds.at(x, y) / 255.0, v = f.at(x, y);
+      f.at(x, y) = (1 - m) * v + m * (outer.transmission * v + (1 - outer.transmission) * outer.temperature);
+    }
 }
 
 }  // namespace portalsim::reference

@@ -92,7 +92,8 @@ struct LayerSeen {
 };
 std::vector<LayerSeen> outfit_layers(const PhysicsConfig& pc, const ModelSettings& m);
 // The share of the skin's excess over the room that reaches the outfit's surface (IR).
-double outfit_surface_share(const ModelSettings& m);
+// With outer_doubled, where the outer garment lies twice (its folds and seams).
+double outfit_surface_share(const ModelSettings& m, bool outer_doubled = false);
 double body_temperature(const Catalogue& cat, const ModelSettings& m, const Subject& s);  // bare body under clothing, K
 double worn_temperature(const Catalogue& cat, const ModelSettings& m, int variant,
                         double skin);  // physical, K, warmed on skin of this temperature
