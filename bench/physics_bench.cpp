@@ -121,6 +121,27 @@ void BM_RawGrid(benchmark::State& state) {
 }
 BENCHMARK(BM_RawGrid)->ArgsProduct({{0, 1}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// Drawn outfits without and with folds. Args: what (0 images of every view, standard tier;
+// 1 features only, fast tier), folds (0 none, 1 drawn from 0..1).
+void BM_ClothingFolds(benchmark::State& state) {
+  auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+  Plan p;
+  p.model.model = Model::physics;
+  const bool images = state.range(0) == 0;
+  if (images) {
+    p.features = false;
+  } else {
+    p.fidelity = tier_fidelity(Tier::fast);
+    p.images = 0;
+  }
+  set_knob(p, *find_knob("clothing"), "random", "--clothing");
+  if (state.range(1) == 1) set_knob(p, *find_knob("clothing_folds"), "0..1", "--clothing-folds");
+  state.SetLabel(std::string(images ? "physics images, " : "physics features, fast, ") +
+                 (state.range(1) == 1 ? "outfits with folds" : "outfits"));
+  bench::time_runs(state, *b, p, images ? 1024 : 8192);
+}
+BENCHMARK(BM_ClothingFolds)->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMillisecond)->UseRealTime();
+
 // The IR view's images only. Args: model (0 thesis, 1 physics), IR NETD in mK (physics).
 void BM_IrImages(benchmark::State& state) {
   auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);

@@ -149,6 +149,23 @@ TEST(ClothingFolds, TheExtremesAreTheReferences) {
   }
 }
 
+// Assets built without fold patterns (a run that gives no --clothing-folds) refuse a plan
+// with folds on both backends rather than read past the atlas; with no folds they run.
+TEST(ClothingFolds, AssetsWithoutPatternsRefuseFolds) {
+  const AssetSet bare = build_assets(catalogue(), false);
+  EXPECT_TRUE(bare.folds.empty());
+  const SceneBatch batch = test::batch_of({test::random_scenario(catalogue(), 1, 3)}, 0);
+  auto ref = make_reference_backend(catalogue(), bare);
+  auto ocl = make_opencl_backend(catalogue(), bare, test::runtime());
+  BatchOutput out;
+  EXPECT_ANY_THROW(ocl->run(batch, folded_plan("coat", "0.5", Tier::standard, true), out));
+  EXPECT_ANY_THROW(ref->run(batch, folded_plan("coat", "0.5", Tier::standard, true), out));
+  BatchOutput k, r;
+  ocl->run(batch, folded_plan("coat", "0", Tier::standard, true), k);
+  ref->run(batch, folded_plan("coat", "0", Tier::standard, true), r);
+  test::expect_camera_parity(compare_outputs(k, r).mmw);
+}
+
 // In IR a fold holds more of the skin's warmth in: the surface is cooler where the pattern
 // is, by more with a heavier share, and unchanged where it is not (no noise, no objects).
 TEST(ClothingFolds, FoldsCoolTheIrSurfaceWhereThePatternIs) {

@@ -80,7 +80,7 @@ void colourise(const uint8_t* index, size_t n, const Palette& palette, uint8_t* 
   for (size_t i = 0; i < n; ++i) std::memcpy(rgb + 3 * i, palette[index[i]].data(), 3);
 }
 
-AssetSet build_assets(const Catalogue& cat) {
+AssetSet build_assets(const Catalogue& cat, bool fold_patterns) {
   AssetSet a;
   a.palette = procedural::ir_palette();
   const ImagesConfig& ic = cat.images;
@@ -118,8 +118,8 @@ AssetSet build_assets(const Catalogue& cat) {
   const int ir_body_from =
       static_cast<int>(std::ceil(((pc.room_temperature + pc.skin_temperature) / 2 - pc.ir_index_min_k) /
                                  ((pc.ir_index_max_k - pc.ir_index_min_k) / 255.0)));
-  a.folds.resize(cat.subjects.size());
-  parallel_for(cat.subjects.size(), default_threads(), [&](size_t begin, size_t end) {
+  if (fold_patterns) a.folds.resize(cat.subjects.size());
+  parallel_for(fold_patterns ? cat.subjects.size() : 0, default_threads(), [&](size_t begin, size_t end) {
     for (size_t s = begin; s < end; ++s) {
       const Subject& sub = cat.subjects[s];
       const int texture = sub.texture >= 0 ? static_cast<int>(sub.texture) : static_cast<int>(s);

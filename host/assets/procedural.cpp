@@ -1053,8 +1053,27 @@ Image fold_pattern(const Image& base, const Sensor& view, int body_lo, int body_
   const double per_col = std::abs(view.field_per_col());
   constexpr double kCreaseEvery = 22.0, kCreaseWidth = 0.3;  // field units; its share of the period
   constexpr double kSeamIn = 3.0, kSeamWidth = 1.5, kCentreWidth = 2.0, kCentreFrom = 40.0;
+  // Crease k lies across the body near v = 22 k, bent with a wavelength, height and phase of
+  // its own, and of its own depth along it: per crease and column, its bend and depth.
+  const double v0 = view.field_row(0.5), v1 = view.field_row(base.height - 0.5);
+  const int64_t k0 = static_cast<int64_t>(std::floor(std::min(v0, v1) / kCreaseEvery)) - 1;
+  const int64_t k1 = static_cast<int64_t>(std::floor(std::max(v0, v1) / kCreaseEvery)) + 1;
+  const size_t W = static_cast<size_t>(base.width);
+  std::vector<double> bend(static_cast<size_t>(k1 - k0 + 1) * W), depth(bend.size());
+  for (int64_t k = k0; k <= k1; ++k) {
+    const auto own = [&](int j) { return hash01(k, j, seed); };
+    const double height = 2.0 + 3.0 * own(3), wave = 25.0 + 20.0 * own(4), shift = own(5);
+    const double deep = 0.35 + 0.65 * own(2), stretch = 40.0 + 30.0 * own(6), at = own(7);
+    for (size_t x = 0; x < W; ++x) {
+      const double u = view.field_col(static_cast<double>(x) + 0.5);
+      const size_t i = static_cast<size_t>(k - k0) * W + x;
+      bend[i] = height * std::sin(2.0 * std::numbers::pi * (u / wave + shift) + phase);
+      depth[i] = deep * (0.5 + 0.5 * std::sin(2.0 * std::numbers::pi * (u / stretch + at)));
+    }
+  }
   for (int y = 0; y < base.height; ++y) {
     const double v = view.field_row(y + 0.5);
+    const int64_t near = static_cast<int64_t>(std::floor(v / kCreaseEvery));
     for (int a = 0; a < base.width;) {
       const auto body = [&](int x) { return base.at(x, y) >= body_lo && base.at(x, y) <= body_hi; };
       if (!body(a)) {
@@ -1065,21 +1084,14 @@ Image fold_pattern(const Image& base, const Sensor& view, int body_lo, int body_
       while (b < base.width && body(b)) ++b;
       const double run = (b - a) * per_col, centre = 0.5 * (a + b);
       for (int x = a; x < b; ++x) {
-        const double u = view.field_col(x + 0.5);
-        // Crease k lies across the body near v = 22 k, bent with a wavelength, height and phase
-        // of its own; each is a band 0.3 of the period wide, of its own depth along it.
+        // A crease's profile across it: (4 t (1 - t))^2 over t in [0, 1) of its width.
         double m = 0;
-        const int64_t near = static_cast<int64_t>(std::floor(v / kCreaseEvery));
         for (int64_t k = near - 1; k <= near + 1; ++k) {
-          const auto own = [&](int j) { return hash01(k, j, seed); };
-          const double bend =
-              (2.0 + 3.0 * own(3)) * std::sin(2.0 * std::numbers::pi * (u / (25.0 + 20.0 * own(4)) + own(5)) + phase);
-          const double at = (v + bend) / kCreaseEvery - static_cast<double>(k);
-          if (at < 0 || at >= kCreaseWidth) continue;
-          const double depth = 0.35 + 0.65 * own(2);
-          const double along = 0.5 + 0.5 * std::sin(2.0 * std::numbers::pi * (u / (40.0 + 30.0 * own(6)) + own(7)));
-          const double profile = std::sin(std::numbers::pi * at / kCreaseWidth);
-          m = std::max(m, depth * along * profile * profile);
+          const size_t i = static_cast<size_t>(k - k0) * W + static_cast<size_t>(x);
+          const double t = ((v + bend[i]) / kCreaseEvery - static_cast<double>(k)) / kCreaseWidth;
+          if (t < 0 || t >= 1) continue;
+          const double bump = 4.0 * t * (1.0 - t);
+          m = std::max(m, depth[i] * bump * bump);
         }
         const double in = std::min(x - a, b - 1 - x) * per_col + 0.5 * per_col;
         if (run >= 4 * kSeamIn && in >= kSeamIn && in < kSeamIn + kSeamWidth) m = 1;

@@ -47,13 +47,13 @@ std::map<std::string, std::string> given_knobs(const CLI::App& app, const std::m
   return given;
 }
 
-void open_catalogue(Session& s, const CommonOptions& o, const RunSpec* spec) {
+void open_catalogue(Session& s, const CommonOptions& o, const RunSpec* spec, bool fold_patterns) {
   auto t0 = std::chrono::steady_clock::now();
   s.catalogue = o.catalogue.empty() ? default_catalogue(o.assets) : load_catalogue(o.catalogue, o.assets);
   if (spec && spec->random_bodies()) use_random_bodies(s.catalogue, spec->bodies_seed(), spec->random_bodies());
   s.catalogue_seconds = since(t0);
   t0 = std::chrono::steady_clock::now();
-  s.assets = build_assets(s.catalogue);
+  s.assets = build_assets(s.catalogue, fold_patterns);
   s.assets_seconds = since(t0);
 }
 

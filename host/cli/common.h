@@ -47,8 +47,9 @@ struct Session {
 Session open_session(const CommonOptions& o);
 // Catalogue and assets only (no backend yet): lets a command check its arguments first.
 // The catalogue and its images; where `spec` asks for random bodies, its drawn bodies in
-// place of the catalogue's subjects.
-void open_catalogue(Session& s, const CommonOptions& o, const RunSpec* spec = nullptr);
+// place of the catalogue's subjects. The subjects' fold patterns are drawn unless the caller
+// knows the run gives no --clothing-folds (fold_patterns false; build_assets).
+void open_catalogue(Session& s, const CommonOptions& o, const RunSpec* spec = nullptr, bool fold_patterns = true);
 void open_backend(Session& s, const CommonOptions& o);
 // The flags that choose a command's subjects: the catalogue's, or random bodies (--bodies
 // random, --body-count, --body-seed). A run spec's commands read them into the spec

@@ -60,7 +60,7 @@ int generate(GenerateOptions& o) {
   Session s;
   // Together: a rank that cannot start stops them all, rather than leaving them waiting.
   ranks->together([&] {
-    open_catalogue(s, common, &spec);
+    open_catalogue(s, common, &spec, spec.settings().model.has_folds());
     check_generate(spec, s.catalogue);
     open_backend(s, common);
   });

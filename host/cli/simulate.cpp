@@ -42,7 +42,7 @@ int simulate(SimulateOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   Session s;
   const RunSpec bodies = bodies_spec(o.body);
-  open_catalogue(s, o.common, &bodies);
+  open_catalogue(s, o.common, &bodies, given_knobs(*o.app, o.knobs).count("clothing_folds") > 0);
   const Catalogue& cat = s.catalogue;
 
   // Everything the user gave is checked before any backend work or any file is written.

@@ -99,6 +99,7 @@ struct ModelSettings {
     return drawn[PS_DRAWN_PIXEL_NOISE].varies() ? drawn[PS_DRAWN_PIXEL_NOISE].hi : pixel_sigma;
   }
   bool raw_grid_drawn() const { return raw_grids.size() > 1; }
+  bool has_folds() const { return clothing_folds > 0 || drawn[PS_DRAWN_CLOTHING_FOLDS].varies(); }
   bool window_drawn() const { return drawn[PS_DRAWN_WINDOW_LO].varies() || drawn[PS_DRAWN_WINDOW_HI].varies(); }
   bool transforms() const { return rotate_lo != 0 || rotate_hi != 0 || scale_lo != 1 || scale_hi != 1 || flip; }
   bool moves_sprites() const { return bilinear || jitter > 0 || transforms(); }

@@ -153,7 +153,7 @@ class Engine {
   // need is computed.
   Engine(const std::vector<std::string>& args, const std::optional<std::vector<std::string>>& datasets)
       : req_(cli::parse_generate(args)) {
-    cli::open_catalogue(session_, req_.common, &req_.spec);
+    cli::open_catalogue(session_, req_.common, &req_.spec, req_.spec.settings().model.has_folds());
     cli::check_generate(req_.spec, session_.catalogue);
     source_.emplace(req_.spec, session_.catalogue);
     plan_ = run_plan(req_.spec, session_.catalogue);

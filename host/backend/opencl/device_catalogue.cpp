@@ -30,6 +30,17 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
   const size_t V = cat.variant_list.size(), views = cat.sensors.size();
   const int R = cat.region_count();
   std::vector<cl_int> base_offsets;
+  // Room for the images, so that a run of 255 random bodies copies its atlas once: the bases
+  // and fold patterns, each sprite three times (plain, and as value and coverage rows with
+  // padding), each noise tile twice.
+  size_t bytes = 0;
+  for (const auto* set : {&assets.bases, &assets.folds})
+    for (const auto& subject_views : *set)
+      for (const Image& img : subject_views) bytes += img.pixels.size();
+  for (const std::vector<Image>& set : assets.sprites)
+    for (const Image& sp : set) bytes += 2 * sp.pixels.size() + 2 * size_t(sp.height) * (sp.width + 2 * PS_PAD);
+  for (const Image& tile : assets.noise) bytes += tile.pixels.size() + size_t(tile.height) * (tile.width + 2 * PS_PAD);
+  atlas_bytes.reserve(bytes);
   // Each subject's base images, then their fold patterns (kernels/composite.cl, fold_row).
   for (const auto& subject_views : assets.bases)
     for (const Image& img : subject_views) base_offsets.push_back(add(img));

@@ -201,6 +201,9 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     const size_t C = outfits.class_first.size(), S = cat.subjects.size(), V = cat.variant_list.size();
     const size_t stride = PS_OUTFIT_HEAD + 2 * S + V + (scene_drawn ? 2 * S + 4 * V : 0);
     const DrawnRange& folds = m.drawn[PS_DRAWN_CLOTHING_FOLDS];
+    // The kernels read each view's fold pattern from the atlas (fold_row).
+    if (m.has_folds() && assets.folds.empty())
+      throw std::logic_error("--clothing-folds: the assets were built without fold patterns");
     clothing = {double(C), double(stride), 0.0, m.clothing_folds, folds.varies() ? folds.hi : m.clothing_folds, 0.0};
     for (int f : outfits.class_first) clothing.push_back(f);
     for (int n : outfits.class_count) clothing.push_back(n);

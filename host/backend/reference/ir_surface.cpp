@@ -69,7 +69,7 @@ void ir_surface(const ViewScene& vs, Field& f) {
   // is the mix of the two.
   if (!dressed || vs.model.clothing_folds == 0) return;
   const double doubled = outfit_surface_share(vs.model, true);
-  const Image& folds = vs.assets.folds[vs.scenario.subject][vs.view];
+  const Image& folds = vs.assets.folds.at(static_cast<size_t>(vs.scenario.subject)).at(static_cast<size_t>(vs.view));
   for (int y = 0; y < f.height; ++y)
     for (int x = 0; x < f.width; ++x) {
       const double m = vs.model.clothing_folds * folds.at(x, y) / 255.0;

@@ -97,7 +97,7 @@ void radiometry(const ViewScene& vs, Field& f) {
   const std::vector<LayerSeen> layers = outfit_layers(pc, vs.model);
   if (layers.empty()) return;  // bare skin
   const LayerSeen outer = layers.back();
-  const Image& folds = vs.assets.folds[vs.scenario.subject][vs.view];
+  const Image& folds = vs.assets.folds.at(static_cast<size_t>(vs.scenario.subject)).at(static_cast<size_t>(vs.view));
   for (int y = 0; y < f.height; ++y)
     for (int x = 0; x < f.width; ++x) {
       const double m = vs.model.clothing_folds * folds.at(x, y) / 255.0, v = f.at(x, y);
