@@ -101,19 +101,26 @@ BENCHMARK(BM_MmwCamera)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-// Args: what (0 images of every view, standard tier; 1 features only, fast tier), raw grid
-// (0: 14x14, 1: 28x28, 2: 40x40, 3: drawn from 14x14,28x28,40x40).
-void BM_RawGrid(benchmark::State& state) {
-  auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+// The physics model's images of every view at the standard tier, or features only at the
+// fast tier.
+Plan images_or_features(bool images) {
   Plan p;
   p.model.model = Model::physics;
-  const bool images = state.range(0) == 0;
   if (images) {
     p.features = false;
   } else {
     p.fidelity = tier_fidelity(Tier::fast);
     p.images = 0;
   }
+  return p;
+}
+
+// Args: what (0 images of every view, standard tier; 1 features only, fast tier), raw grid
+// (0: 14x14, 1: 28x28, 2: 40x40, 3: drawn from 14x14,28x28,40x40).
+void BM_RawGrid(benchmark::State& state) {
+  auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
+  const bool images = state.range(0) == 0;
+  Plan p = images_or_features(images);
   const char* grids[] = {"14x14", "28x28", "40x40", "14x14,28x28,40x40"};
   set_knob(p, *find_knob("mmw_raw"), grids[state.range(1)], "--mmw-raw");
   state.SetLabel(std::string(images ? "physics images, " : "physics features, fast, ") + grids[state.range(1)]);
@@ -125,15 +132,8 @@ BENCHMARK(BM_RawGrid)->ArgsProduct({{0, 1}, {0, 1, 2, 3}})->Unit(benchmark::kMil
 // 1 features only, fast tier), folds (0 none, 1 drawn from 0..1).
 void BM_ClothingFolds(benchmark::State& state) {
   auto b = make_opencl_backend(fx().cat, fx().assets, fx().rt);
-  Plan p;
-  p.model.model = Model::physics;
   const bool images = state.range(0) == 0;
-  if (images) {
-    p.features = false;
-  } else {
-    p.fidelity = tier_fidelity(Tier::fast);
-    p.images = 0;
-  }
+  Plan p = images_or_features(images);
   set_knob(p, *find_knob("clothing"), "random", "--clothing");
   if (state.range(1) == 1) set_knob(p, *find_knob("clothing_folds"), "0..1", "--clothing-folds");
   state.SetLabel(std::string(images ? "physics images, " : "physics features, fast, ") +
