@@ -238,12 +238,11 @@ typedef struct {
  * outfits' count (PS_CLOTHING_*), then each outfit's entry (PS_OUTFIT_*): its factor of every IR
  * shadow, the offset in the entry of its scene moves, its folds' factor k and reference
  * temperature T (a fold of share m turns a value v into T + (1 + f k m)(v - T)), then each
- * subject's (gain, offset) and each
- * variant's value as at PS_PHYS_SUBJECTS, and where the scene block is, each subject's and
- * variant's moves as at its PS_SCENE_SUBJECTS. The gray grids (MMW): each subject's base
- * image's gray through the raw grid's weights, so that its bare grid is gain G + offset (each
- * raw cell's weights sum to 1; kernels/physics_raw.cl). The fold grids (MMW): each subject's
- * fold share m times its gray, then each subject's m alone, through the same weights. */
+ * subject's (gain, offset) and each variant's value as at PS_PHYS_SUBJECTS, and where the
+ * scene block is, each subject's and variant's moves as at its PS_SCENE_SUBJECTS. The gray grids (MMW): each subject's
+ * base image's gray through the raw grid's weights, so that its bare grid is gain G + offset (each raw cell's weights
+ * sum to 1; kernels/physics_raw.cl). The fold grids (MMW): each subject's fold share m times its gray, then each
+ * subject's m alone, through the same weights. */
 #define PS_PHYS_CLOTHING 9
 /* MMW: the display window's ends drawn per scenario (PS_WINDOW_DRAWN): the upper ends of their
  * ranges (the lower ends are PS_PHYS_WINDOW_MIN and PS_PHYS_WINDOW_MAX); the window's ends where fixed. */

@@ -114,24 +114,23 @@ AssetSet build_assets(const Catalogue& cat, bool fold_patterns) {
   });
   // Each base's folds over its body: MMW pixels nearer the subject's body gray than the room's,
   // IR pixels warmer than halfway from the room to the skin (as the contact shadow's test).
-  const PhysicsConfig& pc = cat.physics;
-  const int ir_body_from =
-      static_cast<int>(std::ceil(((pc.room_temperature + pc.skin_temperature) / 2 - pc.ir_index_min_k) /
-                                 ((pc.ir_index_max_k - pc.ir_index_min_k) / 255.0)));
-  if (fold_patterns) a.folds.resize(cat.subjects.size());
-  parallel_for(fold_patterns ? cat.subjects.size() : 0, default_threads(), [&](size_t begin, size_t end) {
-    for (size_t s = begin; s < end; ++s) {
-      const Subject& sub = cat.subjects[s];
-      const int texture = sub.texture >= 0 ? static_cast<int>(sub.texture) : static_cast<int>(s);
-      const int bg = pc.base_background_gray, level = sub.mmw_level, mid = (bg + level + 1) / 2;
-      for (size_t v = 0; v < cat.sensors.size(); ++v) {
-        const Sensor& view = cat.sensors[v];
-        const bool ir = view.camera == Camera::ir;
-        const int lo = ir ? ir_body_from : (level >= bg ? mid : 0), hi = ir ? 255 : (level >= bg ? 255 : mid);
-        a.folds[s].push_back(procedural::fold_pattern(a.bases[s][v], view, lo, hi, texture));
+  if (fold_patterns) {
+    const PhysicsConfig& pc = cat.physics;
+    a.folds.resize(cat.subjects.size());
+    parallel_for(cat.subjects.size(), default_threads(), [&](size_t begin, size_t end) {
+      for (size_t s = begin; s < end; ++s) {
+        const Subject& sub = cat.subjects[s];
+        const int texture = sub.texture >= 0 ? static_cast<int>(sub.texture) : static_cast<int>(s);
+        const int bg = pc.base_background_gray, level = sub.mmw_level, mid = (bg + level + 1) / 2;
+        for (size_t v = 0; v < cat.sensors.size(); ++v) {
+          const Sensor& view = cat.sensors[v];
+          const bool ir = view.camera == Camera::ir;
+          const int lo = ir ? pc.ir_body_index() : (level >= bg ? mid : 0), hi = ir ? 255 : (level >= bg ? 255 : mid);
+          a.folds[s].push_back(procedural::fold_pattern(a.bases[s][v], view, lo, hi, texture));
+        }
       }
-    }
-  });
+    });
+  }
   // Each sprite set's drawings keep the objects' physical size: a catalogue size is in field
   // units, scaled by the set's view pixels per unit. A file is its camera's drawing as given.
   // Drawn on every thread (each drawing stands alone), files one at a time as the bases are.

@@ -551,8 +551,7 @@ void check_knobs(const Plan& plan) {
     throw InputError(std::string("--clothing: ") + kClothingNames[static_cast<size_t>(plan.model.clothing)] +
                      " applies to the physics model (--model physics); the thesis model has the catalogue's clothing");
   // Folds belong to a drawn outfit's outer garment: the catalogue's clothing has no layers.
-  const DrawnRange& folds = plan.model.drawn[PS_DRAWN_CLOTHING_FOLDS];
-  if ((plan.model.clothing_folds > 0 || folds.varies()) && plan.model.clothing == Clothing::catalogue)
+  if (plan.model.has_folds() && plan.model.clothing == Clothing::catalogue)
     throw InputError(
         "--clothing-folds: folds belong to an outfit's outer garment; give --clothing random (or none, shirt, "
         "sweater, jacket, coat) with --model physics");

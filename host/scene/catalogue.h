@@ -1,6 +1,7 @@
 // The catalogue: everything a scenario can name (thesis chapter 4), read from TOML.
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -90,6 +91,12 @@ struct PhysicsConfig {
   }
   double skin_temperature_of(const Subject& s) const {
     return s.skin_temperature > 0 ? s.skin_temperature : skin_temperature;
+  }
+  // The least IR temperature index that is body: warmer than halfway from the room to the
+  // skin (the kernels' contact shadow and the fold patterns read it; the reference has its own).
+  int ir_body_index() const {
+    return static_cast<int>(std::ceil(((room_temperature + skin_temperature) / 2 - ir_index_min_k) /
+                                      ((ir_index_max_k - ir_index_min_k) / 255.0)));
   }
 };
 

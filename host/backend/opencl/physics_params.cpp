@@ -82,9 +82,10 @@ OutfitPhysics outfit_physics(const PhysicsConfig& pc, const Outfit& o) {
     r.mmw_fold_t = temperature;
   }
   r.surface = kSurfaceResistance / total;
-  if (!o.layers.empty())
-    r.ir_fold_k =
-        -kGarments[o.layers.back().garment].clo * kClo / (total + kGarments[o.layers.back().garment].clo * kClo);
+  if (!o.layers.empty()) {
+    const double outer = kGarments[o.layers.back().garment].clo * kClo;
+    r.ir_fold_k = -outer / (total + outer);
+  }
   return r;
 }
 
@@ -223,10 +224,7 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
     // Where an object reaches past the body's outline, its shadow is taken against the room
     // it touches there, not the skin (PsViewLaunch::phys_off_body).
     std::vector<double> off_body;
-    const double per_index = (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0;
-    const double body_from = (pc.room_temperature + pc.skin_temperature) / 2;
-    for (size_t subj = 0; subj < cat.subjects.size(); ++subj)
-      off_body.push_back(std::ceil((body_from - pc.ir_index_min_k) / per_index));
+    for (size_t subj = 0; subj < cat.subjects.size(); ++subj) off_body.push_back(pc.ir_body_index());
     // Each variant's shadow against the room.
     for (size_t v = 0; v < cat.variant_list.size(); ++v) {
       const Material& mat = cat.materials.at(cat.object_of(static_cast<int>(v)).material_id);

@@ -47,10 +47,10 @@ std::vector<LayerSeen> outfit_layers(const PhysicsConfig& pc, const ModelSetting
 }
 
 double outfit_surface_share(const ModelSettings& m, bool outer_doubled) {
+  const std::vector<Layer>& layers = worn_outfit(m).layers;
   double clothed = 0;
-  for (const Layer& l : worn_outfit(m).layers) clothed += kGarments[l.garment].clo * kClo;
-  if (outer_doubled && !worn_outfit(m).layers.empty())
-    clothed += kGarments[worn_outfit(m).layers.back().garment].clo * kClo;
+  for (const Layer& l : layers) clothed += kGarments[l.garment].clo * kClo;
+  if (outer_doubled && !layers.empty()) clothed += kGarments[layers.back().garment].clo * kClo;
   return kSurfaceResistance / (kSurfaceResistance + clothed);
 }
 
