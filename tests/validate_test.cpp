@@ -1,7 +1,11 @@
 // `portalsim validate` as a user meets it: WEKA scores and t-tests on small generated
 // tables, WEKA's own command line as the reference for the folds, the t-tests against
 // scipy, and bad input refused with a message naming the file.
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <boost/math/distributions/students_t.hpp>
+#include <charconv>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -12,6 +16,8 @@
 #include "cli/validate_tables.h"
 #include "io/table_fields.h"
 #include "run_binary.h"
+#include "sink/feature_rows.h"
+#include "sink/h5_file.h"
 
 namespace {
 
@@ -332,6 +338,63 @@ TEST(Validate, ReadsH5AsTheSameRunsArff) {
     EXPECT_TRUE(r.exited && r.status == 3) << portalsim::test::describe(r);
     EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(d / "out")) << file;
+  }
+  fs::remove_all(d);
+}
+
+// A data.h5 may hold any float (the fuzzer found one past llround's long long): finite ones
+// are written so they read back as the same float, a NaN or infinity is refused naming the
+// row and column.
+TEST(ValidateTables, H5FeaturesPastFixedPointReadBackAndNonFiniteAreRefused) {
+  const auto text = [](float v) {
+    std::string s;
+    portalsim::append_number(s, v);
+    return s;
+  };
+  EXPECT_EQ(text(1.5f), "1.5");
+  EXPECT_EQ(text(-0.25f), "-0.25");
+  EXPECT_EQ(text(0.0f), "0");
+  for (const float big : {1e30f, -1e30f, 9.5e14f, -9.5e14f, std::numeric_limits<float>::max()}) {
+    const std::string s = text(big);
+    float back = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), back);
+    EXPECT_TRUE(ec == std::errc() && end == s.data() + s.size() && back == big) << big << " written as " << s;
+  }
+
+  const fs::path d = fresh_dir();
+  portalsim::H5Layout layout;
+  layout.rows = 2;
+  layout.datasets = {{"features", portalsim::TensorType::f32, {2}, {"a", "b"}},
+                     {"metal", portalsim::TensorType::u8, {1}, {}},
+                     {"label", portalsim::TensorType::u8, {}, {}}};
+  const auto write = [&](const std::string& name, const std::array<float, 4>& features) {
+    const std::string path = (d / name).string();
+    const portalsim::H5InPlace place = portalsim::create_h5_in_place(path, layout);
+    const int fd = ::open(path.c_str(), O_WRONLY);
+    ASSERT_GE(fd, 0);
+    const uint8_t metal[2] = {3, 4}, label[2] = {0, 1};
+    for (uint64_t r = 0; r < 2; ++r) {
+      portalsim::write_at(fd, reinterpret_cast<const char*>(&features[2 * r]), 8, place.at(0, r, 8), path);
+      portalsim::write_at(fd, reinterpret_cast<const char*>(&metal[r]), 1, place.at(1, r, 1), path);
+      portalsim::write_at(fd, reinterpret_cast<const char*>(&label[r]), 1, place.at(2, r, 1), path);
+    }
+    ::close(fd);
+  };
+  write("big.h5", {1.5f, 1e30f, -3e20f, 2.0f});
+  const portalsim::cli::Table t = portalsim::cli::read_h5_table((d / "big.h5").string());
+  ASSERT_EQ(t.rows.size(), 2u);
+  EXPECT_EQ(t.rows[0], (std::vector<std::string>{"1.5", text(1e30f), "3", "negative"}));
+  EXPECT_EQ(t.rows[1], (std::vector<std::string>{text(-3e20f), "2", "4", "positive"}));
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    write("bad.h5", {1.5f, 2.0f, 3.0f, bad});
+    try {
+      (void)portalsim::cli::read_h5_table((d / "bad.h5").string());
+      ADD_FAILURE() << bad << " was read";
+    } catch (const portalsim::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.h5: dataset features, row 1, column b: "), std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find(" is not a number generate writes"), std::string::npos) << e.what();
+    }
   }
   fs::remove_all(d);
 }

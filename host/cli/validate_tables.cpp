@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -142,6 +143,10 @@ Table read_h5_table(const std::string& path) {
       std::vector<std::string> row;
       row.reserve(t.names.size());
       for (size_t k = 0; k < nf; ++k) {
+        if (!std::isfinite(f[i * nf + k]))
+          throw InputError(path + ": dataset features, row " + std::to_string(first + i) + ", column " +
+                           features.columns[k] + ": " + std::to_string(f[i * nf + k]) +
+                           " is not a number generate writes");
         std::string v;
         append_number(v, f[i * nf + k]);
         row.push_back(std::move(v));

@@ -7,8 +7,17 @@ namespace portalsim {
 
 void append_number(std::string& out, float v) {
   // Fixed point through integers: several times faster than printf, and the same text
-  // wherever it runs.
-  long long q = std::llround(static_cast<double>(v) * 10000.0);
+  // wherever it runs. What does not fit (no feature portalsim makes: a file read back may
+  // hold anything) is written in the shortest form that reads back as the same float.
+  const double scaled = static_cast<double>(v) * 10000.0;
+  if (!(std::fabs(scaled) < 9.0e18)) {  // llround gives a long long: below 2^63 (9.2e18)
+    char buf[64];
+    const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+    (void)ec;
+    out.append(buf, end);
+    return;
+  }
+  long long q = std::llround(scaled);
   if (q < 0) {
     out.push_back('-');
     q = -q;
