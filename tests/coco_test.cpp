@@ -108,13 +108,17 @@ TEST(Coco, ValidAndAgreesWithMasksAndYolo) {
   std::map<uint64_t, json> images;
   for (const json& im : c.at("images")) images[im.at("id").get<uint64_t>()] = im;
   std::map<std::string, std::vector<json>> per_file;
+  std::map<std::string, portalsim::Image> masks;  // each read once: an image has several annotations
   size_t annotations = 0;
   for (const json& a : c.at("annotations")) {
     const json& im = images.at(a.at("image_id").get<uint64_t>());
     const fs::path png = out / im.at("file_name").get<std::string>();
     ASSERT_TRUE(fs::exists(png)) << png;
     const std::string view = im.at("view"), folder = png.parent_path().string();
-    const portalsim::Image mask = portalsim::read_image(folder + "/mask_" + view + ".png", "mask");
+    const std::string mask_path = folder + "/mask_" + view + ".png";
+    auto known = masks.find(mask_path);
+    if (known == masks.end()) known = masks.emplace(mask_path, portalsim::read_image(mask_path, "mask")).first;
+    const portalsim::Image& mask = known->second;
     int w = 0, h = 0;
     const std::vector<uint8_t> m = decode_rle(a.at("segmentation"), w, h);
     ASSERT_EQ(w, mask.width);

@@ -39,7 +39,10 @@ std::string read(const std::string& path, const ImageLimits& limits, Image& img)
       error = std::string("image samples are ") + spec.format.c_str() + "; expected 8- or 16-bit integers";
     } else {
       img = Image(spec.width, spec.height, spec.nchannels);
-      const bool ok = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, img.pixels.data());
+      // An 8-bit file is read as it is (TypeDesc::UNKNOWN): asked for a conversion, even to
+      // its own type, OpenImageIO 2.4 reads through a 64 MiB buffer allocated per image.
+      const OIIO::TypeDesc as = depth == OIIO::TypeDesc::UINT8 ? OIIO::TypeDesc::UNKNOWN : OIIO::TypeDesc::UINT8;
+      const bool ok = in->read_image(0, 0, 0, spec.nchannels, as, img.pixels.data());
       const std::string err = in->geterror();
       if (!ok || !err.empty()) error = "corrupt or unreadable image" + (err.empty() ? "" : ": " + err);
     }
