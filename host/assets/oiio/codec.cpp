@@ -39,10 +39,17 @@ std::string read(const std::string& path, const ImageLimits& limits, Image& img)
       error = std::string("image samples are ") + spec.format.c_str() + "; expected 8- or 16-bit integers";
     } else {
       img = Image(spec.width, spec.height, spec.nchannels);
-      // An 8-bit file is read as it is (TypeDesc::UNKNOWN): asked for a conversion, even to
-      // its own type, OpenImageIO 2.4 reads through a 64 MiB buffer allocated per image.
-      const OIIO::TypeDesc as = depth == OIIO::TypeDesc::UINT8 ? OIIO::TypeDesc::UNKNOWN : OIIO::TypeDesc::UINT8;
-      const bool ok = in->read_image(0, 0, 0, spec.nchannels, as, img.pixels.data());
+      // Asked for a conversion (even to the file's own type), OpenImageIO 2.4's read_image
+      // reads through a 64 MiB buffer allocated per image: an 8-bit file is read as it is
+      // (TypeDesc::UNKNOWN), a 16-bit one a row at a time, each converted to 8 bits.
+      bool ok = true;
+      if (depth == OIIO::TypeDesc::UINT8) {
+        ok = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UNKNOWN, img.pixels.data());
+      } else {
+        const size_t row = static_cast<size_t>(spec.width) * spec.nchannels;
+        for (int y = 0; ok && y < spec.height; ++y)
+          ok = in->read_scanline(spec.y + y, 0, OIIO::TypeDesc::UINT8, img.pixels.data() + y * row);
+      }
       const std::string err = in->geterror();
       if (!ok || !err.empty()) error = "corrupt or unreadable image" + (err.empty() ? "" : ": " + err);
     }
