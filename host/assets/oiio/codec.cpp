@@ -40,11 +40,14 @@ std::string read(const std::string& path, const ImageLimits& limits, Image& img)
     } else {
       img = Image(spec.width, spec.height, spec.nchannels);
       // Asked for a conversion (even to the file's own type), OpenImageIO 2.4's read_image
-      // reads through a 64 MiB buffer allocated per image: an 8-bit file is read as it is
-      // (TypeDesc::UNKNOWN), a 16-bit one a row at a time, each converted to 8 bits.
+      // reads scanline files through a 64 MiB buffer allocated per image: an 8-bit file is
+      // read as it is (TypeDesc::UNKNOWN), a 16-bit one a row at a time, each converted to
+      // 8 bits; a tiled 16-bit file (no rows to read) through read_image, tile by tile.
       bool ok = true;
       if (depth == OIIO::TypeDesc::UINT8) {
         ok = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UNKNOWN, img.pixels.data());
+      } else if (spec.tile_width != 0) {
+        ok = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, img.pixels.data());
       } else {
         const size_t row = static_cast<size_t>(spec.width) * spec.nchannels;
         for (int y = 0; ok && y < spec.height; ++y)
