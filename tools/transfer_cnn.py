@@ -1,15 +1,22 @@
 #!/usr/bin/python3
-"""portalsim transfer's CNN: trains tools/train_example.py's small CNN on one data.h5's MMW
-views and scores it on others.
+"""portalsim transfer's CNN: trains a small CNN on one data.h5's sensors and scores it on others.
 
-  /usr/bin/python3 transfer_cnn.py OUT.json TRAIN.h5 TEST.h5 [TEST.h5 ...] [--steps 300] [--seed 0]
+  /usr/bin/python3 transfer_cnn.py OUT.json TRAIN.h5 TEST.h5 [TEST.h5 ...]
+      [--inputs mmw,ir,metal] [--steps 300] [--seed 0]
 
-Each data.h5 needs the datasets `upper`, `lower` (uint8 N x H x W, the two MMW views, as
-`generate --what both --format h5` writes them) and `label`. The CNN sees the two views as
-channels, each image standardised (zero mean, unit variance), averaged down 4 times, and trains with Adam (learning rate 2e-3), batch 32, for
---steps steps on batches drawn from the training set in a fixed order (torch's --seed).
-Writes {"correct": [...], "n": [...]} for the test files in order. Needs Debian's
-python3-torch, python3-h5py and python3-numpy.
+--inputs names the sensors the network sees, as a portal's operator fuses them:
+  mmw    the two MMW views, datasets `upper` and `lower` (uint8 N x H x W), as two channels;
+  ir     the IR image's palette indices, dataset `ir_index` (uint8 N x H x W);
+  metal  the metal detector's zones, dataset `metal` (uint8 N x Z).
+Each image is standardised (zero mean, unit variance: a camera's window and its room move
+every pixel of a view together), averaged down 4 times and read by its own convolutional
+branch (tools/train_example.py's small CNN without its last layer, 32 features); the zones
+are standardised per zone with the training set's mean and SD and read by one dense layer
+(32 features); one linear layer decides from the branches' features side by side. With
+--inputs mmw alone the network is tools/train_example.py's, unchanged. Trains with Adam
+(learning rate 2e-3), batch 32, for --steps steps on batches drawn from the training set in
+a fixed order (torch's --seed). Writes {"correct": [...], "n": [...]} for the test files in
+order. Needs Debian's python3-torch, python3-h5py and python3-numpy.
 """
 import argparse
 import json
@@ -20,38 +27,95 @@ import numpy as np
 import torch
 from torch import nn
 
+SENSORS = ("mmw", "ir", "metal")
+DATASETS = {"mmw": ("upper", "lower"), "ir": ("ir_index",), "metal": ("metal",)}
+
+
+def trunk(channels):
+    """The convolutional layers of the small CNN: an image batch to 32 features."""
+    return [nn.AvgPool2d(4),
+            nn.Conv2d(channels, 16, 5, padding=2), nn.ReLU(), nn.MaxPool2d(2),
+            nn.Conv2d(16, 32, 3, padding=1), nn.ReLU(), nn.MaxPool2d(2),
+            nn.Conv2d(32, 32, 3, padding=1), nn.ReLU(), nn.AdaptiveMaxPool2d(1),
+            nn.Flatten()]
+
 
 def model(channels):
     """The small CNN (tools/train_example.py imports it from here)."""
-    return nn.Sequential(
-        nn.AvgPool2d(4),
-        nn.Conv2d(channels, 16, 5, padding=2), nn.ReLU(), nn.MaxPool2d(2),
-        nn.Conv2d(16, 32, 3, padding=1), nn.ReLU(), nn.MaxPool2d(2),
-        nn.Conv2d(32, 32, 3, padding=1), nn.ReLU(), nn.AdaptiveMaxPool2d(1),
-        nn.Flatten(), nn.Linear(32, 2))
+    return nn.Sequential(*trunk(channels), nn.Linear(32, 2))
 
 
-def load(path):
-    """(views uint8 N x 2 x H x W, labels int64 N)."""
+class Fused(nn.Module):
+    """One branch per sensor, their features side by side, one linear decision."""
+
+    def __init__(self, inputs, zones):
+        super().__init__()
+        self.inputs = inputs
+        self.branches = nn.ModuleDict()
+        for s in inputs:
+            if s == "mmw":
+                self.branches[s] = nn.Sequential(*trunk(2))
+            elif s == "ir":
+                self.branches[s] = nn.Sequential(*trunk(1))
+            else:
+                self.branches[s] = nn.Sequential(nn.Linear(zones, 32), nn.ReLU())
+        self.decide = nn.Linear(32 * len(inputs), 2)
+
+    def forward(self, x):
+        return self.decide(torch.cat([self.branches[s](x[s]) for s in self.inputs], dim=1))
+
+
+def load(path, inputs):
+    """({sensor: uint8 tensor}, labels int64 N): images N x C x H x W, zones N x Z."""
     with h5py.File(path, "r") as f:
-        for key in ("upper", "lower", "label"):
+        need = [k for s in inputs for k in DATASETS[s]] + ["label"]
+        for key in need:
             if key not in f:
-                sys.exit(f"{path}: no dataset '{key}': the CNN reads the MMW views upper and lower and the label "
-                         "(a set made with images: --what both --format h5)")
-        if f["upper"].shape != f["lower"].shape:
-            sys.exit(f"{path}: upper and lower differ in shape")
-        x = np.stack([f["upper"][:], f["lower"][:]], axis=1)
+                sys.exit(f"{path}: no dataset '{key}': the CNN's inputs ({','.join(inputs)}) need "
+                         f"{', '.join(need)} (a set made with images: --what both --format h5)")
+        n = f["label"].shape[0]
+        x = {}
+        for s in inputs:
+            if s == "mmw":
+                if f["upper"].shape != f["lower"].shape:
+                    sys.exit(f"{path}: upper and lower differ in shape")
+                x[s] = np.stack([f["upper"][:], f["lower"][:]], axis=1)
+            elif s == "ir":
+                x[s] = f["ir_index"][:][:, None]
+            else:
+                x[s] = f["metal"][:]
+            if x[s].shape[0] != n:
+                sys.exit(f"{path}: {DATASETS[s][0]} has {x[s].shape[0]} rows, label {n}")
         y = f["label"][:].astype(np.int64)
-    return torch.from_numpy(x), torch.from_numpy(y)
+    return {s: torch.from_numpy(v) for s, v in x.items()}, torch.from_numpy(y)
 
 
 def standard(x):
-    """Each image of a uint8 batch N x 2 x H x W to zero mean and unit variance: the camera's
-    window and the room's brightness move every pixel of a view together."""
+    """Each image of a uint8 batch N x C x H x W to zero mean and unit variance."""
     x = x.float()
     mean = x.mean(dim=(2, 3), keepdim=True)
     sd = x.std(dim=(2, 3), keepdim=True).clamp_min(1.0)
     return (x - mean) / sd
+
+
+class Prepare:
+    """A batch of raw sensor tensors to the network's input; zones by the training set's statistics."""
+
+    def __init__(self, train_x, inputs):
+        self.inputs = inputs
+        if "metal" in inputs:
+            z = train_x["metal"].float()
+            self.zone_mean = z.mean(dim=0, keepdim=True)
+            self.zone_sd = z.std(dim=0, keepdim=True).clamp_min(1.0)
+
+    def __call__(self, x, idx):
+        if self.inputs == ["mmw"]:
+            return standard(x["mmw"][idx])
+        out = {}
+        for s in self.inputs:
+            v = x[s][idx]
+            out[s] = (v.float() - self.zone_mean) / self.zone_sd if s == "metal" else standard(v)
+        return out
 
 
 def main():
@@ -59,15 +123,20 @@ def main():
     p.add_argument("out")
     p.add_argument("train")
     p.add_argument("tests", nargs="+")
+    p.add_argument("--inputs", default="mmw", help="comma-separated sensors: mmw, ir, metal")
     p.add_argument("--steps", type=int, default=300)
     p.add_argument("--seed", type=int, default=0)
     a = p.parse_args()
+    inputs = a.inputs.split(",")
+    if not inputs or any(s not in SENSORS for s in inputs) or len(set(inputs)) != len(inputs):
+        p.error(f"--inputs: '{a.inputs}' is not a list of distinct sensors among {', '.join(SENSORS)}")
     torch.manual_seed(a.seed)
     torch.set_num_threads(2)
-    x, y = load(a.train)
+    x, y = load(a.train, inputs)
     if len(set(y.tolist())) < 2:
         sys.exit(f"{a.train}: the training set has a single class")
-    net = model(2)
+    net = model(2) if inputs == ["mmw"] else Fused(inputs, x["metal"].shape[1] if "metal" in x else 0)
+    prepare = Prepare(x, inputs)
     opt = torch.optim.Adam(net.parameters(), lr=2e-3)
     loss_fn = nn.CrossEntropyLoss()
     net.train()
@@ -79,7 +148,7 @@ def main():
             at = 0
         idx = order[at:at + 32]
         opt.zero_grad()
-        loss = loss_fn(net(standard(x[idx])), y[idx])
+        loss = loss_fn(net(prepare(x, idx)), y[idx])
         loss.backward()
         opt.step()
         if (step + 1) % 100 == 0:
@@ -88,10 +157,14 @@ def main():
     correct, n = [], []
     with torch.no_grad():
         for path in a.tests:
-            tx, ty = load(path)
+            tx, ty = load(path, inputs)
+            if "metal" in inputs and tx["metal"].shape[1] != x["metal"].shape[1]:
+                sys.exit(f"{path}: metal has {tx['metal'].shape[1]} zones, the training set "
+                         f"{x['metal'].shape[1]}")
             right = 0
             for at in range(0, len(ty), 256):
-                right += (net(standard(tx[at:at + 256])).argmax(1) == ty[at:at + 256]).sum().item()
+                idx = torch.arange(at, min(at + 256, len(ty)))
+                right += (net(prepare(tx, idx)).argmax(1) == ty[idx]).sum().item()
             correct.append(right)
             n.append(len(ty))
     with open(a.out, "w") as f:

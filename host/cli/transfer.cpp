@@ -48,7 +48,7 @@ constexpr Classifier kClassifiers[] = {{"j48", "weka.classifiers.trees.J48", "J4
                                        {"cnn", nullptr, "CNN"}};
 
 struct Options {
-  std::string train, out, classifiers = "j48,svm", catalogue;
+  std::string train, out, classifiers = "j48,svm", catalogue, cnn_inputs;  // cnn_inputs: "" is kDefaultCnnInputs
   std::vector<std::string> tests;
   int block = 10, cnn_steps = 300;
   double max_loss = 3.0;
@@ -72,8 +72,29 @@ bool good_name(const std::string& n) {
   });
 }
 
-// `images`: the CNN is among the classifiers, so a spec's set is made with its MMW views
-// (data.h5) and any other set must be a data.h5 that holds them.
+// The sensors the CNN may see, by --cnn-inputs' names (tools/transfer_cnn.py reads them).
+constexpr const char* kCnnInputs[] = {"mmw", "ir", "metal"};
+constexpr const char* kDefaultCnnInputs = "mmw,ir,metal";
+
+std::string cnn_input_words(const std::string& sensor) {
+  return sensor == "mmw" ? "the two MMW views" : sensor == "ir" ? "the IR image" : "the metal detector's zones";
+}
+
+// --cnn-inputs' value, checked: distinct names of kCnnInputs, in the order given.
+std::vector<std::string> cnn_inputs(const std::string& text) {
+  std::vector<std::string> out;
+  for (const std::string& s : split_commas(text)) {
+    if (std::find(std::begin(kCnnInputs), std::end(kCnnInputs), s) == std::end(kCnnInputs))
+      throw InputError("--cnn-inputs: unknown sensor '" + s + "' (mmw, ir or metal)");
+    if (std::find(out.begin(), out.end(), s) != out.end()) throw InputError("--cnn-inputs: '" + s + "' is given twice");
+    out.push_back(s);
+  }
+  if (out.empty()) throw InputError("--cnn-inputs: none given (mmw, ir or metal)");
+  return out;
+}
+
+// `images`: the CNN is among the classifiers, so a spec's set is made with its images and
+// zones (data.h5) and any other set must be a data.h5 that holds them.
 Set make_set(const std::string& name, const std::string& source, const std::string& flag, bool images) {
   Set s{.name = name, .source = source, .spec = nullptr, .table = {}};
   if (source.empty()) throw InputError(flag + ": " + name + ": no data set given");
@@ -89,8 +110,8 @@ Set make_set(const std::string& name, const std::string& source, const std::stri
     if (!fs::exists(source, ec)) throw InputError(flag + ": " + source + ": no such file or folder");
     if (images && fs::path(source).extension() != ".h5")
       throw InputError(flag + ": " + source +
-                       ": the CNN needs the MMW views: give a run spec (.toml) or a data.h5 "
-                       "with images");
+                       ": the CNN needs the sensors' images and zones: give a run spec (.toml) or a "
+                       "data.h5 with images");
   }
   return s;
 }
@@ -118,6 +139,13 @@ int run_transfer(const Options& o) {
   }
   if (chosen.empty()) throw InputError("--classifiers: none given (j48, svm, mlp or cnn)");
   const bool cnn = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return !c->weka_class; });
+  if (!o.cnn_inputs.empty() && !cnn) throw InputError("--cnn-inputs: only applies with --classifiers cnn");
+  const std::vector<std::string> sensors = cnn_inputs(o.cnn_inputs.empty() ? kDefaultCnnInputs : o.cnn_inputs);
+  std::string sensor_arg, sensor_list;  // "mmw,metal"; "the two MMW views and the metal detector's zones"
+  for (size_t k = 0; k < sensors.size(); ++k) {
+    sensor_arg += (k == 0 ? "" : ",") + sensors[k];
+    sensor_list += (k == 0 ? "" : k + 1 == sensors.size() ? " and " : ", ") + cnn_input_words(sensors[k]);
+  }
   const bool weka = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return c->weka_class; });
   std::vector<Set> sets;
   sets.push_back(make_set("train", o.train, "--train", cnn));
@@ -193,12 +221,13 @@ int run_transfer(const Options& o) {
                            {"reference", sets[1].name},
                            {"max_loss_points", o.max_loss},
                            {"interval", "95%: Wilson (accuracy), Newcombe's hybrid score (loss)"}};
+  if (cnn) report["cnn_inputs"] = sensors;
   std::vector<std::vector<long>> correct(chosen.size(), std::vector<long>(sets.size(), 0));
   std::string why;
   for (size_t c = 0; c < chosen.size(); ++c) {
-    if (!chosen[c]->weka_class) {  // the CNN, on the sets' MMW views
+    if (!chosen[c]->weka_class) {  // the CNN, on the sets' images and zones
       const std::string scores = (fs::path(scratch.path) / "cnn.json").string();
-      std::vector<std::string> args{scores, "--steps", std::to_string(o.cnn_steps)};
+      std::vector<std::string> args{scores, "--steps", std::to_string(o.cnn_steps), "--inputs", sensor_arg};
       for (const Set& s : sets) args.push_back(images_of(s, made));
       if (!run_python_script(embedded::transfer_cnn, scratch.path, args))
         throw EnvironmentError(
@@ -230,7 +259,9 @@ int run_transfer(const Options& o) {
      << " attributes), tested on each set below. Accuracy in percent with Wilson's 95% interval; loss: `"
      << sets[1].name
      << "`'s accuracy minus the set's, in points, with the 95% interval of a difference of two independent "
-        "proportions (Newcombe's hybrid score).\n\n| test set | instances |";
+        "proportions (Newcombe's hybrid score).";
+  if (cnn) md << " The CNN sees " << sensor_list << ".";
+  md << "\n\n| test set | instances |";
   for (const Classifier* c : chosen) md << " " << c->name << " | " << c->name << " loss |";
   md << "\n| --- | --- |";
   for (size_t c = 0; c < chosen.size(); ++c) md << " --- | --- |";
@@ -296,8 +327,11 @@ std::function<int()> add_transfer(CLI::App& app) {
       ->required();
   cmd->add_option("--out", o->out, "Folder for report.md, report.json and the specs' sets")->required();
   cmd->add_option("--classifiers", o->classifiers,
-                  "Comma-separated: j48, svm, mlp (WEKA, on the features) and cnn (tools/train_example.py's small "
-                  "CNN on the MMW views; python3-torch) (default j48,svm)");
+                  "Comma-separated: j48, svm, mlp (WEKA, on the features) and cnn (a small CNN on the sensors' "
+                  "images and zones, --cnn-inputs; python3-torch) (default j48,svm)");
+  cmd->add_option("--cnn-inputs", o->cnn_inputs,
+                  "Comma-separated sensors the CNN sees: mmw (the two MMW views), ir (the IR image), metal (the "
+                  "metal detector's zones) (default mmw,ir,metal)");
   cmd->add_option("--cnn-steps", o->cnn_steps, "Training steps of the CNN, batches of 32 (default 300)")
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--catalogue", o->catalogue, "Catalogue TOML for the specs and folders (default: built-in)");
