@@ -192,6 +192,10 @@ class BodyModel {
     sh_ = scale(shape_.shoulders_or_build(), 0.5, 1.6);
     ch_ = scale(shape_.chest_or_build(), 0.5, 1.6);
     hp_ = scale(shape_.hips_or_build(), 0.5, 1.6);
+    widths_.build = b_;
+    widths_.shoulders = sh_;
+    widths_.chest = ch_;
+    widths_.hips = hp_;
     arm_len_ = scale(shape_.arm_length, 0.5, 1.5);
     // The arms' turn outwards about the shoulder, from hanging down: held out nearly level,
     // or raised above the head.
@@ -282,15 +286,8 @@ class BodyModel {
 
   double centre_x(double y) const { return 100.0 + lean_ * smoothstep(150.0, 300.0, y); }
 
-  // The width scale at row y: the shoulders' above row 45, the chest's at 100, the hips'
-  // below 228, smoothly between. Exactly `build` where the three are the build.
-  double width_scale(double y) const {
-    if (sh_ == b_ && ch_ == b_ && hp_ == b_) return b_;
-    if (y <= 45.0) return sh_;
-    if (y <= 100.0) return lerp(sh_, ch_, smoothstep(45.0, 100.0, y));
-    if (y < 228.0) return lerp(ch_, hp_, smoothstep(100.0, 228.0, y));
-    return hp_;
-  }
+  // The width scale at row y (scene/body_shape.h, the one definition object places follow).
+  double width_scale(double y) const { return portalsim::width_scale(widths_, y); }
 
   double torso(double u, double y) const {
     const double side = std::fabs(u - centre_x(y)) - torso_half_width(y) * width_scale(y);
@@ -335,7 +332,7 @@ class BodyModel {
     return smin(smin(thigh, shin, 2.0), foot, 4.0);
   }
 
-  BodyShape shape_;
+  BodyShape shape_, widths_;  // widths_: the clamped build and breadths
   double b_ = 1.0, sh_ = 1.0, ch_ = 1.0, hp_ = 1.0, arm_len_ = 1.0, arm_cos_ = 1.0, arm_sin_ = 0.0;
   uint64_t seed_ = 0;
   double arm_spread_ = 0, shoulder_dy_ = 0, stance_ = 0, lean_ = 0, arm_off_ = 64.5;

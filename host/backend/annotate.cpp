@@ -377,7 +377,7 @@ struct Annotator::Kept {
   const Catalogue& cat;
   const AssetSet& assets;
   std::vector<std::vector<Runs>> runs;
-  // Subjects whose places are the same (Sensor::subject_dy in every view) share a body:
+  // Subjects whose places are the same (Sensor::subject_dx and subject_dy in every view) share a body:
   // body[subject] indexes `shape`, which names one such subject.
   std::vector<int> body, shape;
   std::vector<std::vector<Fixed>> fixed;  // per view, (body * variants + variant) * regions + region
@@ -389,7 +389,7 @@ Annotator::Annotator(const Catalogue& cat, const AssetSet& assets) : kept_(new K
     size_t b = 0;
     const auto same = [&](int other) {
       for (const Sensor& s : cat.sensors)
-        if (s.subject_dy[j] != s.subject_dy[other]) return false;
+        if (s.subject_dy[j] != s.subject_dy[other] || s.subject_dx[j] != s.subject_dx[other]) return false;
       return true;
     };
     while (b < kept_->shape.size() && !same(kept_->shape[b])) ++b;

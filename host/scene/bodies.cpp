@@ -108,6 +108,7 @@ Subject draw_body(const Catalogue& cat, uint64_t seed, int k, DrawnBody* drawn) 
   shape.chest = within(d.chest_mm / kUnitBreadths[1], kBreadthRange);
   shape.hips = within(d.hips_mm / kUnitBreadths[2], kBreadthRange);
   shape.build = within((shape.shoulders + shape.chest + shape.hips) / 3.0, kBuildRange);
+  shape.places_follow_width = true;
   shape.leg_length = within(d.crotch_ratio / kUnitCrotch, kLegLengthRange);
   shape.arm_length = within(d.arm_ratio / kUnitArm, kArmLengthRange);
   // Assumed: the three poses equally often (walk-through portals see arms down, imaging

@@ -32,6 +32,9 @@ struct BodyShape {
   // and head's, so `height` stays the stature).
   double arm_length = 1.0, leg_length = 1.0;
   Pose pose = Pose::arms_down;
+  // Whether object places follow the body's width (drawn_col): for drawn bodies and the
+  // catalogue's subjects that give a breadth key; not for `build` alone.
+  bool places_follow_width = false;
 
   double shoulders_or_build() const { return shoulders > 0 ? shoulders : build; }
   double chest_or_build() const { return chest > 0 ? chest : build; }
@@ -69,6 +72,31 @@ inline double drawn_row(const BodyShape& b, double y) {
   const double c = kBodyFloorRow - y, legs = kBodyLegRows;
   const double drawn = c <= legs ? b.leg_length * c : b.leg_length * legs + trunk_scale(b) * (c - legs);
   return kBodyFloorRow - drawn * b.height;
+}
+
+// The body's width scale at body row `y` (the 1.0 body's): the shoulders' above row 45, the
+// chest's at row 100, the hips' below row 228, smoothly between (smoothstep); exactly
+// `build` where the three are the build. The legs' spacing and thighs follow the hips'.
+inline double width_scale(const BodyShape& b, double y) {
+  const double sh = b.shoulders_or_build(), ch = b.chest_or_build(), hp = b.hips_or_build();
+  if (sh == b.build && ch == b.build && hp == b.build) return b.build;
+  const auto step = [](double e0, double e1, double x) {
+    double t = (x - e0) / (e1 - e0);
+    t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+    return t * t * (3.0 - 2.0 * t);
+  };
+  if (y <= 45.0) return sh;
+  if (y <= 100.0) return sh + (ch - sh) * step(45.0, 100.0, y);
+  if (y < 228.0) return ch + (hp - ch) * step(100.0, 228.0, y);
+  return hp;
+}
+
+// The column a point of the body at field column `u` and body row `y` is drawn at, for
+// object places: scaled about the body's centre line (column 100) by the width at that row
+// where places follow the width; `build` alone moves nothing (the thesis placed its objects
+// alike on its subjects of every build).
+inline double drawn_col(const BodyShape& b, double u, double y) {
+  return b.places_follow_width ? 100.0 + (u - 100.0) * width_scale(b, y) : u;
 }
 
 // Its inverse: the body row drawn at field row `y`.

@@ -455,6 +455,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     b.shoulders = in("shoulders", kBreadthRange, b.build);
     b.chest = in("chest", kBreadthRange, b.build);
     b.hips = in("hips", kBreadthRange, b.build);
+    b.places_follow_width = t.contains("shoulders") || t.contains("chest") || t.contains("hips");
     b.arm_length = in("arm_length", kArmLengthRange, 1.0);
     b.leg_length = in("leg_length", kLegLengthRange, 1.0);
     const std::string pose = rd.string(t, "pose", f, std::string("arms-down"));

@@ -31,7 +31,10 @@ void derive_places(const Catalogue& cat, Sensor& s) {
   // c rows above the floor is drawn c * height rows above it, and the legs' part of c also
   // scales by the leg length. Whole pixels, so that integer placement stays integer and
   // height 1 moves nothing.
+  // Across, it follows the body's width at the region's centre (drawn_col), where the
+  // subject's breadths are given.
   s.subject_dy.assign(cat.subjects.size(), {});
+  s.subject_dx.assign(cat.subjects.size(), {});
   for (size_t k = 0; k < cat.subjects.size(); ++k)
     for (int r = 0; r < cat.region_count(); ++r) {
       const BodyShape& b = cat.subjects[k].shape;
@@ -39,6 +42,9 @@ void derive_places(const Catalogue& cat, Sensor& s) {
       const double move = b.leg_length == 1.0 ? (1.0 - b.height) * (s.floor_row - c)
                                               : (drawn_row(b, s.field_row(c)) - s.field_row(c)) * s.jitter_scale_y;
       s.subject_dy[k][r] = static_cast<int>(std::lround(move));
+      const double u = s.field_col(s.rects[r].x + s.rects[r].w / 2.0);
+      const double across = (drawn_col(b, u, s.field_row(c)) - u) / s.field_per_col();
+      s.subject_dx[k][r] = static_cast<int>(std::lround(across));
     }
 }
 

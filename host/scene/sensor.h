@@ -78,6 +78,9 @@ struct Sensor {
   // stature (Subject::height, scaled about the floor): round((1 - height) (floor_row - c)),
   // c the region's centre row. Zero for height 1.
   std::vector<std::array<int, kMaxRegions>> subject_dy;
+  // Per subject, how many whole pixels across it moves with the body's width at that row
+  // (scene/body_shape.h, drawn_col), where the subject's breadths are given; else zero.
+  std::vector<std::array<int, kMaxRegions>> subject_dx;
   // The stages of its chain under each model, in order (names registered in
   // backend/stages.cpp).
   std::vector<std::string> chain{"composite", "pattern_noise", "sensor_noise", "display"};
@@ -90,6 +93,7 @@ struct Sensor {
   // goes through this; pooling uses `rects` as they are.
   Rect place(int subject, int region) const {
     Rect r = rects[region];
+    r.x += subject_dx[subject][region];
     r.y += subject_dy[subject][region];
     return r;
   }
@@ -114,7 +118,7 @@ struct Catalogue;
 // each subject's place offsets. The views' names, cameras, sides, sizes, fields, region
 // rectangles and pooling are read from the catalogue first.
 void derive_view(Catalogue& cat, Sensor& s);
-// The part of it that follows the subjects: each subject's place offsets (subject_dy).
+// The part of it that follows the subjects: each subject's place offsets (subject_dx, subject_dy).
 void derive_places(const Catalogue& cat, Sensor& s);
 
 }  // namespace portalsim

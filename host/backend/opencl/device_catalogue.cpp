@@ -88,7 +88,8 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
       }
     }
     for (size_t j = 0; j < S; ++j)
-      for (int r = 0; r < R; ++r) place_records[(views * V + j * views + k) * R + r] = {{0, s.subject_dy[j][r]}};
+      for (int r = 0; r < R; ++r)
+        place_records[(views * V + j * views + k) * R + r] = {{s.subject_dx[j][r], s.subject_dy[j][r]}};
   }
   std::vector<cl_int> tile_offsets;
   std::vector<cl_float> tile_gains;
