@@ -25,7 +25,7 @@ from torch import nn
 from torch.utils.data import DataLoader
 
 from portalsim.torch import H5Dataset, StreamDataset
-from transfer_cnn import model  # the one network, which portalsim transfer --classifiers cnn trains too
+from transfer_cnn import model  # the one network; portalsim transfer trains it with --cnn-inputs mmw
 
 # The stream's scenarios: a balanced gun set, as the data.h5 example's generate command.
 STREAM = dict(rule="gun", balance=True, what="images", views=("upper", "lower"))
