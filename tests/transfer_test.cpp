@@ -166,6 +166,18 @@ TEST(Transfer, TheCnnSeesTheSensorsItIsGiven) {
   EXPECT_GT(correct, portalsim::test::kSanitized ? -1 : tested * 75 / 100) << j.dump() << "\n" << r.err;
   EXPECT_LE(correct, tested);
   EXPECT_NE(slurp(d / "out" / "report.md").find("The CNN sees the metal detector's zones."), std::string::npos);
+  // A data.h5 of features only has no images for the default inputs: named, nothing written.
+  const auto made = finish(start(t.cap(), {"generate", "--count", "20", "--seed", "1", "--rule", "gun", "--balance",
+                                           "--format", "h5", "--out", (d / "features").string()}),
+                           120);
+  ASSERT_EQ(made.status, 0) << made.err;
+  const std::string h5 = (d / "features" / "data.h5").string();
+  const auto bad =
+      transfer(t, {"--train", h5, "--test", "in=" + h5, "--classifiers", "cnn", "--out", (d / "bad").string()});
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.err.find(h5 + ": no dataset 'upper'"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("the CNN failed (its message is above"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(d / "bad"));
 }
 
 TEST(Transfer, BadArgumentsAreRefusedBeforeAnythingIsWritten) {

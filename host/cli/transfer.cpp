@@ -231,8 +231,8 @@ int run_transfer(const Options& o) {
       for (const Set& s : sets) args.push_back(images_of(s, made));
       if (!run_python_script(embedded::transfer_cnn, scratch.path, args))
         throw EnvironmentError(
-            "transfer: the CNN failed (Debian's python3-torch, python3-h5py and python3-numpy are needed; its "
-            "message is above)");
+            "transfer: the CNN failed (its message is above; it needs Debian's python3-torch, python3-h5py and "
+            "python3-numpy)");
       const nlohmann::json j = nlohmann::json::parse(io::read_text_file(scores, "CNN scores", io::Bom::refuse));
       for (size_t k = 1; k < sets.size(); ++k) {
         correct[c][k] = j.at("correct").at(k - 1).get<long>();
