@@ -53,12 +53,10 @@ class Fused(nn.Module):
         self.inputs = inputs
         self.branches = nn.ModuleDict()
         for s in inputs:
-            if s == "mmw":
-                self.branches[s] = nn.Sequential(*trunk(2))
-            elif s == "ir":
-                self.branches[s] = nn.Sequential(*trunk(1))
-            else:
+            if s == "metal":
                 self.branches[s] = nn.Sequential(nn.Linear(zones, 32), nn.ReLU())
+            else:  # an image sensor, a channel per dataset
+                self.branches[s] = nn.Sequential(*trunk(len(DATASETS[s])))
         self.decide = nn.Linear(32 * len(inputs), 2)
 
     def forward(self, x):
@@ -76,14 +74,13 @@ def load(path, inputs):
         n = f["label"].shape[0]
         x = {}
         for s in inputs:
-            if s == "mmw":
-                if f["upper"].shape != f["lower"].shape:
-                    sys.exit(f"{path}: upper and lower differ in shape")
-                x[s] = np.stack([f["upper"][:], f["lower"][:]], axis=1)
-            elif s == "ir":
-                x[s] = f["ir_index"][:][:, None]
-            else:
+            keys = DATASETS[s]
+            if s == "metal":
                 x[s] = f["metal"][:]
+            else:  # an image sensor: its datasets as channels
+                if len({f[k].shape for k in keys}) != 1:
+                    sys.exit(f"{path}: {' and '.join(keys)} differ in shape")
+                x[s] = np.stack([f[k][:] for k in keys], axis=1)
             if x[s].shape[0] != n:
                 sys.exit(f"{path}: {DATASETS[s][0]} has {x[s].shape[0]} rows, label {n}")
         y = f["label"][:].astype(np.int64)

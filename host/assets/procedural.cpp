@@ -186,16 +186,12 @@ class BodyModel {
   explicit BodyModel(const Body& body) {
     const auto scale = [](double v, double lo, double hi) { return std::isfinite(v) ? std::clamp(v, lo, hi) : 1.0; };
     shape_ = body.shape;
-    b_ = shape_.build = scale(shape_.build, 0.5, 1.6);
+    shape_.build = scale(shape_.build, 0.5, 1.6);
     shape_.height = scale(shape_.height, 0.5, 2.0);
     shape_.leg_length = scale(shape_.leg_length, 0.5, 1.5);
-    sh_ = scale(shape_.shoulders_or_build(), 0.5, 1.6);
-    ch_ = scale(shape_.chest_or_build(), 0.5, 1.6);
-    hp_ = scale(shape_.hips_or_build(), 0.5, 1.6);
-    widths_.build = b_;
-    widths_.shoulders = sh_;
-    widths_.chest = ch_;
-    widths_.hips = hp_;
+    shape_.shoulders = scale(shape_.shoulders_or_build(), 0.5, 1.6);
+    shape_.chest = scale(shape_.chest_or_build(), 0.5, 1.6);
+    shape_.hips = scale(shape_.hips_or_build(), 0.5, 1.6);
     arm_len_ = scale(shape_.arm_length, 0.5, 1.5);
     // The arms' turn outwards about the shoulder, from hanging down: held out nearly level,
     // or raised above the head.
@@ -208,7 +204,7 @@ class BodyModel {
     shoulder_dy_ = 4.0 * var(2) - 2.0;
     stance_ = 3.0 * var(3);
     lean_ = 3.0 * var(4) - 1.5;
-    arm_off_ = 64.5 + (sh_ - 1.0) * 52.0;
+    arm_off_ = 64.5 + (shape_.shoulders - 1.0) * 52.0;
   }
 
   uint64_t seed() const { return seed_; }
@@ -287,7 +283,7 @@ class BodyModel {
   double centre_x(double y) const { return 100.0 + lean_ * smoothstep(150.0, 300.0, y); }
 
   // The width scale at row y (scene/body_shape.h, the one definition object places follow).
-  double width_scale(double y) const { return portalsim::width_scale(widths_, y); }
+  double width_scale(double y) const { return portalsim::width_scale(shape_, y); }
 
   double torso(double u, double y) const {
     const double side = std::fabs(u - centre_x(y)) - torso_half_width(y) * width_scale(y);
@@ -316,15 +312,15 @@ class BodyModel {
   }
 
   double limb_leg(double u, double y, double sgn) const {
-    const double bl = 0.5 + 0.5 * b_;
-    const double x0 = 100.0 + lean_ + sgn * (26.5 * hp_ + 0.3 * stance_);
+    const double bl = 0.5 + 0.5 * shape_.build, hp = shape_.hips;
+    const double x0 = 100.0 + lean_ + sgn * (26.5 * hp + 0.3 * stance_);
     const P p{u, y};
     const P hip{x0, 212}, mid{x0 + sgn * 0.3, 270};
     const P knee{x0 + sgn * (1.0 + 0.5 * stance_), 310};
     const P calf{x0 + sgn * (1.6 + 0.7 * stance_), 333};
     const P ankle{x0 + sgn * (0.5 + 0.5 * stance_), 382};
-    const double thigh = smin(sd_round_cone(p, hip, mid, 26.0 * hp_, 24.0 * hp_),
-                              sd_round_cone(p, mid, knee, 24.0 * hp_, 14.5 * bl), 3.0);
+    const double thigh =
+        smin(sd_round_cone(p, hip, mid, 26.0 * hp, 24.0 * hp), sd_round_cone(p, mid, knee, 24.0 * hp, 14.5 * bl), 3.0);
     const double shin = smin(sd_round_cone(p, knee, calf, 14.5 * bl, 16.5 * bl),
                              sd_round_cone(p, calf, ankle, 16.5 * bl, 7.8 * bl), 2.5);
     // Feet seen from the front: low, wider than the ankle, turned a little outwards.
@@ -332,8 +328,8 @@ class BodyModel {
     return smin(smin(thigh, shin, 2.0), foot, 4.0);
   }
 
-  BodyShape shape_, widths_;  // widths_: the clamped build and breadths
-  double b_ = 1.0, sh_ = 1.0, ch_ = 1.0, hp_ = 1.0, arm_len_ = 1.0, arm_cos_ = 1.0, arm_sin_ = 0.0;
+  BodyShape shape_;  // the body's shape, build, breadths, stature and legs clamped
+  double arm_len_ = 1.0, arm_cos_ = 1.0, arm_sin_ = 0.0;
   uint64_t seed_ = 0;
   double arm_spread_ = 0, shoulder_dy_ = 0, stance_ = 0, lean_ = 0, arm_off_ = 64.5;
 };

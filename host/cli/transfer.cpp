@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "base/error.h"
+#include "base/spoken_list.h"
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "cli/learning_sets.h"
@@ -141,10 +142,11 @@ int run_transfer(const Options& o) {
   const bool cnn = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return !c->weka_class; });
   if (!o.cnn_inputs.empty() && !cnn) throw InputError("--cnn-inputs: only applies with --classifiers cnn");
   const std::vector<std::string> sensors = cnn_inputs(o.cnn_inputs.empty() ? kDefaultCnnInputs : o.cnn_inputs);
-  std::string sensor_arg, sensor_list;  // "mmw,metal"; "the two MMW views and the metal detector's zones"
-  for (size_t k = 0; k < sensors.size(); ++k) {
-    sensor_arg += (k == 0 ? "" : ",") + sensors[k];
-    sensor_list += (k == 0 ? "" : k + 1 == sensors.size() ? " and " : ", ") + cnn_input_words(sensors[k]);
+  std::string sensor_arg;  // "mmw,metal", for tools/transfer_cnn.py
+  std::vector<std::string> sensor_words;
+  for (const std::string& sensor : sensors) {
+    sensor_arg += (sensor_arg.empty() ? "" : ",") + sensor;
+    sensor_words.push_back(cnn_input_words(sensor));
   }
   const bool weka = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return c->weka_class; });
   std::vector<Set> sets;
@@ -260,7 +262,7 @@ int run_transfer(const Options& o) {
      << sets[1].name
      << "`'s accuracy minus the set's, in points, with the 95% interval of a difference of two independent "
         "proportions (Newcombe's hybrid score).";
-  if (cnn) md << " The CNN sees " << sensor_list << ".";
+  if (cnn) md << " The CNN sees " << spoken_list(sensor_words) << ".";
   md << "\n\n| test set | instances |";
   for (const Classifier* c : chosen) md << " " << c->name << " | " << c->name << " loss |";
   md << "\n| --- | --- |";
