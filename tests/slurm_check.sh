@@ -26,11 +26,37 @@ cd "$work"
 spec=(--count 900 --seed 11 --rule gun --what both --format arff,csv,npy,h5 --batch 64)
 "$portalsim" generate "${spec[@]}" --quiet --out "$work/one"
 
+# Waits for job ID to end, failing unless it completed (a job whose dependency failed ends
+# pending). sbatch --wait looks at 2 s and then at 10 s (its sleeps grow fourfold), so a job
+# of 3 s took 10.
+wait_job() {
+  local line state end=$((SECONDS + 300))
+  while [ $SECONDS -lt $end ]; do
+    line=$(scontrol -o show job "$1")
+    state=$(grep -o 'JobState=[A-Z_]*' <<<"$line" | cut -d= -f2)
+    case $state in
+      COMPLETED) return 0 ;;
+      PENDING | CONFIGURING | RUNNING | COMPLETING)
+        if grep -q 'Reason=DependencyNeverSatisfied' <<<"$line"; then
+          echo "slurm.local: job $1 waits on a job that failed" >&2
+          return 1
+        fi
+        sleep 0.2
+        ;;
+      *)
+        echo "slurm.local: job $1 ended $state" >&2
+        return 1
+        ;;
+    esac
+  done
+  echo "slurm.local: job $1 did not end in 300 s" >&2
+  return 1
+}
 # MPI: three ranks on two cores (--overcommit), started by srun inside the job.
-timeout 300 sbatch --wait --ntasks=3 --overcommit "$slurm/generate.sbatch" "$work/mpi" "${spec[@]}" >/dev/null
+wait_job "$(sbatch --parsable --ntasks=3 --overcommit "$slurm/generate.sbatch" "$work/mpi" "${spec[@]}")"
 # An array of three shards, then the merge once all three succeeded.
 id=$(sbatch --parsable --array=0-2 "$slurm/generate.sbatch" "$work/array" "${spec[@]}")
-timeout 300 sbatch --wait --dependency=afterok:"$id" "$slurm/generate.sbatch" --merge "$work/array" 3 >/dev/null
+wait_job "$(sbatch --parsable --dependency=afterok:"$id" "$slurm/generate.sbatch" --merge "$work/array" 3)"
 
 status=0
 for d in mpi array; do

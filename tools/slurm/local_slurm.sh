@@ -64,6 +64,7 @@ SlurmctldPort=6817
 SlurmdPort=6818
 ReturnToService=2
 NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus State=UNKNOWN
+SchedulerParameters=bf_interval=1,sched_interval=2
 PartitionName=debug Nodes=ALL Default=YES MaxTime=INFINITE State=UP OverSubscribe=FORCE:4
 CONF
 export SLURM_CONF=$state/slurm.conf
