@@ -2,8 +2,9 @@
 // raw_grid_pooling.h), one work-item per scenario and pooled view. Each feature, in kelvin
 // before the display window: the scenario's tables where physics_tabulated holds (the
 // subject's bare features, each object's change alone, and each meeting pair's correction;
-// object_range: per (subject, variant, region), then per (subject, variant, region,
-// variant, region), its entries [x, y)),
+// object_range: per (subject, variant, region), then per (subject, pair), its entries
+// [x, y); pair_index: per (variant, region, variant, region), its pair's number or -1, the
+// pairs being those whose boxes meet on some subject, dims.s6 of them),
 // or else its weighted sum of the raw cells physics_raw wrote; then the NETD's noise drawn
 // in feature space (Ly Z Lx^T for the blocks, B z + Lr z_r for the regions); then the
 // window (the scenario's, where its ends are drawn), clamped to 0..255: the mean of its
@@ -77,7 +78,8 @@ FEATURE_NOISE(private)
                                     int raw_cells, global const param* phys, global const int* records,          \
                                     global const uchar* subject, global const short* objects,                    \
                                     global const param* base_features, global const int2* object_range,           \
-                                    global const int* object_feature, global const param* object_value,          \
+                                    global const int* pair_index, global const int* object_feature,           \
+                                    global const param* object_value,          \
                                     preal sd, int8 dims, global const param* noise, ulong index) {                           \
     const int blocks = dims.s0 * dims.s1;                                                                      \
     global const int* rec = records + (size_t)i * PS_REC_LEN;                                                  \
@@ -99,7 +101,9 @@ FEATURE_NOISE(private)
         for (int k = j + 1; k < n; ++k) {                                                                      \
           if (!layers_meet(rec + PS_REC_LAYERS + j * PS_LAYER_LEN, rec + PS_REC_LAYERS + k * PS_LAYER_LEN))    \
             continue;                                                                                          \
-          const int u = pairs0 + (s * combos + tab[j]) * combos + tab[k];                                      \
+          const int pair = pair_index[tab[j] * combos + tab[k]];                                               \
+          if (pair < 0) continue;                                                                              \
+          const int u = pairs0 + s * dims.s6 + pair;                                                           \
           for (int e = object_range[u].x; e < object_range[u].y; ++e) acc[object_feature[e]] += object_value[e];   \
         }                                                                                                      \
     } else {                                                                                                   \
@@ -129,8 +133,8 @@ kernel void physics_features(global const preal* raw, global const int* first, g
                              global const param* phys, int row_len, global float* features, PsViewLaunch L,
                              global const int* records, global const uchar* subject, global const short* objects,
                              global const param* base_features, global const int2* object_range,
-                             global const int* object_feature, global const param* object_value, param netd_lo,
-                             param netd_hi, int2 frames, int8 dims, global const param* noise,
+                             global const int* pair_index, global const int* object_feature,
+                             global const param* object_value, param netd_lo, param netd_hi, int2 frames, int8 dims, global const param* noise,
                              global preal* scratch, global const ulong* indices) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
@@ -150,12 +154,12 @@ kernel void physics_features(global const preal* raw, global const int* first, g
     view_features_private(work, work + count + band_x, work + count + band_x + zlen + band_y * dims.s0, row, i, &L,
                           raw, first, cells,
                           weights, columns, count, raw_cells, phys, records, subject, objects, base_features,
-                          object_range, object_feature, object_value, sd, dims, noise, index);
+                          object_range, pair_index, object_feature, object_value, sd, dims, noise, index);
   } else {
     global preal* work = scratch + (size_t)(i - get_global_offset(0)) * space;  // a launch per chunk
     view_features_global(work, work + count + band_x, work + count + band_x + zlen + band_y * dims.s0, row, i, &L,
                          raw, first, cells,
                          weights, columns, count, raw_cells, phys, records, subject, objects, base_features,
-                         object_range, object_feature, object_value, sd, dims, noise, index);
+                         object_range, pair_index, object_feature, object_value, sd, dims, noise, index);
   }
 }

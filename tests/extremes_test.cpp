@@ -1388,6 +1388,47 @@ std::vector<Scenario> front_and_back_scenes(const Catalogue& c) {
 // The shipped front-and-back portal (scenarios/portal-front-back.toml): four MMW views, two
 // of them the back's, mirrored, through both models and every tier, images and features, as
 // the built-in portal is held.
+// The tabulated raw-grid features (physics model, fast tier) keep each meeting pair's
+// correction per subject: crowded scenes on the catalogue's five subjects, and again on a
+// catalogue that lists them in reverse order (each drawn with its own texture), give the same
+// bytes subject for subject. A correction taken from another subject's table moves them.
+TEST(PortalSubjects, PairCorrectionsAreEachSubjectsOwn) {
+  const std::string text = default_text();
+  const size_t first = text.find("[[subjects]]"), regions = text.find("# --- Regions");
+  ASSERT_TRUE(first != std::string::npos && regions != std::string::npos && first < regions);
+  std::vector<std::string> blocks;
+  for (size_t at = first; at < regions;) {
+    const size_t next = std::min(text.find("[[subjects]]", at + 1), regions);
+    blocks.push_back(text.substr(at, next - at));
+    at = next;
+  }
+  ASSERT_EQ(blocks.size(), 5u);
+  std::string reversed = text.substr(0, first);
+  for (size_t k = blocks.size(); k-- > 0;) reversed += blocks[k];
+  reversed += text.substr(regions);
+  World& w = default_world();
+  World r;
+  r.cat = parse_catalogue(reversed, "test.toml", "", "");
+  for (int k = 0; k < 5; ++k) r.cat.subjects[k].texture = 4 - k;  // the texture of its place in the original
+  ASSERT_EQ(r.cat.subjects[0].name, w.cat.subjects[4].name);
+  r.assets = build_assets(r.cat);
+  r.cl = make_opencl_backend(r.cat, r.assets, test::runtime());
+  std::vector<Scenario> scenes, mirrored;
+  for (int subject = 0; subject < 5; ++subject)
+    for (size_t k = 0; k < 8; ++k) {
+      scenes.push_back(crowded(w.cat, subject, 3 * k + subject));
+      mirrored.push_back(scenes.back());
+      mirrored.back().subject = 4 - subject;
+    }
+  const Plan plan = features_plan(physics_model(151), Tier::fast);
+  ASSERT_EQ(w.cl->paths(plan), (std::vector<std::string>{"features: physics_raw_features (tabulated)"}));
+  BatchOutput a, b;
+  w.cl->run(test::batch_of(scenes, 11), plan, a);
+  r.cl->run(test::batch_of(mirrored, 11), plan, b);
+  ASSERT_EQ(a.features.size(), b.features.size());
+  EXPECT_TRUE(a.features == b.features);
+}
+
 TEST(PortalViews, FrontAndBackPortalMatchesTheReferenceInEveryTier) {
   auto w = make_world(front_back_text());
   ASSERT_EQ(w->cat.sensors.size(), 5u);

@@ -269,6 +269,7 @@ PS_KERNEL_ARGS(AnalyticNoiseArgs, PS_ANALYTIC_NOISE_ARGS)
   X(cl::Buffer, objects)            \
   X(cl::Buffer, base_features)      \
   X(cl::Buffer, object_range)       \
+  X(cl::Buffer, pair_index)         \
   X(cl::Buffer, object_feature)     \
   X(cl::Buffer, object_value)       \
   X(Real, netd_lo)                  \

@@ -63,8 +63,9 @@ class PhysicsRawFeatures final : public FeaturePath {
     bool tabulated = false;
     int count = 0;
     cl::Buffer first, cells, weights, columns;
-    cl_int8 dims{};  // blocks_x, blocks_y, band_x, band_y, regions (RawGridNoise), the first block's column
-    cl::Buffer noise, base_features, object_range, object_feature, object_value;
+    // blocks_x, blocks_y, band_x, band_y, regions (RawGridNoise), the first block's column, pairs
+    cl_int8 dims{};
+    cl::Buffer noise, base_features, object_range, pair_index, object_feature, object_value;
   };
   Tables& tables(Kernels& K, const Plan& plan, ViewDerived& derived, const FeatureLayout& lay, int slot, bool tabulated,
                  const std::vector<char>& batch_variants);
@@ -119,6 +120,7 @@ void PhysicsRawFeatures::features(Kernels& K, const Plan& plan, const Gate& g, c
                                    .objects = b.objects,
                                    .base_features = t.base_features,
                                    .object_range = t.object_range,
+                                   .pair_index = t.pair_index,
                                    .object_feature = t.object_feature,
                                    .object_value = t.object_value,
                                    .netd_lo = {noise.netd_lo},
@@ -173,7 +175,11 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& p
   const int R = cat.region_count();
   std::vector<double> bare(static_cast<size_t>(S) * t.count, 0.0), values;
   const size_t combos = static_cast<size_t>(V) * R;
-  std::vector<cl_int2> object_range(S * combos + S * combos * combos, cl_int2{{0, 0}});  // [begin, end)
+  // [begin, end) per (subject, combo), then per (subject, pair): the pairs are numbered, so
+  // that the table grows with the subjects times the pairs, not times combos squared (255
+  // drawn bodies once took 550 MB and 15 s here).
+  std::vector<cl_int2> object_range(S * combos, cl_int2{{0, 0}});
+  std::vector<cl_int> pair_index(tabulated ? combos * combos : 1, -1);
   std::vector<cl_int> features;
   if (tabulated) {
     // One scenario per subject bare, per (subject, variant, region seen) alone, and per
@@ -192,7 +198,13 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& p
         if (sv.sees(ra) && sv.sees(rb))
           for (int va = 0; va < V; ++va)
             for (int vb = 0; vb < V; ++vb)
-              if (want[va] && want[vb] && meet(va, ra, vb, rb)) pairs.push_back({va, ra, vb, rb});
+              if (want[va] && want[vb] && meet(va, ra, vb, rb)) {
+                pair_index[(static_cast<size_t>(va) * R + ra) * combos + static_cast<size_t>(vb) * R + rb] =
+                    static_cast<cl_int>(pairs.size());
+                pairs.push_back({va, ra, vb, rb});
+              }
+    t.dims.s[6] = static_cast<cl_int>(pairs.size());
+    object_range.resize(S * combos + S * pairs.size(), cl_int2{{0, 0}});
     for (int s = 0; s < S; ++s) {
       Scenario sc;
       sc.subject = s;
@@ -265,15 +277,16 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& p
           }
         }
       // Pairs: both together less each alone, plus the bare grid counted twice over.
-      for (const auto& [va, ra, vb, rb] : pairs) {
+      for (size_t q = 0; q < pairs.size(); ++q) {
+        const auto& [va, ra, vb, rb] = pairs[q];
         const size_t a = static_cast<size_t>(va) * R + ra, c = static_cast<size_t>(vb) * R + rb;
-        entries(S * combos + (s * combos + a) * combos + c,
-                {{at++, 1.0}, {alone[a], -1.0}, {alone[c], -1.0}, {bare_at, 1.0}});
+        entries(S * combos + s * pairs.size() + q, {{at++, 1.0}, {alone[a], -1.0}, {alone[c], -1.0}, {bare_at, 1.0}});
       }
     }
   }
   t.base_features = params(ctx, fp64, bare);
   t.object_range = constant(ctx, object_range);
+  t.pair_index = constant(ctx, pair_index);
   t.object_feature = constant(ctx, features);
   t.object_value = params(ctx, fp64, values);
   t.first = constant(ctx, p.first);
