@@ -177,7 +177,7 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& p
   const size_t combos = static_cast<size_t>(V) * R;
   // [begin, end) per (subject, combo), then per (subject, pair): the pairs are numbered, so
   // that the table grows with the subjects times the pairs, not times combos squared (255
-  // drawn bodies once took 550 MB and 15 s here).
+  // drawn bodies once took 2.6 GB and 15 s here).
   std::vector<cl_int2> object_range(S * combos, cl_int2{{0, 0}});
   std::vector<cl_int> pair_index(tabulated ? combos * combos : 1, -1);
   std::vector<cl_int> features;
