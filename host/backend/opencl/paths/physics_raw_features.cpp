@@ -17,8 +17,8 @@ namespace portalsim::opencl {
 
 namespace {
 
-// The pair tables index (subjects x (variants x regions)^2) cells: past this many, the
-// tables would outgrow the memory they save, and the untabulated kernel runs instead.
+// A bound on the pair tables: subjects x (variants x regions)^2, the most (subject, pair)
+// entries a run could hold; past it the untabulated kernel runs instead.
 constexpr size_t kMaxTabulatedPairs = size_t{1} << 26;
 // Global scratch for work spaces too large for private memory, per launch.
 constexpr size_t kMaxScratchBytes = 64 * kMiB;
@@ -176,8 +176,9 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& p
   std::vector<double> bare(static_cast<size_t>(S) * t.count, 0.0), values;
   const size_t combos = static_cast<size_t>(V) * R;
   // [begin, end) per (subject, combo), then per (subject, pair): the pairs are numbered, so
-  // that the table grows with the subjects times the pairs, not times combos squared (255
-  // drawn bodies once took 2.6 GB and 15 s here).
+  // that the table grows with the subjects times the pairs, not times combos squared, and an
+  // untabulated run makes none (255 drawn bodies' untabulated runs once took 2.6 GB and 15 s
+  // for an index they never read).
   std::vector<cl_int2> object_range(S * combos, cl_int2{{0, 0}});
   std::vector<cl_int> pair_index(tabulated ? combos * combos : 1, -1);
   std::vector<cl_int> features;
