@@ -134,8 +134,9 @@ kernel void physics_features(global const preal* raw, global const int* first, g
                              global const int* records, global const uchar* subject, global const short* objects,
                              global const param* base_features, global const int2* object_range,
                              global const int* pair_index, global const int* object_feature,
-                             global const param* object_value, param netd_lo, param netd_hi, int2 frames, int8 dims, global const param* noise,
-                             global preal* scratch, global const ulong* indices) {
+                             global const param* object_value, param netd_lo, param netd_hi, int2 frames,
+                             int8 dims, global const param* noise, global preal* scratch,
+                             global const ulong* indices) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
   const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);

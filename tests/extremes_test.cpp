@@ -1385,9 +1385,6 @@ std::vector<Scenario> front_and_back_scenes(const Catalogue& c) {
   return v;
 }
 
-// The shipped front-and-back portal (scenarios/portal-front-back.toml): four MMW views, two
-// of them the back's, mirrored, through both models and every tier, images and features, as
-// the built-in portal is held.
 // The tabulated raw-grid features (physics model, fast tier) keep each meeting pair's
 // correction per subject: crowded scenes on the catalogue's five subjects, and again on a
 // catalogue that lists them in reverse order (each drawn with its own texture), give the same
@@ -1429,6 +1426,9 @@ TEST(PortalSubjects, PairCorrectionsAreEachSubjectsOwn) {
   EXPECT_TRUE(a.features == b.features);
 }
 
+// The shipped front-and-back portal (scenarios/portal-front-back.toml): four MMW views, two
+// of them the back's, mirrored, through both models and every tier, images and features, as
+// the built-in portal is held.
 TEST(PortalViews, FrontAndBackPortalMatchesTheReferenceInEveryTier) {
   auto w = make_world(front_back_text());
   ASSERT_EQ(w->cat.sensors.size(), 5u);
