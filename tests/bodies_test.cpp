@@ -5,6 +5,7 @@
 #include "scene/bodies.h"
 
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
 #include <cmath>
 #include <filesystem>
@@ -436,7 +437,7 @@ TEST(Bodies, GenerateRecordsEachRowsBody) {
       {{"--bodies", "random", "--body-count", "0"}, "--body-count: \"0\" is not between 1 and 255"},
       {{"--bodies", "random", "--body-count", "256"}, "is not between 1 and 255"},
       {{"--bodies", "random", "--body-count", "1e3"}, "--body-count"},
-      {{"--bodies", "randomly"}, "--bodies: \"randomly\" is not catalogue or random"},
+      {{"--bodies", "randomly"}, "--bodies: \"randomly\" is not catalogue, random or per-scenario"},
       {{"--body-count", "9"}, "--body-count: only applies to random bodies"}};
   for (const auto& [flags, says] : bad) {
     std::vector<std::string> a = flags;
@@ -471,7 +472,169 @@ TEST(Bodies, GenerateRecordsEachRowsBody) {
   test::spit(t.w() / "s.toml", "count = 3\n\nbodies = \"everyone\"\n");
   const test::Result r = generate(t, {"--spec", (t.w() / "s.toml").string()}, t.w() / "bad");
   EXPECT_NE(r.status, 0);
-  EXPECT_TRUE(test::has(r.err, "s.toml:3: bodies: \"everyone\" is not catalogue or random")) << r.err;
+  EXPECT_TRUE(test::has(r.err, "s.toml:3: bodies: \"everyone\" is not catalogue, random or per-scenario")) << r.err;
+  EXPECT_FALSE(fs::exists(t.w() / "bad"));
+}
+
+// generate --bodies per-scenario: scenario i carries body i of the body seed, made a page
+// of bodies at a time (scene/bodies.h). The rows of `scenarios.csv`, from after its header.
+std::vector<std::string> list_rows(const fs::path& csv) {
+  std::istringstream in(test::slurp(csv));
+  std::vector<std::string> rows;
+  std::string row;
+  std::getline(in, row);
+  while (std::getline(in, row)) rows.push_back(row);
+  return rows;
+}
+// Where the k-th comma (1-based) of a CSV row without quotes is; field k (0-based).
+size_t comma(const std::string& row, int k) {
+  size_t at = std::string::npos;
+  for (int i = 0; i < k; ++i) at = row.find(',', at + 1);
+  return at;
+}
+std::string field(const std::string& row, int k) {
+  const size_t at = k == 0 ? 0 : comma(row, k) + 1;
+  return row.substr(at, row.find(',', at) - at);
+}
+// data.h5's subject dataset.
+std::vector<uint8_t> h5_subjects(const fs::path& file) {
+  std::vector<uint8_t> v;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  EXPECT_GE(f, 0) << file;
+  if (f < 0) return v;
+  const hid_t ds = H5Dopen2(f, "subject", H5P_DEFAULT);
+  EXPECT_GE(ds, 0) << file << ": no dataset subject";
+  if (ds >= 0) {
+    const hid_t space = H5Dget_space(ds);
+    v.resize(static_cast<size_t>(H5Sget_simple_extent_npoints(space)));
+    EXPECT_GE(H5Dread(ds, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), 0);
+    H5Sclose(space);
+    H5Dclose(ds);
+  }
+  H5Fclose(f);
+  return v;
+}
+
+// Each row's body is body `index` of the seed, recorded; and the run's images, features and
+// metal zones are those of a run of random bodies whose list gives scenario i body i + 1
+// (the same bodies, drawn once): across the first page's end, on both backends.
+TEST(Bodies, PerScenarioBodiesAreEachScenariosOwn) {
+  test::TempDir t;
+  const int n = kBodyPage + 63;  // two pages
+  for (const char* backend : {"opencl", "reference"}) {
+    SCOPED_TRACE(backend);
+    const bool ref = std::string(backend) == "reference";
+    // The reference backend: the thesis model's features (its fp64 images are slow).
+    const std::vector<std::string> common =
+        ref ? std::vector<std::string>{"--backend", backend,  "--model",  "thesis",   "--seed",
+                                       "5",         "--what", "features", "--format", "csv"}
+            : std::vector<std::string>{"--backend", backend,  "--model", "physics",  "--seed",
+                                       "5",         "--what", "both",    "--format", "csv"};
+    std::vector<std::string> own = common;
+    own.insert(own.end(), {"--bodies", "per-scenario", "--count", std::to_string(n)});
+    const fs::path a = t.w() / (std::string("own-") + backend);
+    const test::Result r = generate(t, own, a);
+    ASSERT_EQ(r.status, 0) << test::describe(r);
+    const std::vector<std::string> rows = list_rows(a / "scenarios.csv");
+    ASSERT_EQ(rows.size(), static_cast<size_t>(n));
+    std::set<std::string> bodies;
+    std::string list =
+        "index,subject,region1,region2,region3,region4,region5,region6,region7,region8,region9,region10,region11,"
+        "region12,region13\n";
+    for (int i = 0; i < n; ++i) {
+      EXPECT_EQ(field(rows[i], 1), "0") << "row " << i << ": its own body";
+      const std::string body = rows[i].substr(comma(rows[i], 15) + 1, std::string::npos);
+      const std::string drawn = draw_body(test::catalogue(), 5, static_cast<uint64_t>(i)).drawn;
+      EXPECT_EQ(body.substr(0, drawn.size()), drawn) << "row " << i;
+      bodies.insert(drawn);
+      list += std::to_string(i) + "," + std::to_string(i + 1) +
+              rows[i].substr(comma(rows[i], 2), comma(rows[i], 15) - comma(rows[i], 2)) + "\n";
+    }
+    EXPECT_EQ(bodies.size(), static_cast<size_t>(n)) << "a body per scenario";
+    test::spit(t.w() / "list.csv", list);
+    std::vector<std::string> pool = common;
+    pool.insert(pool.end(), {"--bodies", "random", "--body-count", std::to_string(n), "--scenarios",
+                             (t.w() / "list.csv").string()});
+    const fs::path b = t.w() / (std::string("pool-") + backend);
+    ASSERT_EQ(generate(t, pool, b).status, 0);
+    EXPECT_EQ(test::slurp(a / "features.csv"), test::slurp(b / "features.csv"));
+    if (!ref)
+      for (const int i : {0, kBodyPage - 1, kBodyPage, n - 1}) {
+        char dir[16];
+        std::snprintf(dir, sizeof dir, "%08d", i);
+        for (const char* f : {"upper.png", "lower.png", "ir.png", "metal.csv"})
+          EXPECT_EQ(test::slurp(a / "images" / dir / f), test::slurp(b / "images" / dir / f)) << dir << "/" << f;
+      }
+  }
+}
+
+// The same bytes for any batch and for shards that start inside a page; data.h5's subject
+// is 0 (each row's own body); bad combinations are refused naming the flag or the spec
+// file's line, with nothing written; evaluate reads a folder of per-scenario bodies.
+TEST(Bodies, PerScenarioBodiesAnyBatchOrShardAndBadInput) {
+  test::TempDir t;
+  const std::vector<std::string> run = {"--model", "physics",  "--bodies", "per-scenario", "--count",
+                                        "250",     "--seed",   "8",        "--rule",       "gun",
+                                        "--what",  "features", "--format", "csv,h5"};
+  const auto with = [&](std::vector<std::string> more) {
+    std::vector<std::string> a = run;
+    a.insert(a.end(), more.begin(), more.end());
+    return a;
+  };
+  ASSERT_EQ(generate(t, run, t.w() / "a").status, 0);
+  ASSERT_EQ(generate(t, with({"--batch", "37", "--threads", "1"}), t.w() / "b").status, 0);
+  for (const char* f : {"scenarios.csv", "features.csv", "data.h5"})
+    EXPECT_EQ(test::slurp(t.w() / "a" / f), test::slurp(t.w() / "b" / f)) << f;
+  // Shard 1 of 2 is scenarios [125, 250): it starts inside the first page.
+  ASSERT_EQ(generate(t, with({"--shard", "1/2"}), t.w() / "s").status, 0);
+  const std::vector<std::string> whole = list_rows(t.w() / "a" / "scenarios.csv"),
+                                 part = list_rows(t.w() / "s" / "scenarios.csv");
+  ASSERT_EQ(part.size(), 125u);
+  for (size_t i = 0; i < part.size(); ++i) EXPECT_EQ(part[i], whole[125 + i]) << "row " << 125 + i;
+  // The thesis model's sparse features path, whose tables are per subject, steps aside.
+  const test::Result th =
+      test::finish(test::start(t.cap(), {"generate", "--model", "thesis", "--bodies", "per-scenario", "--count", "4",
+                                         "--timing", "--quiet", "--out", (t.w() / "th").string()}),
+                   120);
+  ASSERT_EQ(th.status, 0) << test::describe(th);
+  EXPECT_TRUE(test::has(th.out, "features: pooled from the rendered views")) << th.out;
+  const std::vector<uint8_t> subjects = h5_subjects(t.w() / "a" / "data.h5");
+  EXPECT_EQ(subjects, std::vector<uint8_t>(250, 0)) << "data.h5: 0, each row's own body";
+  const test::Result e = test::finish(test::start(t.cap(), {"evaluate", (t.w() / "a").string(), "--bootstrap", "20",
+                                                            "--no-plot", "--out", (t.w() / "report").string()}),
+                                      300);
+  ASSERT_EQ(e.status, 0) << test::describe(e);
+  EXPECT_TRUE(fs::exists(t.w() / "report" / "report.json"));
+
+  const std::vector<std::pair<std::vector<std::string>, std::string>> bad = {
+      {{"--body-count", "9"}, "--body-count: only applies to random bodies"},
+      {{"--subjects", "1"}, "--subjects: does not apply to per-scenario bodies"},
+      {{"--scenarios", (t.w() / "a" / "scenarios.csv").string()}, "--scenarios: a scenario list names its subjects"}};
+  for (const auto& [flags, says] : bad) {
+    const test::Result r = generate(t, with(flags), t.w() / "bad");
+    EXPECT_EQ(r.status, 2) << flags.front();
+    EXPECT_TRUE(test::has(r.err, says)) << flags.front() << ": " << r.err;
+    EXPECT_FALSE(fs::exists(t.w() / "bad")) << "nothing written for " << flags.front();
+  }
+  // A list with a per-scenario body's subject (0), given to a run of named subjects.
+  const test::Result l =
+      generate(t, {"--bodies", "random", "--body-count", "9", "--scenarios", (t.w() / "a" / "scenarios.csv").string()},
+               t.w() / "bad");
+  EXPECT_EQ(l.status, 3) << "bad input in a file";
+  EXPECT_TRUE(test::has(l.err,
+                        "scenarios.csv:2: subject: \"0\" is not a subject number (1 to 9); 0 is a "
+                        "per-scenario body's"))
+      << l.err;
+  EXPECT_FALSE(fs::exists(t.w() / "bad"));
+  const test::Result s = test::finish(
+      test::start(t.cap(), {"simulate", "gun", "--bodies", "per-scenario", "--out", (t.w() / "bad").string()}), 120);
+  EXPECT_EQ(s.status, 2);
+  EXPECT_TRUE(test::has(s.err, "--bodies: per-scenario bodies are drawn per scenario of a data set")) << s.err;
+  EXPECT_FALSE(fs::exists(t.w() / "bad"));
+  test::spit(t.w() / "s.toml", "count = 3\nbodies = \"per-scenario\"\n\nbody_count = 4\n");
+  const test::Result f = generate(t, {"--spec", (t.w() / "s.toml").string()}, t.w() / "bad");
+  EXPECT_EQ(f.status, 3) << "bad input in a file";
+  EXPECT_TRUE(test::has(f.err, "s.toml:4: body_count: only applies to random bodies")) << f.err;
   EXPECT_FALSE(fs::exists(t.w() / "bad"));
 }
 

@@ -80,10 +80,10 @@ void colourise(const uint8_t* index, size_t n, const Palette& palette, uint8_t* 
   for (size_t i = 0; i < n; ++i) std::memcpy(rgb + 3 * i, palette[index[i]].data(), 3);
 }
 
-AssetSet build_assets(const Catalogue& cat, bool fold_patterns) {
-  AssetSet a;
-  a.palette = procedural::ir_palette();
-  const ImagesConfig& ic = cat.images;
+namespace {
+
+// Each subject's base images and, with fold_patterns, their folds.
+void draw_subjects(AssetSet& a, const Catalogue& cat, bool fold_patterns) {
   // Each subject's base images; drawn ones on every core (a run of random bodies draws up
   // to 255), files one at a time.
   a.bases.resize(cat.subjects.size());
@@ -131,6 +131,24 @@ AssetSet build_assets(const Catalogue& cat, bool fold_patterns) {
       }
     });
   }
+}
+
+}  // namespace
+
+AssetSet with_subjects(const AssetSet& base, const Catalogue& cat) {
+  AssetSet a;
+  a.palette = base.palette;
+  a.sprites = base.sprites;
+  a.noise = base.noise;
+  draw_subjects(a, cat, !base.folds.empty());
+  return a;
+}
+
+AssetSet build_assets(const Catalogue& cat, bool fold_patterns) {
+  AssetSet a;
+  a.palette = procedural::ir_palette();
+  const ImagesConfig& ic = cat.images;
+  draw_subjects(a, cat, fold_patterns);
   // Each sprite set's drawings keep the objects' physical size: a catalogue size is in field
   // units, scaled by the set's view pixels per unit. A file is its camera's drawing as given.
   // Drawn on every thread (each drawing stands alone), files one at a time as the bases are.

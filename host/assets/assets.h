@@ -31,6 +31,10 @@ struct AssetSet {
 // Without fold_patterns, `folds` stays empty (a run that gives no --clothing-folds: a run of
 // 255 random bodies draws them in 0.2 s and carries 30 MB more to the device).
 AssetSet build_assets(const Catalogue& cat, bool fold_patterns = true);
+// `base` (built for a catalogue like `cat` but for its subjects) with `cat`'s subjects'
+// bases, and their folds where `base` has folds: a page of per-scenario bodies
+// (scene/bodies.h, use_page_bodies) keeps the run's sprites and noise.
+AssetSet with_subjects(const AssetSet& base, const Catalogue& cat);
 
 // Converts a loaded user image: to gray (luminance), to a temperature index (nearest
 // palette colour for RGB captures), with alpha taken from the last channel when present.

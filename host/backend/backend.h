@@ -65,6 +65,9 @@ class Backend {
   // The camera views run() renders for `plan` (indices into Catalogue::sensors): those whose
   // images are kept, and the pooled ones where no features path makes the features.
   virtual std::vector<int> rendered_views(const Plan& plan) const = 0;
+  // The same backend (its device and settings) for another catalogue's subjects: a page of
+  // per-scenario bodies (scene/bodies.h). `cat` and `assets` must outlive it.
+  virtual std::unique_ptr<Backend> for_catalogue(const Catalogue& cat, const AssetSet& assets) const = 0;
   // paths()'s name for features made by pooling the rendered views, the way both backends can.
   static constexpr const char* kPooledFeatures = "pooled from the rendered views";
 

@@ -51,6 +51,8 @@ void open_catalogue(Session& s, const CommonOptions& o, const RunSpec* spec, boo
   auto t0 = std::chrono::steady_clock::now();
   s.catalogue = o.catalogue.empty() ? default_catalogue(o.assets) : load_catalogue(o.catalogue, o.assets);
   if (spec && spec->random_bodies()) use_random_bodies(s.catalogue, spec->bodies_seed(), spec->random_bodies());
+  // The first page's: a run makes the others as it reaches them (schedule/body_pages.h).
+  if (spec && spec->per_scenario_bodies()) use_page_bodies(s.catalogue, spec->bodies_seed(), 0);
   s.catalogue_seconds = since(t0);
   t0 = std::chrono::steady_clock::now();
   s.assets = build_assets(s.catalogue, fold_patterns);
@@ -102,8 +104,9 @@ void open_backend(Session& s, const CommonOptions& o) {
 
 void add_body_options(CLI::App& app, BodyOptions& o, const std::string& seed_default) {
   app.add_option("--bodies", o.bodies,
-                 "the subjects: catalogue (its own), or random: bodies drawn from the ANSUR II survey's statistics, "
-                 "each with its own pose and skin, in place of them (docs/model/bodies.md)");
+                 "the subjects: catalogue (its own), random: --body-count bodies drawn from the ANSUR II survey's "
+                 "statistics, each with its own pose and skin, in place of them, or per-scenario: a body drawn so "
+                 "for every scenario (docs/model/bodies.md)");
   app.add_option("--body-count", o.count,
                  "how many random bodies, 1 .. " + std::to_string(kMaxRandomBodies) + " (default " +
                      std::to_string(kDefaultRandomBodies) + ")");
@@ -120,6 +123,10 @@ int parse_body_count(const std::string& text) {
 RunSpec bodies_spec(const BodyOptions& o) {
   RunSpec spec;
   spec.bodies = o.bodies;
+  if (spec.per_scenario_bodies())
+    throw InputError(
+        "--bodies: per-scenario bodies are drawn per scenario of a data set (generate, run, evaluate "
+        "--spec); here, give --bodies random and choose one with --subject");
   if (!o.count.empty()) spec.body_count = parse_body_count(o.count);
   if (!o.seed.empty()) spec.body_seed = io::parse_u64(o.seed, "--body-seed");
   spec.validate();  // names the flags: --bodies, --body-count, --body-seed
@@ -133,13 +140,19 @@ RunSpec bodies_of_folder(const std::string& dir) {
   if (dir.empty() || !std::filesystem::exists(path, ec)) return spec;  // the reader says what is missing
   const nlohmann::json manifest = parse_manifest(io::read_text_file(path, "manifest", io::Bom::refuse), path);
   const nlohmann::json& made = manifest["spec"];
-  if (made.value("bodies", std::string("catalogue")) != "random") return spec;
-  const nlohmann::json& count = made.value("body_count", nlohmann::json());
-  if (!count.is_number_integer() || count.get<int64_t>() < 1 || count.get<int64_t>() > kMaxRandomBodies)
-    throw InputError(path + ": spec.body_count: not a count of random bodies (1 to " +
-                     std::to_string(kMaxRandomBodies) + ")");
-  spec.bodies = "random";
-  spec.body_count = count.get<int>();
+  const std::string bodies = made.value("bodies", std::string("catalogue"));
+  if (bodies == "per-scenario") {
+    spec.bodies = bodies;
+  } else if (bodies == "random") {
+    const nlohmann::json& count = made.value("body_count", nlohmann::json());
+    if (!count.is_number_integer() || count.get<int64_t>() < 1 || count.get<int64_t>() > kMaxRandomBodies)
+      throw InputError(path + ": spec.body_count: not a count of random bodies (1 to " +
+                       std::to_string(kMaxRandomBodies) + ")");
+    spec.bodies = bodies;
+    spec.body_count = count.get<int>();
+  } else {
+    return spec;
+  }
   for (const char* key : {"seed", "body_seed"})
     if (!made.contains(key) || !made[key].is_string())
       throw InputError(path + ": spec." + key + ": expected the seed as a string of digits");

@@ -209,7 +209,7 @@ EvaluateData read_evaluate_data(const std::string& dir, const Catalogue& cat) {
   }
   // Per region: does it hold a threat? From scenarios.csv, row for row with the table.
   const std::string list_path = (fs::path(dir) / "scenarios.csv").string();
-  const ScenarioListFile list(cat, list_path);
+  const ScenarioListFile list(cat, list_path, manifest["spec"].value("bodies", "") == "per-scenario");
   if (list.size() != d.label.size())
     throw InputError(list_path + ": " + std::to_string(list.size()) + " scenarios, the feature table " + table_path +
                      " has " + std::to_string(d.label.size()) + " rows");

@@ -200,6 +200,9 @@ struct Plan {
   bool metal = true;            // metal zones
   bool features = true;         // block and region means of the pooled views
   bool annotations = false;     // per-object boxes and instance masks (backend/annotate.h)
+  // Every scenario has a subject of its own (--bodies per-scenario): paths whose per-subject
+  // tables cost more than rendering a page's scenarios step aside.
+  bool own_subjects = false;
   ModelSettings model;
   Fidelity fidelity;
   // How the IR temperature index is written as RGB (images, h5 `ir`, serve); not part of

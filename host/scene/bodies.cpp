@@ -82,8 +82,8 @@ double within(double v, BodyRange r) { return std::clamp(v, r.lo, r.hi); }
 
 }  // namespace
 
-Subject draw_body(const Catalogue& cat, uint64_t seed, int k, DrawnBody* drawn) {
-  const auto word = [&](uint32_t element) { return draw(seed, static_cast<uint64_t>(k), kStreamBodies, element); };
+Subject draw_body(const Catalogue& cat, uint64_t seed, uint64_t k, DrawnBody* drawn) {
+  const auto word = [&](uint32_t element) { return draw(seed, k, kStreamBodies, element); };
   const Philox4 w0 = word(0), w1 = word(1), w2 = word(2);
   DrawnBody d;
   d.female = (w0[0] >> 31) != 0;
@@ -100,7 +100,7 @@ Subject draw_body(const Catalogue& cat, uint64_t seed, int k, DrawnBody* drawn) 
 
   Subject b;
   char name[32];
-  std::snprintf(name, sizeof name, "body-%03d", k + 1);
+  std::snprintf(name, sizeof name, "body-%03llu", static_cast<unsigned long long>(k) + 1);
   b.name = name;
   BodyShape& shape = b.shape;
   shape.height = within(d.stature_mm / kUnitStature, kHeightRange);
@@ -163,6 +163,13 @@ std::string body_summary(const Subject& s) {
 void use_random_bodies(Catalogue& cat, uint64_t seed, int count) {
   std::vector<Subject> bodies;
   for (int k = 0; k < count; ++k) bodies.push_back(draw_body(cat, seed, k));
+  cat.subjects = std::move(bodies);
+  for (Sensor& s : cat.sensors) derive_places(cat, s);
+}
+
+void use_page_bodies(Catalogue& cat, uint64_t seed, uint64_t page) {
+  std::vector<Subject> bodies;
+  for (int k = 0; k < kBodyPage; ++k) bodies.push_back(draw_body(cat, seed, page * kBodyPage + k));
   cat.subjects = std::move(bodies);
   for (Sensor& s : cat.sensors) derive_places(cat, s);
 }

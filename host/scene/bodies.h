@@ -36,10 +36,22 @@ std::string body_summary(const Subject& s);
 // Body k (0-based) of a run: a pure function of (seed, k) on the counter generator's
 // PS_STREAM_BODIES stream, whatever the run's count, batch or shard. `cat` gives the
 // skin's defaults and the IR index map the subject's images are drawn in.
-Subject draw_body(const Catalogue& cat, uint64_t seed, int k, DrawnBody* drawn = nullptr);
+Subject draw_body(const Catalogue& cat, uint64_t seed, uint64_t k, DrawnBody* drawn = nullptr);
 
 // Replaces the catalogue's subjects by `count` drawn bodies ("body-001", ...) and derives
 // every view's places on them again.
 void use_random_bodies(Catalogue& cat, uint64_t seed, int count);
+
+// Per-scenario bodies (--bodies per-scenario): scenario i carries body i, drawn as above.
+// The kernels name a scenario's subject in a byte, so a run takes its scenarios a page at
+// a time: page p's catalogue holds the bodies of scenarios [p kBodyPage, (p + 1) kBodyPage)
+// and scenario i is its subject i mod kBodyPage. A multiple of data.h5's chunk rows, so
+// that a page's batch ends where a chunk does.
+constexpr int kBodyPage = 192;
+inline uint64_t body_page(uint64_t index) { return index / kBodyPage; }
+inline int page_subject(uint64_t index) { return static_cast<int>(index % kBodyPage); }
+// Replaces the catalogue's subjects by page `page`'s bodies and derives every view's places
+// on them again.
+void use_page_bodies(Catalogue& cat, uint64_t seed, uint64_t page);
 
 }  // namespace portalsim

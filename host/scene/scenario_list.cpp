@@ -41,8 +41,9 @@ std::atomic<uint64_t> g_mark_rows{1u << 16};
 
 }  // namespace
 
-ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, const std::string& path, size_t lineno)
-    : cat_(cat), path_(path) {
+ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, const std::string& path, size_t lineno,
+                           bool own_bodies)
+    : cat_(cat), path_(path), own_bodies_(own_bodies) {
   std::vector<std::string> header;
   header.resize(split_fields(without_line_end(header_line), header, path, lineno));
   fields_ = header.size();
@@ -116,11 +117,15 @@ Scenario ScenarioRows::parse(std::string_view row, size_t lineno, ListedTransfor
   Scenario s;
   const std::string& subj = f[col_subject_];
   int sv = 0;
-  if (subj.empty() || subj.size() > 3 || subj.find_first_not_of("0123456789") != std::string::npos ||
-      (sv = std::stoi(subj)) < 1 || sv > static_cast<int>(cat_.subjects.size()))
+  if (own_bodies_) {
+    if (subj != "0") throw InputError(at() + ": subject: \"" + subj + "\" is not 0 (each scenario's own body)");
+  } else if (subj.empty() || subj.size() > 3 || subj.find_first_not_of("0123456789") != std::string::npos ||
+             (sv = std::stoi(subj)) < 1 || sv > static_cast<int>(cat_.subjects.size())) {
     throw InputError(at() + ": subject: \"" + subj + "\" is not a subject number (1 to " +
-                     std::to_string(cat_.subjects.size()) + ")");
-  s.subject = sv - 1;
+                     std::to_string(cat_.subjects.size()) + ")" +
+                     (subj == "0" ? "; 0 is a per-scenario body's, which a list cannot name" : ""));
+  }
+  s.subject = own_bodies_ ? 0 : sv - 1;
   for (int r = 0; r < cat_.region_count(); ++r) {
     static const std::string kNone = "none";
     const std::string& token = f[col_region_[r]].empty() ? kNone : f[col_region_[r]];
@@ -267,7 +272,7 @@ void ScenarioListFile::set_piece_bytes_for_tests(size_t bytes, uint64_t mark_row
   g_mark_rows = mark_rows;
 }
 
-ScenarioListFile::ScenarioListFile(const Catalogue& cat, std::string path)
+ScenarioListFile::ScenarioListFile(const Catalogue& cat, std::string path, bool own_bodies)
     : path_(std::move(path)), mark_rows_(g_mark_rows), cursor_(std::make_unique<Cursor>()) {
   fd_ = io::open_regular_file(path_, "scenario file");
   Cursor& c = *cursor_;
@@ -281,7 +286,8 @@ ScenarioListFile::ScenarioListFile(const Catalogue& cat, std::string path)
     if (c.line == 1 && line.starts_with("\xEF\xBB\xBF")) line.remove_prefix(3);
     io::check_line(line, path_, c.line);
     const std::string_view body = without_line_end(line);
-    if (!body.empty() && body[0] != '#') columns_ = std::make_unique<ScenarioRows>(cat, line, path_, c.line);
+    if (!body.empty() && body[0] != '#')
+      columns_ = std::make_unique<ScenarioRows>(cat, line, path_, c.line, own_bodies);
   }
   if (!columns_) throw InputError(path_ + ": empty scenario file (expected a header line)");
   // Count the rows, marking where every mark_rows_-th starts; no row is parsed here.

@@ -34,8 +34,10 @@ inline constexpr size_t kMaxFieldBytes = 256;
 // A list's columns (from its header line) and the parsing of its rows.
 class ScenarioRows {
  public:
-  // `header`: the header line (no line end); `line` its line number in `path`.
-  ScenarioRows(const Catalogue& cat, std::string_view header, const std::string& path, size_t line);
+  // `header`: the header line (no line end); `line` its line number in `path`. With
+  // `own_bodies`, the list of a run of per-scenario bodies: every subject is 0 (its own body).
+  ScenarioRows(const Catalogue& cat, std::string_view header, const std::string& path, size_t line,
+               bool own_bodies = false);
   bool has_transforms() const { return transform_columns_ != 0; }
   // Object tokens already read, per thread: lists repeat a few names millions of times.
   struct TokenHash {
@@ -52,6 +54,7 @@ class ScenarioRows {
  private:
   const Catalogue& cat_;
   std::string path_;
+  bool own_bodies_;
   size_t fields_ = 0;
   int col_subject_ = -1, col_label_ = -1;
   std::array<int, kMaxRegions> col_region_{};
@@ -69,7 +72,8 @@ std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view
 // for, from the nearest mark. Memory stays flat whatever the file's length.
 class ScenarioListFile {
  public:
-  ScenarioListFile(const Catalogue& cat, std::string path);
+  // `own_bodies`: as ScenarioRows's (evaluate reads a run of per-scenario bodies' list).
+  ScenarioListFile(const Catalogue& cat, std::string path, bool own_bodies = false);
   ~ScenarioListFile();
   ScenarioListFile(const ScenarioListFile&) = delete;
   ScenarioListFile& operator=(const ScenarioListFile&) = delete;

@@ -51,14 +51,19 @@ struct SceneBatch {
   std::vector<uint8_t> subject;   // n
   std::vector<int16_t> objects;   // n * regions, region-major within a scenario
   std::vector<uint8_t> label;     // n
+  // Per-scenario bodies (scene/bodies.h): each scenario's body as drawn (Subject::drawn);
+  // `subject` is then its place in the body page. Empty for a run's own subjects.
+  std::vector<std::string> bodies;
 
   size_t size() const { return subject.size(); }
+  bool own_bodies() const { return !bodies.empty(); }
   uint64_t index_of(size_t i) const { return indices.empty() ? first_index + i : indices[i]; }
   void clear() {
     indices.clear();
     subject.clear();
     objects.clear();
     label.clear();
+    bodies.clear();
   }
   void push(const Scenario& s) {
     subject.push_back(static_cast<uint8_t>(s.subject));

@@ -91,7 +91,7 @@ std::string tensor_meaning(const std::string& name, const Portal& portal) {
                      "), then region means (names in its columns attribute)";
   static const std::map<std::string, std::string> m{
       {"label", "1 = threat, 0 = not"},
-      {"subject", "the subject, 1-based"},
+      {"subject", "the subject, 1-based; 0 where every scenario has its own body (scenarios.csv records each)"},
       {"region_orientation", "per region: the drawing's index (object_drawings: h, v), -1 none"},
       {"region_label", "per region: the rule applied to that region's object alone"},
       {"region_rotation", "per region: the object's angle in degrees, counter-clockwise (0 where empty)"},

@@ -15,6 +15,7 @@
 #include "base/error.h"
 #include "base/parallel.h"
 #include "base/sizes.h"
+#include "schedule/body_pages.h"
 #include "schedule/dataset_card.h"
 #include "schedule/identity.h"
 #include "schedule/run_state.h"
@@ -197,7 +198,8 @@ FolderStart examine_folder(const std::string& dir, const json& identity, bool re
 // Generates, computes and writes scenarios [written, res.end) batch by batch: the main
 // thread generates and computes batch k while a writer thread writes batch k-1, records
 // `checkpoint(next)` and advances `written` (which an error leaves where it stood).
-void run_batches(const ScenarioSource& source, const Plan& plan, Backend& backend,
+// Per-scenario bodies (`pages`): a batch never crosses a page of bodies, and runs on its page's backend.
+void run_batches(const ScenarioSource& source, const Plan& plan, Backend& backend, BodyPages* pages,
                  std::vector<std::unique_ptr<Sink>>& sinks, unsigned threads, const PipelineOptions& opt,
                  const std::function<void(uint64_t)>& checkpoint, PipelineResult& res, Clock::time_point t0,
                  std::atomic<uint64_t>& written) {
@@ -223,18 +225,19 @@ void run_batches(const ScenarioSource& source, const Plan& plan, Backend& backen
   std::exception_ptr compute_error;
   double last_draw = -1;
   try {
-    for (uint64_t at = first; at < res.end; at += res.batch) {
+    for (uint64_t at = first, n = 0; at < res.end; at += n) {
+      n = std::min<uint64_t>(res.batch, res.end - at);
+      if (pages) n = std::min<uint64_t>(n, (body_page(at) + 1) * kBodyPage - at);
       if (opt.stop && *opt.stop) {
         res.interrupted = true;
         break;
       }
       if (hand.failed()) break;
       std::unique_ptr<Job> job = hand.recycled();
-      const size_t n = static_cast<size_t>(std::min<uint64_t>(res.batch, res.end - at));
       SceneBatch& b = job->scenes;
-      source.fill(at, n, threads, b);
+      source.fill(at, static_cast<size_t>(n), threads, b);
       const auto tc = Clock::now();
-      backend.run(b, plan, job->out);
+      (pages ? pages->backend_for(body_page(at), b) : backend).run(b, plan, job->out);
       res.compute_seconds += since(tc);
       const auto tw = Clock::now();
       hand.put(std::move(job));
@@ -304,6 +307,11 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
 
   const Plan plan = run_plan(spec, cat);
   res.batch = opt.batch ? opt.batch : default_batch(plan, cat, backend);
+  std::optional<BodyPages> pages;
+  if (spec.per_scenario_bodies()) {
+    pages.emplace(cat, assets, backend, spec.bodies_seed());
+    res.batch = std::min<size_t>(res.batch, kBodyPage);
+  }
   const unsigned threads = opt.threads ? opt.threads : default_threads();
   const json identity = run_identity(spec, cat, source.total(), opt, res);
 
@@ -383,7 +391,7 @@ PipelineResult run_pipeline(const RunSpec& spec, const Catalogue& cat, const Ass
   std::atomic<uint64_t> written{first};
   std::exception_ptr error;
   try {
-    run_batches(source, plan, backend, sinks, threads, opt, checkpoint, res, t0, written);
+    run_batches(source, plan, backend, pages ? &*pages : nullptr, sinks, threads, opt, checkpoint, res, t0, written);
   } catch (...) {
     error = std::current_exception();
   }

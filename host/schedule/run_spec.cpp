@@ -21,6 +21,9 @@ nlohmann::json RunSpec::to_json() const {
     j["bodies"] = bodies;
     j["body_count"] = random_bodies();
     j["body_seed"] = std::to_string(bodies_seed());
+  } else if (per_scenario_bodies()) {
+    j["bodies"] = bodies;
+    j["body_seed"] = std::to_string(bodies_seed());
   }
   j["rule"] = rule;
   j["balance"] = balance;
@@ -84,15 +87,23 @@ void RunSpec::validate() const {
                      ": only applies to image folders (--what images or both, without h5 or npy "
                      "image tensors)");
   if (balance && rule.empty()) throw InputError(where("balance") + ": needs a threat rule (--rule)");
-  if (bodies != "catalogue" && bodies != "random")
-    throw InputError(where("bodies") + ": \"" + bodies + "\" is not catalogue or random");
-  if (body_seed && bodies != "random")
-    throw InputError(where("body_seed") + ": only applies to random bodies (--bodies random)");
+  if (bodies != "catalogue" && bodies != "random" && bodies != "per-scenario")
+    throw InputError(where("bodies") + ": \"" + bodies + "\" is not catalogue, random or per-scenario");
+  if (body_seed && !drawn_bodies())
+    throw InputError(where("body_seed") + ": only applies to drawn bodies (--bodies random or per-scenario)");
   if (body_count != 0 && bodies != "random")
     throw InputError(where("body_count") + ": only applies to random bodies (--bodies random)");
   if (body_count < 0 || body_count > kMaxRandomBodies)
     throw InputError(where("body_count") + ": " + std::to_string(body_count) + " is not between 1 and " +
                      std::to_string(kMaxRandomBodies));
+  // A scenario's subject is its own body: none to choose, and a list's subject column names
+  // one of a catalogue's.
+  if (per_scenario_bodies() && !subjects.empty())
+    throw InputError(where("subjects") + ": does not apply to per-scenario bodies (each scenario has its own)");
+  if (per_scenario_bodies() && !scenarios.empty())
+    throw InputError(
+        where("scenarios") +
+        ": a scenario list names its subjects, which per-scenario bodies do not have; use --bodies random");
   (void)settings();  // checks the tier and knobs
 }
 
@@ -223,8 +234,8 @@ void parse_spec(std::string_view text, const std::string& path, RunSpec& spec) {
       spec.balance = boolean(node, key);
     } else if (key == "bodies") {
       spec.bodies = string(node, key);
-      if (spec.bodies != "catalogue" && spec.bodies != "random")
-        throw InputError(at(node, key) + ": \"" + spec.bodies + "\" is not catalogue or random");
+      if (spec.bodies != "catalogue" && spec.bodies != "random" && spec.bodies != "per-scenario")
+        throw InputError(at(node, key) + ": \"" + spec.bodies + "\" is not catalogue, random or per-scenario");
     } else if (key == "body_seed") {
       spec.body_seed = static_cast<uint64_t>(integer(node, key, 0, INT64_MAX));
     } else if (key == "body_count") {

@@ -23,10 +23,13 @@ struct RunSpec {
   int min_objects = 0, max_objects = 4;
   std::vector<int> subjects;  // 1-based; empty = all
   // "catalogue": the catalogue's subjects; "random": body_count bodies drawn from the seed
-  // (scene/bodies.h), which replace them.
+  // (scene/bodies.h), which replace them; "per-scenario": a body of its own for every
+  // scenario, drawn from the seed and its index (scene/bodies.h, use_page_bodies).
   std::string bodies = "catalogue";
   int body_count = 0;  // 0: kDefaultRandomBodies where the bodies are random
   int random_bodies() const { return bodies == "random" ? (body_count ? body_count : kDefaultRandomBodies) : 0; }
+  bool per_scenario_bodies() const { return bodies == "per-scenario"; }
+  bool drawn_bodies() const { return random_bodies() > 0 || per_scenario_bodies(); }
   // The seed the random bodies are drawn from: the run's, unless given apart (to test on
   // the training bodies with other scenarios, or on other bodies with the same ones).
   std::optional<uint64_t> body_seed;

@@ -11,7 +11,7 @@
 namespace portalsim {
 
 ScenarioSource::ScenarioSource(const RunSpec& spec, const Catalogue& cat)
-    : model_(spec.settings().model), regions_(cat.region_count()) {
+    : model_(spec.settings().model), own_bodies_(spec.per_scenario_bodies()), regions_(cat.region_count()) {
   if (!spec.rule.empty()) rule_.emplace(cat, spec.rule, spec.where("rule"));
   if (!spec.scenarios.empty()) {
     list_ = std::make_shared<ScenarioListFile>(cat, spec.scenarios);
@@ -63,7 +63,7 @@ void ScenarioSource::fill(uint64_t at, size_t n, unsigned threads, SceneBatch& b
               return;
             }
       }
-      b.subject[i] = static_cast<uint8_t>(s.subject);
+      b.subject[i] = static_cast<uint8_t>(own_bodies_ ? page_subject(at + i) : s.subject);
       std::copy(s.objects.begin(), s.objects.begin() + regions_, b.objects.begin() + i * regions_);
       b.label[i] = static_cast<uint8_t>(s.label);
     }
@@ -84,6 +84,7 @@ Plan run_plan(const RunSpec& spec, const Catalogue& cat) {
   plan.metal = true;
   plan.images = spec.wants_images() ? kAllViews : 0;
   plan.annotations = spec.annotations;
+  plan.own_subjects = spec.per_scenario_bodies();
   validate(plan, cat);
   return plan;
 }

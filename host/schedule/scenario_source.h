@@ -37,6 +37,7 @@ class ScenarioSource {
   std::shared_ptr<ScenarioListFile> list_;  // read as a stream: memory stays flat
   std::string path_;
   ModelSettings model_;  // the knobs a list's recorded transforms are checked against
+  bool own_bodies_;      // per-scenario bodies: a scenario's subject is its place in its page
   int regions_ = 0;      // the catalogue's: the batches' stride
   std::optional<ThreatRule> rule_;
   uint64_t total_ = 0;

@@ -141,7 +141,8 @@ class ScenarioListSink final : public Sink {
     for (size_t i = 0; i < scenes.size(); ++i) {
       s += std::to_string(scenes.first_index + i);
       s += ',';
-      s += std::to_string(scenes.subject[i] + 1);
+      // 0: the scenario's own body (per-scenario bodies; its columns below record it).
+      s += std::to_string(scenes.own_bodies() ? 0u : scenes.subject[i] + 1u);
       for (int r = 0; r < R; ++r) {
         s += ',';
         const int16_t v = scenes.objects[i * R + r];
@@ -179,9 +180,10 @@ class ScenarioListSink final : public Sink {
         const std::array<int, 2> g = raw_grid_at(ctx_.model, scenes.first_index + i);
         s += ',' + std::to_string(g[0]) + ',' + std::to_string(g[1]);
       }
-      if (!ctx_.cat->subjects[scenes.subject[i]].drawn.empty()) {
+      const std::string& body = scenes.own_bodies() ? scenes.bodies[i] : ctx_.cat->subjects[scenes.subject[i]].drawn;
+      if (!body.empty()) {
         s += ',';
-        s += ctx_.cat->subjects[scenes.subject[i]].drawn;
+        s += body;
       }
       if (ctx_.model.clothing != Clothing::catalogue) {
         // The outfit (plan.h, outfit_at), then its transmission and clo, shortest exact text.

@@ -166,7 +166,8 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
         },
         true);
     add("subject", TensorType::u8, {}, [](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
-      for (size_t i = lo; i < hi; ++i) dst[i - lo] = static_cast<char>(b.subject[i] + 1);
+      // 0: every scenario has its own body (scenarios.csv numbers and records it).
+      for (size_t i = lo; i < hi; ++i) dst[i - lo] = static_cast<char>(b.own_bodies() ? 0 : b.subject[i] + 1);
       return std::string_view(dst, hi - lo);
     });
     add("region_object", TensorType::i16, {regions},

@@ -153,6 +153,11 @@ class Engine {
   // need is computed.
   Engine(const std::vector<std::string>& args, const std::optional<std::vector<std::string>>& datasets)
       : req_(cli::parse_generate(args)) {
+    if (req_.spec.per_scenario_bodies())
+      throw InputError(
+          "bodies: \"per-scenario\" is for portalsim generate and run; a stream takes bodies=\"random\" "
+          "(up to " +
+          std::to_string(kMaxRandomBodies) + " of them, body_count)");
     cli::open_catalogue(session_, req_.common, &req_.spec, req_.spec.settings().model.has_folds());
     cli::check_generate(req_.spec, session_.catalogue);
     source_.emplace(req_.spec, session_.catalogue);

@@ -32,6 +32,10 @@ class OpenCLBackend final : public Backend {
 
   std::string name() const override { return "opencl"; }
 
+  std::unique_ptr<Backend> for_catalogue(const Catalogue& cat, const AssetSet& assets) const override {
+    return std::make_unique<OpenCLBackend>(cat, assets, rt_);
+  }
+
   void run(const SceneBatch& batch, const Plan& plan, BatchOutput& out) override {
     if (drawn_grids(plan))
       run_by_raw_grid(batch, plan, out);

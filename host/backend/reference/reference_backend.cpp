@@ -15,6 +15,9 @@ class ReferenceBackend final : public Backend {
     for (const Sensor& s : cat.sensors) check_chain(s);
   }
   std::string name() const override { return "reference"; }
+  std::unique_ptr<Backend> for_catalogue(const Catalogue& cat, const AssetSet& assets) const override {
+    return std::make_unique<ReferenceBackend>(cat, assets);
+  }
   std::vector<std::string> paths(const Plan& plan) const override {
     std::vector<std::string> taken;
     for (int k : rendered_views(plan)) taken.push_back(cat_.sensors[k].name + ": fp64 stages");
