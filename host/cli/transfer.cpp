@@ -180,14 +180,15 @@ int run_transfer(const Options& o) {
     open_backend(session, co);
     PipelineOptions popt;
     popt.progress = false;
-    // Sets of random bodies draw theirs from their body seed: one session per (body seed,
-    // count), which the sets that share them share (the training bodies tested again).
+    // Sets of drawn bodies draw theirs from their body seed: one session per (body seed,
+    // count; 0 for a body per scenario), which the sets that share them share (the training
+    // bodies tested again).
     std::map<std::pair<uint64_t, int>, Session> drawn;
     for (Set& s : sets) {
       if (!s.spec) continue;
       const std::string dir = (fs::path(made) / s.name).string();
       Session* use = &session;
-      if (s.spec->random_bodies()) {
+      if (s.spec->drawn_bodies()) {
         const auto [it, fresh] = drawn.try_emplace({s.spec->bodies_seed(), s.spec->random_bodies()});
         if (fresh) {
           open_catalogue(it->second, co, s.spec.get());

@@ -13,15 +13,17 @@ struct BodyPages::Page {
 
 BodyPages::BodyPages(const Catalogue& cat, const AssetSet& assets, Backend& backend, uint64_t seed)
     : cat_(cat), assets_(assets), backend_(backend), seed_(seed) {
-  cat_is_page0_ = cat.subjects.size() == static_cast<size_t>(kBodyPage) &&
-                  cat.subjects[0].drawn == draw_body(cat, seed, 0).drawn &&
-                  cat.subjects[kBodyPage - 1].drawn == draw_body(cat, seed, kBodyPage - 1).drawn;
+  // The run's sinks write its catalogue's body columns: it must hold drawn bodies, page 0's.
+  if (cat.subjects.size() != static_cast<size_t>(kBodyPage) || cat.subjects[0].drawn != draw_body(cat, seed, 0).drawn ||
+      cat.subjects[kBodyPage - 1].drawn != draw_body(cat, seed, kBodyPage - 1).drawn)
+    throw std::logic_error(
+        "body pages: the run's catalogue does not hold page 0's bodies (open_catalogue with its spec)");
 }
 
 BodyPages::~BodyPages() = default;
 
 Backend& BodyPages::backend_for(uint64_t page, SceneBatch& batch) {
-  const bool borrowed = page == 0 && cat_is_page0_;
+  const bool borrowed = page == 0;
   if (!borrowed && (!page_ || current_ != page)) {
     const auto t0 = std::chrono::steady_clock::now();
     page_.reset();  // the last page's images and device tables go before the next's are made

@@ -13,8 +13,8 @@ namespace portalsim {
 
 class BodyPages {
  public:
-  // `cat`, `assets` and `backend` are the run's: where `cat`'s subjects are page 0's bodies
-  // of `seed` (open_catalogue makes them so), page 0 runs on them.
+  // `cat`, `assets` and `backend` are the run's, and page 0's: `cat`'s subjects must be page
+  // 0's bodies of `seed` (open_catalogue makes them so; else std::logic_error).
   BodyPages(const Catalogue& cat, const AssetSet& assets, Backend& backend, uint64_t seed);
   ~BodyPages();
   // The backend for page `page`'s scenarios, and their bodies' records in `batch.bodies`
@@ -29,7 +29,6 @@ class BodyPages {
   const AssetSet& assets_;
   Backend& backend_;
   uint64_t seed_;
-  bool cat_is_page0_;
   std::unique_ptr<Page> page_;  // the page made last (null while page 0 runs on the run's)
   uint64_t current_ = 0;
   double seconds_ = 0;
