@@ -6,10 +6,13 @@
 
 #include <gtest/gtest.h>
 #include <hdf5.h>
+#include <xxhash.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -186,6 +189,75 @@ TEST(Bodies, DrawnImagesFollowTheShape) {
   Body same;
   same.shape.shoulders = same.shape.chest = same.shape.hips = 1.0;
   EXPECT_EQ(procedural::mmw_body(same, true, 200, 200).pixels, up1.pixels);
+}
+
+// The drawn bodies' images, pinned: 48 bodies of seed 11 (all three poses, both sexes) and
+// eight extreme shapes, every view of the catalogue and, for the extremes, the back's
+// views, each hashed (XXH3-64) against tests/golden/bodies.txt. The drawing's shortcuts
+// (assets/procedural.cpp: a row's noise cells, a limb not evaluated where its floor shows
+// it cannot be the nearer) must not move a bit. After an intended change to the drawing:
+//   PORTALSIM_UPDATE_GOLDEN=1 build/portalsim_tests --gtest_filter='Bodies.DrawnImagesArePinned'
+TEST(Bodies, DrawnImagesArePinned) {
+  const std::string file = std::string(PORTALSIM_SOURCE_DIR) + "/tests/golden/bodies.txt";
+  Catalogue cat = test::catalogue();
+  use_random_bodies(cat, 11, 48);
+  const Subject drawn = cat.subjects[0];
+  int k = 0;
+  for (const double b : {0.5, 1.5})
+    for (const double h : {0.85, 1.15})
+      for (const Pose pose : {Pose::arms_down, Pose::arms_raised}) {
+        Subject x = drawn;
+        x.name = "extreme-" + std::to_string(++k);
+        x.shape.shoulders = x.shape.hips = b;
+        x.shape.chest = 2.0 - b;
+        x.shape.build = 1.0;
+        x.shape.height = h;
+        x.shape.leg_length = h < 1 ? 0.9 : 1.1;
+        x.shape.arm_length = b < 1 ? 1.15 : 0.85;
+        x.shape.pose = k % 4 == 0 ? Pose::arms_out : pose;
+        x.texture = 1000 + k;
+        cat.subjects.push_back(x);
+      }
+  const AssetSet a = build_assets(cat, false);
+  std::map<std::string, std::string> now;
+  const auto put = [&](const std::string& key, const Image& im) {
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx",
+                  static_cast<unsigned long long>(XXH3_64bits(im.pixels.data(), im.pixels.size())));
+    now[key] = hex;
+  };
+  for (size_t s = 0; s < cat.subjects.size(); ++s) {
+    const Subject& sub = cat.subjects[s];
+    for (size_t v = 0; v < cat.sensors.size(); ++v) put(sub.name + " " + cat.sensors[v].name, a.bases[s][v]);
+    if (sub.name.rfind("extreme-", 0) != 0) continue;
+    procedural::Body body;
+    body.subject = static_cast<int>(sub.texture);
+    body.shape = sub.shape;
+    put(sub.name + " back-upper", procedural::mmw_view(body, Frame{0, 0, 200, 200}, Side::back, 200, 200));
+    put(sub.name + " back-lower", procedural::mmw_view(body, Frame{0, 200, 200, 200}, Side::back, 200, 200));
+    put(sub.name + " back-ir", procedural::ir_view(body, Frame{}, Side::back, 100, 200));
+  }
+  if (const char* u = std::getenv("PORTALSIM_UPDATE_GOLDEN"); u && std::string(u) == "1") {
+    std::ofstream out(file);
+    out << "# XXH3-64 of drawn bodies' base images (tests/bodies_test.cpp, Bodies.DrawnImagesArePinned).\n";
+    for (const auto& [key, hash] : now) out << key << " " << hash << "\n";
+  }
+  std::map<std::string, std::string> committed;
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream f(line);
+    std::string name, view, hash;
+    f >> name >> view >> hash;
+    committed[name + " " + view] = hash;
+  }
+  EXPECT_EQ(committed.size(), now.size()) << file << ": regenerate it (see the test)";
+  int moved = 0;
+  for (const auto& [key, hash] : now) moved += committed.count(key) == 0 || committed[key] != hash;
+  EXPECT_EQ(moved, 0) << "of " << now.size() << " images differ from " << file;
+  std::set<int> poses;
+  for (const Subject& sub : cat.subjects) poses.insert(static_cast<int>(sub.shape.pose));
+  EXPECT_EQ(poses.size(), 3u) << "every pose drawn";
 }
 
 // The drawn map and its inverse agree, and object places follow it for every view.

@@ -78,6 +78,44 @@ double fbm(double x, double y, uint64_t seed) {
   return 0.67 * value_noise(x, y, seed) + 0.33 * value_noise(2.03 * x + 17.1, 2.03 * y - 5.3, seed + 1);
 }
 
+// value_noise and fbm along one row (y fixed), as the body views draw them: the lattice row
+// and its fade once, a cell's four corner hashes once while x stays in the cell. The same
+// operations in the same order, so the same bits.
+class NoiseRow {
+ public:
+  NoiseRow(double y, uint64_t seed) : seed_(seed) {
+    const double fy = std::floor(y);
+    iy_ = static_cast<int64_t>(fy);
+    ty_ = smooth(y - fy);
+  }
+  double operator()(double x) {
+    const double fx = std::floor(x);
+    const auto ix = static_cast<int64_t>(fx);
+    if (!cached_ || ix != ix_) {
+      a_ = hash_signed(ix, iy_, seed_), b_ = hash_signed(ix + 1, iy_, seed_);
+      c_ = hash_signed(ix, iy_ + 1, seed_), d_ = hash_signed(ix + 1, iy_ + 1, seed_);
+      ix_ = ix;
+      cached_ = true;
+    }
+    const double tx = smooth(x - fx);
+    return lerp(lerp(a_, b_, tx), lerp(c_, d_, tx), ty_);
+  }
+
+ private:
+  uint64_t seed_;
+  int64_t iy_ = 0, ix_ = 0;
+  double ty_ = 0, a_ = 0, b_ = 0, c_ = 0, d_ = 0;
+  bool cached_ = false;
+};
+class FbmRow {
+ public:
+  FbmRow(double y, uint64_t seed) : first_(y, seed), second_(2.03 * y - 5.3, seed + 1) {}
+  double operator()(double x) { return 0.67 * first_(x) + 0.33 * second_(2.03 * x + 17.1); }
+
+ private:
+  NoiseRow first_, second_;
+};
+
 // Triangle wave in [0, 1] with period 1, smoothed to a cosine-like shape (1 at integers).
 double wave(double t) {
   const double f = t - std::floor(t);
@@ -205,6 +243,8 @@ class BodyModel {
     stance_ = 3.0 * var(3);
     lean_ = 3.0 * var(4) - 1.5;
     arm_off_ = 64.5 + (shape_.shoulders - 1.0) * 52.0;
+    arms_[0] = arm_of(-1.0), arms_[1] = arm_of(1.0);
+    legs_[0] = leg_of(-1.0), legs_[1] = leg_of(1.0);
   }
 
   uint64_t seed() const { return seed_; }
@@ -240,7 +280,8 @@ class BodyModel {
       // Arms keep |u - 100| >= arm_off_ - 12, so deep inside the torso they cannot change
       // the union or the IR weights (both ignore a part 14 units further than the nearest).
       const double bound = arm_off_ - 12.0 - std::fabs(u - 100.0);
-      arm = bound >= core + 14.0 ? bound : std::min(limb_arm(u, y, -1.0), limb_arm(u, y, 1.0));
+      arm = bound >= core + 14.0 ? bound
+                                 : nearer(arms_[0], arms_[1], {u, y}, [&](int k) { return limb_arm(u, y, arms_[k]); });
     }
     if (y < 80.0) {  // shoulders round over into the deltoids
       const double delt = std::min(sd_circle({u, y}, {100 - arm_off_, 43 + sdy}, 10.5),
@@ -248,7 +289,8 @@ class BodyModel {
       core = smin(core, delt, 8.0);
     }
     double leg = far;
-    if (y > 180.0) leg = std::min(limb_leg(u, y, -1.0), limb_leg(u, y, 1.0));
+    if (y > 180.0)
+      leg = nearer(legs_[0], legs_[1], {u, y}, [&](int k) { return limb_leg(u, y, legs_[k], k ? 1.0 : -1.0); });
     f.d_core = core;
     f.d_head = head;
     f.d_arm = arm;
@@ -290,10 +332,38 @@ class BodyModel {
     return std::max({side, 18.0 - y, y - 262.0});
   }
 
-  // sgn -1: the subject's right arm, on the image's left.
-  double limb_arm(double u, double y, double sgn) const {
+  // A limb's round cones (joint k to joint k + 1, radius r[k] to r[k + 1]; a foot's cone
+  // apart), joined with smin: its joints depend on the body only, so they are found once.
+  struct Limb {
+    P j[5];
+    double r[5];
+    // Two boxes of joints and each's largest radius: the limb's distance is at least the
+    // nearer box's distance less its radius, less the smins' most (their widths / 4).
+    double box[2][4], box_r[2], slack;
+    // At most what the limb's distance can be at p (see box): where the other limb's value
+    // is already below it, the min is the other's, bit for bit.
+    double floor(P p) const {
+      double d = 1e300;
+      for (int b = 0; b < 2; ++b) {
+        const double dx = std::max({box[b][0] - p.x, 0.0, p.x - box[b][1]});
+        const double dy = std::max({box[b][2] - p.y, 0.0, p.y - box[b][3]});
+        d = std::min(d, len(dx, dy) - box_r[b]);
+      }
+      return d - slack - 1e-6;  // the margin covers the cones' rounding
+    }
+    void bound(int b, int from, int to) {
+      box[b][0] = box[b][2] = 1e300, box[b][1] = box[b][3] = -1e300, box_r[b] = 0;
+      for (int k = from; k <= to; ++k) {
+        box[b][0] = std::min(box[b][0], j[k].x), box[b][1] = std::max(box[b][1], j[k].x);
+        box[b][2] = std::min(box[b][2], j[k].y), box[b][3] = std::max(box[b][3], j[k].y);
+        box_r[b] = std::max(box_r[b], r[k]);
+      }
+    }
+  };
+
+  // sgn -1: the subject's right arm, on the image's left. Joints top, elbow, wrist, hand.
+  Limb arm_of(double sgn) const {
     const double x0 = 100.0 + sgn * arm_off_;
-    const P p{u, y};
     const P top{x0, 43 + shoulder_dy_};
     // A joint at (out, down) from the shoulder's top in the hanging arm, stretched by the
     // arm's length and turned outwards by the pose (exactly the old points hanging at 1).
@@ -302,23 +372,52 @@ class BodyModel {
       if (shape_.pose == Pose::arms_down) return P{x0 + dx, y + (arm_len_ - 1.0) * (y - top.y)};
       return P{top.x + dx * arm_cos_ + sgn * dy * arm_sin_, top.y - sgn * dx * arm_sin_ + dy * arm_cos_};
     };
-    const P elbow = joint(2.5 + 0.4 * arm_spread_, 113);
-    const P wrist = joint(5.0 + arm_spread_, 171);
-    const P hand = joint(6.0 + 1.1 * arm_spread_, 186);
-    const double upper = sd_round_cone(p, top, elbow, 10.5, 8.2);
-    const double fore = sd_round_cone(p, elbow, wrist, 8.2, 6.3);
-    const double palm = sd_round_cone(p, wrist, hand, 6.3, 7.2);
+    Limb a{{top,
+            joint(2.5 + 0.4 * arm_spread_, 113),
+            joint(5.0 + arm_spread_, 171),
+            joint(6.0 + 1.1 * arm_spread_, 186),
+            {}},
+           {10.5, 8.2, 6.3, 7.2, 0},
+           {},
+           {},
+           (1.5 + 1.5) / 4};
+    a.bound(0, 0, 1);
+    a.bound(1, 1, 3);
+    return a;
+  }
+  double limb_arm(double u, double y, const Limb& a) const {
+    const P p{u, y};
+    const double upper = sd_round_cone(p, a.j[0], a.j[1], 10.5, 8.2);
+    const double fore = sd_round_cone(p, a.j[1], a.j[2], 8.2, 6.3);
+    const double palm = sd_round_cone(p, a.j[2], a.j[3], 6.3, 7.2);
     return smin(smin(upper, fore, 1.5), palm, 1.5);
   }
 
-  double limb_leg(double u, double y, double sgn) const {
+  // Joints hip, mid, knee, calf, ankle; the foot from the ankle.
+  Limb leg_of(double sgn) const {
     const double bl = 0.5 + 0.5 * shape_.build, hp = shape_.hips;
     const double x0 = 100.0 + lean_ + sgn * (26.5 * hp + 0.3 * stance_);
+    Limb l{{{x0, 212},
+            {x0 + sgn * 0.3, 270},
+            {x0 + sgn * (1.0 + 0.5 * stance_), 310},
+            {x0 + sgn * (1.6 + 0.7 * stance_), 333},
+            {x0 + sgn * (0.5 + 0.5 * stance_), 382}},
+           {26.0 * hp, 24.0 * hp, 14.5 * bl, 16.5 * bl, 7.8 * bl},
+           {},
+           {},
+           (3.0 + 2.5 + 2.0 + 4.0) / 4};
+    l.bound(0, 0, 2);
+    l.bound(1, 2, 4);
+    // The foot: its cone's ends lie within 5.5 across and 11 down of the ankle, radius 7.5 bl.
+    l.box[1][0] = std::min(l.box[1][0], l.j[4].x - 5.5), l.box[1][1] = std::max(l.box[1][1], l.j[4].x + 5.5);
+    l.box[1][3] = std::max(l.box[1][3], 393.0);
+    l.box_r[1] = std::max(l.box_r[1], 7.5 * bl);
+    return l;
+  }
+  double limb_leg(double u, double y, const Limb& l, double sgn) const {
+    const double bl = 0.5 + 0.5 * shape_.build, hp = shape_.hips;
     const P p{u, y};
-    const P hip{x0, 212}, mid{x0 + sgn * 0.3, 270};
-    const P knee{x0 + sgn * (1.0 + 0.5 * stance_), 310};
-    const P calf{x0 + sgn * (1.6 + 0.7 * stance_), 333};
-    const P ankle{x0 + sgn * (0.5 + 0.5 * stance_), 382};
+    const P &hip = l.j[0], &mid = l.j[1], &knee = l.j[2], &calf = l.j[3], &ankle = l.j[4];
     const double thigh =
         smin(sd_round_cone(p, hip, mid, 26.0 * hp, 24.0 * hp), sd_round_cone(p, mid, knee, 24.0 * hp, 14.5 * bl), 3.0);
     const double shin = smin(sd_round_cone(p, knee, calf, 14.5 * bl, 16.5 * bl),
@@ -328,10 +427,24 @@ class BodyModel {
     return smin(smin(thigh, shin, 2.0), foot, 4.0);
   }
 
+  // min(limb 0, limb 1), the right's first as std::min takes them; the limb whose floor is
+  // above the other's value is not evaluated (it cannot be the min).
+  template <class Eval>
+  static double nearer(const Limb& a, const Limb& b, P p, const Eval& eval) {
+    const double fa = a.floor(p), fb = b.floor(p);
+    if (fa <= fb) {
+      const double va = eval(0);
+      return fb >= va ? va : std::min(va, eval(1));
+    }
+    const double vb = eval(1);
+    return fa >= vb ? vb : std::min(eval(0), vb);
+  }
+
   BodyShape shape_;  // the body's shape, build, breadths, stature and legs clamped
   double arm_len_ = 1.0, arm_cos_ = 1.0, arm_sin_ = 0.0;
   uint64_t seed_ = 0;
   double arm_spread_ = 0, shoulder_dy_ = 0, stance_ = 0, lean_ = 0, arm_off_ = 64.5;
+  Limb arms_[2]{}, legs_[2]{};  // the subject's right, then left
 };
 
 // How many following pixels of a row a 1-Lipschitz field stays above zero for, given its
@@ -917,10 +1030,12 @@ Image mmw_view(const Body& body, const Frame& field, Side side, int width, int h
   for (int y = 0; y < height; ++y) {
     const double v = (y + 0.5) * pv + field.y;
     const double vb = model.body_row(v);  // the body drawn here; the room stays at v
-    int next = 0;                         // pixels before `next` are known to be clear of the body
+    NoiseRow room_noise(v / 9.0, seed + 2);
+    FbmRow skin_noise(vb / 22.0, seed + 4);
+    int next = 0;  // pixels before `next` are known to be clear of the body
     for (int x = 0; x < width; ++x) {
       const double u = field_u(field, back, pu, x);
-      const double room = bg + 2.0 * value_noise(u / 9.0, v / 9.0, seed + 2) + 1.5 * hash_signed(x, y, seed + 3);
+      const double room = bg + 2.0 * room_noise(u / 9.0) + 1.5 * hash_signed(x, y, seed + 3);
       double val = room;
       if (x < next) {
         img.at(x, y) = to_u8(val);
@@ -932,8 +1047,8 @@ Image mmw_view(const Body& body, const Frame& field, Side side, int width, int h
       if (c > 0.0) {
         const double depth = clamp01(-f.d / 26.0);
         const double s = 1.0 - (1.0 - depth) * (1.0 - depth);
-        const double skin = level + 34.0 * (s - 0.7) + 4.0 * fbm(u / 22.0, vb / 22.0, seed + 4) +
-                            2.5 * hash_signed(x, y, seed + 5) - chin * f.chin * f.chin;
+        const double skin = level + 34.0 * (s - 0.7) + 4.0 * skin_noise(u / 22.0) + 2.5 * hash_signed(x, y, seed + 5) -
+                            chin * f.chin * f.chin;
         val = lerp(room, skin, c);
       }
       img.at(x, y) = to_u8(val);
@@ -954,10 +1069,12 @@ Image ir_view(const Body& body, const Frame& field, Side side, int width, int he
   for (int y = 0; y < height; ++y) {
     const double v = (y + 0.5) * pv + field.y;
     const double vb = model.body_row(v);  // the body drawn here; the room stays at v
+    NoiseRow room_noise(v / 12.0, seed + 6);
+    FbmRow skin_noise(vb / 15.0, seed + 7);
     int next = 0;
     for (int x = 0; x < width; ++x) {
       const double u = field_u(field, back, pu, x);
-      const double back = bg + 3.0 * v / 400.0 + 1.5 * value_noise(u / 12.0, v / 12.0, seed + 6);
+      const double back = bg + 3.0 * v / 400.0 + 1.5 * room_noise(u / 12.0);
       double val = back;
       if (x < next) {
         img.at(x, y) = to_u8(val);
@@ -982,7 +1099,7 @@ Image ir_view(const Body& body, const Frame& field, Side side, int width, int he
         double t = (wc * t_trunk + wh * t_head + wa * t_arm) / (wc + wh + wa);
         const double depth = clamp01(-f.d / 9.0);
         t -= 16.0 * (1.0 - depth) * (1.0 - depth);  // the surface turns away at the edges
-        t += 1.5 * fbm(u / 15.0, vb / 15.0, seed + 7);
+        t += 1.5 * skin_noise(u / 15.0);
         val = lerp(back, t, c);
       }
       img.at(x, y) = to_u8(val);
