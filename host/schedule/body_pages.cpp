@@ -1,6 +1,5 @@
 #include "schedule/body_pages.h"
 
-#include <chrono>
 #include <stdexcept>
 
 namespace portalsim {
@@ -25,7 +24,6 @@ BodyPages::~BodyPages() = default;
 Backend& BodyPages::backend_for(uint64_t page, SceneBatch& batch) {
   const bool borrowed = page == 0;
   if (!borrowed && (!page_ || current_ != page)) {
-    const auto t0 = std::chrono::steady_clock::now();
     page_.reset();  // the last page's images and device tables go before the next's are made
     auto p = std::make_unique<Page>();
     p->cat = cat_;
@@ -34,7 +32,6 @@ Backend& BodyPages::backend_for(uint64_t page, SceneBatch& batch) {
     p->backend = backend_.for_catalogue(p->cat, p->assets);
     page_ = std::move(p);
     current_ = page;
-    seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   const Catalogue& cat = borrowed ? cat_ : page_->cat;
   batch.bodies.resize(batch.size());

@@ -20,8 +20,6 @@ class BodyPages {
   // The backend for page `page`'s scenarios, and their bodies' records in `batch.bodies`
   // (all of the batch's scenarios must lie in the page).
   Backend& backend_for(uint64_t page, SceneBatch& batch);
-  // Seconds spent drawing pages' bodies and making their backends.
-  double seconds() const { return seconds_; }
 
  private:
   struct Page;
@@ -31,7 +29,6 @@ class BodyPages {
   uint64_t seed_;
   std::unique_ptr<Page> page_;  // the page made last (null while page 0 runs on the run's)
   uint64_t current_ = 0;
-  double seconds_ = 0;
 };
 
 }  // namespace portalsim
