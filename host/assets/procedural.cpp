@@ -63,24 +63,9 @@ double smooth(double t) {
 double smoothstep(double e0, double e1, double x) { return smooth((x - e0) / (e1 - e0)); }
 double lerp(double a, double b, double t) { return a + (b - a) * t; }
 
-// Bilinear value noise with a smooth fade, in [-1, 1].
-double value_noise(double x, double y, uint64_t seed) {
-  const double fx = std::floor(x), fy = std::floor(y);
-  const auto ix = static_cast<int64_t>(fx), iy = static_cast<int64_t>(fy);
-  const double tx = smooth(x - fx), ty = smooth(y - fy);
-  const double a = hash_signed(ix, iy, seed), b = hash_signed(ix + 1, iy, seed);
-  const double c = hash_signed(ix, iy + 1, seed), d = hash_signed(ix + 1, iy + 1, seed);
-  return lerp(lerp(a, b, tx), lerp(c, d, tx), ty);
-}
-
-// Two octaves, still roughly in [-1, 1].
-double fbm(double x, double y, uint64_t seed) {
-  return 0.67 * value_noise(x, y, seed) + 0.33 * value_noise(2.03 * x + 17.1, 2.03 * y - 5.3, seed + 1);
-}
-
-// value_noise and fbm along one row (y fixed), as the body views draw them: the lattice row
-// and its fade once, a cell's four corner hashes once while x stays in the cell. The same
-// operations in the same order, so the same bits.
+// Bilinear value noise with a smooth fade, in [-1, 1], along one row (y fixed): the lattice
+// row and its fade once, a cell's four corner hashes once while x stays in the cell (the body
+// views draw whole rows of it).
 class NoiseRow {
  public:
   NoiseRow(double y, uint64_t seed) : seed_(seed) {
@@ -107,6 +92,9 @@ class NoiseRow {
   double ty_ = 0, a_ = 0, b_ = 0, c_ = 0, d_ = 0;
   bool cached_ = false;
 };
+double value_noise(double x, double y, uint64_t seed) { return NoiseRow(y, seed)(x); }
+
+// Two octaves, still roughly in [-1, 1]; and along one row.
 class FbmRow {
  public:
   FbmRow(double y, uint64_t seed) : first_(y, seed), second_(2.03 * y - 5.3, seed + 1) {}
@@ -115,6 +103,7 @@ class FbmRow {
  private:
   NoiseRow first_, second_;
 };
+double fbm(double x, double y, uint64_t seed) { return FbmRow(y, seed)(x); }
 
 // Triangle wave in [0, 1] with period 1, smoothed to a cosine-like shape (1 at integers).
 double wave(double t) {
@@ -289,8 +278,7 @@ class BodyModel {
       core = smin(core, delt, 8.0);
     }
     double leg = far;
-    if (y > 180.0)
-      leg = nearer(legs_[0], legs_[1], {u, y}, [&](int k) { return limb_leg(u, y, legs_[k], k ? 1.0 : -1.0); });
+    if (y > 180.0) leg = nearer(legs_[0], legs_[1], {u, y}, [&](int k) { return limb_leg(u, y, legs_[k]); });
     f.d_core = core;
     f.d_head = head;
     f.d_arm = arm;
@@ -332,11 +320,11 @@ class BodyModel {
     return std::max({side, 18.0 - y, y - 262.0});
   }
 
-  // A limb's round cones (joint k to joint k + 1, radius r[k] to r[k + 1]; a foot's cone
-  // apart), joined with smin: its joints depend on the body only, so they are found once.
+  // A limb's round cones, joined with smin: joint k to joint k + 1, radius r[k] to r[k + 1]
+  // (a leg's foot: joints 5 to 6). Its joints depend on the body only, so they are found once.
   struct Limb {
-    P j[5];
-    double r[5];
+    P j[7];
+    double r[7];
     // Two boxes of joints and each's largest radius: the limb's distance is at least the
     // nearer box's distance less its radius, less the smins' most (their widths / 4).
     double box[2][4], box_r[2], slack;
@@ -359,6 +347,7 @@ class BodyModel {
         box_r[b] = std::max(box_r[b], r[k]);
       }
     }
+    double cone(P p, int k, int l) const { return sd_round_cone(p, j[k], j[l], r[k], r[l]); }
   };
 
   // sgn -1: the subject's right arm, on the image's left. Joints top, elbow, wrist, hand.
@@ -372,59 +361,47 @@ class BodyModel {
       if (shape_.pose == Pose::arms_down) return P{x0 + dx, y + (arm_len_ - 1.0) * (y - top.y)};
       return P{top.x + dx * arm_cos_ + sgn * dy * arm_sin_, top.y - sgn * dx * arm_sin_ + dy * arm_cos_};
     };
-    Limb a{{top,
-            joint(2.5 + 0.4 * arm_spread_, 113),
-            joint(5.0 + arm_spread_, 171),
-            joint(6.0 + 1.1 * arm_spread_, 186),
-            {}},
-           {10.5, 8.2, 6.3, 7.2, 0},
-           {},
-           {},
-           (1.5 + 1.5) / 4};
+    Limb a{
+        {top, joint(2.5 + 0.4 * arm_spread_, 113), joint(5.0 + arm_spread_, 171), joint(6.0 + 1.1 * arm_spread_, 186)},
+        {10.5, 8.2, 6.3, 7.2},
+        {},
+        {},
+        (1.5 + 1.5) / 4};
     a.bound(0, 0, 1);
     a.bound(1, 1, 3);
     return a;
   }
   double limb_arm(double u, double y, const Limb& a) const {
     const P p{u, y};
-    const double upper = sd_round_cone(p, a.j[0], a.j[1], 10.5, 8.2);
-    const double fore = sd_round_cone(p, a.j[1], a.j[2], 8.2, 6.3);
-    const double palm = sd_round_cone(p, a.j[2], a.j[3], 6.3, 7.2);
-    return smin(smin(upper, fore, 1.5), palm, 1.5);
+    return smin(smin(a.cone(p, 0, 1), a.cone(p, 1, 2), 1.5), a.cone(p, 2, 3), 1.5);
   }
 
-  // Joints hip, mid, knee, calf, ankle; the foot from the ankle.
+  // Joints hip, mid, knee, calf, ankle, then the foot's two ends: seen from the front, low,
+  // wider than the ankle, turned a little outwards.
   Limb leg_of(double sgn) const {
     const double bl = 0.5 + 0.5 * shape_.build, hp = shape_.hips;
     const double x0 = 100.0 + lean_ + sgn * (26.5 * hp + 0.3 * stance_);
+    const double ankle = x0 + sgn * (0.5 + 0.5 * stance_);
     Limb l{{{x0, 212},
             {x0 + sgn * 0.3, 270},
             {x0 + sgn * (1.0 + 0.5 * stance_), 310},
             {x0 + sgn * (1.6 + 0.7 * stance_), 333},
-            {x0 + sgn * (0.5 + 0.5 * stance_), 382}},
-           {26.0 * hp, 24.0 * hp, 14.5 * bl, 16.5 * bl, 7.8 * bl},
+            {ankle, 382},
+            {ankle + sgn * 0.5, 389},
+            {ankle + sgn * 5.5, 393}},
+           {26.0 * hp, 24.0 * hp, 14.5 * bl, 16.5 * bl, 7.8 * bl, 7.5 * bl, 5.0 * bl},
            {},
            {},
            (3.0 + 2.5 + 2.0 + 4.0) / 4};
     l.bound(0, 0, 2);
-    l.bound(1, 2, 4);
-    // The foot: its cone's ends lie within 5.5 across and 11 down of the ankle, radius 7.5 bl.
-    l.box[1][0] = std::min(l.box[1][0], l.j[4].x - 5.5), l.box[1][1] = std::max(l.box[1][1], l.j[4].x + 5.5);
-    l.box[1][3] = std::max(l.box[1][3], 393.0);
-    l.box_r[1] = std::max(l.box_r[1], 7.5 * bl);
+    l.bound(1, 2, 6);
     return l;
   }
-  double limb_leg(double u, double y, const Limb& l, double sgn) const {
-    const double bl = 0.5 + 0.5 * shape_.build, hp = shape_.hips;
+  double limb_leg(double u, double y, const Limb& l) const {
     const P p{u, y};
-    const P &hip = l.j[0], &mid = l.j[1], &knee = l.j[2], &calf = l.j[3], &ankle = l.j[4];
-    const double thigh =
-        smin(sd_round_cone(p, hip, mid, 26.0 * hp, 24.0 * hp), sd_round_cone(p, mid, knee, 24.0 * hp, 14.5 * bl), 3.0);
-    const double shin = smin(sd_round_cone(p, knee, calf, 14.5 * bl, 16.5 * bl),
-                             sd_round_cone(p, calf, ankle, 16.5 * bl, 7.8 * bl), 2.5);
-    // Feet seen from the front: low, wider than the ankle, turned a little outwards.
-    const double foot = sd_round_cone(p, {ankle.x + sgn * 0.5, 389}, {ankle.x + sgn * 5.5, 393}, 7.5 * bl, 5.0 * bl);
-    return smin(smin(thigh, shin, 2.0), foot, 4.0);
+    const double thigh = smin(l.cone(p, 0, 1), l.cone(p, 1, 2), 3.0);
+    const double shin = smin(l.cone(p, 2, 3), l.cone(p, 3, 4), 2.5);
+    return smin(smin(thigh, shin, 2.0), l.cone(p, 5, 6), 4.0);
   }
 
   // min(limb 0, limb 1), the right's first as std::min takes them; the limb whose floor is

@@ -160,18 +160,22 @@ std::string body_summary(const Subject& s) {
   return f[0] + ", " + stature + ", " + f[7];
 }
 
-void use_random_bodies(Catalogue& cat, uint64_t seed, int count) {
+namespace {
+
+// Bodies [first, first + count) as the catalogue's subjects, every view's places derived again.
+void use_bodies(Catalogue& cat, uint64_t seed, uint64_t first, int count) {
   std::vector<Subject> bodies;
-  for (int k = 0; k < count; ++k) bodies.push_back(draw_body(cat, seed, k));
+  for (int k = 0; k < count; ++k) bodies.push_back(draw_body(cat, seed, first + k));
   cat.subjects = std::move(bodies);
   for (Sensor& s : cat.sensors) derive_places(cat, s);
 }
 
+}  // namespace
+
+void use_random_bodies(Catalogue& cat, uint64_t seed, int count) { use_bodies(cat, seed, 0, count); }
+
 void use_page_bodies(Catalogue& cat, uint64_t seed, uint64_t page) {
-  std::vector<Subject> bodies;
-  for (int k = 0; k < kBodyPage; ++k) bodies.push_back(draw_body(cat, seed, page * kBodyPage + k));
-  cat.subjects = std::move(bodies);
-  for (Sensor& s : cat.sensors) derive_places(cat, s);
+  use_bodies(cat, seed, page * kBodyPage, kBodyPage);
 }
 
 }  // namespace portalsim
