@@ -21,6 +21,7 @@
 #include "cli/common.h"
 #include "cli/python_requests.h"
 #include "plan/knobs.h"
+#include "schedule/body_pages.h"
 #include "schedule/scenario_source.h"
 
 namespace py = pybind11;
@@ -94,6 +95,29 @@ py::dict to_arrays(const std::shared_ptr<Rows>& rows, const std::vector<TensorCo
   return d;
 }
 
+// Joins the rows of batches `parts` (in order) into `r`'s own buffers: a batch of
+// per-scenario bodies that crosses a page is made a page's part at a time.
+void join_rows(Rows& r, const std::vector<Rows>& parts, const std::vector<TensorColumn>& columns, size_t n) {
+  r.made.resize(columns.size());
+  r.made_bytes.resize(columns.size(), 0);
+  r.rows.assign(columns.size(), {});
+  for (size_t k = 0; k < columns.size(); ++k) {
+    const size_t bytes = n * columns[k].ds.row_bytes();
+    if (r.made_bytes[k] < bytes || !r.made[k]) {
+      r.made[k].reset(new char[std::max<size_t>(1, bytes)]);
+      r.made_bytes[k] = bytes;
+    }
+    size_t at = 0;
+    for (const Rows& p : parts) {
+      if (at + p.rows[k].size() > bytes) throw std::logic_error("join_rows: the parts hold more rows than the batch");
+      std::memcpy(r.made[k].get() + at, p.rows[k].data(), p.rows[k].size());
+      at += p.rows[k].size();
+    }
+    if (at != bytes) throw std::logic_error("join_rows: the parts hold fewer rows than the batch");
+    r.rows[k] = std::string_view(r.made[k].get(), bytes);
+  }
+}
+
 // Makes each column's rows of a computed batch: the views point into the batch, the rest
 // (the IR palette, labels by region, ...) are made in pieces on `threads` threads.
 void make_rows(Rows& r, const std::vector<TensorColumn>& columns, unsigned threads) {
@@ -153,11 +177,6 @@ class Engine {
   // need is computed.
   Engine(const std::vector<std::string>& args, const std::optional<std::vector<std::string>>& datasets)
       : req_(cli::parse_generate(args)) {
-    if (req_.spec.per_scenario_bodies())
-      throw InputError(
-          "bodies: \"per-scenario\" is for portalsim generate and run; a stream takes bodies=\"random\" "
-          "(up to " +
-          std::to_string(kMaxRandomBodies) + " of them, body_count)");
     cli::open_catalogue(session_, req_.common, &req_.spec, req_.spec.settings().model.has_folds());
     cli::check_generate(req_.spec, session_.catalogue);
     source_.emplace(req_.spec, session_.catalogue);
@@ -222,20 +241,24 @@ class Engine {
     if (source_->listed() && (start > source_->total() || count > source_->total() - start))
       throw InputError("batch: scenarios " + std::to_string(start) + ".." + std::to_string(start + count) +
                        " are past the end of the scenario list (" + std::to_string(source_->total()) + ")");
-    if (!session_.backend) open_backend_here(session_, req_.common);
+    if (!session_.backend) {
+      open_backend_here(session_, req_.common);
+      if (req_.spec.per_scenario_bodies())
+        pages_.emplace(session_.catalogue, session_.assets, *session_.backend, req_.spec.bodies_seed());
+    }
     std::unique_ptr<Rows> r = pool.take();
-    const auto t0 = Clock::now();
-    source_->fill(start, count, threads_, r->scenes);
-    const auto t1 = Clock::now();
-    session_.backend->run(r->scenes, plan_, r->out);
-    const auto t2 = Clock::now();
-    make_rows(*r, columns_, threads_);
-    const auto t3 = Clock::now();
-    std::lock_guard<std::mutex> lock(times_m_);
-    times_.scenarios += count;
-    times_.scenes += seconds(t0, t1);
-    times_.kernels += seconds(t1, t2);
-    times_.rows += seconds(t2, t3);
+    if (!pages_ || body_page(start) == body_page(start + count - 1)) {
+      make(start, count, *r);
+      return r;
+    }
+    // Per-scenario bodies: a page's scenarios run on that page's backend (schedule/body_pages.h).
+    std::vector<Rows> parts;
+    for (uint64_t lo = start; lo < start + count;) {
+      const uint64_t hi = std::min<uint64_t>(start + count, (body_page(lo) + 1) * kBodyPage);
+      make(lo, static_cast<size_t>(hi - lo), parts.emplace_back());
+      lo = hi;
+    }
+    join_rows(*r, parts, columns_, count);
     return r;
   }
 
@@ -252,6 +275,7 @@ class Engine {
  private:
   cli::GenerateRequest req_;
   cli::Session session_;
+  std::optional<BodyPages> pages_;  // per-scenario bodies: each page's catalogue and backend
   std::optional<ScenarioSource> source_;
   Plan plan_;
   unsigned threads_ = 1;
@@ -259,6 +283,23 @@ class Engine {
   std::vector<TensorColumn> columns_;
   std::mutex times_m_;
   Times times_;
+
+  // Scenarios [start, start + count), all in one page where bodies are per scenario: their rows.
+  void make(uint64_t start, size_t count, Rows& r) {
+    const auto t0 = Clock::now();
+    source_->fill(start, count, threads_, r.scenes);
+    Backend& backend = pages_ ? pages_->backend_for(body_page(start), r.scenes) : *session_.backend;
+    const auto t1 = Clock::now();
+    backend.run(r.scenes, plan_, r.out);
+    const auto t2 = Clock::now();
+    make_rows(r, columns_, threads_);
+    const auto t3 = Clock::now();
+    std::lock_guard<std::mutex> lock(times_m_);
+    times_.scenarios += count;
+    times_.scenes += seconds(t0, t1);
+    times_.kernels += seconds(t1, t2);
+    times_.rows += seconds(t2, t3);
+  }
 };
 
 // An Engine and the thread that renders the batch after the one asked for, while Python

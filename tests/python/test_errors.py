@@ -63,11 +63,8 @@ def test_flags_for_files_only_are_refused(key, value):
                                    "`portalsim generate` writes, and portalsim.Generator writes none)"), str(e.value)
 
 
-def test_per_scenario_bodies_are_for_generate(portalsim_bin, tmp_path):
-    """A stream takes a pool of random bodies; a body per scenario is generate's (its pages)."""
-    with pytest.raises(ValueError, match=r'^bodies: "per-scenario" is for portalsim generate and run; a stream '
-                                         r'takes bodies="random"'):
-        portalsim.Generator(seed=1, bodies="per-scenario")
+def test_per_scenario_bodies_are_not_for_simulate(portalsim_bin, tmp_path):
+    """simulate shows one chosen subject; a body per scenario is a data set's (generate, the stream)."""
     want = cli_error(portalsim_bin, "simulate", "gun", "--bodies", "per-scenario", "--out", str(tmp_path / "x"))
     with pytest.raises(ValueError) as e:
         portalsim.simulate(["gun"], bodies="per-scenario")

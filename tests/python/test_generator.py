@@ -75,6 +75,29 @@ def test_batch_is_generate_rows(case, tmp_path, portalsim_bin, root, monkeypatch
             assert a.tobytes() == w.tobytes(), f"{case} {k}: rows {start}..{start + count} (batches of {step}) differ"
 
 
+def test_per_scenario_bodies_are_generate_rows_across_pages(tmp_path, portalsim_bin):
+    """A body per scenario: batches inside a page, across its end, and back to page 0."""
+    n = 200  # page 0 (0..191) and part of page 1
+    kw = {"seed": 3, "count": n, "what": "both", "model": "physics", "bodies": "per-scenario", "body_seed": 4}
+    out = tmp_path / "set"
+    subprocess.run([portalsim_bin, "generate", *flags(kw), "--format", "h5", "--out", str(out), "--quiet"],
+                   check=True)
+    with h5py.File(out / "data.h5", "r") as f:
+        want = {k: f[k][:] for k in f.attrs["datasets"]}
+    assert not want["subject"].any()  # every row its own body
+    gen = portalsim.Generator(**kw)
+    assert sorted(gen.datasets) == sorted(want)
+    for start, count, step in ((150, 50, 50), (0, n, n), (185, 15, 4), (190, 4, 4), (0, 192, 64)):
+        got = {k: [] for k in gen.datasets}
+        for s in range(start, start + count, step):
+            for k, a in gen.batch(s, min(step, start + count - s)).items():
+                got[k].append(a)
+        for k in gen.datasets:
+            a, w = np.concatenate(got[k]), want[k][start:start + count]
+            assert a.dtype == w.dtype and a.shape == w.shape, f"{k}: {a.dtype} {a.shape}, file {w.dtype} {w.shape}"
+            assert a.tobytes() == w.tobytes(), f"{k}: rows {start}..{start + count} (batches of {step}) differ"
+
+
 def test_portal_counts_shape_the_batch(root):
     """A catalogue of 20 regions and 33 zones gives its batch keys its own shapes: a zone
     column each, a region column each, an image and a mask per camera view."""
