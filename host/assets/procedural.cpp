@@ -153,22 +153,35 @@ double sd_capsule(P p, P a, P b, double r) {
   return len(pax - bax * h, pay - bay * h) - r;
 }
 
-// Segment a-b whose radius goes from ra to rb (a tapered capsule, exact).
-double sd_round_cone(P p, P a, P b, double ra, double rb) {
-  const double bx = b.x - a.x, by = b.y - a.y;
-  const double h = bx * bx + by * by;
-  const double dr = ra - rb;
-  if (h <= dr * dr + 1e-9) return std::min(sd_circle(p, a, ra), sd_circle(p, b, rb));
-  const double px = p.x - a.x, py = p.y - a.y;
-  const double qx = std::fabs(px * by - py * bx) / h, qy = (px * bx + py * by) / h;
-  const double cx = std::sqrt(h - dr * dr), cy = dr;
-  const double k = cx * qy - cy * qx;
-  const double m = cx * qx + cy * qy;
-  const double n = qx * qx + qy * qy;
-  if (k < 0.0) return std::sqrt(h * n) - ra;
-  if (k > cx) return std::sqrt(h * (n + 1.0 - 2.0 * qy)) - rb;
-  return m - ra;
-}
+// Segment a-b whose radius goes from ra to rb (a tapered capsule, exact). What depends on
+// the cone alone is found once, so a body's cones are not set up again at every pixel.
+class RoundCone {
+ public:
+  RoundCone() = default;
+  RoundCone(P a, P b, double ra, double rb)
+      : a_(a), b_(b), ra_(ra), rb_(rb), bx_(b.x - a.x), by_(b.y - a.y), h_(bx_ * bx_ + by_ * by_), dr_(ra - rb) {
+    point_ = h_ <= dr_ * dr_ + 1e-9;
+    if (!point_) cx_ = std::sqrt(h_ - dr_ * dr_);
+  }
+  double operator()(P p) const {
+    if (point_) return std::min(sd_circle(p, a_, ra_), sd_circle(p, b_, rb_));
+    const double px = p.x - a_.x, py = p.y - a_.y;
+    const double qx = std::fabs(px * by_ - py * bx_) / h_, qy = (px * bx_ + py * by_) / h_;
+    const double cx = cx_, cy = dr_;
+    const double k = cx * qy - cy * qx;
+    const double m = cx * qx + cy * qy;
+    const double n = qx * qx + qy * qy;
+    if (k < 0.0) return std::sqrt(h_ * n) - ra_;
+    if (k > cx) return std::sqrt(h_ * (n + 1.0 - 2.0 * qy)) - rb_;
+    return m - ra_;
+  }
+
+ private:
+  P a_{}, b_{};
+  double ra_ = 0, rb_ = 0, bx_ = 0, by_ = 0, h_ = 0, dr_ = 0, cx_ = 0;
+  bool point_ = true;
+};
+double sd_round_cone(P p, P a, P b, double ra, double rb) { return RoundCone(a, b, ra, rb)(p); }
 
 // Exact distance to a simple polygon.
 double sd_polygon(P p, const std::vector<P>& v) {
@@ -234,6 +247,10 @@ class BodyModel {
     arm_off_ = 64.5 + (shape_.shoulders - 1.0) * 52.0;
     arms_[0] = arm_of(-1.0), arms_[1] = arm_of(1.0);
     legs_[0] = leg_of(-1.0), legs_[1] = leg_of(1.0);
+    // The trapezius slopes' cones (eval joins them to the core).
+    const double tx = arm_off_ - 9.0;
+    trap_[0] = RoundCone({100, 13}, {100 - tx, 33 + shoulder_dy_}, 13, 10);
+    trap_[1] = RoundCone({100, 13}, {100 + tx, 33 + shoulder_dy_}, 13, 10);
   }
 
   uint64_t seed() const { return seed_; }
@@ -243,7 +260,15 @@ class BodyModel {
   // height 1 and leg length 1.
   double body_row(double y) const { return portalsim::body_row(shape_, y); }
 
-  BodyField eval(double u, double y) const {
+  // What eval needs of body row y that does not change along the row.
+  struct Row {
+    double y;
+    double centre, half_width;  // the torso's centre and half width
+  };
+  Row row(double y) const { return {y, centre_x(y), torso_half_width(y) * width_scale(y)}; }
+
+  BodyField eval(double u, const Row& row) const {
+    const double y = row.y;
     BodyField f{};
     const double far = 1e9;
     const double sdy = shoulder_dy_;
@@ -251,17 +276,15 @@ class BodyModel {
     double head = far;
     double jaw = far, neck = far;
     if (y < 60.0) {
-      neck = sd_round_cone({u, y}, {100, -6}, {100, 17}, 11.5, 13.0);
-      jaw = sd_round_cone({u, y}, {100, -36}, {100, -10}, 30.0, 19.0);
+      neck = neck_({u, y});
+      jaw = jaw_({u, y});
       head = smin(neck, jaw, 2.0);
     }
     // Core: shoulder girdle, trapezius slopes, torso and pelvis.
-    double core = torso(u, y);
+    double core = torso(u, row);
     if (y < 80.0) {
       // Trapezius slopes from the neck down to round deltoids.
-      const double tx = arm_off_ - 9.0;
-      const double trap = std::min(sd_round_cone({u, y}, {100, 13}, {100 - tx, 33 + sdy}, 13, 10),
-                                   sd_round_cone({u, y}, {100, 13}, {100 + tx, 33 + sdy}, 13, 10));
+      const double trap = std::min(trap_[0]({u, y}), trap_[1]({u, y}));
       core = smin(core, trap, 6.0);
     }
     double arm = far;
@@ -315,9 +338,9 @@ class BodyModel {
   // The width scale at row y (scene/body_shape.h, the one definition object places follow).
   double width_scale(double y) const { return portalsim::width_scale(shape_, y); }
 
-  double torso(double u, double y) const {
-    const double side = std::fabs(u - centre_x(y)) - torso_half_width(y) * width_scale(y);
-    return std::max({side, 18.0 - y, y - 262.0});
+  double torso(double u, const Row& row) const {
+    const double side = std::fabs(u - row.centre) - row.half_width;
+    return std::max({side, 18.0 - row.y, row.y - 262.0});
   }
 
   // A limb's round cones, joined with smin: joint k to joint k + 1, radius r[k] to r[k + 1]
@@ -347,7 +370,12 @@ class BodyModel {
         box_r[b] = std::max(box_r[b], r[k]);
       }
     }
-    double cone(P p, int k, int l) const { return sd_round_cone(p, j[k], j[l], r[k], r[l]); }
+    RoundCone cones[6];  // joint k to k + 1 (see finish)
+    // The cones from the joints, once the joints are set.
+    void finish() {
+      for (int k = 0; k < 6; ++k) cones[k] = RoundCone(j[k], j[k + 1], r[k], r[k + 1]);
+    }
+    double cone(P p, int k) const { return cones[k](p); }
   };
 
   // sgn -1: the subject's right arm, on the image's left. Joints top, elbow, wrist, hand.
@@ -366,14 +394,16 @@ class BodyModel {
         {10.5, 8.2, 6.3, 7.2},
         {},
         {},
-        (1.5 + 1.5) / 4};
+        (1.5 + 1.5) / 4,
+        {}};
     a.bound(0, 0, 1);
     a.bound(1, 1, 3);
+    a.finish();
     return a;
   }
   double limb_arm(double u, double y, const Limb& a) const {
     const P p{u, y};
-    return smin(smin(a.cone(p, 0, 1), a.cone(p, 1, 2), 1.5), a.cone(p, 2, 3), 1.5);
+    return smin(smin(a.cone(p, 0), a.cone(p, 1), 1.5), a.cone(p, 2), 1.5);
   }
 
   // Joints hip, mid, knee, calf, ankle, then the foot's two ends: seen from the front, low,
@@ -392,16 +422,18 @@ class BodyModel {
            {26.0 * hp, 24.0 * hp, 14.5 * bl, 16.5 * bl, 7.8 * bl, 7.5 * bl, 5.0 * bl},
            {},
            {},
-           (3.0 + 2.5 + 2.0 + 4.0) / 4};
+           (3.0 + 2.5 + 2.0 + 4.0) / 4,
+           {}};
     l.bound(0, 0, 2);
     l.bound(1, 2, 6);
+    l.finish();
     return l;
   }
   double limb_leg(double u, double y, const Limb& l) const {
     const P p{u, y};
-    const double thigh = smin(l.cone(p, 0, 1), l.cone(p, 1, 2), 3.0);
-    const double shin = smin(l.cone(p, 2, 3), l.cone(p, 3, 4), 2.5);
-    return smin(smin(thigh, shin, 2.0), l.cone(p, 5, 6), 4.0);
+    const double thigh = smin(l.cone(p, 0), l.cone(p, 1), 3.0);
+    const double shin = smin(l.cone(p, 2), l.cone(p, 3), 2.5);
+    return smin(smin(thigh, shin, 2.0), l.cone(p, 5), 4.0);
   }
 
   // min(limb 0, limb 1), the right's first as std::min takes them; the limb whose floor is
@@ -422,6 +454,8 @@ class BodyModel {
   uint64_t seed_ = 0;
   double arm_spread_ = 0, shoulder_dy_ = 0, stance_ = 0, lean_ = 0, arm_off_ = 64.5;
   Limb arms_[2]{}, legs_[2]{};  // the subject's right, then left
+  RoundCone trap_[2];           // the trapezius slopes, right then left
+  RoundCone neck_{{100, -6}, {100, 17}, 11.5, 13.0}, jaw_{{100, -36}, {100, -10}, 30.0, 19.0};
 };
 
 // How many following pixels of a row a 1-Lipschitz field stays above zero for, given its
@@ -1007,6 +1041,7 @@ Image mmw_view(const Body& body, const Frame& field, Side side, int width, int h
   for (int y = 0; y < height; ++y) {
     const double v = (y + 0.5) * pv + field.y;
     const double vb = model.body_row(v);  // the body drawn here; the room stays at v
+    const BodyModel::Row row = model.row(vb);
     NoiseRow room_noise(v / 9.0, seed + 2);
     FbmRow skin_noise(vb / 22.0, seed + 4);
     int next = 0;  // pixels before `next` are known to be clear of the body
@@ -1018,7 +1053,7 @@ Image mmw_view(const Body& body, const Frame& field, Side side, int width, int h
         img.at(x, y) = to_u8(val);
         continue;
       }
-      const BodyField f = model.eval(u, vb);
+      const BodyField f = model.eval(u, row);
       next = x + 1 + skip_pixels(f.d - e, pu, width);
       const double c = coverage(f.d, e);
       if (c > 0.0) {
@@ -1046,6 +1081,7 @@ Image ir_view(const Body& body, const Frame& field, Side side, int width, int he
   for (int y = 0; y < height; ++y) {
     const double v = (y + 0.5) * pv + field.y;
     const double vb = model.body_row(v);  // the body drawn here; the room stays at v
+    const BodyModel::Row row = model.row(vb);
     NoiseRow room_noise(v / 12.0, seed + 6);
     FbmRow skin_noise(vb / 15.0, seed + 7);
     int next = 0;
@@ -1057,7 +1093,7 @@ Image ir_view(const Body& body, const Frame& field, Side side, int width, int he
         img.at(x, y) = to_u8(val);
         continue;
       }
-      const BodyField f = model.eval(u, vb);
+      const BodyField f = model.eval(u, row);
       next = x + 1 + skip_pixels(f.d - e, pu, width);
       const double c = coverage(f.d, e);
       if (c > 0.0) {
