@@ -252,7 +252,8 @@ class Engine {
       return r;
     }
     // Per-scenario bodies: a page's scenarios run on that page's backend (schedule/body_pages.h).
-    std::vector<Rows> parts;
+    std::vector<Rows> parts;  // never moved: a part's rows may point into its own output
+    parts.reserve(static_cast<size_t>(body_page(start + count - 1) - body_page(start) + 1));
     for (uint64_t lo = start; lo < start + count;) {
       const uint64_t hi = std::min<uint64_t>(start + count, (body_page(lo) + 1) * kBodyPage);
       make(lo, static_cast<size_t>(hi - lo), parts.emplace_back());
