@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <numbers>
 #include <span>
@@ -346,11 +347,24 @@ class BodyModel {
   // A limb's round cones, joined with smin: joint k to joint k + 1, radius r[k] to r[k + 1]
   // (a leg's foot: joints 5 to 6). Its joints depend on the body only, so they are found once.
   struct Limb {
-    P j[7];
-    double r[7];
+    Limb() = default;
+    // Joints and radii (the rest zero), the smins' most, and the two boxes: joints 0..split
+    // and split..last.
+    Limb(std::initializer_list<P> joints, std::initializer_list<double> radii, double smin_slack, int split, int last)
+        : slack(smin_slack) {
+      if (joints.size() > 7 || radii.size() != joints.size())
+        throw std::logic_error("Limb: up to 7 joints, a radius each");
+      std::copy(joints.begin(), joints.end(), j);
+      std::copy(radii.begin(), radii.end(), r);
+      bound(0, 0, split);
+      bound(1, split, last);
+      for (int k = 0; k < 6; ++k) cones[k] = RoundCone(j[k], j[k + 1], r[k], r[k + 1]);
+    }
+    P j[7]{};
+    double r[7]{};
     // Two boxes of joints and each's largest radius: the limb's distance is at least the
     // nearer box's distance less its radius, less the smins' most (their widths / 4).
-    double box[2][4], box_r[2], slack;
+    double box[2][4]{}, box_r[2]{}, slack = 0;
     // At most what the limb's distance can be at p (see box): where the other limb's value
     // is already below it, the min is the other's, bit for bit.
     double floor(P p) const {
@@ -370,11 +384,7 @@ class BodyModel {
         box_r[b] = std::max(box_r[b], r[k]);
       }
     }
-    RoundCone cones[6];  // joint k to k + 1 (see finish)
-    // The cones from the joints, once the joints are set.
-    void finish() {
-      for (int k = 0; k < 6; ++k) cones[k] = RoundCone(j[k], j[k + 1], r[k], r[k + 1]);
-    }
+    RoundCone cones[6];  // joint k to k + 1
     double cone(P p, int k) const { return cones[k](p); }
   };
 
@@ -389,17 +399,9 @@ class BodyModel {
       if (shape_.pose == Pose::arms_down) return P{x0 + dx, y + (arm_len_ - 1.0) * (y - top.y)};
       return P{top.x + dx * arm_cos_ + sgn * dy * arm_sin_, top.y - sgn * dx * arm_sin_ + dy * arm_cos_};
     };
-    Limb a{
+    return Limb(
         {top, joint(2.5 + 0.4 * arm_spread_, 113), joint(5.0 + arm_spread_, 171), joint(6.0 + 1.1 * arm_spread_, 186)},
-        {10.5, 8.2, 6.3, 7.2},
-        {},
-        {},
-        (1.5 + 1.5) / 4,
-        {}};
-    a.bound(0, 0, 1);
-    a.bound(1, 1, 3);
-    a.finish();
-    return a;
+        {10.5, 8.2, 6.3, 7.2}, (1.5 + 1.5) / 4, 1, 3);
   }
   double limb_arm(double u, double y, const Limb& a) const {
     const P p{u, y};
@@ -412,22 +414,15 @@ class BodyModel {
     const double bl = 0.5 + 0.5 * shape_.build, hp = shape_.hips;
     const double x0 = 100.0 + lean_ + sgn * (26.5 * hp + 0.3 * stance_);
     const double ankle = x0 + sgn * (0.5 + 0.5 * stance_);
-    Limb l{{{x0, 212},
-            {x0 + sgn * 0.3, 270},
-            {x0 + sgn * (1.0 + 0.5 * stance_), 310},
-            {x0 + sgn * (1.6 + 0.7 * stance_), 333},
-            {ankle, 382},
-            {ankle + sgn * 0.5, 389},
-            {ankle + sgn * 5.5, 393}},
-           {26.0 * hp, 24.0 * hp, 14.5 * bl, 16.5 * bl, 7.8 * bl, 7.5 * bl, 5.0 * bl},
-           {},
-           {},
-           (3.0 + 2.5 + 2.0 + 4.0) / 4,
-           {}};
-    l.bound(0, 0, 2);
-    l.bound(1, 2, 6);
-    l.finish();
-    return l;
+    return Limb({{x0, 212},
+                 {x0 + sgn * 0.3, 270},
+                 {x0 + sgn * (1.0 + 0.5 * stance_), 310},
+                 {x0 + sgn * (1.6 + 0.7 * stance_), 333},
+                 {ankle, 382},
+                 {ankle + sgn * 0.5, 389},
+                 {ankle + sgn * 5.5, 393}},
+                {26.0 * hp, 24.0 * hp, 14.5 * bl, 16.5 * bl, 7.8 * bl, 7.5 * bl, 5.0 * bl}, (3.0 + 2.5 + 2.0 + 4.0) / 4,
+                2, 6);
   }
   double limb_leg(double u, double y, const Limb& l) const {
     const P p{u, y};

@@ -40,6 +40,23 @@ struct Rows {
   std::vector<std::unique_ptr<char[]>> made;  // per column: the rows made here (not views)
   std::vector<size_t> made_bytes;
   std::vector<std::string_view> rows;  // per column
+
+  // A new batch of `columns` columns, without rows; the buffers made before are kept.
+  void start(size_t columns) {
+    made.resize(columns);
+    made_bytes.resize(columns, 0);
+    rows.assign(columns, {});
+  }
+  // Column k's rows in a buffer of its own, of `bytes` (an earlier batch's where it is large
+  // enough).
+  char* own(size_t k, size_t bytes) {
+    if (made_bytes[k] < bytes || !made[k]) {
+      made[k].reset(new char[std::max<size_t>(1, bytes)]);
+      made_bytes[k] = bytes;
+    }
+    rows[k] = std::string_view(made[k].get(), bytes);
+    return made[k].get();
+  }
 };
 
 // Finished batches whose buffers the next one reuses, so that a long stream touches no new
@@ -98,23 +115,17 @@ py::dict to_arrays(const std::shared_ptr<Rows>& rows, const std::vector<TensorCo
 // Joins the rows of batches `parts` (in order) into `r`'s own buffers: a batch of
 // per-scenario bodies that crosses a page is made a page's part at a time.
 void join_rows(Rows& r, const std::vector<Rows>& parts, const std::vector<TensorColumn>& columns, size_t n) {
-  r.made.resize(columns.size());
-  r.made_bytes.resize(columns.size(), 0);
-  r.rows.assign(columns.size(), {});
+  r.start(columns.size());
   for (size_t k = 0; k < columns.size(); ++k) {
     const size_t bytes = n * columns[k].ds.row_bytes();
-    if (r.made_bytes[k] < bytes || !r.made[k]) {
-      r.made[k].reset(new char[std::max<size_t>(1, bytes)]);
-      r.made_bytes[k] = bytes;
-    }
+    char* dst = r.own(k, bytes);
     size_t at = 0;
     for (const Rows& p : parts) {
       if (at + p.rows[k].size() > bytes) throw std::logic_error("join_rows: the parts hold more rows than the batch");
-      std::memcpy(r.made[k].get() + at, p.rows[k].data(), p.rows[k].size());
+      std::memcpy(dst + at, p.rows[k].data(), p.rows[k].size());
       at += p.rows[k].size();
     }
     if (at != bytes) throw std::logic_error("join_rows: the parts hold fewer rows than the batch");
-    r.rows[k] = std::string_view(r.made[k].get(), bytes);
   }
 }
 
@@ -122,9 +133,7 @@ void join_rows(Rows& r, const std::vector<Rows>& parts, const std::vector<Tensor
 // (the IR palette, labels by region, ...) are made in pieces on `threads` threads.
 void make_rows(Rows& r, const std::vector<TensorColumn>& columns, unsigned threads) {
   const size_t n = r.scenes.size();
-  r.made.resize(columns.size());
-  r.made_bytes.resize(columns.size(), 0);
-  r.rows.assign(columns.size(), {});
+  r.start(columns.size());
   struct Piece {
     size_t column, lo, hi;
   };
@@ -134,12 +143,8 @@ void make_rows(Rows& r, const std::vector<TensorColumn>& columns, unsigned threa
       r.rows[k] = columns[k].fill(r.scenes, r.out, 0, n, nullptr);
       continue;
     }
-    const size_t row = std::max<size_t>(1, columns[k].ds.row_bytes()), bytes = n * row;
-    if (r.made_bytes[k] < bytes || !r.made[k]) {
-      r.made[k].reset(new char[std::max<size_t>(1, bytes)]);
-      r.made_bytes[k] = bytes;
-    }
-    r.rows[k] = std::string_view(r.made[k].get(), bytes);
+    const size_t row = std::max<size_t>(1, columns[k].ds.row_bytes());
+    r.own(k, n * row);
     const size_t step = std::max<size_t>(1, (256u << 10) / row);  // pieces of about 256 KiB
     for (size_t lo = 0; lo < n; lo += step) pieces.push_back({k, lo, std::min(n, lo + step)});
   }
