@@ -244,6 +244,25 @@ TEST(Mpi, AFailingRankStopsEveryRankAndIsNamed) {
   EXPECT_FALSE(fs::exists(dir / "manifest.json"));
 }
 
+// The binary links no MPI: under a launcher it loads its MPI module, and where that is
+// missing it stops before writing, naming the module and where it looked.
+TEST(Mpi, AMissingMpiModuleIsNamed) {
+  TempDir t;
+  const fs::path alone = t.w() / "bin" / "portalsim", out = t.w() / "out";
+  fs::create_directories(alone.parent_path());
+  fs::copy_file(portalsim::test::kBinary, alone);
+  const Result r = finish(
+      start_program(t.cap(), "/usr/bin/env",
+                    {"OMPI_COMM_WORLD_SIZE=2", alone.string(), "generate", "--count", "4", "--out", out.string()}),
+      60);
+  SCOPED_TRACE(describe(r));
+  EXPECT_TRUE(r.exited && r.status == 5) << "5: the machine";
+  EXPECT_NE(r.err.find("started by an MPI launcher, but this portalsim has no MPI module libportalsim_mpi.so"),
+            std::string::npos);
+  EXPECT_NE(r.err.find((alone.parent_path() / "libportalsim_mpi.so").string()), std::string::npos) << "where it looked";
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(Mpi, AnOutputMergeCannotJoinIsRefusedBeforeAnyRankWrites) {
   TempDir t;
   const fs::path dir = t.w() / "out";

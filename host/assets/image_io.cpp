@@ -12,6 +12,7 @@
 #include "assets/oiio/codec.h"
 #include "assets/png_writer.h"
 #include "base/error.h"
+#include "base/module.h"
 #include "io/input_file.h"
 
 namespace portalsim {
@@ -54,45 +55,16 @@ class QuietOutput {
 }  // namespace
 
 namespace {
-// The folders where the OpenImageIO module may be, in order: beside the object that holds
-// this code (a build folder, the Python package), beside the executable, and where
-// `cmake --install` puts it relative to bin/ (PORTALSIM_OIIO_MODULE_RELPATH).
-std::vector<std::filesystem::path> module_folders() {
-  namespace fs = std::filesystem;
-  std::vector<fs::path> folders;
-  Dl_info info{};
-  std::error_code ec;
-  if (dladdr(reinterpret_cast<void*>(&module_folders), &info) && info.dli_fname && *info.dli_fname)
-    folders.push_back(fs::absolute(info.dli_fname, ec).parent_path());
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    folders.push_back(exe.parent_path());
-    folders.push_back((exe.parent_path() / PORTALSIM_OIIO_MODULE_RELPATH).lexically_normal());
-  }
-  return folders;
-}
-
 const oiio::Codec& load_codec() {
-  std::string tried, reason;
-  for (const std::filesystem::path& folder : module_folders()) {
-    const std::string file = (folder / PORTALSIM_OIIO_MODULE).string();
-    tried += (tried.empty() ? "" : ", ") + file;
-    if (!std::filesystem::exists(file)) continue;
-    // Never closed: its functions serve the whole process.
-    void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
-    if (!handle) {
-      reason = dlerror();
-      continue;
-    }
-    using Entry = const oiio::Codec* (*)();
-    const auto entry = reinterpret_cast<Entry>(dlsym(handle, "portalsim_oiio_codec"));
-    const oiio::Codec* codec = entry ? entry() : nullptr;
-    if (codec && codec->version == oiio::kCodecVersion) return *codec;
-    reason = file + " is from another build of portalsim";
-  }
+  ModuleLoad load;
+  if (const auto* codec =
+          module_table<oiio::Codec>(PORTALSIM_OIIO_MODULE, "portalsim_oiio_codec", oiio::kCodecVersion, load))
+    return *codec;
   throw EnvironmentError("image files are read and written by portalsim's OpenImageIO module " +
-                         std::string(PORTALSIM_OIIO_MODULE) + ", " + (reason.empty() ? "not found" : reason) +
-                         " (looked in: " + tried + "); reinstall portalsim");
+                         std::string(PORTALSIM_OIIO_MODULE) + ", " + (load.reason.empty() ? "not found" : load.reason) +
+                         " (looked in: " + load.tried +
+                         "); reinstall portalsim, or from a bundle unpack its images add-on, portalsim-" +
+                         PORTALSIM_VERSION + "-linux-x86_64-images.tar.gz, over it");
 }
 
 // Loaded on first use, once for the process.

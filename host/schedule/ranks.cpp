@@ -1,12 +1,12 @@
 #include "schedule/ranks.h"
 
+#include <dlfcn.h>
+
 #include <cstdlib>
 
 #include "base/error.h"
-
-#ifdef PORTALSIM_MPI
-#include <mpi.h>
-#endif
+#include "base/module.h"
+#include "schedule/mpi/comm.h"
 
 namespace portalsim {
 
@@ -63,35 +63,42 @@ class SingleRank final : public Ranks {
   std::vector<std::string> all_gather(const std::string& mine) override { return {mine}; }
 };
 
-#ifdef PORTALSIM_MPI
+// The MPI module (schedule/mpi/comm.h), loaded on the first call: it links the system's
+// MPI, which must be the launcher's.
+const mpi::Comm& load_comm() {
+  const std::string file = PORTALSIM_MPI_MODULE;
+  ModuleLoad load;
+  if (const auto* comm = module_table<mpi::Comm>(file, "portalsim_mpi_comm", mpi::kCommVersion, load)) return *comm;
+  if (!load.reason.empty())
+    throw EnvironmentError("started by an MPI launcher, but portalsim's MPI module " + file +
+                           " did not load: " + load.reason +
+                           " (it needs the system's Open MPI, libmpi.so.40, the launcher's own: on Debian, "
+                           "apt-get install openmpi-bin)");
+  // Each rank would run alone into the same folder: refuse rather than race.
+  throw EnvironmentError("started by an MPI launcher, but this portalsim has no MPI module " + file +
+                         " (looked in: " + load.tried +
+                         "): build it with libopenmpi-dev installed (CMake finds it), or run without mpirun");
+}
+
 class MpiRanks final : public Ranks {
  public:
-  MpiRanks() {
-    int provided = 0;
-    // Only the main thread calls MPI; the writer and PoCL threads never do.
-    if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
-      throw EnvironmentError("MPI_Init_thread failed: the MPI launcher and this build's Open MPI do not agree");
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
-    MPI_Comm_size(MPI_COMM_WORLD, &size_);
-    std::atexit([] {
-      int finalized = 0;
-      MPI_Finalized(&finalized);
-      if (!finalized) MPI_Finalize();
-    });
+  MpiRanks() : comm_(load_comm()) {
+    if (comm_.init(&rank_, &size_) != 0)
+      throw EnvironmentError("MPI_Init_thread failed: the MPI launcher and the system's Open MPI do not agree");
   }
   int rank() const override { return rank_; }
   int size() const override { return size_; }
   std::vector<std::string> all_gather(const std::string& mine) override {
     const int n = static_cast<int>(mine.size());
     std::vector<int> sizes(static_cast<size_t>(size_)), offsets(static_cast<size_t>(size_));
-    MPI_Allgather(&n, 1, MPI_INT, sizes.data(), 1, MPI_INT, MPI_COMM_WORLD);
+    comm_.all_gather_int(n, sizes.data());
     int total = 0;
     for (int r = 0; r < size_; ++r) {
       offsets[static_cast<size_t>(r)] = total;
       total += sizes[static_cast<size_t>(r)];
     }
     std::string all(static_cast<size_t>(total), '\0');
-    MPI_Allgatherv(mine.data(), n, MPI_CHAR, all.data(), sizes.data(), offsets.data(), MPI_CHAR, MPI_COMM_WORLD);
+    comm_.all_gather_bytes(mine.data(), n, all.data(), sizes.data(), offsets.data());
     std::vector<std::string> out;
     for (int r = 0; r < size_; ++r)
       out.push_back(all.substr(static_cast<size_t>(offsets[static_cast<size_t>(r)]),
@@ -100,9 +107,9 @@ class MpiRanks final : public Ranks {
   }
 
  private:
+  const mpi::Comm& comm_;
   int rank_ = 0, size_ = 1;
 };
-#endif
 
 }  // namespace
 
@@ -110,15 +117,8 @@ std::unique_ptr<Ranks> single_rank() { return std::make_unique<SingleRank>(); }
 
 Ranks* mpi_ranks() {
   if (!launched_by_mpi()) return nullptr;
-#ifdef PORTALSIM_MPI
   static MpiRanks ranks;
   return &ranks;
-#else
-  // Each rank would run alone into the same folder: refuse rather than race.
-  throw EnvironmentError(
-      "started by an MPI launcher, but this portalsim was built without MPI: install libopenmpi-dev and build "
-      "again (CMake finds it), or run without mpirun");
-#endif
 }
 
 }  // namespace portalsim

@@ -26,8 +26,9 @@ class Ranks {
 std::unique_ptr<Ranks> single_rank();
 
 // The MPI ranks when this process was started by an MPI launcher; null when it was not.
-// The first call initialises MPI, which stays up until the process exits. Throws
-// EnvironmentError when launched so but built without MPI.
+// The first call loads the MPI module (schedule/mpi/comm.h) and initialises MPI, which stays
+// up until the process exits. Throws EnvironmentError, naming the module and the loader's
+// message, when launched so but the module is missing or cannot load the system's MPI.
 Ranks* mpi_ranks();
 
 }  // namespace portalsim
