@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "backend/opencl/drivers.h"
 #include "base/error.h"
 
 namespace portalsim {
@@ -100,16 +101,18 @@ std::vector<std::pair<std::string, cl::Device>> all_devices(std::string& failed)
 }
 
 // Why OpenCL is not usable, after `what` ("no OpenCL platform found") and `call` (the OpenCL
-// call that failed and its error, or ""): PoCL needs a writable kernel cache, and without
-// one offers no platform, no device or no program, so an unwritable cache is named first;
-// else what to install.
+// call that failed and its error, or ""): first what the drivers' search found (drivers.h),
+// where no driver is installed or one does not load; else PoCL's kernel cache, without which
+// PoCL offers no platform, no device or no program.
 std::string not_usable(const std::string& what, const std::string& call) {
   const std::string failed = what + (call.empty() ? "" : ": " + call);
+  const DriverSearch drivers = search_opencl_drivers();
+  if (!drivers.all_load) return failed + "; " + drivers.text + "; --backend reference works without OpenCL";
   if (const std::string problem = cache_problem(); !problem.empty())
     return "PoCL's kernel cache, " + pocl_cache() + ", " + problem + " (" + failed +
            "); POCL_CACHE_DIR, or XDG_CACHE_HOME, must name a writable folder; --backend reference works without "
            "OpenCL";
-  return failed + " (is pocl-opencl-icd installed?); --backend reference works without one";
+  return failed + " (" + drivers.text + "); --backend reference works without OpenCL";
 }
 }  // namespace
 
