@@ -1,10 +1,18 @@
 #!/usr/bin/env bash
-# ctest bundle.minimal_root: tools/bundle.sh's tarball, unpacked into a bare Debian 12 root
-# (debootstrap --variant=minbase, no build packages), must run simulate and generate with
-# --backend reference and no OpenCL driver, then on the OpenCL backend once Debian's
-# pocl-opencl-icd alone is installed, each byte for byte as the build's own binary outside;
-# and its Python package must import under the root's /usr/bin/python3 and give the build's
-# arrays. As root (chroot, mounts); the roots are made once (Debian's mirror) and cached.
+# ctest bundle.minimal_root: tools/bundle.sh's tarball, unpacked into bare roots
+# (debootstrap --variant=minbase, no build packages), byte for byte as the build's own binary
+# outside:
+# - Debian 12: simulate and generate with --backend reference and no OpenCL driver, then on
+#   the OpenCL backend once Debian's pocl-opencl-icd alone is installed; its Python package
+#   under the root's /usr/bin/python3 gives the build's arrays;
+# - Debian 13 (glibc 2.41, GCC 14's libstdc++) with its pocl-opencl-icd (PoCL 6, LLVM 18):
+#   the same commands on the OpenCL backend, the driver loaded next to the bundle's
+#   libraries; its Python (3.13) refuses the 3.11 module with a message that says so;
+# - Debian 12 with openmpi-bin: `mpirun -np 2` of the bundle's binary, under the root's own
+#   Open MPI, equals one process;
+# - an OpenCL driver that does not load is named with the loader's reason.
+# As root (chroot, mounts); the roots are made once (Debian's mirror) and cached, and get
+# /proc, /sys and /dev mounted as a real machine has them.
 # Usage: bundle_check.sh SOURCE_DIR BUILD_DIR PORTALSIM
 set -euo pipefail
 fail() { echo "bundle_check: $*" >&2; exit 1; }
@@ -37,12 +45,16 @@ mnt() {  # mnt ROOT: /proc and /dev for apt and the runs, /sys for PoCL (hwloc r
   mount --rbind /sys "$1/sys" && mounts+=("$1/sys")
 }
 
-# The roots: "base" (minbase + python3-numpy) and "pocl" (base + pocl-opencl-icd), made with
-# the host's apt sources so that PoCL is the host's version. Each is made in a temporary
-# folder and renamed when complete, under a lock, so a cut-off run leaves no half root.
-cache=${PORTALSIM_ROOT_CACHE:-/var/cache/portalsim}/bookworm-minbase-v1
-mkdir -p "$cache"
-exec 9>"$cache/.lock"
+# The roots, each made in a temporary folder and renamed when complete, under a lock, so a
+# cut-off run leaves no half root. Debian 12's: "base" (minbase + python3-numpy), "pocl"
+# (base + pocl-opencl-icd) and "mpi" (base + openmpi-bin), made with the host's apt sources so
+# that PoCL is the host's version; Debian 13's: "trixie" (minbase + python3 +
+# pocl-opencl-icd), from the same mirror.
+cache_root=${PORTALSIM_ROOT_CACHE:-/var/cache/portalsim}
+cache=$cache_root/bookworm-minbase-v1
+trixie=$cache_root/trixie-minbase-v1/pocl
+mkdir -p "$cache" "${trixie%/*}"
+exec 9>"$cache_root/.lock"
 flock 9
 in_root() { local root=$1; shift; chroot "$root" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin LC_ALL=C.UTF-8 "$@"; }
 apt_in_root() {
@@ -50,27 +62,42 @@ apt_in_root() {
   in_root "$1" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${@:2}" >/dev/null
   in_root "$1" apt-get clean
 }
+bootstrap() {  # bootstrap SUITE ROOT: a minbase root of SUITE in ROOT.tmp
+  local suite=$1 root=$2
+  echo "bundle_check: making the minimal $suite root $root (debootstrap, a minute or two)"
+  rm -rf "$root.tmp"
+  debootstrap --variant=minbase "$suite" "$root.tmp" http://deb.debian.org/debian >"$root.debootstrap.log" 2>&1 ||
+    fail "debootstrap failed: $root.debootstrap.log"
+  cp -L /etc/resolv.conf "$root.tmp/etc/resolv.conf"
+}
+derive() {  # derive FROM NAME PACKAGES...: the root FROM with PACKAGES installed, as NAME
+  local from=$1 root=$2
+  [ ! -d "$root" ] || return 0
+  echo "bundle_check: making $root (${*:3})"
+  rm -rf "$root.tmp"
+  cp -a "$from" "$root.tmp"
+  mnt "$root.tmp"
+  apt_in_root "$root.tmp" "${@:3}"
+  cleanup
+  mv "$root.tmp" "$root"
+}
 if [ ! -d "$cache/base" ]; then
-  echo "bundle_check: making the minimal root $cache/base (debootstrap, about a minute)"
-  rm -rf "$cache/base.tmp"
-  debootstrap --variant=minbase bookworm "$cache/base.tmp" http://deb.debian.org/debian >"$cache/debootstrap.log" 2>&1 ||
-    fail "debootstrap failed: $cache/debootstrap.log"
+  bootstrap bookworm "$cache/base"
   rm -f "$cache/base.tmp/etc/apt/sources.list"
   cp /etc/apt/sources.list.d/debian.sources "$cache/base.tmp/etc/apt/sources.list.d/"
-  cp -L /etc/resolv.conf "$cache/base.tmp/etc/resolv.conf"
   mnt "$cache/base.tmp"
   apt_in_root "$cache/base.tmp" python3-numpy
   cleanup
   mv "$cache/base.tmp" "$cache/base"
 fi
-if [ ! -d "$cache/pocl" ]; then
-  echo "bundle_check: making $cache/pocl (the base root with pocl-opencl-icd)"
-  rm -rf "$cache/pocl.tmp"
-  cp -a "$cache/base" "$cache/pocl.tmp"
-  mnt "$cache/pocl.tmp"
-  apt_in_root "$cache/pocl.tmp" pocl-opencl-icd
+derive "$cache/base" "$cache/pocl" pocl-opencl-icd
+derive "$cache/base" "$cache/mpi" openmpi-bin
+if [ ! -d "$trixie" ]; then
+  bootstrap trixie "$trixie"
+  mnt "$trixie.tmp"
+  apt_in_root "$trixie.tmp" python3-minimal pocl-opencl-icd
   cleanup
-  mv "$cache/pocl.tmp" "$cache/pocl"
+  mv "$trixie.tmp" "$trixie"
 fi
 flock -u 9
 
@@ -93,12 +120,18 @@ devs=$(in_root "$cache/base" dpkg-query -W -f '${Package}\n' | grep -- '-dev$' |
 PORTALSIM_BUILD_DIR=$build bash "$src/tools/bundle.sh"
 version=$("$host_bin" --version | awk '{print $NF}')
 tarball=$build/portalsim-$version-linux-x86_64.tar.gz
+images_tarball=$build/portalsim-$version-linux-x86_64-images.tar.gz
 [ -f "$tarball" ] || fail "tools/bundle.sh made no $tarball"
+[ -f "$images_tarball" ] || fail "tools/bundle.sh made no images add-on $images_tarball"
 work=$build/bundle-check
 rm -rf "$work"
 mkdir -p "$work/bundle" "$work/host"
 tar -C "$work/bundle" -xzf "$tarball"
 bundle=$work/bundle/portalsim-$version-linux-x86_64
+# The bundle alone holds no OpenImageIO: its module and libraries are the add-on's.
+for f in lib/portalsim/libportalsim_oiio.so python/portalsim/libportalsim_oiio.so lib/libOpenImageIO.so.2.4; do
+  [ ! -e "$bundle/$f" ] || fail "the bundle holds $f, which belongs to its images add-on"
+done
 [ -x "$bundle/bin/portalsim" ] || fail "the tarball has no bin/portalsim"
 [ -d "$build/python/portalsim" ] || fail "$build/python/portalsim is missing: build the target portalsim_python"
 
@@ -126,68 +159,137 @@ run_host() {  # run_host DIR BACKEND: the build's binary and module, outside
     PYTHONPATH=$build/python /usr/bin/python3 -c "$python_code" "$backend" >python.txt) ||
     fail "the build's own portalsim failed outside the root ($backend)"
 }
-run_root() {  # run_root ROOT DIR BACKEND: the bundle inside ROOT, with nothing but it on the paths
-  local root=$cache/$1 dir=$work/$1-$3 backend=$3
+run_root() {  # run_root LABEL ROOT BACKEND PYTHON: the bundle inside ROOT, with nothing but it on the paths;
+  # PYTHON "same": the package gives the build's arrays; "refused": it says it needs CPython 3.11
+  local label=$1 root=$2 backend=$3 python=$4
+  local dir=$work/$label-$backend
   mkdir -p "$dir" "$root/opt/portalsim" "$root/check"
   mount --bind "$bundle" "$root/opt/portalsim" && mounts+=("$root/opt/portalsim")
   mount -o remount,bind,ro "$root/opt/portalsim"
   mount --bind "$dir" "$root/check" && mounts+=("$root/check")
   mnt "$root"
-  # Every library but glibc's resolves inside the bundle.
+  # Every library but glibc's and the C++ runtime's resolves inside the bundle.
   local ldd_out
   ldd_out=$(in_root "$root" ldd /opt/portalsim/bin/portalsim /opt/portalsim/python/portalsim/_core.cpython-311-x86_64-linux-gnu.so \
     /opt/portalsim/lib/portalsim/libportalsim_oiio.so /opt/portalsim/python/portalsim/libportalsim_oiio.so) ||
-    fail "ldd failed in the $1 root"
-  if grep -q 'not found' <<<"$ldd_out"; then fail "in the $1 root, libraries are missing: $(grep 'not found' <<<"$ldd_out" | tr -s ' \t' ' ')"; fi
+    fail "ldd failed in the $label root"
+  if grep -q 'not found' <<<"$ldd_out"; then fail "in the $label root, libraries are missing: $(grep 'not found' <<<"$ldd_out" | tr -s ' \t' ' ')"; fi
   local outside
   outside=$(awk '$2 == "=>" && $3 !~ /^\/opt\/portalsim\// {print $1}' <<<"$ldd_out" |
-    grep -v -E '^(libc|libm|libpthread|libdl|librt|libresolv|libmvec)\.so\.[0-9]+$' || true)
-  [ -z "$outside" ] || fail "in the $1 root, libraries resolve outside the bundle: $outside"
+    grep -v -E '^(libc|libm|libpthread|libdl|librt|libresolv|libmvec|libstdc\+\+|libgcc_s)\.so\.[0-9]+$' || true)
+  [ -z "$outside" ] || fail "in the $label root, libraries resolve outside the bundle: $outside"
   run_in() { in_root "$root" env HOME=/check/home POCL_CACHE_DIR=/check/pocl-cache PYTHONDONTWRITEBYTECODE=1 \
                sh -c 'mkdir -p "$HOME" && cd /check && "$@"' sh "$@"; }
-  run_in /opt/portalsim/bin/portalsim --version >/dev/null || fail "bin/portalsim --version failed in the $1 root"
+  run_in /opt/portalsim/bin/portalsim --version >/dev/null || fail "bin/portalsim --version failed in the $label root"
   run_in /opt/portalsim/bin/portalsim "${simulate[@]}" --backend "$backend" >/dev/null ||
-    fail "simulate --backend $backend failed in the $1 root"
+    fail "simulate --backend $backend failed in the $label root"
   run_in /opt/portalsim/bin/portalsim "${simulate_physics[@]}" --backend "$backend" >/dev/null ||
-    fail "simulate --model physics --backend $backend failed in the $1 root"
+    fail "simulate --model physics --backend $backend failed in the $label root"
   run_in /opt/portalsim/bin/portalsim "${generate[@]}" --backend "$backend" --quiet >/dev/null ||
-    fail "generate --backend $backend failed in the $1 root"
-  run_in env PYTHONPATH=/opt/portalsim/python /usr/bin/python3 -c "$python_code" "$backend" >"$dir/python.txt" ||
-    fail "the Python package failed in the $1 root under /usr/bin/python3 ($backend)"
+    fail "generate --backend $backend failed in the $label root"
+  if [ "$python" = same ]; then
+    run_in env PYTHONPATH=/opt/portalsim/python /usr/bin/python3 -c "$python_code" "$backend" >"$dir/python.txt" ||
+      fail "the Python package failed in the $label root under /usr/bin/python3 ($backend)"
+  else
+    local refusal
+    refusal=$(run_in env PYTHONPATH=/opt/portalsim/python /usr/bin/python3 -c 'import portalsim' 2>&1) &&
+      fail "the Python package imported in the $label root, whose Python is not 3.11"
+    grep -q "was built for another Python than this one" <<<"$refusal" ||
+      fail "in the $label root, the Python package's refusal does not say why: $refusal"
+    echo "bundle_check: $label root: import portalsim says: $(tail -n1 <<<"$refusal")"
+    cp "$work/host/$backend/python.txt" "$dir/python.txt"  # not made here: the comparison below skips it
+  fi
   cleanup
   rm -rf "$dir/home" "$dir/pocl-cache"
-  diff -r "$work/host/$backend" "$dir" >"$work/$1-$3.diff" ||
-    fail "the $1 root's outputs ($backend) differ from the build's: $work/$1-$3.diff"
-  echo "bundle_check: $1 root, --backend $backend: $(find "$dir" -type f | wc -l) files byte-identical to the build's"
+  diff -r "$work/host/$backend" "$dir" >"$work/$label-$backend.diff" ||
+    fail "the $label root's outputs ($backend) differ from the build's: $work/$label-$backend.diff"
+  echo "bundle_check: $label root, --backend $backend: $(find "$dir" -type f | wc -l) files byte-identical to the build's"
+}
+
+# in_mounted ROOT DIR COMMAND...: COMMAND in ROOT, in DIR mounted at /check, with the bundle
+# at /opt/portalsim; prints its output; returns its status.
+in_mounted() {
+  local root=$1 dir=$2 rc=0 out
+  shift 2
+  mkdir -p "$root/check" "$root/opt/portalsim"
+  mount --bind "$dir" "$root/check" && mounts+=("$root/check")
+  mount --bind "$bundle" "$root/opt/portalsim" && mounts+=("$root/opt/portalsim")
+  mnt "$root"
+  out=$(in_root "$root" sh -c 'cd /check && "$@"' sh "$@" 2>&1) || rc=$?
+  cleanup
+  printf '%s\n' "$out"
+  return $rc
 }
 
 run_host reference reference
 run_host opencl opencl
-run_root base reference reference
 
-# With no driver, the OpenCL backend must fail with a message, not crash.
-mkdir -p "$cache/base/check"
-mount --bind "$work/host" "$cache/base/check" && mounts+=("$cache/base/check")
-mnt "$cache/base"
-mount --bind "$bundle" "$cache/base/opt/portalsim" && mounts+=("$cache/base/opt/portalsim")
+# The bundle without its images add-on: the built-in catalogue's PNG images are the build's;
+# a JPEG stops with exit 5 and names the add-on.
+mkdir -p "$work/core-only"
+in_mounted "$cache/base" "$work/core-only" /opt/portalsim/bin/portalsim "${simulate[@]}" --backend reference >/dev/null ||
+  fail "simulate failed in the base root without the images add-on"
+diff -r "$work/host/reference/simulate" "$work/core-only/simulate" >"$work/core-only.diff" ||
+  fail "without the images add-on, simulate differs from the build's: $work/core-only.diff"
 set +e
-msg=$(in_root "$cache/base" /opt/portalsim/bin/portalsim bench --list-devices 2>&1)
+msg=$(in_mounted "$cache/base" "$work/core-only" /opt/portalsim/bin/portalsim "${simulate_physics[@]}" --backend reference)
 rc=$?
 set -e
-cleanup
+[ "$rc" = 5 ] && grep -q "images add-on, portalsim-$version-linux-x86_64-images.tar.gz" <<<"$msg" ||
+  fail "a JPEG without the images add-on exits $rc and does not name the add-on: $msg"
+echo "bundle_check: base root, no images add-on: PNG byte-identical; JPEG exits 5: $msg"
+tar -C "$work/bundle" -xzf "$images_tarball"
+
+run_root base "$cache/base" reference same
+
+# With no driver, the OpenCL backend must fail with a message, not crash, and say what to install.
+set +e
+msg=$(in_mounted "$cache/base" "$work/host" /opt/portalsim/bin/portalsim bench --list-devices)
+rc=$?
+set -e
 case $rc in
   0) fail "bench --list-devices succeeded in the base root, which has no OpenCL driver" ;;
-  1|2|3|4|5) [ -n "$msg" ] || fail "bench --list-devices failed silently without a driver (exit $rc)" ;;
+  1|2|3|4|5) grep -q "no OpenCL driver is installed" <<<"$msg" || fail "bench --list-devices without a driver (exit $rc) does not say that none is installed: $msg" ;;
   *) fail "bench --list-devices crashed without a driver (exit $rc): $msg" ;;
 esac
 echo "bundle_check: base root, no driver: bench --list-devices exits $rc: $msg"
 
-run_root pocl opencl opencl
-mount --bind "$bundle" "$cache/pocl/opt/portalsim" && mounts+=("$cache/pocl/opt/portalsim")
-mnt "$cache/pocl"
-devices=$(in_root "$cache/pocl" /opt/portalsim/bin/portalsim bench --list-devices) ||
-  fail "bench --list-devices failed in the pocl root"
-cleanup
+run_root pocl "$cache/pocl" opencl same
+devices=$(in_mounted "$cache/pocl" "$work/host" /opt/portalsim/bin/portalsim bench --list-devices) ||
+  fail "bench --list-devices failed in the pocl root: $devices"
 grep -q 'Portable Computing Language' <<<"$devices" || fail "bench --list-devices in the pocl root names no PoCL device: $devices"
 echo "bundle_check: pocl root: $devices"
+
+# Debian 13: its PoCL 6 needs GCC 14's libstdc++, which the bundle must leave to the system.
+run_root trixie "$trixie" opencl refused
+devices=$(in_mounted "$trixie" "$work/host" /opt/portalsim/bin/portalsim bench --list-devices) ||
+  fail "bench --list-devices failed in the Debian 13 root: $devices"
+grep -q 'Portable Computing Language' <<<"$devices" || fail "bench --list-devices in the Debian 13 root names no PoCL device: $devices"
+echo "bundle_check: Debian 13 root: $devices"
+# A driver that does not load (here a bundled libstdc++ older than the one it needs, as the
+# bundle once had) is named with the loader's reason, not mistaken for no driver.
+set +e
+msg=$(in_mounted "$trixie" "$work/host" env LD_LIBRARY_PATH=/opt/portalsim/lib/fallback /opt/portalsim/bin/portalsim bench --list-devices)
+rc=$?
+set -e
+[ "$rc" = 5 ] || fail "with an older libstdc++ first, bench --list-devices in the Debian 13 root exits $rc, not 5: $msg"
+grep -q "pocl.icd names libpocl.so.2.*, which does not load: .*GLIBCXX_3.4.3[0-9]' not found" <<<"$msg" ||
+  fail "with an older libstdc++ first, the message does not name the driver and the loader's reason: $msg"
+echo "bundle_check: Debian 13 root, GCC 12's libstdc++ first: $msg"
+
+# MPI: the root's own mpirun starts two ranks of the bundle's binary, which load the MPI
+# module and through it the root's Open MPI; the folder equals one process's, byte for byte.
+mpi_dir=$work/mpi
+mkdir -p "$mpi_dir" "$cache/mpi/check" "$cache/mpi/opt/portalsim"
+mount --bind "$bundle" "$cache/mpi/opt/portalsim" && mounts+=("$cache/mpi/opt/portalsim")
+mount --bind "$mpi_dir" "$cache/mpi/check" && mounts+=("$cache/mpi/check")
+mnt "$cache/mpi"
+mpi_generate=(/opt/portalsim/bin/portalsim generate --count 120 --seed 5 --what both --format arff,csv,npy,h5 --backend reference)
+mpi_out=$(in_root "$cache/mpi" env HOME=/check sh -c 'cd /check && "$@" --quiet --out one &&
+  mpirun --allow-run-as-root --oversubscribe -np 2 "$@" --out two' sh "${mpi_generate[@]}" 2>&1) ||
+  { cleanup; fail "generate, or mpirun -np 2 of it, failed in the mpi root: $mpi_out"; }
+cleanup
+grep -q "2 ranks" <<<"$mpi_out" || fail "mpirun -np 2 in the mpi root did not run as 2 ranks: $mpi_out"
+diff -r "$mpi_dir/one" "$mpi_dir/two" >"$work/mpi.diff" || fail "mpirun -np 2 in the mpi root differs from one process: $work/mpi.diff"
+echo "bundle_check: mpi root: mpirun -np 2 equals one process ($(find "$mpi_dir/two" -type f | wc -l) files)"
 echo "bundle_check: passed ($(du -h "$tarball" | cut -f1) bundle)"

@@ -86,6 +86,8 @@ TEST(ImageModule, MissingIsAnEnvironmentErrorNamingWhereItLooked) {
   not_found.append(kModule).append(", not found");
   EXPECT_TRUE(has(jpg.err, not_found)) << describe(jpg);
   EXPECT_TRUE(has(jpg.err, (alone.parent_path() / kModule).string())) << describe(jpg);
+  EXPECT_TRUE(has(jpg.err, "images add-on, portalsim-" PORTALSIM_VERSION "-linux-x86_64-images.tar.gz"))
+      << "a bundle without its add-on is told where the module is" << describe(jpg);
   EXPECT_FALSE(fs::exists(t.w() / "jpg"));
 }
 

@@ -16,7 +16,23 @@ datasets (H5Dataset over a data.h5, StreamDataset straight from the kernels).
 Supported interpreter: Debian's /usr/bin/python3 (tools/install-python.sh installs the package
 for it). docs/guide/python.md is the guide.
 """
-from . import _core
+try:
+    from . import _core
+except ImportError as _error:
+    import pathlib as _pathlib
+    import sys as _sys
+    import sysconfig as _sysconfig
+
+    _built = sorted(p.name for p in _pathlib.Path(__file__).parent.glob("_core*.so"))
+    _wanted = "_core" + (_sysconfig.get_config_var("EXT_SUFFIX") or ".so")
+    if _built and _wanted not in _built:
+        # pybind11 has no stable ABI: the module serves the one CPython it was built for.
+        raise ImportError(
+            f"portalsim's module {', '.join(_built)} was built for another Python than this one "
+            f"({_sys.executable}, {_sys.version.split()[0]}, which loads {_wanted}); run it with "
+            "that Python, or build portalsim for this one (docs/guide/python.md)"
+        ) from _error
+    raise
 
 __version__ = _core.version
 __all__ = ["Generator", "simulate", "__version__"]
