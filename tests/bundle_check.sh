@@ -8,8 +8,8 @@
 # - Debian 13 (glibc 2.41, GCC 14's libstdc++) with its pocl-opencl-icd (PoCL 6, LLVM 18):
 #   the same commands on the OpenCL backend, the driver loaded next to the bundle's
 #   libraries; its Python (3.13) refuses the 3.11 module with a message that says so;
-# - Debian 12 with openmpi-bin: `mpirun -np 2` of the bundle's binary, under the root's own
-#   Open MPI, equals one process;
+# - Debian 12 and 13 with openmpi-bin: `mpirun -np 2` of the bundle's binary, under the
+#   root's own Open MPI (4.1, 5.0), equals one process;
 # - an OpenCL driver that does not load is named with the loader's reason.
 # As root (chroot, mounts); the roots are made once (Debian's mirror) and cached, and get
 # /proc, /sys and /dev mounted as a real machine has them.
@@ -48,11 +48,11 @@ mnt() {  # mnt ROOT: /proc and /dev for apt and the runs, /sys for PoCL (hwloc r
 # The roots, each made in a temporary folder and renamed when complete, under a lock, so a
 # cut-off run leaves no half root. Debian 12's: "base" (minbase + python3-numpy), "pocl"
 # (base + pocl-opencl-icd) and "mpi" (base + openmpi-bin), made with the host's apt sources so
-# that PoCL is the host's version; Debian 13's: "trixie" (minbase + python3 +
-# pocl-opencl-icd), from the same mirror.
+# that PoCL is the host's version; Debian 13's: "pocl" (minbase + python3 + pocl-opencl-icd)
+# and "mpi" (that + openmpi-bin), from the same mirror.
 cache_root=${PORTALSIM_ROOT_CACHE:-/var/cache/portalsim}
 cache=$cache_root/bookworm-minbase-v1
-trixie=$cache_root/trixie-minbase-v1/pocl
+trixie=$cache_root/trixie-minbase-v1/pocl trixie_mpi=$cache_root/trixie-minbase-v1/mpi
 mkdir -p "$cache" "${trixie%/*}"
 exec 9>"$cache_root/.lock"
 flock 9
@@ -99,6 +99,7 @@ if [ ! -d "$trixie" ]; then
   cleanup
   mv "$trixie.tmp" "$trixie"
 fi
+derive "$trixie" "$trixie_mpi" openmpi-bin
 flock -u 9
 
 # The base root has no OpenCL at all, and neither root any of the build's libraries or
@@ -277,19 +278,24 @@ grep -q "pocl.icd names libpocl.so.2.*, which does not load: .*GLIBCXX_3.4.3[0-9
   fail "with an older libstdc++ first, the message does not name the driver and the loader's reason: $msg"
 echo "bundle_check: Debian 13 root, GCC 12's libstdc++ first: $msg"
 
-# MPI: the root's own mpirun starts two ranks of the bundle's binary, which load the MPI
-# module and through it the root's Open MPI; the folder equals one process's, byte for byte.
-mpi_dir=$work/mpi
-mkdir -p "$mpi_dir" "$cache/mpi/check" "$cache/mpi/opt/portalsim"
-mount --bind "$bundle" "$cache/mpi/opt/portalsim" && mounts+=("$cache/mpi/opt/portalsim")
-mount --bind "$mpi_dir" "$cache/mpi/check" && mounts+=("$cache/mpi/check")
-mnt "$cache/mpi"
+# MPI: the root's own mpirun (Open MPI 4.1 in Debian 12, 5.0 in Debian 13) starts two ranks
+# of the bundle's binary, which load the MPI module and through it the root's Open MPI; the
+# folder equals one process's, byte for byte.
 mpi_generate=(/opt/portalsim/bin/portalsim generate --count 120 --seed 5 --what both --format arff,csv,npy,h5 --backend reference)
-mpi_out=$(in_root "$cache/mpi" env HOME=/check sh -c 'cd /check && "$@" --quiet --out one &&
-  mpirun --allow-run-as-root --oversubscribe -np 2 "$@" --out two' sh "${mpi_generate[@]}" 2>&1) ||
-  { cleanup; fail "generate, or mpirun -np 2 of it, failed in the mpi root: $mpi_out"; }
-cleanup
-grep -q "2 ranks" <<<"$mpi_out" || fail "mpirun -np 2 in the mpi root did not run as 2 ranks: $mpi_out"
-diff -r "$mpi_dir/one" "$mpi_dir/two" >"$work/mpi.diff" || fail "mpirun -np 2 in the mpi root differs from one process: $work/mpi.diff"
-echo "bundle_check: mpi root: mpirun -np 2 equals one process ($(find "$mpi_dir/two" -type f | wc -l) files)"
+check_mpi() {  # check_mpi LABEL ROOT
+  local label=$1 root=$2 dir=$work/$1 out
+  mkdir -p "$dir" "$root/check" "$root/opt/portalsim"
+  mount --bind "$bundle" "$root/opt/portalsim" && mounts+=("$root/opt/portalsim")
+  mount --bind "$dir" "$root/check" && mounts+=("$root/check")
+  mnt "$root"
+  out=$(in_root "$root" env HOME=/check sh -c 'cd /check && "$@" --quiet --out one &&
+    mpirun --allow-run-as-root --oversubscribe -np 2 "$@" --out two' sh "${mpi_generate[@]}" 2>&1) ||
+    { cleanup; fail "generate, or mpirun -np 2 of it, failed in the $label root: $out"; }
+  cleanup
+  grep -q "2 ranks" <<<"$out" || fail "mpirun -np 2 in the $label root did not run as 2 ranks: $out"
+  diff -r "$dir/one" "$dir/two" >"$work/$label.diff" || fail "mpirun -np 2 in the $label root differs from one process: $work/$label.diff"
+  echo "bundle_check: $label root (Open MPI $(in_root "$root" dpkg-query -W -f '${Version}' openmpi-bin)): mpirun -np 2 equals one process ($(find "$dir/two" -type f | wc -l) files)"
+}
+check_mpi mpi "$cache/mpi"
+check_mpi trixie-mpi "$trixie_mpi"
 echo "bundle_check: passed ($(du -h "$tarball" | cut -f1) bundle)"
