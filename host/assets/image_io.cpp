@@ -1,6 +1,5 @@
 #include "assets/image_io.h"
 
-#include <dlfcn.h>
 #include <fcntl.h>
 #include <unistd.h>
 

@@ -1,7 +1,5 @@
 #include "schedule/ranks.h"
 
-#include <dlfcn.h>
-
 #include <cstdlib>
 
 #include "base/error.h"
