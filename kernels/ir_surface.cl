@@ -40,7 +40,7 @@ kernel void stage_ir_surface(VIEW_STAGE_ARGS) {
   const SceneDraw scene = scene_draw(phys, seed, index);
   preal gain, offset;
   subject_kelvin(&scene, subject[i], &gain, &offset);
-  for (int x = 0; x < L.width; ++x) T[x] += gain * (preal)base[x] + offset;
+  for (int x = 0; x < L.width; ++x) T[x] += gray_kelvin(gain, (preal)base[x], offset);
   fold_values(&scene, fold_row(atlas, bases, subject, &L, i, y), T, L.width);
 }
 
@@ -72,11 +72,11 @@ inline void ir_window(global const preal* restrict T, global uchar* restrict o, 
   int p = a;
 #if !defined(PRECISION_FP64)
   for (; p + 64 <= b; p += 64)
-    store64(window_levels16(vload16(0, T + p), lo, scale), window_levels16(vload16(1, T + p), lo, scale),
-            window_levels16(vload16(2, T + p), lo, scale), window_levels16(vload16(3, T + p), lo, scale), o + p);
-  for (; p + 16 <= b; p += 16) store16(window_levels16(vload16(0, T + p), lo, scale), o + p);
+    store64(window_level16(vload16(0, T + p), lo, scale), window_level16(vload16(1, T + p), lo, scale),
+            window_level16(vload16(2, T + p), lo, scale), window_level16(vload16(3, T + p), lo, scale), o + p);
+  for (; p + 16 <= b; p += 16) store16(window_level16(vload16(0, T + p), lo, scale), o + p);
 #endif
-  for (; p < b; ++p) o[p] = (uchar)clamp(floor((T[p] - lo) * scale + (preal)0.5), (preal)0, (preal)255);
+  for (; p < b; ++p) o[p] = window_level(T[p], lo, scale);
 }
 
 // One work-item per scenario: the view's pixels are one run in memory.

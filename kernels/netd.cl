@@ -100,8 +100,8 @@ __attribute__((always_inline)) inline void gauss128x2(uint2 seed, ulong index, i
   const uint16 wb[4] = {convert_uint16(b0), convert_uint16(b1), convert_uint16(b2), convert_uint16(b3)};
 #pragma unroll
   for (int w = 0; w < 4; ++w) {
-    const uint16 alo = (wa[w] >> (16 - PS_GAUSS_BITS)) & (PS_GAUSS_TABLE - 1), ahi = wa[w] >> (32 - PS_GAUSS_BITS);
-    const uint16 blo = (wb[w] >> (16 - PS_GAUSS_BITS)) & (PS_GAUSS_TABLE - 1), bhi = wb[w] >> (32 - PS_GAUSS_BITS);
+    const uint16 alo = PS_GAUSS_INDEX(wa[w], 0), ahi = PS_GAUSS_INDEX(wa[w], 16);
+    const uint16 blo = PS_GAUSS_INDEX(wb[w], 0), bhi = PS_GAUSS_INDEX(wb[w], 16);
     g[2 * w] = GATHER16(table, alo);
     g[2 * w + 1] = GATHER16(table, ahi);
     h[2 * w] = GATHER16(table, blo);

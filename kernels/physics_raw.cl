@@ -50,7 +50,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   subject_kelvin(&scene, s, &gain, &offset);
   if (scene.outfit >= 0) {
     global const param* gray = phys + (int)phys[(int)phys[PS_PHYS_CLOTHING] + PS_CLOTHING_GRIDS] + (size_t)s * cells;
-    for (int k = 0; k < cells; ++k) r[k] = gain * (preal)gray[k] + offset;
+    for (int k = 0; k < cells; ++k) r[k] = gray_kelvin(gain, (preal)gray[k], offset);
     // Its folds: the fold grids' share-weighted gray A and share B (PS_CLOTHING_FOLD_GRIDS) add
     // fold (gain A + (offset - fold_t) B), the raw grid of fold m (v - fold_t) over the bare body.
     if (scene.fold != 0) {
@@ -92,7 +92,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     if (x_lo >= x_hi) continue;
     global const uchar* base = base_row(atlas, bases, subject, &L, i, y);
     for (int x = x_lo; x < x_hi; ++x) {
-      const preal t0 = gain * (preal)base[x] + offset;
+      const preal t0 = gray_kelvin(gain, (preal)base[x], offset);
       d[x] = lay_values(&Ly, atlas, x, lv, t0) - t0;
     }
     if (scene.fold != 0) {  // the change passes the folds as the bare body does

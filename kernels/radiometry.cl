@@ -65,6 +65,16 @@ inline void subject_kelvin(const SceneDraw* d, int s, preal* gain, preal* offset
   *offset += (preal)d->moves[2 * s + 1] * d->t;
 }
 
+// A gray value's kelvin through a subject's (gain, offset) (subject_kelvin), for one value
+// and for 16: the one text of the bare body's surface (radiometry, ir_surface and their
+// fast paths).
+#define GRAY_KELVIN(F) \
+  inline F __attribute__((overloadable)) gray_kelvin(preal gain, F gray, preal offset) { return gain * gray + offset; }
+GRAY_KELVIN(preal)
+#if !defined(PRECISION_FP64)
+GRAY_KELVIN(float16)
+#endif
+
 // Each variant's value in the scenario's outfit (PS_PHYS_VARIANTS where the clothing is the
 // catalogue's).
 inline global const param* variant_values(const SceneDraw* d, int subjects) { return d->head + 2 * subjects; }
@@ -121,6 +131,6 @@ kernel void stage_radiometry(VIEW_STAGE_ARGS) {
   Layers Ly;
   composite_layers(&Ly, rec, &L, y);
   layer_values(&Ly, variant_values(&scene, L.subjects), &scene, L.subjects, lv);
-  for (int x = 0; x < L.width; ++x) T[x] = lay_values(&Ly, atlas, x, lv, gain * (preal)base[x] + offset);
+  for (int x = 0; x < L.width; ++x) T[x] = lay_values(&Ly, atlas, x, lv, gray_kelvin(gain, (preal)base[x], offset));
   fold_values(&scene, fold_row(atlas, bases, subject, &L, i, y), T, L.width);
 }

@@ -39,6 +39,21 @@
 GAUSS_POLY(float, int)
 GAUSS_POLY(float16, int16)
 
+// Box-Muller of Philox words r0, r1 (one pair, or 16 side by side): the draws rad cos and
+// rad sin into *g0 and *g1.
+#define BOX_MULLER(F, U)                                                                        \
+  inline void __attribute__((overloadable)) box_muller(U r0, U r1, F* g0, F* g1) {            \
+    const F u1 = 1.0f - convert_##F(r0 >> 8) * (1.0f / 16777216.0f);                           \
+    const F u2 = convert_##F(r1 >> 8) * (1.0f / 16777216.0f);                                   \
+    const F rad = sqrt(-2.0f * ln_poly(u1));                                                    \
+    F s, c;                                                                                     \
+    sincos_turns(u2, &s, &c);                                                                   \
+    *g0 = rad * c;                                                                              \
+    *g1 = rad * s;                                                                              \
+  }
+BOX_MULLER(float, uint)
+BOX_MULLER(float16, uint16)
+
 // Philox4x32-10 of 16 counters at once (kernels/philox.cl, lane by lane). Each 32-bit word
 // lives in a 64-bit lane, so one vpmuludq gives 8 whole products: hi = p >> 32, and lo is p
 // itself, whose high half only ever reaches a multiply (which masks it off) or an xor into
@@ -96,24 +111,16 @@ inline greal2 gauss_pair_of(uint2 seed, ulong index, uint stream, int view, int 
 #else
 inline greal2 gauss_pair_of(uint2 seed, ulong index, uint stream, int view, int pair) {
   const uint4 r = draw(seed, index, stream, ((uint)view << PS_PIXEL_NOISE_VIEW_SHIFT) | (uint)pair);
-  const float u1 = 1.0f - (float)(r.x >> 8) * (1.0f / 16777216.0f);
-  const float u2 = (float)(r.y >> 8) * (1.0f / 16777216.0f);
-  const float rad = sqrt(-2.0f * ln_poly(u1));
-  float s, c;
-  sincos_turns(u2, &s, &c);
-  return (float2)(rad * c, rad * s);
+  float g0, g1;
+  box_muller(r.x, r.y, &g0, &g1);
+  return (float2)(g0, g1);
 }
 
 // Box-Muller of 16 Philox outputs (words r0, r1): the draws of 32 pixels, interleaved,
 // the first 16 pixels in *g0 and the next 16 in *g1.
 __attribute__((always_inline)) inline void box_muller16(uint16 r0, uint16 r1, float16* g0, float16* g1) {
-  const float16 u1 = 1.0f - convert_float16(r0 >> 8) * (1.0f / 16777216.0f);
-  const float16 u2 = convert_float16(r1 >> 8) * (1.0f / 16777216.0f);
-  const float16 rad = sqrt(-2.0f * ln_poly(u1));
-  float16 s, c;
-  sincos_turns(u2, &s, &c);
-  c *= rad;
-  s *= rad;
+  float16 c, s;
+  box_muller(r0, r1, &c, &s);
   *g0 = shuffle2(c, s, (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23));
   *g1 = shuffle2(c, s, (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
 }
@@ -176,7 +183,7 @@ __attribute__((always_inline)) inline void gauss128(uint2 seed, ulong index, uin
   philox16(&c[0], &c[1], &c[2], &c[3], seed);
 #pragma unroll
   for (int w = 0; w < 4; ++w) {
-    const uint16 lo = (c[w] >> (16 - PS_GAUSS_BITS)) & (PS_GAUSS_TABLE - 1), hi = c[w] >> (32 - PS_GAUSS_BITS);
+    const uint16 lo = PS_GAUSS_INDEX(c[w], 0), hi = PS_GAUSS_INDEX(c[w], 16);  // cells 16 b + .., + 16
     g[2 * w] = GATHER16(table, lo);
     g[2 * w + 1] = GATHER16(table, hi);
   }
@@ -190,10 +197,18 @@ __attribute__((always_inline)) inline void gauss128(uint2 seed, ulong index, uin
 // integers, so the float steps are one multiply and the written fma()s, alike for 1 and 16.
 // The thesis model's pixel noise draws from PS_STREAM_PIXEL_NOISE_FAST (ih_pixel), the
 // physics cameras' NETD from their table Gaussians' streams (netd.cl, ir_surface*.cl).
-inline greal ih_shape(int d) {
-  const greal t = (greal)d * ((greal)1 / (greal)255), t2 = t * t;
-  return t * fma(t2, fma(t2, (greal)PS_IH_C5, (greal)PS_IH_C3), (greal)PS_IH_C1);
-}
+// ih_shape of one d and ih_shape16 of 16 (F the element type, P its scalar, I the ints).
+#define IH_SHAPE(F, P, I, S)                                                                         \
+  inline F ih_shape##S(I d) {                                                                      \
+    const F t = convert_##F(d) * ((P)1 / (P)255), t2 = t * t;                                      \
+    return t * fma(t2, fma(t2, (F)((P)PS_IH_C5), (F)((P)PS_IH_C3)), (F)((P)PS_IH_C1));             \
+  }
+#if defined(PRECISION_FP64)
+IH_SHAPE(double, double, int, )
+#else
+IH_SHAPE(float, float, int, )
+IH_SHAPE(float16, float, int16, 16)
+#endif
 inline greal ih_cell(uint2 seed, ulong index, uint stream, int view, int p) {
   const uint h = cell_word(seed, index, stream, view, p) >> PS_GAUSS_SHIFT(p);
   return ih_shape((int)(h & 0xffu) + (int)((h >> 8) & 0xffu) - 255);
@@ -202,10 +217,6 @@ inline greal ih_pixel(uint2 seed, ulong index, int view, int p) {
   return ih_cell(seed, index, PS_STREAM_PIXEL_NOISE_FAST, view, p);
 }
 #if !defined(PRECISION_FP64)
-inline float16 ih_shape16(int16 d) {
-  const float16 t = convert_float16(d) * (1.0f / 255.0f), t2 = t * t;
-  return t * fma(t2, fma(t2, (float16)((float)PS_IH_C5), (float16)((float)PS_IH_C3)), (float16)((float)PS_IH_C1));
-}
 // The Irwin-Hall draws of cells 128 b .. 128 b + 127 of a view's field in `stream`: g[j]
 // holds cells 128 b + 16 j .. + 15. Both halves' byte sums come from one masked add per word.
 __attribute__((always_inline)) inline void ih128(uint2 seed, ulong index, uint stream, int view, int b,
