@@ -6,22 +6,7 @@
 // launch from the knobs): view pixel (x, y) is sum_r dy[y][r] sum_c dx[c][x] raw[r][c]. One
 // work-item per scenario draws the whole view.
 
-// Kelvin t through a display window (lo, scale = 255 / (max - lo)) to a level 0..255,
-// floor(x + 1/2) clamped: clamped before the truncation, which is then floor. One text for
-// one value (window_level) and for 16 (window_level16; P is the scalar type, I the ints).
-#define WINDOW_LEVEL(F, P, I, U, S)                                                   \
-  inline U window_level##S(F t, P lo, P scale) {                                     \
-    return convert_##U(convert_##I(fmin(fmax((t - lo) * scale + (P)0.5, (P)0), (P)255))); \
-  }
-#if defined(PRECISION_FP64)
-WINDOW_LEVEL(double, double, int, uchar, )
-#else
-WINDOW_LEVEL(float, float, int, uchar, )
-WINDOW_LEVEL(float16, float, int16, uchar16, 16)
-#endif
-
 #if !defined(PRECISION_FP64)
-
 // The 16 view columns x0 .. x0 + 15 of a view row whose vertically weighted raw values are
 // r: each raw column of [lo, hi] against its 16 weights, in column order. A column whose
 // weight is zero for a pixel adds +-0 to its sum, which leaves it as it is, so a pixel's

@@ -4,27 +4,6 @@
 // plus, for each view row an object crosses, that row's change (composite minus bare, in
 // kelvin) projected through the folded weights: raw[r][c] += wy[r][y] sum_x wx[c][x] d(x, y).
 // Tested against the chain of stage kernels and the reference (tests/physics_test.cpp).
-// Whether two layers' boxes, widened by the bilinear fringe, meet.
-inline bool layers_meet(global const int* a, global const int* b) {
-  return a[PS_LAYER_X0] - 2 < b[PS_LAYER_X0] + b[PS_LAYER_W] + 2 && b[PS_LAYER_X0] - 2 < a[PS_LAYER_X0] + a[PS_LAYER_W] + 2 &&
-         a[PS_LAYER_Y0] - 2 < b[PS_LAYER_Y0] + b[PS_LAYER_H] + 2 && b[PS_LAYER_Y0] - 2 < a[PS_LAYER_Y0] + a[PS_LAYER_H] + 2;
-}
-
-// Whether a scenario's view is its tabulated responses (features-only runs,
-// PS_FLAG_TABULATED): each object's alone, plus a pair's correction where two boxes meet.
-// That is exact when every object stands at its place (no jitter, no randomised
-// transform) and meets at most one other (so no pixel lies under three).
-inline bool physics_tabulated(global const int* rec, const PsViewLaunch* L) {
-  if (!(L->flags & PS_FLAG_TABULATED) || (L->flags & PS_FLAG_AFFINE) || L->jitter_x > 0.0f || L->jitter_y > 0.0f)
-    return false;
-  for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
-    int meets = 0;
-    for (int k = 0; k < rec[PS_REC_COUNT]; ++k)
-      meets += k != j && layers_meet(rec + PS_REC_LAYERS + j * PS_LAYER_LEN, rec + PS_REC_LAYERS + k * PS_LAYER_LEN);
-    if (meets > 1) return false;
-  }
-  return true;
-}
 
 kernel void physics_raw(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
@@ -123,7 +102,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     }
   }
 
-  // The netd stage: the scenario's frames averaged (kernels/netd.cl).
+  // The netd stage: the scenario's frames averaged (kernels/lib/physics.cl, netd_frames).
   int frames;
   const preal sd = mmw_noise_of(phys, L.frames, seed, index, &frames);
   if (sd > 0) netd_frames(r, cells, sd, frames, seed, index, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);
