@@ -94,7 +94,7 @@
 #define PS_DRAWN_WINDOW_HI 9u
 /* physics: the MMW raw grid of a run given a list of grids (--mmw-raw 24x24,28x28): the
  * grid below(word 0, grids) of the list. The host draws it and runs each grid's scenarios
- * together (an index table, kernels/philox.cl's scenario_index); not a numeric knob. */
+ * together (an index table, kernels/lib/philox.cl's scenario_index); not a numeric knob. */
 #define PS_DRAWN_MMW_RAW 10u
 /* physics: the share of the outer garment's folds and seams that lies doubled (--clothing-folds,
  * docs/model/clothing.md), under a drawn outfit. */
@@ -229,7 +229,7 @@ typedef struct {
  * then per subject the change of its (gain, offset) over the illumination's range, per
  * variant its value's change over that range, its change per unit of exp(-worn / tau), 1 / tau
  * and exp(-worn_lo / tau) (PS_SCENE_*), then (MMW) each subject's bare raw grid's change over
- * the illumination's range (kernels/radiometry.cl, scene_draw). */
+ * the illumination's range (kernels/lib/physics.cl, scene_draw). */
 #define PS_PHYS_SCENE 8
 /* Where the clothing is drawn per scenario (--clothing), the offset of the clothing block (0:
  * the catalogue's clothing): its classes C, each outfit's stride, the offset of the MMW gray

@@ -8,7 +8,7 @@
 // +0 to a sum that starts at +0 changes no bit): the same bits (tests/ir_physics_test.cpp).
 
 // Pixels [a, b) of row T: the bare surface (ir_surface's kelvin of the base image), added
-// to the values there (add) or alone, in stage_ir_surface's form (which
+// to the values there (add) or alone, by gray_kelvin as stage_ir_surface (which
 // -cl-fast-relaxed-math then rewrites alike). fp32 builds in explicit 16-lane vectors
 // (LLVM's own stop at 8).
 inline void bare_surface(global preal* restrict T, global const uchar* restrict base, int a, int b, preal gain,
@@ -17,14 +17,14 @@ inline void bare_surface(global preal* restrict T, global const uchar* restrict 
 #if !defined(PRECISION_FP64)
   if (add)
     for (; x + 16 <= b; x += 16)
-      vstore16(vload16(0, T + x) + (gain * convert_float16(load16(base + x)) + offset), 0, T + x);
+      vstore16(vload16(0, T + x) + gray_kelvin(gain, convert_float16(load16(base + x)), offset), 0, T + x);
   else
-    for (; x + 16 <= b; x += 16) vstore16(gain * convert_float16(load16(base + x)) + offset, 0, T + x);
+    for (; x + 16 <= b; x += 16) vstore16(gray_kelvin(gain, convert_float16(load16(base + x)), offset), 0, T + x);
 #endif
   if (add)
-    for (; x < b; ++x) T[x] += gain * (preal)base[x] + offset;
+    for (; x < b; ++x) T[x] += gray_kelvin(gain, (preal)base[x], offset);
   else
-    for (; x < b; ++x) T[x] = gain * (preal)base[x] + offset;
+    for (; x < b; ++x) T[x] = gray_kelvin(gain, (preal)base[x], offset);
 }
 
 // Scenario i's view. Scratch: the row blur, H x W, then each shadow row's blurred span
@@ -147,7 +147,7 @@ inline void ir_noisy_block(global const float* restrict T, global uchar* restric
   if (p + 128 <= pixels) {
     uchar16 l[8];
 #pragma unroll
-    for (int j = 0; j < 8; ++j) l[j] = window_levels16(IR_NOISY(LOADF16(global, T + p + 16 * j) + sd * g[j]), lo, scale);
+    for (int j = 0; j < 8; ++j) l[j] = window_level16(IR_NOISY(LOADF16(global, T + p + 16 * j) + sd * g[j]), lo, scale);
     store64(l[0], l[1], l[2], l[3], o + p);
     store64(l[4], l[5], l[6], l[7], o + p + 64);
     return;
@@ -155,12 +155,12 @@ inline void ir_noisy_block(global const float* restrict T, global uchar* restric
   for (int j = 0; j < 8; ++j) {
     const int q = p + 16 * j;
     if (q + 16 <= pixels) {
-      store16(window_levels16(IR_NOISY(LOADF16(global, T + q) + sd * g[j]), lo, scale), o + q);
+      store16(window_level16(IR_NOISY(LOADF16(global, T + q) + sd * g[j]), lo, scale), o + q);
     } else {
       float t[16];
       vstore16(g[j], 0, t);
       for (int k = q; k < pixels; ++k)
-        o[k] = (uchar)clamp(floor((IR_NOISY(T[k] + sd * t[k - q]) - lo) * scale + 0.5f), 0.0f, 255.0f);
+        o[k] = window_level(IR_NOISY(T[k] + sd * t[k - q]), lo, scale);
       break;
     }
   }
@@ -182,8 +182,7 @@ inline void ir_noisy_window(global const preal* restrict T, global uchar* restri
   for (int p = 0; p < pixels; ++p) {
     const preal g = fast ? ih_cell(seed, index, PS_STREAM_IR_NOISE, view, p)
                          : gauss_cell(seed, index, PS_STREAM_IR_NOISE, view, p, table);
-    const preal t = IR_NOISY(T[p] + sd * g);
-    o[p] = (uchar)clamp(floor((t - lo) * scale + (preal)0.5), (preal)0, (preal)255);
+    o[p] = window_level(IR_NOISY(T[p] + sd * g), lo, scale);
   }
 #else
   if (fast) {

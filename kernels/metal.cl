@@ -3,13 +3,6 @@
 // subject's base values, then clamped to [1, 200]. Integer arithmetic throughout, so it
 // matches the reference exactly. One work-item per scenario.
 
-// The scenario's detector noise (the knob metal_noise): noise_lo, or where the knob is
-// drawn per scenario (noise_hi > noise_lo), noise_lo + below(word 0, noise_hi - noise_lo + 1)
-// of PS_STREAM_KNOB_DRAW (host: metal_noise_at).
-inline int metal_noise_of(uint2 seed, ulong index, int noise_lo, int noise_hi) {
-  return knob_draw(noise_lo, noise_hi, seed, index, PS_DRAWN_METAL_NOISE);
-}
-
 kernel void metal_zones(global const uchar* influence, global const uchar* variant_category,
                         global const uchar* base_zones, global const uchar* subject, global const short* objects,
                         uint n, uint2 seed, uint2 first, global const ulong* indices, int noise_lo, int noise_hi,

@@ -6,20 +6,7 @@
 // launch from the knobs): view pixel (x, y) is sum_r dy[y][r] sum_c dx[c][x] raw[r][c]. One
 // work-item per scenario draws the whole view.
 
-// Kelvin t through the launch's display window to a level 0..255, rounded half up, clamped.
-inline uchar window_level(preal t, global const param* phys) {
-  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
-  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
-  return (uchar)clamp(floor((t - lo) * scale + (preal)0.5), (preal)0, (preal)255);
-}
-
 #if !defined(PRECISION_FP64)
-// window_level on 16 values, lo and scale as window_level has them: clamped before the
-// truncation, which is then floor.
-inline uchar16 window_levels16(float16 t, float lo, float scale) {
-  return convert_uchar16(convert_int16(fmin(fmax((t - lo) * scale + 0.5f, 0.0f), 255.0f)));
-}
-
 // The 16 view columns x0 .. x0 + 15 of a view row whose vertically weighted raw values are
 // r: each raw column of [lo, hi] against its 16 weights, in column order. A column whose
 // weight is zero for a pixel adds +-0 to its sum, which leaves it as it is, so a pixel's
@@ -50,7 +37,7 @@ inline float16 mmw_run(global const float* restrict r, global const param* dx, i
         global const float* rc = r + lo[m];                                                                         \
         float16 t = 0.0f;                                                                                           \
         _Pragma("unroll") for (int k = 0; k < K; ++k) t += rc[k] * w[m][k];                                         \
-        l[m] = window_levels16(t, wlo, scale);                                                                      \
+        l[m] = window_level16(t, wlo, scale);                                                                      \
       }                                                                                                             \
       MMW_STORE##N(l, ob);                                                                                          \
     }                                                                                                               \
@@ -88,7 +75,7 @@ inline void mmw_runs(global const float* restrict rows, global uchar* restrict o
   for (int y = y0; y < y1; ++y, r += RW, ob += W) {
     uchar16 l[4];
     for (int m = 0; m < count; ++m)
-      l[m] = window_levels16(mmw_run(r, dx, lo[m], hi[m], stride, x0 + 16 * m), wlo, scale);
+      l[m] = window_level16(mmw_run(r, dx, lo[m], hi[m], stride, x0 + 16 * m), wlo, scale);
     if (count == 4)
       store64(l[0], l[1], l[2], l[3], ob);
     else
@@ -240,13 +227,15 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
     }
   }
 #if defined(PRECISION_FP64)
+  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
+  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
   for (int y = 0; y < H; ++y) {
     global const preal* r = rows + (size_t)y * RW;
     for (int x = 0; x < W; ++x) {
       const int b = x / 16;
       preal t = 0;
       for (int c = (int)dxband[2 * b]; c <= (int)dxband[2 * b + 1]; ++c) t += r[c] * (preal)dx[c * stride + x];
-      o[(size_t)y * W + x] = window_level(t, phys);
+      o[(size_t)y * W + x] = window_level(t, lo, scale);
     }
   }
 #else
@@ -280,7 +269,7 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
   global uchar* ob = o;
   for (int y = 0; y < H; ++y, r += RW, ob += W) {
     uchar l[16];
-    vstore16(window_levels16(mmw_run(r, dx, (int)dxband[0], (int)dxband[1], stride, 0), lo, scale), 0, l);
+    vstore16(window_level16(mmw_run(r, dx, (int)dxband[0], (int)dxband[1], stride, 0), lo, scale), 0, l);
     for (int k = 0; k < W; ++k) ob[k] = l[k];
   }
 #endif

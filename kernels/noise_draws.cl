@@ -1,7 +1,7 @@
 // The unit draws of a sensor model's per-pixel noise as this build makes them (`portalsim
 // tradeoff`'s distribution columns): pixels [0, cells) of view 0 of scenario first + i, one
 // work-item per scenario. Under NOISE_DRAW_IH (noise_draw irwin-hall) both models' draws are
-// Irwin-Hall (kernels/sensor_noise.cl): the thesis pixel noise's stream, the physics MMW raw
+// Irwin-Hall (kernels/lib/gauss.cl): the thesis pixel noise's stream, the physics MMW raw
 // noise's; otherwise the thesis pixel noise is Box-Muller and the physics raw noise table
 // Gaussians (table: the host's quantiles).
 kernel void noise_draws(uint seed_lo, uint seed_hi, ulong first, int physics, int cells, global const param* table,

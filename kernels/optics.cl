@@ -2,9 +2,6 @@
 // a Gaussian of the Airy core's FWHM (1.02 lambda / D), normalised over 2 R + 1 taps and
 // applied along rows (field -> scratch), then along columns (scratch -> field). Pixels
 // past the view's edge repeat the edge.
-inline global const param* psf_taps(global const param* phys, const PsViewLaunch* L) {
-  return phys + PS_PHYS_TAPS(L->subjects, L->variants) + L->psf_radius;
-}
 
 // Each pixel's sum runs over the taps in the same order whatever the loop shape: the
 // loops over x are the inner ones, on restrict pointers, so that LLVM vectorises them

@@ -141,7 +141,7 @@ kernel void physics_features(global const preal* raw, global const int* first, g
   if (i >= L.n) return;
   const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);
   // The NETD over the frames' mean: netd_lo where neither is drawn (the host's NETD /
-  // sqrt(frames)), else the scenario's draw (kernels/netd.cl).
+  // sqrt(frames)), else the scenario's draw (kernels/lib/physics.cl).
   int one;
   const preal sd = netd_hi <= netd_lo && frames.y <= frames.x
                        ? (preal)netd_lo

@@ -4,27 +4,6 @@
 // plus, for each view row an object crosses, that row's change (composite minus bare, in
 // kelvin) projected through the folded weights: raw[r][c] += wy[r][y] sum_x wx[c][x] d(x, y).
 // Tested against the chain of stage kernels and the reference (tests/physics_test.cpp).
-// Whether two layers' boxes, widened by the bilinear fringe, meet.
-inline bool layers_meet(global const int* a, global const int* b) {
-  return a[PS_LAYER_X0] - 2 < b[PS_LAYER_X0] + b[PS_LAYER_W] + 2 && b[PS_LAYER_X0] - 2 < a[PS_LAYER_X0] + a[PS_LAYER_W] + 2 &&
-         a[PS_LAYER_Y0] - 2 < b[PS_LAYER_Y0] + b[PS_LAYER_H] + 2 && b[PS_LAYER_Y0] - 2 < a[PS_LAYER_Y0] + a[PS_LAYER_H] + 2;
-}
-
-// Whether a scenario's view is its tabulated responses (features-only runs,
-// PS_FLAG_TABULATED): each object's alone, plus a pair's correction where two boxes meet.
-// That is exact when every object stands at its place (no jitter, no randomised
-// transform) and meets at most one other (so no pixel lies under three).
-inline bool physics_tabulated(global const int* rec, const PsViewLaunch* L) {
-  if (!(L->flags & PS_FLAG_TABULATED) || (L->flags & PS_FLAG_AFFINE) || L->jitter_x > 0.0f || L->jitter_y > 0.0f)
-    return false;
-  for (int j = 0; j < rec[PS_REC_COUNT]; ++j) {
-    int meets = 0;
-    for (int k = 0; k < rec[PS_REC_COUNT]; ++k)
-      meets += k != j && layers_meet(rec + PS_REC_LAYERS + j * PS_LAYER_LEN, rec + PS_REC_LAYERS + k * PS_LAYER_LEN);
-    if (meets > 1) return false;
-  }
-  return true;
-}
 
 kernel void physics_raw(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
@@ -50,7 +29,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   subject_kelvin(&scene, s, &gain, &offset);
   if (scene.outfit >= 0) {
     global const param* gray = phys + (int)phys[(int)phys[PS_PHYS_CLOTHING] + PS_CLOTHING_GRIDS] + (size_t)s * cells;
-    for (int k = 0; k < cells; ++k) r[k] = gain * (preal)gray[k] + offset;
+    for (int k = 0; k < cells; ++k) r[k] = gray_kelvin(gain, (preal)gray[k], offset);
     // Its folds: the fold grids' share-weighted gray A and share B (PS_CLOTHING_FOLD_GRIDS) add
     // fold (gain A + (offset - fold_t) B), the raw grid of fold m (v - fold_t) over the bare body.
     if (scene.fold != 0) {
@@ -92,7 +71,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     if (x_lo >= x_hi) continue;
     global const uchar* base = base_row(atlas, bases, subject, &L, i, y);
     for (int x = x_lo; x < x_hi; ++x) {
-      const preal t0 = gain * (preal)base[x] + offset;
+      const preal t0 = gray_kelvin(gain, (preal)base[x], offset);
       d[x] = lay_values(&Ly, atlas, x, lv, t0) - t0;
     }
     if (scene.fold != 0) {  // the change passes the folds as the bare body does
@@ -123,7 +102,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     }
   }
 
-  // The netd stage: the scenario's frames averaged (kernels/netd.cl).
+  // The netd stage: the scenario's frames averaged (kernels/lib/physics.cl, netd_frames).
   int frames;
   const preal sd = mmw_noise_of(phys, L.frames, seed, index, &frames);
   if (sd > 0) netd_frames(r, cells, sd, frames, seed, index, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);

@@ -2,14 +2,6 @@
 // region's rectangle. Sums are exact integers; partial edge blocks average the pixels
 // they hold. Launched once per pooled view.
 
-// A mean of 8-bit pixels: whole part by integer division, remainder in float, so a flat
-// area's mean is exact even when -cl-fast-relaxed-math makes float division approximate
-// (host/sink/folder_reader.cpp computes the same expression). Clamped to the pixel range.
-inline float mean_of(uint sum, int count) {
-  const uint q = sum / (uint)count, r = sum % (uint)count;
-  return clamp((float)q + (float)r / (float)count, 0.0f, 255.0f);
-}
-
 // One work-item per (scenario, block) of one view; its blocks start at column `offset`.
 kernel void pool_blocks(global const uchar* img, uint n, int W, int H, int block, int bx_count, int by_count,
                         int offset, int row_len, global float* features) {

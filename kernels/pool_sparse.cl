@@ -338,7 +338,7 @@ kernel void analytic_noise(global float* features, global const int4* rects, glo
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const ulong index = scenario_index(indices, first.x, first.y, i);
-  // The scenario's sigma: the knob's, or its draw (kernels/sensor_noise.cl).
+  // The scenario's sigma: the knob's, or its draw (kernels/lib/gauss.cl, pixel_sigma_of).
   const float sigma = knob_draw(sigma_lo, sigma_hi, seed, index, PS_DRAWN_PIXEL_NOISE);
   // grids: per pooled view (width, height, blocks across, first column); the regions follow.
   const int4 last = grids[npooled - 1];

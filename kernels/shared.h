@@ -18,7 +18,7 @@
  * (p / 16) % 2 (low first) of word (p % 128) / 32, whose top PS_GAUSS_BITS bits are k
  * (PS_GAUSS_INDEX), and takes k to Phi^-1((k + 1/2) / PS_GAUSS_TABLE). So one draw of the
  * generator gives 8 cells, and 16 draws side by side give 128 in runs of 16
- * (kernels/sensor_noise.cl, gauss128). 12 bits keep the table (16 KB of floats) in the L1
+ * (kernels/lib/gauss.cl, gauss128). 12 bits keep the table (16 KB of floats) in the L1
  * cache, where 16 bits (256 KB) made every gather miss it; sd 1 - 1.6e-4, |g| <= 3.67. */
 #define PS_GAUSS_ELEMENT(view, p) (((PS_U32)(view) << PS_PIXEL_NOISE_VIEW_SHIFT) | (PS_U32)(16 * ((p) >> 7) + ((p)&15)))
 #define PS_GAUSS_WORD(p) (((p)&127) >> 5)

@@ -6,12 +6,6 @@
 // a camera's automatic gain does per frame. The fixed window (PS_WINDOW_FIXED) leaves the
 // grid. One work-item per scenario; the order statistics come from a copy in scratch, by
 // Hoare's selection.
-// Scenario `index`'s drawn window ends (PS_WINDOW_DRAWN; host: window_lo_at, window_hi_at),
-// each uniform over its range: from PS_PHYS_WINDOW_MIN to _MIN_HI, and _MAX to _MAX_HI.
-inline void drawn_window(global const param* phys, uint2 seed, ulong index, preal* lo, preal* hi) {
-  *lo = knob_draw((preal)phys[PS_PHYS_WINDOW_MIN], (preal)phys[PS_PHYS_WINDOW_MIN_HI], seed, index, PS_DRAWN_WINDOW_LO);
-  *hi = knob_draw((preal)phys[PS_PHYS_WINDOW_MAX], (preal)phys[PS_PHYS_WINDOW_MAX_HI], seed, index, PS_DRAWN_WINDOW_HI);
-}
 
 inline preal select_rank(global preal* restrict a, int n, int k) {
   int lo = 0, hi = n - 1;

@@ -4,8 +4,8 @@
     mutant_program.py ROOT OUT [FILE TEXT REPLACEMENT]
     mutant_program.py ROOT --check LIST
 
-The program is the files of CMakeLists.txt's PORTALSIM_KERNELS list, in its order, joined
-by a newline (cmake/embed.cmake). With a mutation, TEXT must occur exactly once in FILE.
+The program is the files of CMakeLists.txt's PORTALSIM_KERNELS: its helpers list, then
+every kernels/*.cl in name order, joined by a newline (cmake/embed.cmake). With a mutation, TEXT must occur exactly once in FILE.
 --check reads every mutation of LIST (FILE<TAB>TEXT<TAB>REPLACEMENT<TAB>WHY, # comments)
 and fails, naming each line, where a TEXT no longer occurs exactly once in its FILE or a
 line is malformed: a kernel edit that moved a mutation's text shows before a run (ctest
@@ -18,7 +18,10 @@ import sys
 
 def kernel_texts(root: str) -> tuple[list[str], dict[str, str]]:
     cmake = (pathlib.Path(root) / "CMakeLists.txt").read_text(encoding="utf-8")
-    files = re.search(r"set\(PORTALSIM_KERNELS\s+([^)]*)\)", cmake).group(1).split()
+    # The helpers in their declared order, then every kernels/*.cl in name order (CMake's glob).
+    helpers = re.search(r"set\(PORTALSIM_KERNEL_HELPERS\s+([^)]*)\)", cmake).group(1).split()
+    stages = sorted(p.relative_to(root).as_posix() for p in (pathlib.Path(root) / "kernels").glob("*.cl"))
+    files = helpers + stages
     return files, {f: (pathlib.Path(root) / f).read_text(encoding="utf-8") for f in files}
 
 

@@ -64,37 +64,47 @@ typedef int real;  // value * 256
 typedef float greal;
 typedef float2 greal2;
 typedef float param;
-inline real from_pixel(uchar b) { return (int)b << 8; }
-inline real blend(real v, uchar value, uchar coverage, param alpha) {
-  const int a = (int)(alpha * (float)coverage * (256.0f / 255.0f) + 0.5f);  // 0..256
-  return v + ((a * (((int)value << 8) - v)) >> 8);
-}
+// A pixel's arithmetic over element type R (int or int16; F, U: its float and byte types),
+// one text for the scalar helpers (S empty) and the 16-lane ones (S 16).
+#define PIXEL_OPS(R, F, U, S)                                                                              \
+  inline R from_pixel##S(U b) { return convert_##R(b) << 8; }                                             \
+  inline R blend##S(R v, U value, U coverage, param alpha) {                                              \
+    const R a = convert_##R(alpha * convert_##F(coverage) * (256.0f / 255.0f) + 0.5f); /* 0..256 */      \
+    return v + ((a * ((convert_##R(value) << 8) - v)) >> 8);                                              \
+  }                                                                                                       \
+  inline R noise_acc##S(R n, U t) { return n + (convert_##R(t) - 128); }                                  \
+  inline R add_noise##S(R v, float gain, R n) { return v + (int)rint(gain * 256.0f) * n; }                \
+  inline R add_gauss##S(R v, param sigma, F g) { return v + convert_##R(RINT(sigma * g * 256.0f)); }      \
+  inline U to_pixel##S(R v) { return convert_##U(clamp((v + 128) >> 8, 0, 255)); }                       \
+  inline R real##S##_zero(void) { return (R)(0); }
+PIXEL_OPS(int, float, uchar, )
 inline real blend_frac(real v, greal pv, greal c, param alpha) {
   return (int)rint((1.0f - alpha * c) * (float)v + alpha * pv * 256.0f);
 }
-inline real noise_acc(real n, uchar t) { return n + ((int)t - 128); }
-inline real add_noise(real v, float gain, real n) { return v + (int)rint(gain * 256.0f) * n; }
-inline real add_gauss(real v, param sigma, float g) { return v + (int)rint(sigma * g * 256.0f); }
-inline uchar to_pixel(real v) { return (uchar)clamp((v + 128) >> 8, 0, 255); }
-inline real real_zero(void) { return 0; }
 
 #else
 typedef float real;
 typedef float greal;
 typedef float2 greal2;
 typedef float param;
-inline real from_pixel(uchar b) { return (float)b; }
-// v + a (s - v), a = alpha coverage / 255, one rounding in the fused multiply-add.
-inline real blend(real v, uchar value, uchar coverage, param alpha) {
-  const float a = alpha * (float)coverage / 255.0f;
-  return fma(a, (float)value - v, v);
-}
+// A pixel's arithmetic over element type R (float or float16; U its byte type), one text
+// for the scalar helpers (S empty) and the 16-lane ones (S 16). blend: v + a (s - v),
+// a = alpha coverage / 255, one rounding in the fused multiply-add. to_pixel: floor(v +
+// 0.5) clamped, as the reference; clamping first and then truncating gives the same byte
+// for every v and needs no floor.
+#define PIXEL_OPS(R, U, S)                                                                                  \
+  inline R from_pixel##S(U b) { return convert_##R(b); }                                                  \
+  inline R blend##S(R v, U value, U coverage, param alpha) {                                              \
+    const R a = alpha * convert_##R(coverage) / 255.0f;                                                   \
+    return fma(a, convert_##R(value) - v, v);                                                             \
+  }                                                                                                       \
+  inline R noise_acc##S(R n, U t) { return n + (convert_##R(t) - 128.0f); }                               \
+  inline R add_noise##S(R v, float gain, R n) { return v + gain * n; }                                    \
+  inline R add_gauss##S(R v, param sigma, R g) { return fma((R)(sigma), g, v); }                          \
+  inline U to_pixel##S(R v) { return convert_##U(clamp(v + 0.5f, 0.0f, 255.0f)); }                       \
+  inline R real##S##_zero(void) { return (R)(0.0f); }
+PIXEL_OPS(float, uchar, )
 inline real blend_frac(real v, greal pv, greal c, param alpha) { return (1.0f - alpha * c) * v + alpha * pv; }
-inline real noise_acc(real n, uchar t) { return n + ((float)t - 128.0f); }
-inline real add_noise(real v, float gain, real n) { return v + gain * n; }
-inline real add_gauss(real v, param sigma, float g) { return fma(sigma, g, v); }
-inline uchar to_pixel(real v) { return (uchar)clamp(floor(v + 0.5f), 0.0f, 255.0f); }
-inline real real_zero(void) { return 0.0f; }
 #endif
 
 // The same arithmetic on 16 pixels at once, element for element (so bit for bit), for the
@@ -103,30 +113,10 @@ inline real real_zero(void) { return 0.0f; }
 #define VECTOR_RENDER 1
 #if defined(PRECISION_FIXED)
 typedef int16 real16;
-inline real16 from_pixel16(uchar16 b) { return convert_int16(b) << 8; }
-inline real16 blend16(real16 v, uchar16 value, uchar16 coverage, param alpha) {
-  const int16 a = convert_int16(alpha * convert_float16(coverage) * (256.0f / 255.0f) + 0.5f);
-  return v + ((a * ((convert_int16(value) << 8) - v)) >> 8);
-}
-inline real16 noise_acc16(real16 n, uchar16 t) { return n + (convert_int16(t) - 128); }
-inline real16 add_noise16(real16 v, float gain, real16 n) { return v + (int)rint(gain * 256.0f) * n; }
-inline real16 add_gauss16(real16 v, param sigma, float16 g) { return v + convert_int16(RINT(sigma * g * 256.0f)); }
-inline uchar16 to_pixel16(real16 v) { return convert_uchar16(clamp((v + 128) >> 8, 0, 255)); }
-inline real16 real16_zero(void) { return (int16)(0); }
+PIXEL_OPS(int16, float16, uchar16, 16)
 #else
 typedef float16 real16;
-inline real16 from_pixel16(uchar16 b) { return convert_float16(b); }
-inline real16 blend16(real16 v, uchar16 value, uchar16 coverage, param alpha) {
-  const float16 a = alpha * convert_float16(coverage) / 255.0f;
-  return fma(a, convert_float16(value) - v, v);
-}
-inline real16 noise_acc16(real16 n, uchar16 t) { return n + (convert_float16(t) - 128.0f); }
-inline real16 add_noise16(real16 v, float gain, real16 n) { return v + gain * n; }
-inline real16 add_gauss16(real16 v, param sigma, float16 g) { return fma((float16)(sigma), g, v); }
-// floor(v + 0.5) clamped, as to_pixel: clamping first and then truncating gives the same
-// byte for every v and needs no floor.
-inline uchar16 to_pixel16(real16 v) { return convert_uchar16(clamp(v + 0.5f, 0.0f, 255.0f)); }
-inline real16 real16_zero(void) { return (float16)(0.0f); }
+PIXEL_OPS(float16, uchar16, 16)
 #endif
 #endif
 
