@@ -76,7 +76,8 @@ TEST(ProceduralTest, TheDeclaredShapesAreExactlyTheDrawnOnes) {
 
 // The clothing's folds, pinned (no other test pins their bytes): XXH3-64 over every view's
 // fold pattern of the built-in subjects and of eight drawn bodies (every pose), in order.
-// After an intended change to the drawing, put the printed value here.
+// The folds' sines and the arms' turn are base/plain_math.h's, so the pin holds whatever
+// libm the build links. After an intended change to the drawing, put the printed value here.
 TEST(ProceduralTest, FoldsArePinned) {
   Catalogue drawn = test::catalogue();
   use_random_bodies(drawn, 11, 8);

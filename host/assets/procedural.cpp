@@ -1,6 +1,7 @@
 // Procedural default images. Geometry is signed distance fields (negative inside) built
 // from a handful of primitives; texture comes from an integer hash, so the bytes depend
-// only on IEEE arithmetic (+, *, /, sqrt, floor), never on libm or a platform RNG.
+// only on IEEE arithmetic (+, *, /, sqrt, floor), never on libm or a platform RNG: the
+// pose's and the folds' sines are base/plain_math.h's, made of those operations alone.
 #include "assets/procedural.h"
 
 #include <algorithm>
@@ -13,6 +14,8 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "base/plain_math.h"
 
 namespace portalsim::procedural {
 namespace {
@@ -237,8 +240,8 @@ class BodyModel {
     // The arms' turn outwards about the shoulder, from hanging down: held out nearly level,
     // or raised above the head.
     const double turn = shape_.pose == Pose::arms_out ? 75.0 : (shape_.pose == Pose::arms_raised ? 160.0 : 0.0);
-    arm_cos_ = std::cos(turn * 3.14159265358979323846 / 180.0);
-    arm_sin_ = std::sin(turn * 3.14159265358979323846 / 180.0);
+    const plain::SinCos arm = plain::sincos(turn * 3.14159265358979323846 / 180.0);
+    arm_cos_ = arm.cos, arm_sin_ = arm.sin;
     seed_ = mix64(static_cast<uint64_t>(static_cast<int64_t>(body.subject)) + 0x5eed);
     auto var = [&](int k) { return hash01(k, 0, seed_); };
     arm_spread_ = 4.0 * var(1);
@@ -1185,8 +1188,8 @@ Image fold_pattern(const Image& base, const Sensor& view, int body_lo, int body_
     for (size_t x = 0; x < W; ++x) {
       const double u = view.field_col(static_cast<double>(x) + 0.5);
       const size_t i = static_cast<size_t>(k - k0) * W + x;
-      bend[i] = height * std::sin(2.0 * std::numbers::pi * (u / wave + shift) + phase);
-      depth[i] = deep * (0.5 + 0.5 * std::sin(2.0 * std::numbers::pi * (u / stretch + at)));
+      bend[i] = height * plain::sin(2.0 * std::numbers::pi * (u / wave + shift) + phase);
+      depth[i] = deep * (0.5 + 0.5 * plain::sin(2.0 * std::numbers::pi * (u / stretch + at)));
     }
   }
   for (int y = 0; y < base.height; ++y) {
