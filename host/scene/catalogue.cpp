@@ -382,6 +382,9 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     Region& r = cat.regions[i];
     r.id = static_cast<int>(i + 1);
     r.name = rd.string(t, "name", f);
+    // It labels evaluate's per-region report and the page's lists.
+    for (size_t j = 0; j < i; ++j)
+      if (cat.regions[j].name == r.name) rd.fail(t.get("name"), f + ".name", "\"" + r.name + "\" is named twice");
     const toml::node* rn = rd.need(t, "rects", f + ".rects");
     const toml::table* rects = rn->as_table();
     if (!rects || rects->empty()) rd.fail(rn, f + ".rects", "expected a table of view = [x, y, w, h], at least one");
