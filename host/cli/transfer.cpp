@@ -77,8 +77,29 @@ bool good_name(const std::string& n) {
 constexpr const char* kCnnInputs[] = {"mmw", "ir", "metal"};
 constexpr const char* kDefaultCnnInputs = "mmw,ir,metal";
 
-std::string cnn_input_words(const std::string& sensor) {
-  return sensor == "mmw" ? "the two MMW views" : sensor == "ir" ? "the IR image" : "the metal detector's zones";
+// The data.h5 datasets each image sensor's branch reads, from the catalogue's views: every
+// MMW view (a front-and-back portal's four), and each IR view's palette indices.
+struct CnnDatasets {
+  std::vector<std::string> mmw, ir;
+};
+const std::vector<std::string> kMetalDatasets{"metal"};
+CnnDatasets cnn_datasets(const Catalogue& cat) {
+  CnnDatasets d;
+  for (const Sensor& s : cat.sensors)
+    (s.camera == Camera::mmw ? d.mmw : d.ir).push_back(s.palette ? s.name + "_index" : s.name);
+  return d;
+}
+
+std::string joined(const std::vector<std::string>& v, const char* sep) {
+  std::string out;
+  for (const std::string& s : v) out += (out.empty() ? "" : sep) + s;
+  return out;
+}
+
+std::string cnn_input_words(const std::string& sensor, const CnnDatasets& d) {
+  if (sensor == "mmw") return "the MMW views (" + joined(d.mmw, ", ") + ")";
+  if (sensor == "ir") return (d.ir.size() == 1 ? "the IR image (" : "the IR images (") + joined(d.ir, ", ") + ")";
+  return "the metal detector's zones";
 }
 
 // --cnn-inputs' value, checked: distinct names of kCnnInputs, in the order given.
@@ -92,6 +113,30 @@ std::vector<std::string> cnn_inputs(const std::string& text) {
   }
   if (out.empty()) throw InputError("--cnn-inputs: none given (mmw, ir or metal)");
   return out;
+}
+
+// What the CNN is given: --cnn-inputs' sensors, the datasets each reads (from the catalogue
+// the sets are made with, and a data.h5 set was made with), the script's arguments for
+// them, and the report's words and list.
+struct Cnn {
+  std::vector<std::string> sensors, words, args;
+  nlohmann::json datasets = nlohmann::json::array();  // in the order the CNN reads them
+};
+Cnn cnn_of(const Options& o) {
+  Cnn c;
+  c.sensors = cnn_inputs(o.cnn_inputs.empty() ? kDefaultCnnInputs : o.cnn_inputs);
+  const CnnDatasets d = cnn_datasets(o.catalogue.empty() ? default_catalogue() : load_catalogue(o.catalogue));
+  for (const std::string& sensor : c.sensors) {
+    const std::vector<std::string>& read = sensor == "mmw" ? d.mmw : sensor == "ir" ? d.ir : kMetalDatasets;
+    if (read.empty())
+      throw InputError("--cnn-inputs: " + sensor + ", but the catalogue (" +
+                       (o.catalogue.empty() ? std::string("built-in") : o.catalogue) + ") has no " +
+                       (sensor == "mmw" ? "MMW" : "IR") + " view");
+    c.words.push_back(cnn_input_words(sensor, d));
+    for (const std::string& ds : read) c.datasets.push_back(ds);
+  }
+  c.args = {"--inputs", joined(c.sensors, ","), "--mmw-views", joined(d.mmw, ","), "--ir-views", joined(d.ir, ",")};
+  return c;
 }
 
 // `images`: the CNN is among the classifiers, so a spec's set is made with its images and
@@ -141,13 +186,7 @@ int run_transfer(const Options& o) {
   if (chosen.empty()) throw InputError("--classifiers: none given (j48, svm, mlp or cnn)");
   const bool cnn = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return !c->weka_class; });
   if (!o.cnn_inputs.empty() && !cnn) throw InputError("--cnn-inputs: only applies with --classifiers cnn");
-  const std::vector<std::string> sensors = cnn_inputs(o.cnn_inputs.empty() ? kDefaultCnnInputs : o.cnn_inputs);
-  std::string sensor_arg;  // "mmw,metal", for tools/transfer_cnn.py
-  std::vector<std::string> sensor_words;
-  for (const std::string& sensor : sensors) {
-    sensor_arg += (sensor_arg.empty() ? "" : ",") + sensor;
-    sensor_words.push_back(cnn_input_words(sensor));
-  }
+  const Cnn cnn_in = cnn ? cnn_of(o) : Cnn{};
   const bool weka = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return c->weka_class; });
   std::vector<Set> sets;
   sets.push_back(make_set("train", o.train, "--train", cnn));
@@ -224,13 +263,17 @@ int run_transfer(const Options& o) {
                            {"reference", sets[1].name},
                            {"max_loss_points", o.max_loss},
                            {"interval", "95%: Wilson (accuracy), Newcombe's hybrid score (loss)"}};
-  if (cnn) report["cnn_inputs"] = sensors;
+  if (cnn) {
+    report["cnn_inputs"] = cnn_in.sensors;
+    report["cnn_datasets"] = cnn_in.datasets;
+  }
   std::vector<std::vector<long>> correct(chosen.size(), std::vector<long>(sets.size(), 0));
   std::string why;
   for (size_t c = 0; c < chosen.size(); ++c) {
     if (!chosen[c]->weka_class) {  // the CNN, on the sets' images and zones
       const std::string scores = (fs::path(scratch.path) / "cnn.json").string();
-      std::vector<std::string> args{scores, "--steps", std::to_string(o.cnn_steps), "--inputs", sensor_arg};
+      std::vector<std::string> args{scores, "--steps", std::to_string(o.cnn_steps)};
+      args.insert(args.end(), cnn_in.args.begin(), cnn_in.args.end());
       for (const Set& s : sets) args.push_back(images_of(s, made));
       if (!run_python_script(embedded::transfer_cnn, scratch.path, args))
         throw EnvironmentError(
@@ -263,7 +306,7 @@ int run_transfer(const Options& o) {
      << sets[1].name
      << "`'s accuracy minus the set's, in points, with the 95% interval of a difference of two independent "
         "proportions (Newcombe's hybrid score).";
-  if (cnn) md << " The CNN sees " << spoken_list(sensor_words) << ".";
+  if (cnn) md << " The CNN sees " << spoken_list(cnn_in.words) << ".";
   md << "\n\n| test set | instances |";
   for (const Classifier* c : chosen) md << " " << c->name << " | " << c->name << " loss |";
   md << "\n| --- | --- |";
@@ -332,9 +375,10 @@ std::function<int()> add_transfer(CLI::App& app) {
   cmd->add_option("--classifiers", o->classifiers,
                   "Comma-separated: j48, svm, mlp (WEKA, on the features) and cnn (a small CNN on the sensors' "
                   "images and zones, --cnn-inputs; python3-torch) (default j48,svm)");
-  cmd->add_option("--cnn-inputs", o->cnn_inputs,
-                  "Comma-separated sensors the CNN sees: mmw (the two MMW views), ir (the IR image), metal (the "
-                  "metal detector's zones) (default mmw,ir,metal)");
+  cmd->add_option(
+      "--cnn-inputs", o->cnn_inputs,
+      "Comma-separated sensors the CNN sees: mmw (the catalogue's MMW views), ir (the IR image), metal (the "
+      "metal detector's zones) (default mmw,ir,metal)");
   cmd->add_option("--cnn-steps", o->cnn_steps, "Training steps of the CNN, batches of 32 (default 300)")
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--catalogue", o->catalogue, "Catalogue TOML for the specs and folders (default: built-in)");
