@@ -194,7 +194,7 @@ TEST(Bodies, DrawnImagesFollowTheShape) {
 // The drawn bodies' images, pinned: 48 bodies of seed 11 (all three poses, both sexes) and
 // eight extreme shapes, every view of the catalogue and, for the extremes, the back's
 // views, each hashed (XXH3-64) against tests/golden/bodies.txt. The drawing's shortcuts
-// (assets/procedural.cpp: a row's noise cells, a limb not evaluated where its floor shows
+// (assets/procedural_body.cpp: a row's noise cells, a limb not evaluated where its floor shows
 // it cannot be the nearer) must not move a bit. After an intended change to the drawing:
 //   PORTALSIM_UPDATE_GOLDEN=1 build/portalsim_tests --gtest_filter='Bodies.DrawnImagesArePinned'
 TEST(Bodies, DrawnImagesArePinned) {

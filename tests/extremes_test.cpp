@@ -1692,6 +1692,7 @@ TEST(PortalViews, BadViewsAndRegionsAreRefusedNamingTheField) {
   const std::vector<Case> cases{
       {"name = \"back_upper\"", "name = \"upper\"  # again", "views[3].name", "named twice"},
       {"name = \"back_upper\"", "name = \"Back Upper\"", "views[3].name", "a-z, 0-9 and _"},
+      {"name = \"lower-back\"", "name = \"upper-back\"  # again", "regions[15].name", "named twice"},
       {"camera = \"ir\"", "camera = \"thermal\"", "views[5].camera", "\"mmw\" or \"ir\""},
       {"side = \"back\"", "side = \"left\"", "views[3].side", "\"front\" or \"back\""},
       {"field = [0, 200, 200, 200]", "field = [0, 200, 0, 200]", "views[2].field[2]", "out of range"},

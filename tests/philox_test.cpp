@@ -1,7 +1,7 @@
 // The counter generator against its specification (docs/model/determinism.md): the
 // published Random123 known-answer vectors and hand-computed draws, applied to the
 // reference's C++ (scene/philox.h, backend/reference/draws.h) and, through the OpenCL
-// runtime, to the kernels' own implementation (kernels/philox.cl, kernels/sensor_noise.cl).
+// runtime, to the kernels' own implementation (kernels/lib/philox.cl, kernels/sensor_noise.cl).
 #include "scene/philox.h"
 
 #include <gtest/gtest.h>

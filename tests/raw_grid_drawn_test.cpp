@@ -1,6 +1,6 @@
 // The MMW raw grid drawn per scenario from a list (--mmw-raw 14x14,28x28,40x40; plan.h
 // raw_grid_at): the OpenCL backend runs each grid's scenarios as a part of their own, their
-// indices in a table (kernels/philox.cl, scenario_index); every scenario is what a run at its
+// indices in a table (kernels/lib/philox.cl, scenario_index); every scenario is what a run at its
 // grid alone makes of it, both backends agree, and each row's grid is recorded.
 #include <gtest/gtest.h>
 

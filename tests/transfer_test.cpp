@@ -180,6 +180,27 @@ TEST(Transfer, TheCnnSeesTheSensorsItIsGiven) {
   EXPECT_FALSE(fs::exists(d / "bad"));
 }
 
+// The CNN reads the catalogue's MMW views, not two names of the built-in's: on the
+// front-and-back portal its mmw branch takes the back camera's two views as well (one
+// step: the subject is which datasets it reads, not what it learns).
+TEST(Transfer, TheCnnReadsEveryMmwViewOfTheCatalogue) {
+  const portalsim::test::TempDir t;
+  const fs::path d = t.w();
+  spit(d / "train.toml", "count = 20\nseed = 1\nrule = \"gun\"\nbalance = true\n");
+  spit(d / "test.toml", "count = 10\nseed = 2\nrule = \"gun\"\nbalance = true\n");
+  const auto r =
+      transfer(t, {"--catalogue", std::string(PORTALSIM_SOURCE_DIR) + "/scenarios/portal-front-back.toml", "--train",
+                   (d / "train.toml").string(), "--test", "in=" + (d / "test.toml").string(), "--classifiers", "cnn",
+                   "--cnn-inputs", "mmw,ir", "--cnn-steps", "1", "--out", (d / "out").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(d / "out" / "report.json"));
+  EXPECT_EQ(j["cnn_datasets"], nlohmann::json::array({"upper", "lower", "back_upper", "back_lower", "ir_index"}));
+  EXPECT_NE(r.err.find("the CNN reads upper, lower, back_upper, back_lower, ir_index"), std::string::npos) << r.err;
+  EXPECT_NE(slurp(d / "out" / "report.md")
+                .find("The CNN sees the MMW views (upper, lower, back_upper, back_lower) and the IR image (ir_index)."),
+            std::string::npos);
+}
+
 TEST(Transfer, BadArgumentsAreRefusedBeforeAnythingIsWritten) {
   const portalsim::test::TempDir t;
   const fs::path d = t.w();

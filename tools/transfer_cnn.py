@@ -2,18 +2,20 @@
 """portalsim transfer's CNN: trains a small CNN on one data.h5's sensors and scores it on others.
 
   /usr/bin/python3 transfer_cnn.py OUT.json TRAIN.h5 TEST.h5 [TEST.h5 ...]
-      [--inputs mmw,ir,metal] [--steps 300] [--seed 0]
+      [--inputs mmw,ir,metal] [--mmw-views upper,lower] [--ir-views ir_index] [--steps 300] [--seed 0]
 
 --inputs names the sensors the network sees, as a portal's operator fuses them:
-  mmw    the two MMW views, datasets `upper` and `lower` (uint8 N x H x W), as two channels;
-  ir     the IR image's palette indices, dataset `ir_index` (uint8 N x H x W);
+  mmw    the catalogue's MMW views, datasets named by --mmw-views (uint8 N x H x W), a
+         channel each: `upper` and `lower` for the built-in portal, four with a back camera;
+  ir     the IR views' palette indices, datasets named by --ir-views (uint8 N x H x W);
   metal  the metal detector's zones, dataset `metal` (uint8 N x Z).
+portalsim transfer passes --mmw-views and --ir-views from the catalogue's [[views]].
 Each image is standardised (zero mean, unit variance: a camera's window and its room move
 every pixel of a view together), averaged down 4 times and read by its own convolutional
 branch (tools/train_example.py's small CNN without its last layer, 32 features); the zones
 are standardised per zone with the training set's mean and SD and read by one dense layer
 (32 features); one linear layer decides from the branches' features side by side. With
---inputs mmw alone the network is tools/train_example.py's, unchanged. Trains with Adam
+--inputs mmw alone the network is tools/train_example.py's (a channel per MMW view). Trains with Adam
 (learning rate 2e-3), batch 32, for --steps steps on batches drawn from the training set in
 a fixed order (torch's --seed). Writes {"correct": [...], "n": [...]} for the test files in
 order. Needs Debian's python3-torch, python3-h5py and python3-numpy.
@@ -28,6 +30,7 @@ import torch
 from torch import nn
 
 SENSORS = ("mmw", "ir", "metal")
+# Each sensor's datasets, the built-in catalogue's until main() sets the catalogue's.
 DATASETS = {"mmw": ("upper", "lower"), "ir": ("ir_index",), "metal": ("metal",)}
 
 
@@ -121,18 +124,25 @@ def main():
     p.add_argument("train")
     p.add_argument("tests", nargs="+")
     p.add_argument("--inputs", default="mmw", help="comma-separated sensors: mmw, ir, metal")
+    p.add_argument("--mmw-views", default=",".join(DATASETS["mmw"]), help="the MMW views' datasets")
+    p.add_argument("--ir-views", default=",".join(DATASETS["ir"]), help="the IR views' palette index datasets")
     p.add_argument("--steps", type=int, default=300)
     p.add_argument("--seed", type=int, default=0)
     a = p.parse_args()
     inputs = a.inputs.split(",")
     if not inputs or any(s not in SENSORS for s in inputs) or len(set(inputs)) != len(inputs):
         p.error(f"--inputs: '{a.inputs}' is not a list of distinct sensors among {', '.join(SENSORS)}")
+    for s, names in (("mmw", a.mmw_views), ("ir", a.ir_views)):
+        DATASETS[s] = tuple(n for n in names.split(",") if n)
+        if s in inputs and not DATASETS[s]:
+            p.error(f"--inputs: {s}, but --{s}-views names no dataset")
+    print(f"transfer: the CNN reads {', '.join(k for s in inputs for k in DATASETS[s])}", file=sys.stderr, flush=True)
     torch.manual_seed(a.seed)
     torch.set_num_threads(2)
     x, y = load(a.train, inputs)
     if len(set(y.tolist())) < 2:
         sys.exit(f"{a.train}: the training set has a single class")
-    net = model(2) if inputs == ["mmw"] else Fused(inputs, x["metal"].shape[1] if "metal" in x else 0)
+    net = model(len(DATASETS["mmw"])) if inputs == ["mmw"] else Fused(inputs, x["metal"].shape[1] if "metal" in x else 0)
     prepare = Prepare(x, inputs)
     opt = torch.optim.Adam(net.parameters(), lr=2e-3)
     loss_fn = nn.CrossEntropyLoss()

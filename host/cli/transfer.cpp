@@ -77,8 +77,29 @@ bool good_name(const std::string& n) {
 constexpr const char* kCnnInputs[] = {"mmw", "ir", "metal"};
 constexpr const char* kDefaultCnnInputs = "mmw,ir,metal";
 
-std::string cnn_input_words(const std::string& sensor) {
-  return sensor == "mmw" ? "the two MMW views" : sensor == "ir" ? "the IR image" : "the metal detector's zones";
+// The data.h5 datasets each image sensor's branch reads, from the catalogue's views: every
+// MMW view (a front-and-back portal's four), and each IR view's palette indices.
+struct CnnDatasets {
+  std::vector<std::string> mmw, ir;
+};
+const std::vector<std::string> kMetalDatasets{"metal"};
+CnnDatasets cnn_datasets(const Catalogue& cat) {
+  CnnDatasets d;
+  for (const Sensor& s : cat.sensors)
+    (s.camera == Camera::mmw ? d.mmw : d.ir).push_back(s.palette ? s.name + "_index" : s.name);
+  return d;
+}
+
+std::string joined(const std::vector<std::string>& v, const char* sep) {
+  std::string out;
+  for (const std::string& s : v) out += (out.empty() ? "" : sep) + s;
+  return out;
+}
+
+std::string cnn_input_words(const std::string& sensor, const CnnDatasets& d) {
+  if (sensor == "mmw") return "the MMW views (" + joined(d.mmw, ", ") + ")";
+  if (sensor == "ir") return (d.ir.size() == 1 ? "the IR image (" : "the IR images (") + joined(d.ir, ", ") + ")";
+  return "the metal detector's zones";
 }
 
 // --cnn-inputs' value, checked: distinct names of kCnnInputs, in the order given.
@@ -92,6 +113,30 @@ std::vector<std::string> cnn_inputs(const std::string& text) {
   }
   if (out.empty()) throw InputError("--cnn-inputs: none given (mmw, ir or metal)");
   return out;
+}
+
+// What the CNN is given: --cnn-inputs' sensors, the datasets each reads (from the catalogue
+// the sets are made with, and a data.h5 set was made with), the script's arguments for
+// them, and the report's words and list.
+struct Cnn {
+  std::vector<std::string> sensors, words, args;
+  nlohmann::json datasets = nlohmann::json::array();  // in the order the CNN reads them
+};
+Cnn cnn_of(const Options& o) {
+  Cnn c;
+  c.sensors = cnn_inputs(o.cnn_inputs.empty() ? kDefaultCnnInputs : o.cnn_inputs);
+  const CnnDatasets d = cnn_datasets(o.catalogue.empty() ? default_catalogue() : load_catalogue(o.catalogue));
+  for (const std::string& sensor : c.sensors) {
+    const std::vector<std::string>& read = sensor == "mmw" ? d.mmw : sensor == "ir" ? d.ir : kMetalDatasets;
+    if (read.empty())
+      throw InputError("--cnn-inputs: " + sensor + ", but the catalogue (" +
+                       (o.catalogue.empty() ? std::string("built-in") : o.catalogue) + ") has no " +
+                       (sensor == "mmw" ? "MMW" : "IR") + " view");
+    c.words.push_back(cnn_input_words(sensor, d));
+    for (const std::string& ds : read) c.datasets.push_back(ds);
+  }
+  c.args = {"--inputs", joined(c.sensors, ","), "--mmw-views", joined(d.mmw, ","), "--ir-views", joined(d.ir, ",")};
+  return c;
 }
 
 // `images`: the CNN is among the classifiers, so a spec's set is made with its images and
@@ -128,10 +173,10 @@ std::string percent(double fraction) {
   return b;
 }
 
-int run_transfer(const Options& o) {
-  // Every argument is checked before anything is written or run.
+// --classifiers' value, checked: known names, each once, in the order given.
+std::vector<const Classifier*> chosen_classifiers(const std::string& text) {
   std::vector<const Classifier*> chosen;
-  for (const std::string& c : split_commas(o.classifiers)) {
+  for (const std::string& c : split_commas(text)) {
     const auto it = std::find_if(std::begin(kClassifiers), std::end(kClassifiers),
                                  [&](const Classifier& k) { return lower(c) == k.key; });
     if (it == std::end(kClassifiers))
@@ -139,18 +184,13 @@ int run_transfer(const Options& o) {
     if (std::find(chosen.begin(), chosen.end(), &*it) == chosen.end()) chosen.push_back(&*it);
   }
   if (chosen.empty()) throw InputError("--classifiers: none given (j48, svm, mlp or cnn)");
-  const bool cnn = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return !c->weka_class; });
-  if (!o.cnn_inputs.empty() && !cnn) throw InputError("--cnn-inputs: only applies with --classifiers cnn");
-  const std::vector<std::string> sensors = cnn_inputs(o.cnn_inputs.empty() ? kDefaultCnnInputs : o.cnn_inputs);
-  std::string sensor_arg;  // "mmw,metal", for tools/transfer_cnn.py
-  std::vector<std::string> sensor_words;
-  for (const std::string& sensor : sensors) {
-    sensor_arg += (sensor_arg.empty() ? "" : ",") + sensor;
-    sensor_words.push_back(cnn_input_words(sensor));
-  }
-  const bool weka = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return c->weka_class; });
+  return chosen;
+}
+
+// --train and each --test NAME=SET, checked, the training set first.
+std::vector<Set> sets_of(const Options& o, bool images) {
   std::vector<Set> sets;
-  sets.push_back(make_set("train", o.train, "--train", cnn));
+  sets.push_back(make_set("train", o.train, "--train", images));
   std::set<std::string> names{"train"};
   for (const std::string& t : o.tests) {
     const size_t eq = t.find('=');
@@ -159,52 +199,53 @@ int run_transfer(const Options& o) {
     if (!good_name(name))
       throw InputError("--test: '" + name + "' is not a name (letters, digits, '-', '_', '.'; at most 64)");
     if (!names.insert(name).second) throw InputError("--test: the name '" + name + "' is given twice");
-    sets.push_back(make_set(name, t.substr(eq + 1), "--test", cnn));
+    sets.push_back(make_set(name, t.substr(eq + 1), "--test", images));
   }
   if (sets.size() < 2) throw InputError("--test: at least one test set is needed (NAME=SET)");
-  if (const auto missing = weka_missing(); weka && missing) throw EnvironmentError("transfer: " + *missing);
+  return sets;
+}
 
-  const WorkDir scratch;
-  StagedFolder folder(o.out);
-  // The specs' sets, made here and kept under sets/.
-  const bool any_spec = std::any_of(sets.begin(), sets.end(), [](const Set& s) { return s.spec != nullptr; });
-  const std::string made = any_spec ? folder.path("sets") : std::string();
-  if (any_spec) {
-    fs::create_directories(made);
-    CommonOptions co;
-    co.catalogue = o.catalogue;
-    Session session;
-    open_catalogue(session, co);
-    for (const Set& s : sets)
-      if (s.spec) validate(s.spec->settings(), session.catalogue);
-    open_backend(session, co);
-    PipelineOptions popt;
-    popt.progress = false;
-    // Sets of drawn bodies draw theirs from their body seed: one session per (body seed,
-    // count; 0 for a body per scenario), which the sets that share them share (the training
-    // bodies tested again).
-    std::map<std::pair<uint64_t, int>, Session> drawn;
-    for (Set& s : sets) {
-      if (!s.spec) continue;
-      const std::string dir = (fs::path(made) / s.name).string();
-      Session* use = &session;
-      if (s.spec->drawn_bodies()) {
-        const auto [it, fresh] = drawn.try_emplace({s.spec->bodies_seed(), s.spec->random_bodies()});
-        if (fresh) {
-          open_catalogue(it->second, co, s.spec.get());
-          open_backend(it->second, co);
-        }
-        use = &it->second;
+// The specs' sets, made under `made` (OUT/sets/) and read back as feature tables.
+void make_spec_sets(const Options& o, std::vector<Set>& sets, const std::string& made) {
+  fs::create_directories(made);
+  CommonOptions co;
+  co.catalogue = o.catalogue;
+  Session session;
+  open_catalogue(session, co);
+  for (const Set& s : sets)
+    if (s.spec) validate(s.spec->settings(), session.catalogue);
+  open_backend(session, co);
+  PipelineOptions popt;
+  popt.progress = false;
+  // Sets of drawn bodies draw theirs from their body seed: one session per (body seed,
+  // count; 0 for a body per scenario), which the sets that share them share (the training
+  // bodies tested again).
+  std::map<std::pair<uint64_t, int>, Session> drawn;
+  for (Set& s : sets) {
+    if (!s.spec) continue;
+    const std::string dir = (fs::path(made) / s.name).string();
+    Session* use = &session;
+    if (s.spec->drawn_bodies()) {
+      const auto [it, fresh] = drawn.try_emplace({s.spec->bodies_seed(), s.spec->random_bodies()});
+      if (fresh) {
+        open_catalogue(it->second, co, s.spec.get());
+        open_backend(it->second, co);
       }
-      run_pipeline(*s.spec, use->catalogue, use->assets, *use->backend, dir, popt);
-      std::fprintf(stderr, "transfer: %s: %llu scenarios from %s\n", s.name.c_str(),
-                   static_cast<unsigned long long>(s.spec->count), s.source.c_str());
-      s.table = read_arff((fs::path(dir) / "features.arff").string());
-      s.table.path = (fs::path(o.out) / "sets" / s.name / "features.arff").string();
+      use = &it->second;
     }
+    run_pipeline(*s.spec, use->catalogue, use->assets, *use->backend, dir, popt);
+    std::fprintf(stderr, "transfer: %s: %llu scenarios from %s\n", s.name.c_str(),
+                 static_cast<unsigned long long>(s.spec->count), s.source.c_str());
+    s.table = read_arff((fs::path(dir) / "features.arff").string());
+    s.table.path = (fs::path(o.out) / "sets" / s.name / "features.arff").string();
   }
+}
+
+// The other sets' tables, read; every set checked against the training set's attributes;
+// each written as ARFF under `scratch` with the classes of all, for WEKA. Their paths.
+std::vector<std::string> arff_tables(const Options& o, std::vector<Set>& sets, const std::string& scratch) {
   for (Set& s : sets)
-    if (!s.spec) s.table = load_table(s.source, scratch.path, s.name, o.block, o.catalogue);
+    if (!s.spec) s.table = load_table(s.source, scratch, s.name, o.block, o.catalogue);
   std::set<std::string> classes;
   for (const Set& s : sets) {
     check_same_attributes(sets[0].table, s.table);
@@ -214,56 +255,56 @@ int run_transfer(const Options& o) {
   if (sets[0].table.classes.size() < 2) throw InputError(sets[0].table.path + ": the training set has a single class");
   std::vector<std::string> arff;
   for (const Set& s : sets) {
-    arff.push_back((fs::path(scratch.path) / (s.name + ".arff")).string());
+    arff.push_back((fs::path(scratch) / (s.name + ".arff")).string());
     write_arff(s.table, classes, arff.back());
   }
+  return arff;
+}
 
-  // Scores: per classifier, per test set, correct of n.
-  nlohmann::json report = {{"train", {{"source", sets[0].source}, {"instances", sets[0].table.rows.size()}}},
-                           {"attributes", sets[0].table.names.size() - 1},
-                           {"reference", sets[1].name},
-                           {"max_loss_points", o.max_loss},
-                           {"interval", "95%: Wilson (accuracy), Newcombe's hybrid score (loss)"}};
-  if (cnn) report["cnn_inputs"] = sensors;
-  std::vector<std::vector<long>> correct(chosen.size(), std::vector<long>(sets.size(), 0));
-  std::string why;
-  for (size_t c = 0; c < chosen.size(); ++c) {
-    if (!chosen[c]->weka_class) {  // the CNN, on the sets' images and zones
-      const std::string scores = (fs::path(scratch.path) / "cnn.json").string();
-      std::vector<std::string> args{scores, "--steps", std::to_string(o.cnn_steps), "--inputs", sensor_arg};
-      for (const Set& s : sets) args.push_back(images_of(s, made));
-      if (!run_python_script(embedded::transfer_cnn, scratch.path, args))
-        throw EnvironmentError(
-            "transfer: the CNN failed (its message is above; it needs Debian's python3-torch, python3-h5py and "
-            "python3-numpy)");
-      const nlohmann::json j = nlohmann::json::parse(io::read_text_file(scores, "CNN scores", io::Bom::refuse));
-      for (size_t k = 1; k < sets.size(); ++k) {
-        correct[c][k] = j.at("correct").at(k - 1).get<long>();
-        if (j.at("n").at(k - 1).get<size_t>() != sets[k].table.rows.size())
-          throw InputError(images_of(sets[k], made) + ": its images and its feature table differ in count");
-        std::fprintf(stderr, "transfer: CNN on %s: %s%%\n", sets[k].name.c_str(),
-                     percent(double(correct[c][k]) / static_cast<double>(sets[k].table.rows.size())).c_str());
-      }
-      continue;
-    }
-    for (size_t k = 1; k < sets.size(); ++k) {
-      const auto s = weka_score(chosen[c]->weka_class, arff[0], arff[k], 0, 1, why);
-      if (!s) throw EnvironmentError(std::string("WEKA ") + chosen[c]->name + ": " + why);
-      const long n = static_cast<long>(sets[k].table.rows.size());
-      correct[c][k] = n - s->misclassified;
-      std::fprintf(stderr, "transfer: %s on %s: %s%%\n", chosen[c]->name, sets[k].name.c_str(),
-                   percent(double(correct[c][k]) / n).c_str());
-    }
+// The CNN trained on the first set's images and zones, scored on each other's: correct per
+// set (0 for the training set).
+std::vector<long> cnn_scores(const Options& o, const Cnn& cnn, const std::vector<Set>& sets, const std::string& made,
+                             const std::string& scratch) {
+  const std::string scores = (fs::path(scratch) / "cnn.json").string();
+  std::vector<std::string> args{scores, "--steps", std::to_string(o.cnn_steps)};
+  args.insert(args.end(), cnn.args.begin(), cnn.args.end());
+  for (const Set& s : sets) args.push_back(images_of(s, made));
+  if (!run_python_script(embedded::transfer_cnn, scratch, args))
+    throw EnvironmentError(
+        "transfer: the CNN failed (its message is above; it needs Debian's python3-torch, python3-h5py and "
+        "python3-numpy)");
+  const nlohmann::json j = nlohmann::json::parse(io::read_text_file(scores, "CNN scores", io::Bom::refuse));
+  std::vector<long> correct(sets.size(), 0);
+  for (size_t k = 1; k < sets.size(); ++k) {
+    correct[k] = j.at("correct").at(k - 1).get<long>();
+    if (j.at("n").at(k - 1).get<size_t>() != sets[k].table.rows.size())
+      throw InputError(images_of(sets[k], made) + ": its images and its feature table differ in count");
+    std::fprintf(stderr, "transfer: CNN on %s: %s%%\n", sets[k].name.c_str(),
+                 percent(double(correct[k]) / static_cast<double>(sets[k].table.rows.size())).c_str());
   }
+  return correct;
+}
 
-  std::ostringstream md;
-  md << "# portalsim transfer\n\nTrained on `" << sets[0].source << "` (" << sets[0].table.rows.size() << " instances, "
-     << sets[0].table.names.size() - 1
-     << " attributes), tested on each set below. Accuracy in percent with Wilson's 95% interval; loss: `"
-     << sets[1].name
-     << "`'s accuracy minus the set's, in points, with the 95% interval of a difference of two independent "
-        "proportions (Newcombe's hybrid score).";
-  if (cnn) md << " The CNN sees " << spoken_list(sensor_words) << ".";
+// A WEKA classifier trained on the first ARFF, scored on each other's: correct per set.
+std::vector<long> weka_scores(const Classifier& c, const std::vector<std::string>& arff, const std::vector<Set>& sets) {
+  std::vector<long> correct(sets.size(), 0);
+  std::string why;
+  for (size_t k = 1; k < sets.size(); ++k) {
+    const auto s = weka_score(c.weka_class, arff[0], arff[k], 0, 1, why);
+    if (!s) throw EnvironmentError(std::string("WEKA ") + c.name + ": " + why);
+    const long n = static_cast<long>(sets[k].table.rows.size());
+    correct[k] = n - s->misclassified;
+    std::fprintf(stderr, "transfer: %s on %s: %s%%\n", c.name, sets[k].name.c_str(),
+                 percent(double(correct[k]) / n).c_str());
+  }
+  return correct;
+}
+
+// report.md and report.json's scores: per test set and classifier, the accuracy with its
+// interval and, past the reference (the first test set), the loss against it; then whether
+// each classifier holds.
+void add_scores(const Options& o, const std::vector<const Classifier*>& chosen, const std::vector<Set>& sets,
+                const std::vector<std::vector<long>>& correct, std::ostringstream& md, nlohmann::json& report) {
   md << "\n\n| test set | instances |";
   for (const Classifier* c : chosen) md << " " << c->name << " | " << c->name << " loss |";
   md << "\n| --- | --- |";
@@ -307,6 +348,49 @@ int run_transfer(const Options& o) {
     if (sets.size() >= 3) md << " (largest loss " << percent(worst_loss / 100) << " points, `" << worst << "`)";
     md << (c + 1 < chosen.size() ? ";" : ".\n");
   }
+}
+
+int run_transfer(const Options& o) {
+  // Every argument is checked before anything is written or run.
+  const std::vector<const Classifier*> chosen = chosen_classifiers(o.classifiers);
+  const bool cnn = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return !c->weka_class; });
+  if (!o.cnn_inputs.empty() && !cnn) throw InputError("--cnn-inputs: only applies with --classifiers cnn");
+  const Cnn cnn_in = cnn ? cnn_of(o) : Cnn{};
+  const bool weka = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return c->weka_class; });
+  std::vector<Set> sets = sets_of(o, cnn);
+  if (const auto missing = weka_missing(); weka && missing) throw EnvironmentError("transfer: " + *missing);
+
+  const WorkDir scratch;
+  StagedFolder folder(o.out);
+  // The specs' sets, made here and kept under sets/.
+  const bool any_spec = std::any_of(sets.begin(), sets.end(), [](const Set& s) { return s.spec != nullptr; });
+  const std::string made = any_spec ? folder.path("sets") : std::string();
+  if (any_spec) make_spec_sets(o, sets, made);
+  const std::vector<std::string> arff = arff_tables(o, sets, scratch.path);
+
+  // Scores: per classifier, per test set, correct of n.
+  std::vector<std::vector<long>> correct;
+  for (const Classifier* c : chosen)
+    correct.push_back(c->weka_class ? weka_scores(*c, arff, sets) : cnn_scores(o, cnn_in, sets, made, scratch.path));
+
+  nlohmann::json report = {{"train", {{"source", sets[0].source}, {"instances", sets[0].table.rows.size()}}},
+                           {"attributes", sets[0].table.names.size() - 1},
+                           {"reference", sets[1].name},
+                           {"max_loss_points", o.max_loss},
+                           {"interval", "95%: Wilson (accuracy), Newcombe's hybrid score (loss)"}};
+  if (cnn) {
+    report["cnn_inputs"] = cnn_in.sensors;
+    report["cnn_datasets"] = cnn_in.datasets;
+  }
+  std::ostringstream md;
+  md << "# portalsim transfer\n\nTrained on `" << sets[0].source << "` (" << sets[0].table.rows.size() << " instances, "
+     << sets[0].table.names.size() - 1
+     << " attributes), tested on each set below. Accuracy in percent with Wilson's 95% interval; loss: `"
+     << sets[1].name
+     << "`'s accuracy minus the set's, in points, with the 95% interval of a difference of two independent "
+        "proportions (Newcombe's hybrid score).";
+  if (cnn) md << " The CNN sees " << spoken_list(cnn_in.words) << ".";
+  add_scores(o, chosen, sets, correct, md, report);
   write_text_atomic(folder.path("report.md"), md.str());
   write_text_atomic(folder.path("report.json"), report.dump(2) + "\n");
   folder.commit();
@@ -332,9 +416,10 @@ std::function<int()> add_transfer(CLI::App& app) {
   cmd->add_option("--classifiers", o->classifiers,
                   "Comma-separated: j48, svm, mlp (WEKA, on the features) and cnn (a small CNN on the sensors' "
                   "images and zones, --cnn-inputs; python3-torch) (default j48,svm)");
-  cmd->add_option("--cnn-inputs", o->cnn_inputs,
-                  "Comma-separated sensors the CNN sees: mmw (the two MMW views), ir (the IR image), metal (the "
-                  "metal detector's zones) (default mmw,ir,metal)");
+  cmd->add_option(
+      "--cnn-inputs", o->cnn_inputs,
+      "Comma-separated sensors the CNN sees: mmw (the catalogue's MMW views), ir (the IR image), metal (the "
+      "metal detector's zones) (default mmw,ir,metal)");
   cmd->add_option("--cnn-steps", o->cnn_steps, "Training steps of the CNN, batches of 32 (default 300)")
       ->check(CLI::Range(1, 1000000));
   cmd->add_option("--catalogue", o->catalogue, "Catalogue TOML for the specs and folders (default: built-in)");

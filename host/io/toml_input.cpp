@@ -102,6 +102,11 @@ toml::table parse_toml(std::string_view text, const std::string& source) {
 
 void reject_unknown_keys(const toml::table& t, std::initializer_list<std::string_view> known, const std::string& source,
                          const std::string& field) {
+  reject_unknown_keys(t, std::span<const std::string_view>(known.begin(), known.size()), source, field);
+}
+
+void reject_unknown_keys(const toml::table& t, std::span<const std::string_view> known, const std::string& source,
+                         const std::string& field) {
   for (const auto& [k, node] : t) {
     const std::string_view key = k.str();
     if (std::find(known.begin(), known.end(), key) != known.end()) continue;

@@ -5,6 +5,7 @@
 #include <toml++/toml.h>
 
 #include <initializer_list>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -19,6 +20,8 @@ toml::table parse_toml(std::string_view text, const std::string& source);
 // Throws InputError naming the first key of `t` that is not in `known`, its line, and
 // the known key nearest to it ("mmw_uper: unknown key (did you mean mmw_upper?)").
 void reject_unknown_keys(const toml::table& t, std::initializer_list<std::string_view> known, const std::string& source,
+                         const std::string& field);
+void reject_unknown_keys(const toml::table& t, std::span<const std::string_view> known, const std::string& source,
                          const std::string& field);
 
 }  // namespace portalsim::io

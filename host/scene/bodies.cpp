@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "base/plain_math.h"
 #include "scene/philox.h"
 
 namespace portalsim {
@@ -54,8 +55,9 @@ constexpr double kSkinTemperatureSd = 1.0, kSkinTemperatureSpan = 2.5;
 // Two standard normals from two 32-bit words (Box-Muller; u1 in (0, 1]).
 std::array<double, 2> normals(uint32_t a, uint32_t b) {
   const double u1 = 1.0 - uniform24(a), u2 = uniform24(b);
-  const double radius = std::sqrt(-2.0 * std::log(u1)), angle = 2.0 * 3.14159265358979323846 * u2;
-  return {radius * std::cos(angle), radius * std::sin(angle)};
+  const double radius = std::sqrt(-2.0 * plain::log(u1)), angle = 2.0 * 3.14159265358979323846 * u2;
+  const plain::SinCos sc = plain::sincos(angle);
+  return {radius * sc.cos, radius * sc.sin};
 }
 
 // z independent standard normals -> correlated ones with the survey's correlations

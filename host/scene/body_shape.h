@@ -1,4 +1,4 @@
-// A body's shape: the numbers the procedural body is drawn from (assets/procedural.cpp) and
+// A body's shape: the numbers the procedural body is drawn from (assets/procedural_body.cpp) and
 // the vertical map that object places follow (Sensor::subject_dy). One definition, so that
 // the drawn body and the places on it cannot drift apart. Units are the portal's field
 // (scene/sensor.h): 200 across, the floor 400 below the upper view's top.

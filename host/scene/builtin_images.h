@@ -1,5 +1,5 @@
 // What a catalogue may name without giving image files: the shapes and noise patterns
-// that assets/procedural.cpp draws. Declared here so the catalogue can be checked
+// that assets/procedural*.cpp draw. Declared here so the catalogue can be checked
 // without the drawing code; tests/procedural_test.cpp holds the two lists equal.
 #pragma once
 #include <algorithm>

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 
@@ -158,6 +159,129 @@ struct Reader {
   }
 };
 
+// A numeric key of a catalogue table, declared once: its range, its default (the field's
+// value, where the key may be left out) and the field it sets, a number or an integer. The
+// sections read their keys from these lists in order, and refuse any other key, so a
+// bound, a message and the list of known keys all come from one line.
+template <class T>
+struct NumberKey {
+  const char* key;
+  double lo, hi;
+  double T::*number = nullptr;
+  int T::*integer = nullptr;
+  const char* above = nullptr;  // a key before it in the list whose value it must exceed
+};
+
+// [physics]: every key optional (the physics model's defaults, PhysicsConfig).
+constexpr NumberKey<PhysicsConfig> kPhysicsKeys[] = {
+    {"frequency_ghz", 1.0, 10000.0, &PhysicsConfig::frequency_ghz},
+    {"aperture_m", 1e-3, 100.0, &PhysicsConfig::aperture_m},
+    {"fov_rad", 1e-3, 3.0, &PhysicsConfig::fov_rad},
+    {"range_m", 0.01, 1000.0, &PhysicsConfig::range_m},
+    {"skin_emissivity", 0.0, 1.0, &PhysicsConfig::skin_emissivity},
+    {"skin_temperature", 1.0, 1000.0, &PhysicsConfig::skin_temperature},
+    {"clothing_transmission", 0.0, 1.0, &PhysicsConfig::clothing_transmission},
+    {"clothing_temperature", 1.0, 1000.0, &PhysicsConfig::clothing_temperature},
+    {"background_temperature", 1.0, 1000.0, &PhysicsConfig::background_temperature},
+    {"room_temperature", 1.0, 1000.0, &PhysicsConfig::room_temperature},
+    {"base_background_gray", 0, 254, nullptr, &PhysicsConfig::base_background_gray},
+    {"ir_index_min_k", 1.0, 1000.0, &PhysicsConfig::ir_index_min_k},
+    {"ir_index_max_k", 1.0, 1000.0, &PhysicsConfig::ir_index_max_k, nullptr, "ir_index_min_k"},
+    {"ir_coupling", 0.0, 1.0, &PhysicsConfig::ir_coupling},
+    {"ir_spread_mm", 0.0, 1000.0, &PhysicsConfig::ir_spread_mm},
+    {"ir_display_min", 0.0, 1000.0, &PhysicsConfig::ir_display_min},
+    {"ir_display_max", 0.0, 1000.0, &PhysicsConfig::ir_display_max, nullptr, "ir_display_min"},
+};
+
+// [images]: optional but for alpha.
+constexpr NumberKey<ImagesConfig> kImagesKeys[] = {
+    {"alpha", 0.0, 1.0, &ImagesConfig::alpha},
+    {"noise_size", 1, 4096, nullptr, &ImagesConfig::noise_size},
+};
+constexpr const char* kImagesRequired[] = {"alpha"};
+
+// [metal.physics]'s single values, all required; the ranges keep every value physical and
+// every computed signal finite. Its per-zone arrays follow (kMetalZoneKeys).
+constexpr NumberKey<MetalPhysics> kMetalPhysicsKeys[] = {
+    {"body_height", 0.5, 3.0, &MetalPhysics::body_height},
+    {"panel_separation", 0.2, 5.0, &MetalPhysics::panel_separation},
+    {"tx_moment", 1e-6, 1e6, &MetalPhysics::tx_moment},
+    {"rx_moment", 1e-6, 1e6, &MetalPhysics::rx_moment},
+};
+struct ZoneArrayKey {
+  const char* key;
+  double lo, hi;
+  std::vector<double> MetalPhysics::*values;
+};
+constexpr ZoneArrayKey kMetalZoneKeys[] = {
+    {"tx_height", 0.0, 5.0, &MetalPhysics::tx_height},
+    {"rx_height", 0.0, 5.0, &MetalPhysics::rx_height},
+    {"gain", 0.0, 1e12, &MetalPhysics::gain},
+};
+
+// [[materials]]'s numbers, both required.
+constexpr NumberKey<Material> kMaterialKeys[] = {
+    {"emissivity", 0.0, 1.0, &Material::emissivity},
+    {"warm_minutes", 1e-3, 1e6, &Material::warm_minutes},
+};
+
+// [[subjects]]: the body's shape over the 1.0 body (scene/body_shape.h's ranges); a breadth
+// left out is the build, the rest 1.0.
+struct ShapeKey {
+  const char* key;
+  BodyRange range;
+  double BodyShape::*field;
+  bool defaults_to_build;
+};
+constexpr ShapeKey kShapeKeys[] = {
+    {"build", kBuildRange, &BodyShape::build, false},
+    // Stature about the 1.75 m body of [metal.physics] (docs/model/subjects.md).
+    {"height", kHeightRange, &BodyShape::height, false},
+    {"shoulders", kBreadthRange, &BodyShape::shoulders, true},
+    {"chest", kBreadthRange, &BodyShape::chest, true},
+    {"hips", kBreadthRange, &BodyShape::hips, true},
+    {"arm_length", kArmLengthRange, &BodyShape::arm_length, false},
+    {"leg_length", kLegLengthRange, &BodyShape::leg_length, false},
+};
+// Its skin, where it differs from [physics]'s, and its images' levels (defaults: Subject's).
+constexpr NumberKey<Subject> kSubjectKeys[] = {
+    {"skin_emissivity", kSkinEmissivityRange.lo, kSkinEmissivityRange.hi, &Subject::skin_emissivity},
+    {"skin_temperature", kSkinTemperatureRange.lo, kSkinTemperatureRange.hi, &Subject::skin_temperature},
+    {"mmw_level", 0, 255, nullptr, &Subject::mmw_level},
+    {"ir_core", 0, 255, nullptr, &Subject::ir_core},
+    {"ir_limb", 0, 255, nullptr, &Subject::ir_limb},
+};
+
+template <class T, size_t N>
+std::vector<std::string_view> key_names(const NumberKey<T> (&keys)[N]) {
+  std::vector<std::string_view> out;
+  for (const NumberKey<T>& k : keys) out.push_back(k.key);
+  return out;
+}
+
+// Reads `keys` of table `t` (field `f`) into `into`, in order. A key left out keeps the
+// field's value unless `required` holds it (every key where `required` is empty).
+template <class T, size_t N>
+void read_keys(const Reader& rd, const toml::table& t, const std::string& f, const NumberKey<T> (&keys)[N], T& into,
+               std::span<const char* const> required = {}, bool all_required = false) {
+  for (const NumberKey<T>& k : keys) {
+    const bool need = all_required || std::any_of(required.begin(), required.end(),
+                                                  [&](const char* r) { return std::string_view(r) == k.key; });
+    if (k.number) {
+      into.*k.number = need ? rd.number(t, k.key, f, k.lo, k.hi) : rd.number(t, k.key, f, k.lo, k.hi, into.*k.number);
+    } else {
+      const auto lo = static_cast<long long>(k.lo), hi = static_cast<long long>(k.hi);
+      into.*k.integer = need ? rd.integer(t, k.key, f, lo, hi) : rd.integer(t, k.key, f, lo, hi, into.*k.integer);
+    }
+    if (k.above) {
+      const auto other = std::find_if(std::begin(keys), std::end(keys),
+                                      [&](const NumberKey<T>& o) { return std::string_view(o.key) == k.above; });
+      if (into.*k.number <= into.*other->number)
+        rd.fail(&t, f + "." + k.key, "must be above " + f + "." + std::string(k.above));
+    }
+  }
+}
+
 std::string fnv1a_hex(std::string_view text) {
   uint64_t h = 1469598103934665603ull;
   for (unsigned char c : text) {
@@ -175,16 +299,14 @@ void read_metal_physics(const Reader& rd, const toml::node* node, Catalogue& cat
   const std::string f = "metal.physics";
   const toml::table* t = node->as_table();
   if (!t) rd.fail(node, f, "expected a table");
-  io::reject_unknown_keys(*t,
-                          {"body_height", "panel_separation", "tx_moment", "rx_moment", "tx_panel", "tx_height",
-                           "rx_height", "gain", "polarizability"},
-                          rd.file, f);
+  std::vector<std::string_view> known = key_names(kMetalPhysicsKeys);
+  known.push_back("tx_panel");
+  for (const ZoneArrayKey& k : kMetalZoneKeys) known.push_back(k.key);
+  known.push_back("polarizability");
+  io::reject_unknown_keys(*t, known, rd.file, f);
   MetalPhysics& mp = cat.metal_physics;
   mp.present = true;
-  mp.body_height = rd.number(*t, "body_height", f, 0.5, 3.0);
-  mp.panel_separation = rd.number(*t, "panel_separation", f, 0.2, 5.0);
-  mp.tx_moment = rd.number(*t, "tx_moment", f, 1e-6, 1e6);
-  mp.rx_moment = rd.number(*t, "rx_moment", f, 1e-6, 1e6);
+  read_keys(rd, *t, f, kMetalPhysicsKeys, mp, {}, true);
   {
     const toml::node* n = rd.need(*t, "tx_panel", f + ".tx_panel");
     const toml::array* a = n->as_array();
@@ -198,9 +320,7 @@ void read_metal_physics(const Reader& rd, const toml::node* node, Catalogue& cat
       mp.tx_side.push_back(e->as_string()->get() == "a" ? -1 : 1);
     }
   }
-  mp.tx_height = rd.numbers(*t, "tx_height", f, cat.zones, 0.0, 5.0);
-  mp.rx_height = rd.numbers(*t, "rx_height", f, cat.zones, 0.0, 5.0);
-  mp.gain = rd.numbers(*t, "gain", f, cat.zones, 0.0, 1e12);
+  for (const ZoneArrayKey& k : kMetalZoneKeys) mp.*k.values = rd.numbers(*t, k.key, f, cat.zones, k.lo, k.hi);
   const toml::node* pn = rd.need(*t, "polarizability", f + ".polarizability");
   const toml::table* pol = pn->as_table();
   if (!pol) rd.fail(pn, f + ".polarizability", "expected a table of category = cm^3");
@@ -270,102 +390,20 @@ void read_views(const Reader& rd, const toml::table& root, Catalogue& cat) {
   }
 }
 
-}  // namespace
-
-const ImageSource& Subject::image(std::string_view view) const {
-  static const ImageSource procedural;
-  const auto it = images.find(view);
-  return it == images.end() ? procedural : it->second;
-}
-
-std::array<double, 9> Catalogue::polarizability(int variant_id) const {
-  // Along the drawing's long side, as long_side lays it: across (x) or up (z).
-  const bool up = long_side(variant_id)[0] == 0.0;
-  return polarizability(variant_id, up ? std::array<double, 3>{0, 0, 1} : std::array<double, 3>{1, 0, 0});
-}
-
-std::array<double, 9> Catalogue::polarizability(int variant_id, const std::array<double, 3>& u) const {
-  const Object& o = object_of(variant_id);
-  const double m = metal_physics.polarizability.empty() ? 0.0 : metal_physics.polarizability[o.metal];
-  const double a = o.metal_anisotropy;
-  const double across = m * 3.0 / (a + 2.0);
-  // Diagonal across (1 - u_i^2) + across a u_i^2, off the diagonal across (a - 1) u_i u_j:
-  // along an axis, exactly across and across a.
-  std::array<double, 9> t{};
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      t[i * 3 + j] =
-          i == j ? across * (1.0 - u[i] * u[i]) + across * a * (u[i] * u[i]) : across * (a - 1.0) * u[i] * u[j];
-  return t;
-}
-
-std::array<double, 2> Catalogue::long_side(int variant_id) const {
-  const Object& o = object_of(variant_id);
-  const double scale = metres_per_field_unit();
-  const bool turned = variant(variant_id).code == "v";
-  const int w = turned ? o.height : o.width, h = turned ? o.width : o.height;
-  return w >= h ? std::array<double, 2>{w * scale, 0.0} : std::array<double, 2>{0.0, h * scale};
-}
-
-std::string normalise_name(std::string_view name) {
-  std::string out;
-  for (unsigned char c : name)
-    if (std::isalnum(c)) out.push_back(static_cast<char>(std::tolower(c)));
-  return out;
-}
-
-std::string Catalogue::variant_name(int variant_id) const {
-  const Object& o = object_of(variant_id);
-  const Variant& v = variant(variant_id);
-  return v.code.empty() ? o.name : o.name + ":" + v.code;
-}
-
-std::string Catalogue::object_names() const {
-  std::string names;
-  for (const Object& o : objects) names += (names.empty() ? "" : ", ") + o.name;
-  return names;
-}
-
-int Catalogue::find_object(std::string_view name) const {
-  const std::string key = normalise_name(name);
-  if (key.empty()) return -1;
-  for (size_t i = 0; i < objects.size(); ++i) {
-    if (normalise_name(objects[i].name) == key) return static_cast<int>(i);
-    for (const std::string& a : objects[i].aliases)
-      if (normalise_name(a) == key) return static_cast<int>(i);
-  }
-  return -1;
-}
-
-Catalogue parse_catalogue(std::string_view text, const std::string& source_name, const std::string& base_dir,
-                          const std::string& assets_dir) {
-  Reader rd{source_name, base_dir, assets_dir};
-  const toml::table root = io::parse_toml(text, source_name);
-  io::reject_unknown_keys(root,
-                          {"format", "default_pool", "images", "views", "metal", "subjects", "regions", "objects",
-                           "noise", "physics", "materials"},
-                          source_name, "");
-  Catalogue cat;
-  cat.source = source_name;
-  cat.hash = fnv1a_hex(text);
-
-  if (const toml::node* f = root.get("format")) rd.integer(f, "format", 1, 1);
-
-  // [images]
+// [images]: the compositing settings.
+void read_images(const Reader& rd, const toml::table& root, Catalogue& cat) {
   const toml::node* imgs_node = rd.need(root, "images", "images");
   const toml::table* imgs = imgs_node->as_table();
   if (!imgs) rd.fail(imgs_node, "images", "expected a table");
   for (const char* moved : {"mmw_width", "mmw_height", "ir_width", "ir_height"})
     if (const toml::node* n = imgs->get(moved))
       rd.fail(n, std::string("images.") + moved, "the views' sizes are [[views]] entries now (size = [WIDTH, HEIGHT])");
-  io::reject_unknown_keys(*imgs, {"alpha", "noise_size"}, source_name, "images");
-  ImagesConfig& ic = cat.images;
-  ic.alpha = rd.number(*imgs, "alpha", "images", 0.0, 1.0);
-  ic.noise_size = rd.integer(*imgs, "noise_size", "images", 1, 4096, 64);
+  io::reject_unknown_keys(*imgs, key_names(kImagesKeys), rd.file, "images");
+  read_keys(rd, *imgs, "images", kImagesKeys, cat.images, kImagesRequired);
+}
 
-  read_views(rd, root, cat);
-
-  // [[regions]]: each with its rectangle in every view that sees it.
+// [[regions]]: each with its rectangle in every view that sees it.
+void read_regions(const Reader& rd, const toml::table& root, Catalogue& cat) {
   const toml::array& regions = rd.array_of_tables(root, "regions");
   if (regions.empty() || regions.size() > static_cast<size_t>(kMaxRegions))
     rd.fail(&regions, "regions",
@@ -378,10 +416,13 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
       if (const toml::node* n = t.get(moved))
         rd.fail(n, f + "." + moved,
                 "regions are numbered in their order and placed by rects = { VIEW = [x, y, w, h], ... } now");
-    io::reject_unknown_keys(t, {"name", "rects"}, source_name, f);
+    io::reject_unknown_keys(t, {"name", "rects"}, rd.file, f);
     Region& r = cat.regions[i];
     r.id = static_cast<int>(i + 1);
     r.name = rd.string(t, "name", f);
+    // It labels evaluate's per-region report and the page's lists.
+    for (size_t j = 0; j < i; ++j)
+      if (cat.regions[j].name == r.name) rd.fail(t.get("name"), f + ".name", "\"" + r.name + "\" is named twice");
     const toml::node* rn = rd.need(t, "rects", f + ".rects");
     const toml::table* rects = rn->as_table();
     if (!rects || rects->empty()) rd.fail(rn, f + ".rects", "expected a table of view = [x, y, w, h], at least one");
@@ -394,13 +435,15 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
       view.region_mask |= 1u << i;
     }
   }
+}
 
-  // [metal] before the objects (they refer to its categories) and the subjects (their
-  // base_zones are one per zone); after the regions (an influence row per region).
+// [metal]: the zones, the categories, each category's influence table per region and
+// [metal.physics].
+void read_metal(const Reader& rd, const toml::table& root, Catalogue& cat) {
   const toml::node* metal_node = rd.need(root, "metal", "metal");
   const toml::table* metal = metal_node->as_table();
   if (!metal) rd.fail(metal_node, "metal", "expected a table");
-  io::reject_unknown_keys(*metal, {"zones", "categories", "influence", "physics"}, source_name, "metal");
+  io::reject_unknown_keys(*metal, {"zones", "categories", "influence", "physics"}, rd.file, "metal");
   {
     cat.zones = static_cast<int>(rd.integer(rd.need(*metal, "zones", "metal.zones"), "metal.zones", 1, kMaxZones));
     const toml::node* cn = rd.need(*metal, "categories", "metal.categories");
@@ -432,40 +475,32 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     }
     if (const toml::node* pn = metal->get("physics")) read_metal_physics(rd, pn, cat);
   }
+}
 
-  // [[subjects]]
+// [[subjects]]: the catalogue's bodies.
+void read_subjects(const Reader& rd, const toml::table& root, Catalogue& cat) {
   const toml::array& subjects = rd.array_of_tables(root, "subjects");
   if (subjects.empty() || subjects.size() > 255) rd.fail(&subjects, "subjects", "expected 1 to 255 subjects");
+  std::vector<std::string_view> known{"name"};
+  for (const ShapeKey& k : kShapeKeys) known.push_back(k.key);
+  known.push_back("pose");
+  for (std::string_view k : key_names(kSubjectKeys)) known.push_back(k);
+  known.insert(known.end(), {"base_zones", "images"});
   for (size_t i = 0; i < subjects.size(); ++i) {
     const toml::table& t = *subjects.get(i)->as_table();
     const std::string f = "subjects[" + std::to_string(i + 1) + "]";
-    io::reject_unknown_keys(
-        t,
-        {"name", "build", "height", "shoulders", "chest", "hips", "arm_length", "leg_length", "pose", "skin_emissivity",
-         "skin_temperature", "mmw_level", "ir_core", "ir_limb", "base_zones", "images"},
-        source_name, f);
+    io::reject_unknown_keys(t, known, rd.file, f);
     Subject s;
     s.name = rd.string(t, "name", f);
-    const auto in = [&](const char* key, BodyRange r, double dflt) { return rd.number(t, key, f, r.lo, r.hi, dflt); };
     BodyShape& b = s.shape;
-    b.build = in("build", kBuildRange, 1.0);
-    // Stature about the 1.75 m body of [metal.physics] (docs/model/subjects.md).
-    b.height = in("height", kHeightRange, 1.0);
     // Breadths default to the build, so a subject that gives only `build` is drawn as before.
-    b.shoulders = in("shoulders", kBreadthRange, b.build);
-    b.chest = in("chest", kBreadthRange, b.build);
-    b.hips = in("hips", kBreadthRange, b.build);
+    for (const ShapeKey& k : kShapeKeys)
+      b.*k.field = rd.number(t, k.key, f, k.range.lo, k.range.hi, k.defaults_to_build ? b.build : 1.0);
     b.places_follow_width = t.contains("shoulders") || t.contains("chest") || t.contains("hips");
-    b.arm_length = in("arm_length", kArmLengthRange, 1.0);
-    b.leg_length = in("leg_length", kLegLengthRange, 1.0);
     const std::string pose = rd.string(t, "pose", f, std::string("arms-down"));
     if (!parse_pose(pose, b.pose))
       rd.fail(t.get("pose"), f + ".pose", "\"" + pose + "\" is not a pose (arms-down, arms-raised, arms-out)");
-    if (t.get("skin_emissivity")) s.skin_emissivity = in("skin_emissivity", kSkinEmissivityRange, 0.0);
-    if (t.get("skin_temperature")) s.skin_temperature = in("skin_temperature", kSkinTemperatureRange, 0.0);
-    s.mmw_level = rd.integer(t, "mmw_level", f, 0, 255, 150);
-    s.ir_core = rd.integer(t, "ir_core", f, 0, 255, 215);
-    s.ir_limb = rd.integer(t, "ir_limb", f, 0, 255, 175);
+    read_keys(rd, t, f, kSubjectKeys, s);
     s.base_zones = rd.ints(rd.need(t, "base_zones", f + ".base_zones"), f + ".base_zones", cat.zones, 1, 200);
     if (const toml::node* in = t.get("images")) {
       const toml::table* it = in->as_table();
@@ -483,60 +518,40 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
                 "only a procedural body can be drawn at another height; this subject names image files (images)");
     cat.subjects.push_back(std::move(s));
   }
+}
 
-  // [physics] and [[materials]]: optional; the physics model needs them.
+// [physics]: optional; the physics model's scene and sensor.
+void read_physics(const Reader& rd, const toml::table& root, Catalogue& cat) {
   if (const toml::node* pn = root.get("physics")) {
     const toml::table* pt = pn->as_table();
     if (!pt) rd.fail(pn, "physics", "expected a table");
-    io::reject_unknown_keys(*pt,
-                            {"frequency_ghz", "aperture_m", "fov_rad", "range_m", "skin_emissivity", "skin_temperature",
-                             "clothing_transmission", "clothing_temperature", "background_temperature",
-                             "room_temperature", "base_background_gray", "ir_index_min_k", "ir_index_max_k",
-                             "ir_coupling", "ir_spread_mm", "ir_display_min", "ir_display_max"},
-                            source_name, "physics");
-    PhysicsConfig& pc = cat.physics;
-    pc.frequency_ghz = rd.number(*pt, "frequency_ghz", "physics", 1.0, 10000.0, pc.frequency_ghz);
-    pc.aperture_m = rd.number(*pt, "aperture_m", "physics", 1e-3, 100.0, pc.aperture_m);
-    pc.fov_rad = rd.number(*pt, "fov_rad", "physics", 1e-3, 3.0, pc.fov_rad);
-    pc.range_m = rd.number(*pt, "range_m", "physics", 0.01, 1000.0, pc.range_m);
-    pc.skin_emissivity = rd.number(*pt, "skin_emissivity", "physics", 0.0, 1.0, pc.skin_emissivity);
-    pc.skin_temperature = rd.number(*pt, "skin_temperature", "physics", 1.0, 1000.0, pc.skin_temperature);
-    pc.clothing_transmission = rd.number(*pt, "clothing_transmission", "physics", 0.0, 1.0, pc.clothing_transmission);
-    pc.clothing_temperature = rd.number(*pt, "clothing_temperature", "physics", 1.0, 1000.0, pc.clothing_temperature);
-    pc.background_temperature =
-        rd.number(*pt, "background_temperature", "physics", 1.0, 1000.0, pc.background_temperature);
-    pc.room_temperature = rd.number(*pt, "room_temperature", "physics", 1.0, 1000.0, pc.room_temperature);
-    pc.base_background_gray = rd.integer(*pt, "base_background_gray", "physics", 0, 254, pc.base_background_gray);
-    pc.ir_index_min_k = rd.number(*pt, "ir_index_min_k", "physics", 1.0, 1000.0, pc.ir_index_min_k);
-    pc.ir_index_max_k = rd.number(*pt, "ir_index_max_k", "physics", 1.0, 1000.0, pc.ir_index_max_k);
-    if (pc.ir_index_max_k <= pc.ir_index_min_k)
-      rd.fail(pt, "physics.ir_index_max_k", "must be above physics.ir_index_min_k");
-    pc.ir_coupling = rd.number(*pt, "ir_coupling", "physics", 0.0, 1.0, pc.ir_coupling);
-    pc.ir_spread_mm = rd.number(*pt, "ir_spread_mm", "physics", 0.0, 1000.0, pc.ir_spread_mm);
-    pc.ir_display_min = rd.number(*pt, "ir_display_min", "physics", 0.0, 1000.0, pc.ir_display_min);
-    pc.ir_display_max = rd.number(*pt, "ir_display_max", "physics", 0.0, 1000.0, pc.ir_display_max);
-    if (pc.ir_display_max <= pc.ir_display_min)
-      rd.fail(pt, "physics.ir_display_max", "must be above physics.ir_display_min");
+    io::reject_unknown_keys(*pt, key_names(kPhysicsKeys), rd.file, "physics");
+    read_keys(rd, *pt, "physics", kPhysicsKeys, cat.physics);
   }
+}
+
+// [[materials]]: optional; the physics model's objects' materials.
+void read_materials(const Reader& rd, const toml::table& root, Catalogue& cat) {
   if (root.get("materials")) {
     const toml::array& mats = rd.array_of_tables(root, "materials");
     if (mats.size() > 1000) rd.fail(&mats, "materials", "expected at most 1000 materials");
     for (size_t i = 0; i < mats.size(); ++i) {
       const toml::table& t = *mats.get(i)->as_table();
       const std::string f = "materials[" + std::to_string(i + 1) + "]";
-      io::reject_unknown_keys(t, {"name", "emissivity", "warm_minutes", "source"}, source_name, f);
+      io::reject_unknown_keys(t, {"name", "emissivity", "warm_minutes", "source"}, rd.file, f);
       Material m;
       m.name = rd.string(t, "name", f);
       for (const Material& other : cat.materials)
         if (other.name == m.name) rd.fail(t.get("name"), f + ".name", "\"" + m.name + "\" is named twice");
-      m.emissivity = rd.number(t, "emissivity", f, 0.0, 1.0);
-      m.warm_minutes = rd.number(t, "warm_minutes", f, 1e-3, 1e6);
+      read_keys(rd, t, f, kMaterialKeys, m, {}, true);
       rd.string(t, "source", f);  // every value says where it comes from
       cat.materials.push_back(m);
     }
   }
+}
 
-  // [[objects]]
+// [[objects]]: after [metal] and [[materials]], which they name.
+void read_objects(const Reader& rd, const toml::table& root, Catalogue& cat) {
   const toml::array& objects = rd.array_of_tables(root, "objects");
   if (objects.empty() || objects.size() > 1000) rd.fail(&objects, "objects", "expected 1 to 1000 objects");
   for (size_t i = 0; i < objects.size(); ++i) {
@@ -545,7 +560,7 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     io::reject_unknown_keys(t,
                             {"name", "aliases", "class", "family", "material", "metal", "shape", "size", "mmw_level",
                              "ir_level", "variants", "mmw", "ir", "mmw_h", "mmw_v", "ir_h", "ir_v", "metal_anisotropy"},
-                            source_name, f);
+                            rd.file, f);
     Object o;
     o.name = rd.string(t, "name", f);
     for (const char* reserved : {"", "none", "all", "class", "family"})  // words of pools and rules
@@ -638,8 +653,10 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
     if (cat.variant_list.size() > 30000) rd.fail(&t, f, "too many object variants (at most 30000)");
     cat.objects.push_back(std::move(o));
   }
+}
 
-  // default_pool: object names, after the objects it names.
+// default_pool: object names, after the objects it names.
+void read_default_pool(const Reader& rd, const toml::table& root, Catalogue& cat) {
   if (const toml::node* dp = root.get("default_pool")) {
     const toml::array* a = dp->as_array();
     if (!a || a->empty()) rd.fail(dp, "default_pool", "expected a non-empty array of object names");
@@ -655,14 +672,16 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
   } else {
     for (size_t o = 0; o < cat.objects.size(); ++o) cat.default_pool.push_back(static_cast<int>(o));
   }
+}
 
-  // [[noise]]
+// [[noise]]: the thesis's MMW noise patterns.
+void read_noise(const Reader& rd, const toml::table& root, Catalogue& cat) {
   const toml::array& noise = rd.array_of_tables(root, "noise");
   if (noise.empty() || noise.size() > 255) rd.fail(&noise, "noise", "expected 1 to 255 noise patterns");
   for (size_t i = 0; i < noise.size(); ++i) {
     const toml::table& t = *noise.get(i)->as_table();
     const std::string f = "noise[" + std::to_string(i + 1) + "]";
-    io::reject_unknown_keys(t, {"name", "gain", "image"}, source_name, f);
+    io::reject_unknown_keys(t, {"name", "gain", "image"}, rd.file, f);
     NoisePattern p;
     p.name = rd.string(t, "name", f);
     p.gain = rd.number(t, "gain", f, 0.0, 100.0, 1.0);
@@ -673,9 +692,11 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
                   " noise patterns have procedural defaults; give an image");
     cat.noise.push_back(std::move(p));
   }
-  for (Sensor& view : cat.sensors) derive_view(cat, view);
-  // Each view draws the objects at its scale: none larger than an image may be (4096 a side,
-  // as a view or an object's catalogue size).
+}
+
+// Each view draws the objects at its scale: none larger than an image may be (4096 a side,
+// as a view or an object's catalogue size). After derive_view, which sets the scales.
+void check_drawn_sizes(const Reader& rd, const toml::table& root, Catalogue& cat) {
   const toml::array& views = *root.get("views")->as_array();
   for (size_t k = 0; k < cat.sensors.size(); ++k) {
     const Sensor& s = cat.sensors[k];
@@ -687,6 +708,103 @@ Catalogue parse_catalogue(std::string_view text, const std::string& source_name,
                     " field units) more than 4096 pixels long; give the view a larger field or a smaller size");
     }
   }
+}
+
+}  // namespace
+
+const ImageSource& Subject::image(std::string_view view) const {
+  static const ImageSource procedural;
+  const auto it = images.find(view);
+  return it == images.end() ? procedural : it->second;
+}
+
+std::array<double, 9> Catalogue::polarizability(int variant_id) const {
+  // Along the drawing's long side, as long_side lays it: across (x) or up (z).
+  const bool up = long_side(variant_id)[0] == 0.0;
+  return polarizability(variant_id, up ? std::array<double, 3>{0, 0, 1} : std::array<double, 3>{1, 0, 0});
+}
+
+std::array<double, 9> Catalogue::polarizability(int variant_id, const std::array<double, 3>& u) const {
+  const Object& o = object_of(variant_id);
+  const double m = metal_physics.polarizability.empty() ? 0.0 : metal_physics.polarizability[o.metal];
+  const double a = o.metal_anisotropy;
+  const double across = m * 3.0 / (a + 2.0);
+  // Diagonal across (1 - u_i^2) + across a u_i^2, off the diagonal across (a - 1) u_i u_j:
+  // along an axis, exactly across and across a.
+  std::array<double, 9> t{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      t[i * 3 + j] =
+          i == j ? across * (1.0 - u[i] * u[i]) + across * a * (u[i] * u[i]) : across * (a - 1.0) * u[i] * u[j];
+  return t;
+}
+
+std::array<double, 2> Catalogue::long_side(int variant_id) const {
+  const Object& o = object_of(variant_id);
+  const double scale = metres_per_field_unit();
+  const bool turned = variant(variant_id).code == "v";
+  const int w = turned ? o.height : o.width, h = turned ? o.width : o.height;
+  return w >= h ? std::array<double, 2>{w * scale, 0.0} : std::array<double, 2>{0.0, h * scale};
+}
+
+std::string normalise_name(std::string_view name) {
+  std::string out;
+  for (unsigned char c : name)
+    if (std::isalnum(c)) out.push_back(static_cast<char>(std::tolower(c)));
+  return out;
+}
+
+std::string Catalogue::variant_name(int variant_id) const {
+  const Object& o = object_of(variant_id);
+  const Variant& v = variant(variant_id);
+  return v.code.empty() ? o.name : o.name + ":" + v.code;
+}
+
+std::string Catalogue::object_names() const {
+  std::string names;
+  for (const Object& o : objects) names += (names.empty() ? "" : ", ") + o.name;
+  return names;
+}
+
+int Catalogue::find_object(std::string_view name) const {
+  const std::string key = normalise_name(name);
+  if (key.empty()) return -1;
+  for (size_t i = 0; i < objects.size(); ++i) {
+    if (normalise_name(objects[i].name) == key) return static_cast<int>(i);
+    for (const std::string& a : objects[i].aliases)
+      if (normalise_name(a) == key) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+Catalogue parse_catalogue(std::string_view text, const std::string& source_name, const std::string& base_dir,
+                          const std::string& assets_dir) {
+  Reader rd{source_name, base_dir, assets_dir};
+  const toml::table root = io::parse_toml(text, source_name);
+  io::reject_unknown_keys(root,
+                          {"format", "default_pool", "images", "views", "metal", "subjects", "regions", "objects",
+                           "noise", "physics", "materials"},
+                          source_name, "");
+  Catalogue cat;
+  cat.source = source_name;
+  cat.hash = fnv1a_hex(text);
+
+  if (const toml::node* f = root.get("format")) rd.integer(f, "format", 1, 1);
+
+  read_images(rd, root, cat);
+  read_views(rd, root, cat);
+  read_regions(rd, root, cat);
+  // [metal] before the objects (they refer to its categories) and the subjects (their
+  // base_zones are one per zone); after the regions (an influence row per region).
+  read_metal(rd, root, cat);
+  read_subjects(rd, root, cat);
+  read_physics(rd, root, cat);
+  read_materials(rd, root, cat);
+  read_objects(rd, root, cat);
+  read_default_pool(rd, root, cat);
+  read_noise(rd, root, cat);
+  for (Sensor& view : cat.sensors) derive_view(cat, view);
+  check_drawn_sizes(rd, root, cat);
   return cat;
 }
 

@@ -1,6 +1,6 @@
 // Philox4x32-10 (Salmon et al., "Parallel random numbers: as easy as 1, 2, 3", SC11),
 // the counter-based generator behind every random draw, written for the host and the
-// reference from docs/model/determinism.md. kernels/philox.cl is the kernels' own
+// reference from docs/model/determinism.md. kernels/lib/philox.cl is the kernels' own
 // implementation; tests/philox_test.cpp holds both to the published vectors.
 //
 // A draw is a pure function of (seed, scenario index, stream, element):

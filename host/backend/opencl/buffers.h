@@ -39,7 +39,7 @@ cl::Buffer constant(cl::Context& ctx, const std::vector<T>& v) {
   return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, copy.size() * sizeof(T), copy.data());
 }
 
-// Model parameters at the kernels' parameter precision (kernels/precision.cl).
+// Model parameters at the kernels' parameter precision (kernels/lib/precision.cl).
 inline cl::Buffer params(cl::Context& ctx, bool fp64, const std::vector<double>& v) {
   return fp64 ? constant(ctx, v) : constant(ctx, std::vector<cl_float>(v.begin(), v.end()));
 }

@@ -32,7 +32,7 @@ struct Device {
 
 // One batch on the device: its scenarios' subjects and objects, the run's seed and the
 // batch's first scenario index, or where the batch is not contiguous (SceneBatch::indices)
-// each scenario's index (null otherwise: kernels/philox.cl, scenario_index).
+// each scenario's index (null otherwise: kernels/lib/philox.cl, scenario_index).
 struct DeviceBatch {
   size_t n = 0;
   cl::Buffer subject, objects;

@@ -41,7 +41,7 @@ DeviceCatalogue::DeviceCatalogue(const Catalogue& cat, const AssetSet& assets, c
     for (const Image& sp : set) bytes += 2 * sp.pixels.size() + 2 * size_t(sp.height) * (sp.width + 2 * PS_PAD);
   for (const Image& tile : assets.noise) bytes += tile.pixels.size() + size_t(tile.height) * (tile.width + 2 * PS_PAD);
   atlas_bytes.reserve(bytes);
-  // Each subject's base images, then their fold patterns (kernels/composite.cl, fold_row).
+  // Each subject's base images, then their fold patterns (kernels/lib/view.cl, fold_row).
   for (const auto& subject_views : assets.bases)
     for (const Image& img : subject_views) base_offsets.push_back(add(img));
   for (const auto& subject_views : assets.folds)

@@ -13,7 +13,7 @@
 
 namespace portalsim::opencl {
 
-// A model parameter at the kernels' parameter precision (kernels/precision.cl: `param`),
+// A model parameter at the kernels' parameter precision (kernels/lib/precision.cl: `param`),
 // double in fp64 builds, float otherwise.
 struct Real {
   double value = 0;

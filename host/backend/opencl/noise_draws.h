@@ -1,5 +1,5 @@
 // The unit draws of a sensor model's per-pixel noise as a fidelity variant's kernels make
-// them (kernels/sensor_noise.cl, noise_draws), for `portalsim tradeoff`'s distribution
+// them (kernels/noise_draws.cl), for `portalsim tradeoff`'s distribution
 // columns: the thesis model's pixel noise (the variant's noise_draw), the physics model's
 // MMW raw noise (table Gaussians, or under irwin-hall the fast tier's draws).
 #pragma once

@@ -23,7 +23,7 @@ constexpr size_t kMaxTabulatedPairs = size_t{1} << 26;
 // Global scratch for work spaces too large for private memory, per launch.
 constexpr size_t kMaxScratchBytes = 64 * kMiB;
 
-// Whether two boxes, widened by the bilinear fringe, meet (kernels/physics_raw.cl, layers_meet).
+// Whether two boxes, widened by the bilinear fringe, meet (kernels/lib/physics.cl, layers_meet).
 bool boxes_meet(const Rect& a, const Rect& b) {
   return a.x - 2 < b.x + b.w + 2 && b.x - 2 < a.x + a.w + 2 && a.y - 2 < b.y + b.h + 2 && b.y - 2 < a.y + a.h + 2;
 }
