@@ -10,19 +10,15 @@
 
 #include "run_binary.h"
 
+namespace portalsim::test {
 namespace {
 
 namespace fs = std::filesystem;
-using portalsim::test::describe;
-using portalsim::test::has;
-using portalsim::test::Result;
-using portalsim::test::spit;
-using portalsim::test::TempDir;
 
 // `portalsim bench --list-devices` with `vendors` as OCL_ICD_VENDORS.
 Result list_devices(const TempDir& t, const std::string& vendors) {
-  return portalsim::test::finish(portalsim::test::start_program(
-      t.cap(), "/usr/bin/env", {"OCL_ICD_VENDORS=" + vendors, portalsim::test::kBinary, "bench", "--list-devices"}));
+  return finish(
+      start_program(t.cap(), "/usr/bin/env", {"OCL_ICD_VENDORS=" + vendors, kBinary, "bench", "--list-devices"}));
 }
 
 TEST(OpenCLDrivers, ADriverThatDoesNotLoadIsNamedWithTheLoadersReason) {
@@ -75,3 +71,4 @@ TEST(OpenCLDrivers, TheSystemsDriverNamedAloneLoads) {
 }
 
 }  // namespace
+}  // namespace portalsim::test
