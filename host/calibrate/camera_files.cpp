@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "base/error.h"
+#include "base/trim.h"
 
 namespace portalsim::calibrate {
 
@@ -26,11 +27,6 @@ std::string rounded(double v, int decimals) {
   s.precision(decimals);
   s << v;
   return s.str();
-}
-
-std::string trim(const std::string& s) {
-  const size_t a = s.find_first_not_of(" \t\r");
-  return a == std::string::npos ? "" : s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
 }
 
 }  // namespace

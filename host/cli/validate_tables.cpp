@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "base/error.h"
+#include "base/trim.h"
 #include "io/input_file.h"
 #include "io/table_fields.h"
 #include "sink/feature_rows.h"
@@ -16,12 +17,6 @@
 namespace portalsim::cli {
 
 namespace {
-
-std::string trim(const std::string& s) {
-  const size_t a = s.find_first_not_of(" \t\r");
-  if (a == std::string::npos) return "";
-  return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
-}
 
 void check_row(const std::string& path, int line, const Table& t, const std::vector<std::string>& f) {
   const std::string where = path + ":" + std::to_string(line);

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <vector>
 
+#include "base/trim.h"
+
 namespace portalsim {
 
 namespace {
@@ -28,11 +30,7 @@ std::string named_library(const fs::path& icd) {
   std::ifstream in(icd);
   std::string line;
   std::getline(in, line);
-  const auto blank = [](unsigned char c) { return c == ' ' || c == '\t' || c == '\r'; };
-  while (!line.empty() && blank(static_cast<unsigned char>(line.back()))) line.pop_back();
-  const auto first =
-      std::find_if_not(line.begin(), line.end(), [&](char c) { return blank(static_cast<unsigned char>(c)); });
-  return std::string(first, line.end());
+  return trim(line);
 }
 
 // The drivers the loader would try, and where it looked (for the message when there are none).
@@ -43,15 +41,14 @@ std::vector<Driver> drivers(std::string& where) {
   std::error_code ec;
   std::vector<Driver> found;
   if (!vendors.empty() && !fs::is_directory(vendors, ec)) {
+    where = "OCL_ICD_VENDORS=" + vendors;
     if (vendors.size() > 4 && vendors.compare(vendors.size() - 4, 4, ".icd") == 0) {
       fs::path icd = vendors;
       if (vendors.find('/') == std::string::npos && fs::exists(folder / vendors, ec)) icd = folder / vendors;
-      where = "OCL_ICD_VENDORS=" + vendors;
       if (fs::is_regular_file(icd, ec)) found.push_back({icd.string(), named_library(icd)});
-      return found;
+    } else {
+      found.push_back({"", vendors});
     }
-    where = "OCL_ICD_VENDORS=" + vendors;
-    found.push_back({"", vendors});
     return found;
   }
   const fs::path dir = !vendors.empty() ? fs::path(vendors) : folder;
@@ -75,9 +72,8 @@ DriverSearch search_opencl_drivers() {
                        " holds no .icd file (on Debian, apt-get install pocl-opencl-icd for the CPU)"};
   std::string loaded;
   for (const Driver& d : all) {
-    const std::string named =
-        d.icd.empty() ? where : d.icd + " names " + (d.library.empty() ? "no library" : d.library);
-    if (d.library.empty()) return {false, named + " on its first line, so its driver cannot load"};
+    if (d.library.empty()) return {false, d.icd + " names no library on its first line, so its driver cannot load"};
+    const std::string named = d.icd.empty() ? where : d.icd + " names " + d.library;
     dlerror();
     void* handle = dlopen(d.library.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (!handle) {
