@@ -88,10 +88,9 @@ while read -r soname path; do
   [ -n "$pkg" ] || { echo "bundle.sh: $path belongs to no Debian package; refusing to bundle it" >&2; exit 1; }
   case $pkg in
     libc6) system_sonames+=("$soname"); continue ;;
-    libstdc++6 | libgcc-s1) system_sonames+=("$soname"); fallback+=("$path"); packages[$pkg]=1; package_of[$soname]=$pkg; continue ;;
+    libstdc++6 | libgcc-s1) system_sonames+=("$soname"); fallback+=("$path") ;;
+    *) install -m 644 "$(realpath "$path")" "$stage/lib/$soname" ;;
   esac
-  cp -L "$path" "$stage/lib/$soname"
-  chmod 644 "$stage/lib/$soname"
   packages[$pkg]=1
   package_of[$soname]=$pkg
 done < <(libs)
