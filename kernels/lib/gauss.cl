@@ -213,16 +213,19 @@ IH_SHAPE(double, double, int, )
 IH_SHAPE(float, float, int, )
 IH_SHAPE(float16, float, int16, 16)
 #endif
+// Both 16-bit halves' byte sums of a word (each at most 510), in its halves: one masked
+// add for a cell (ih_cell) and for 16 words (ih128).
+#define IH_BYTE_SUMS(w) (((w)&0x00ff00ffu) + (((w) >> 8) & 0x00ff00ffu))
 inline greal ih_cell(uint2 seed, ulong index, uint stream, int view, int p) {
-  const uint h = cell_word(seed, index, stream, view, p) >> PS_GAUSS_SHIFT(p);
-  return ih_shape((int)(h & 0xffu) + (int)((h >> 8) & 0xffu) - 255);
+  const uint s = IH_BYTE_SUMS(cell_word(seed, index, stream, view, p)) >> PS_GAUSS_SHIFT(p);
+  return ih_shape((int)(s & 0xffffu) - 255);
 }
 inline greal ih_pixel(uint2 seed, ulong index, int view, int p) {
   return ih_cell(seed, index, PS_STREAM_PIXEL_NOISE_FAST, view, p);
 }
 #if !defined(PRECISION_FP64)
 // The Irwin-Hall draws of cells 128 b .. 128 b + 127 of a view's field in `stream`: g[j]
-// holds cells 128 b + 16 j .. + 15. Both halves' byte sums come from one masked add per word.
+// holds cells 128 b + 16 j .. + 15.
 __attribute__((always_inline)) inline void ih128(uint2 seed, ulong index, uint stream, int view, int b,
                                                  float16* g) {
   uint16 c[4];
@@ -230,29 +233,30 @@ __attribute__((always_inline)) inline void ih128(uint2 seed, ulong index, uint s
   philox16(&c[0], &c[1], &c[2], &c[3], seed);
 #pragma unroll
   for (int w = 0; w < 4; ++w) {
-    const int16 s = as_int16((c[w] & 0x00ff00ffu) + ((c[w] >> 8) & 0x00ff00ffu));
+    const int16 s = as_int16(IH_BYTE_SUMS(c[w]));
     g[2 * w] = ih_shape16((s & 0xffff) - 255);
     g[2 * w + 1] = ih_shape16((s >> 16) - 255);
   }
 }
 #endif
 
-// Adds sd times the table Gaussians of cells [0, cells) to v (one scenario's field), or,
-// where !accumulate, writes them there: gauss_cells_global and gauss_cells_private.
+// Adds sd times draws of cells [0, cells) to v (one scenario's field), or, where
+// !accumulate, writes them there: NAME_SPACE, with DRAW1 a cell p's draw and DRAW128 (fp32)
+// cells 128 (p >> 7) .. + 127 into float16 g[8]. gauss_cells_global and gauss_cells_private
+// draw table Gaussians, ih_cells_global the fast tier's Irwin-Hall draws.
 #if defined(PRECISION_FP64)
-#define GAUSS_CELLS(SPACE)                                                                                         \
-  inline void gauss_cells_##SPACE(SPACE preal* restrict v, int cells, preal sd, bool accumulate, uint2 seed,     \
-                                  ulong index, uint stream, int view, global const param* table) {               \
-    for (int p = 0; p < cells; ++p)                                                                              \
-      v[p] = (accumulate ? v[p] : 0) + sd * gauss_cell(seed, index, stream, view, p, table);                     \
+#define DRAW_CELLS(NAME, SPACE, DRAW1, DRAW128)                                                                    \
+  inline void NAME##_##SPACE(SPACE preal* restrict v, int cells, preal sd, bool accumulate, uint2 seed,          \
+                             ulong index, uint stream, int view, global const param* table) {                    \
+    for (int p = 0; p < cells; ++p) v[p] = (accumulate ? v[p] : 0) + sd * DRAW1;                                 \
   }
 #else
-#define GAUSS_CELLS(SPACE)                                                                                         \
-  inline void gauss_cells_##SPACE(SPACE preal* restrict v, int cells, preal sd, bool accumulate, uint2 seed,     \
-                                  ulong index, uint stream, int view, global const param* table) {               \
+#define DRAW_CELLS(NAME, SPACE, DRAW1, DRAW128)                                                                    \
+  inline void NAME##_##SPACE(SPACE preal* restrict v, int cells, preal sd, bool accumulate, uint2 seed,          \
+                             ulong index, uint stream, int view, global const param* table) {                    \
     for (int p = 0; p < cells; p += 128) {                                                                       \
       float16 g[8];                                                                                              \
-      gauss128(seed, index, stream, view, p >> 7, table, g);                                                     \
+      DRAW128;                                                                                                   \
       for (int j = 0; j < 8; ++j) {                                                                              \
         const int q = p + 16 * j;                                                                                \
         if (q + 16 <= cells) {                                                                                   \
@@ -267,6 +271,9 @@ __attribute__((always_inline)) inline void ih128(uint2 seed, ulong index, uint s
     }                                                                                                            \
   }
 #endif
+#define GAUSS_CELLS(SPACE)                                                         \
+  DRAW_CELLS(gauss_cells, SPACE, gauss_cell(seed, index, stream, view, p, table), \
+             gauss128(seed, index, stream, view, p >> 7, table, g))
 GAUSS_CELLS(global)
 GAUSS_CELLS(private)
 
@@ -323,29 +330,11 @@ __attribute__((always_inline)) inline void gauss128x2(uint2 seed, ulong index, i
 
 // Adds sd times the draws of cells [0, cells) of `stream` to v: table Gaussians, or with
 // `fast` the fast tier's draws. The stage kernels' noise (stage_netd's rows go cell by cell).
+DRAW_CELLS(ih_cells, global, ih_cell(seed, index, stream, view, p), ih128(seed, index, stream, view, p >> 7, g))
 inline void noise_cells(global preal* restrict v, int cells, preal sd, uint2 seed, ulong index, uint stream, int view,
                         global const param* table, bool fast) {
-  if (!fast) {
+  if (fast)
+    ih_cells_global(v, cells, sd, true, seed, index, stream, view, table);
+  else
     gauss_cells_global(v, cells, sd, true, seed, index, stream, view, table);
-    return;
-  }
-#if defined(PRECISION_FP64)
-  for (int p = 0; p < cells; ++p) v[p] = v[p] + sd * ih_cell(seed, index, stream, view, p);
-#else
-  for (int p = 0; p < cells; p += 128) {
-    float16 g[8];
-    ih128(seed, index, stream, view, p >> 7, g);
-    for (int j = 0; j < 8; ++j) {
-      const int q = p + 16 * j;
-      if (q + 16 <= cells) {
-        STOREF16(global, LOADF16(global, v + q) + sd * g[j], v + q);
-      } else {
-        float t[16];
-        vstore16(g[j], 0, t);
-        for (int k = q; k < cells; ++k) v[k] = v[k] + sd * t[k - q];
-        break;
-      }
-    }
-  }
-#endif
 }
