@@ -47,6 +47,72 @@ constexpr TrigCase kTrig[] = {
     {0x1.657184ae74487p+1, 0x1.5e3a8748a0bf8p-2, -0x1.e11f642522d1bp-1},    // 160 degrees
 };
 
+struct Case {
+  double x, y;
+};
+constexpr Case kExps[] = {
+    {0x0.0p+0, 0x1.0000000000000p+0},
+    {0x1.b7cdfd9d7bdbbp-34, 0x1.000000006df38p+0},  // 1e-10
+    {-0x1.b7cdfd9d7bdbbp-34, 0x1.ffffffff24190p-1},
+    {0x1.0000000000000p-1, 0x1.a61298e1e069cp+0},  // 0.5
+    {-0x1.0000000000000p-1, 0x1.368b2fc6f960ap-1},
+    {0x1.0000000000000p+0, 0x1.5bf0a8b145769p+1},  // 1
+    {-0x1.0000000000000p+0, 0x1.78b56362cef38p-2},
+    {0x1.62e42fefa39efp-2, 0x1.6a09e667f3bccp+0},  // ln 2 / 2
+    {0x1.4000000000000p+1, 0x1.85d6fd931e0bbp+3},
+    {-0x1.d000000000000p+2, 0x1.7455fe323fafdp-11},  // -7.25
+    {0x1.4000000000000p+3, 0x1.5829dcf950560p+14},
+    {0x1.9000000000000p+6, 0x1.3494a9b171bf5p+144},  // 100
+    {-0x1.9000000000000p+6, 0x1.a8c1f14e2af5dp-145},
+    {0x1.5e00000000000p+9, 0x1.d945df4f8ec8ep+1009},  // 700
+    {-0x1.5e00000000000p+9, 0x1.14f2b0fb9307fp-1010},
+    {-0x1.5555555555555p-2, 0x1.6edd3122f2ea5p-1},  // -1/3
+    {-0x1.999999999999ap-7, 0x1.f9a3cc26c0f05p-1},
+    {-0x1.2c00000000000p+5, 0x1.dd5c566301ec8p-55},   // -37.5
+    {0x1.62c0000000000p+9, 0x1.81e9b4b52d0c9p+1023},  // 709.5
+};
+constexpr Case kExp10s[] = {
+    {-0x1.8000000000000p+1, 0x1.0624dd2f1a9fcp-10},  {-0x1.0000000000000p-2, 0x1.1feb33c1c381ep-1},   // -3, -0.25
+    {-0x1.999999999999ap-4, 0x1.96b230bcdc434p-1},   {0x0.0p+0, 0x1.0000000000000p+0},                // -0.1, 0
+    {0x1.3333333333333p-2, 0x1.fec982d5bb8afp+0},    {0x1.0000000000000p+0, 0x1.4000000000000p+3},    // 0.3, 1
+    {0x1.0000000000000p+1, 0x1.9000000000000p+6},    {-0x1.9000000000000p+3, 0x1.640a72acc33c6p-42},  // 2, -12.5
+    {0x1.e000000000000p+3, 0x1.c6bf526340000p+49},   {0x1.2c00000000000p+8, 0x1.7e43c8800759cp+996},  // 15, 300
+    {-0x1.2c00000000000p+8, 0x1.56e1fc2f8f359p-997}, {-0x1.65fd8adab9f56p-5, 0x1.cefcfd5da6823p-1},   // -300, -0.0437
+};
+constexpr Case kTans[] = {
+    {0x1.5798ee2308c3ap-27, 0x1.5798ee2308c3ap-27}, {0x1.999999999999ap-4, 0x1.9af8877430b80p-4},   // 1e-8, 0.1
+    {0x1.0c152382d7365p-2, 0x1.126145e9ecd56p-2},   {0x1.0000000000000p-1, 0x1.17b4f5bf3474ap-1},   // 15 degrees, 0.5
+    {0x1.921fb54442d18p-1, 0x1.fffffffffffffp-1},   {0x1.0000000000000p+0, 0x1.8eb245cbee3a6p+0},   // pi/4, 1
+    {0x1.8000000000000p+0, 0x1.c33ed50b88777p+3},   {0x1.921fb54442d18p+0, 0x1.d02967c31cdb5p+53},  // 1.5, pi/2
+    {0x1.0000000000000p+1, -0x1.17af62e0950f8p+1},  {0x1.8000000000000p+1, -0x1.23ef71254b86fp-3},  // 2, 3
+    {-0x1.999999999999ap-2, -0x1.b0f0b49dcdcd8p-2}, {0x1.4000000000000p+3, 0x1.4bf5f34be3782p-1},   // -0.4, 10
+    {0x1.9000000000000p+6, -0x1.2ca74d62b5d38p-1},  {0x1.657184ae74487p-2, 0x1.74b49cf3902d4p-2},   // 100, 20 degrees
+};
+
+TEST(PlainMath, ExpAndExp10AreCorrectlyRoundedAtKnownValues) {
+  for (const Case& c : kExps) EXPECT_EQ(exp(c.x), c.y) << std::hexfloat << c.x;
+  for (const Case& c : kExp10s) EXPECT_EQ(exp10(c.x), c.y) << std::hexfloat << c.x;
+  EXPECT_EQ(exp(710.0), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(exp(-746.0), 0.0);
+  EXPECT_GT(exp(-744.0), 0.0);  // subnormal
+  EXPECT_TRUE(std::isnan(exp(std::numeric_limits<double>::quiet_NaN())));
+  EXPECT_EQ(exp10(309.0), std::numeric_limits<double>::infinity());
+}
+
+TEST(PlainMath, TanIsCorrectlyRoundedAtKnownValues) {
+  for (const Case& c : kTans) EXPECT_EQ(tan(c.x), c.y) << std::hexfloat << c.x;
+  EXPECT_TRUE(std::isnan(tan(2e6)));
+}
+
+// Between the known values: e^a e^b = e^(a+b) and 10^x = e^(x ln 10) to an ulp or two, over
+// the exponents the physics tables take (Gaussian taps, warming, fabrics' losses).
+TEST(PlainMath, ExpAgreesWithItself) {
+  for (double x = -40.0; x <= 5.0; x += 0.0123457) {
+    EXPECT_NEAR(exp(x) * exp(-x), 1.0, 4e-16) << x;
+    EXPECT_NEAR(exp10(x) / exp(x * 2.302585092994046), 1.0, 1e-13) << x;  // x ln 10's rounding
+  }
+}
+
 TEST(PlainMath, LogIsCorrectlyRoundedAtKnownValues) {
   for (const LogCase& c : kLogs) EXPECT_EQ(log(c.x), c.ln) << std::hexfloat << c.x;
   EXPECT_TRUE(std::isnan(log(0.0)));

@@ -46,10 +46,11 @@ constexpr DD div(DD a, DD b) {
   return fast_two_sum(q, (r.hi + r.lo) / b.hi);
 }
 
-// pi / 2 in three doubles (159 bits), ln 2 in two.
+// pi / 2 in three doubles (159 bits), ln 2 and ln 10 in two.
 constexpr double kHalfPi1 = 0x1.921fb54442d18p+0, kHalfPi2 = 0x1.1a62633145c07p-54, kHalfPi3 = -0x1.f1976b7ed8fbcp-110,
                  kTwoOverPi = 0x1.45f306dc9c883p-1;
 constexpr DD kLn2{0x1.62e42fefa39efp-1, 0x1.abc9e3b39803fp-56};
+constexpr DD kLn10{0x1.26bb1bbb55516p+1, -0x1.f48ad494ea3e9p-53};
 
 // p(t) = sum c[j] t^j by Horner's rule: the terms j >= dd_from in plain doubles (they are
 // below 1e-6 of the result, so their rounding is below 1e-22 of it), the rest in DD.
@@ -117,6 +118,56 @@ double log(double x) {
 
 namespace {
 
+// 1 / j! as DD, for exp on |r| <= 0.35 (24 terms: 1e-35).
+constexpr int kExpTerms = 24;
+constexpr auto kExp = [] {
+  struct T {
+    DD c[kExpTerms];
+  } t{};
+  DD f{1.0, 0.0};
+  for (int j = 0; j < kExpTerms; ++j) {
+    if (j > 0) f = div(f, {static_cast<double>(j), 0.0});
+    t.c[j] = f;
+  }
+  return t;
+}();
+
+// 2^k as a double, for -1074 <= k <= 1023.
+double two_to(int k) {
+  if (k < -1022) return two_to(k + 54) * 0x1p-54;
+  return std::bit_cast<double>(static_cast<uint64_t>(k + 1023) << 52);
+}
+
+// e^x of x given in DD: x = k ln 2 + r with |r| <= ln 2 / 2 (k ln 2 exact in DD), e^r by its
+// series in DD, then 2^k, in two steps where the result is subnormal (rounded there twice:
+// no caller goes near it).
+double exp_dd(DD x) {
+  if (std::isnan(x.hi)) return x.hi;
+  if (x.hi > 709.8) return std::numeric_limits<double>::infinity();
+  if (x.hi < -745.2) return 0.0;
+  constexpr double kRound = 0x1.8p52;
+  const double k = (x.hi * (1.0 / kLn2.hi) + kRound) - kRound;
+  DD r = add(x, two_prod(-k, kLn2.hi));
+  r = add(r, {-k * kLn2.lo, 0.0});
+  const DD e = horner(kExp.c, 8, r);
+  const int ki = static_cast<int>(k);
+  if (ki < -1021) return (e.hi + e.lo) * two_to(ki + 64) * 0x1p-64;
+  if (ki > 1023) return (e.hi + e.lo) * two_to(ki - 1) * 2.0;
+  return (e.hi + e.lo) * two_to(ki);
+}
+
+}  // namespace
+
+double exp(double x) { return exp_dd({x, 0.0}); }
+
+double exp10(double x) {
+  if (std::isnan(x)) return x;
+  if (std::abs(x) > 400.0) return x > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+  return exp_dd(mul({x, 0.0}, kLn10));
+}
+
+namespace {
+
 // x = k pi/2 + r with |r| <= pi/4 (a hair more where k rounds), r in DD: each k * part of
 // pi/2 is exact as a DD, k < 2^20. Then sin x and cos x are +-sin r or +-cos r by k mod 4,
 // and r = +-(a + b) with a = i / 32 from the table: sin r = +-(S + S (cos b - 1) + C sin b),
@@ -149,14 +200,20 @@ Reduced reduce(double x) {
           fast_two_sum(b.hi, b.lo + sin_tail),
           fast_two_sum(-0.5 * bb.hi, -0.5 * bb.lo + cos_tail)};
 }
-double sin_r(const Reduced& q) {
+DD sin_r_dd(const Reduced& q) {
   const DD s = add(q.s, add(mul(q.s, q.cos_b_minus_1), mul(q.c, q.sin_b)));
-  const double v = s.hi + s.lo;
-  return q.negative ? -v : v;
+  return q.negative ? DD{-s.hi, -s.lo} : s;
+}
+DD cos_r_dd(const Reduced& q) {
+  const DD sb = mul(q.s, q.sin_b);
+  return add(q.c, add(mul(q.c, q.cos_b_minus_1), {-sb.hi, -sb.lo}));
+}
+double sin_r(const Reduced& q) {
+  const DD s = sin_r_dd(q);
+  return s.hi + s.lo;
 }
 double cos_r(const Reduced& q) {
-  const DD sb = mul(q.s, q.sin_b);
-  const DD c = add(q.c, add(mul(q.c, q.cos_b_minus_1), {-sb.hi, -sb.lo}));
+  const DD c = cos_r_dd(q);
   return c.hi + c.lo;
 }
 bool in_range(double x) { return std::abs(x) <= 1e6; }  // false for NaN too
@@ -193,6 +250,15 @@ SinCos sincos(double x) {
     default:
       return {-cs, sn};
   }
+}
+
+// sin r / cos r in DD, rounded once; tan x = tan r for even k, -1 / tan r for odd.
+double tan(double x) {
+  if (!in_range(x)) return kNaN;
+  const Reduced q = reduce(x);
+  const DD s = sin_r_dd(q), c = cos_r_dd(q);
+  const DD t = q.quadrant % 2 ? div({-c.hi, -c.lo}, s) : div(s, c);
+  return t.hi + t.lo;
 }
 
 }  // namespace portalsim::plain

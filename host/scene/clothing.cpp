@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "base/plain_math.h"
+
 namespace portalsim {
 
 std::string Outfit::name() const {
@@ -17,7 +19,7 @@ std::string Outfit::name() const {
 double Outfit::transmission() const {
   double db = 0;
   for (const Layer& l : layers) db += kFabrics[l.fabric].db_per_mm * kGarments[l.garment].thickness_mm;
-  return std::pow(10.0, -db / 10.0);
+  return plain::exp10(-db / 10.0);
 }
 
 double Outfit::clo() const {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "base/plain_math.h"
+
 namespace portalsim::opencl {
 
 namespace {
@@ -37,7 +39,7 @@ std::vector<double> axis(int size, int raw, DisplayFilter filter, double sigma) 
   const int R = static_cast<int>(std::ceil(4.0 * sigma));
   std::vector<double> g(2 * size_t(R) + 1);
   double total = 0;
-  for (int d = -R; d <= R; ++d) total += g[size_t(d + R)] = std::exp(-0.5 * d * d / (sigma * sigma));
+  for (int d = -R; d <= R; ++d) total += g[size_t(d + R)] = plain::exp(-0.5 * d * d / (sigma * sigma));
   std::vector<double> s(w.size(), 0.0);
   for (int x = 0; x < size; ++x)
     for (int d = -R; d <= R; ++d) {
