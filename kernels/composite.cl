@@ -19,11 +19,13 @@ inline void place_affine(global int* ly, const PsViewLaunch* L, uint2 seed, ulon
   const greal s = range[2] + (range[3] - range[2]) * (greal)uniform24(q.y);
   const greal f = (L->flags & PS_FLAG_FLIP) && (q.z >> 31) ? (greal)-1 : (greal)1;
 #if defined(PRECISION_FP64)
-  const greal rad = deg * (M_PI / 180.0);  // the reference's formulas, to its last bits where it can
-#else
-  const greal rad = deg * (M_PI_F / 180.0f);
-#endif
+  // The reference's formulas, to its last bits where it can: the device's cos and sin.
+  const greal rad = deg * (M_PI / 180.0);
   const greal c = cos(rad), sn = sin(rad);
+#else
+  greal c, sn;  // a polynomial (lib/gauss.cl), so that no device's math library sets the bytes
+  sincos_turns(deg * (1.0f / 360.0f), &sn, &c);
+#endif
   // Forward: image = centre + s R F (sprite - sprite centre), R = [c sn; -sn c] (counter-
   // clockwise with y down), F = diag(f, 1); inverse: sprite = sprite centre + F R^T (image - centre) / s.
   put_greal(ly + PS_LAYER_CX, cx);

@@ -347,7 +347,8 @@ kernel void analytic_noise(global float* features, global const int4* rects, glo
   int slot = 0;
   for (int f = 0; f < row_len; f += 2) {
     const uint4 r = draw(seed, index, PS_STREAM_BLOCK_NOISE, (uint)f);
-    const float2 g = gauss2(r.x, r.y);
+    float g0, g1;
+    box_muller(r.x, r.y, &g0, &g1);  // the per-pixel noise's Box-Muller (lib/gauss.cl)
     for (int k = 0; k < 2 && f + k < row_len; ++k) {
       const int q = f + k;
       int count;
@@ -360,7 +361,7 @@ kernel void analytic_noise(global float* features, global const int4* rects, glo
         const int4 rc = rects[q - block_features];
         count = rc.z * rc.w;
       }
-      row[q] = clamp(row[q] + sigma * rsqrt((float)count) * (k ? g.y : g.x), 0.0f, 255.0f);
+      row[q] = clamp(row[q] + sigma * rsqrt((float)count) * (k ? g1 : g0), 0.0f, 255.0f);
     }
   }
 }

@@ -5,6 +5,7 @@
 #include "scene/philox.h"
 
 #include <gtest/gtest.h>
+#include <xxhash.h>
 
 #include <algorithm>
 #include <cmath>
@@ -247,7 +248,7 @@ TEST(Philox, PixelGaussianHandComputed) {
     view.push_back(c.view);
     pixel.push_back(c.pixel);
   }
-  // The kernels' Box-Muller (gauss2) on their own draw of the pair: float against the
+  // The kernels' Box-Muller (box_muller) on their own draw of the pair: float against the
   // hand-computed double.
   const size_t n = seed.size();
   cl::Buffer out(rt.context(), CL_MEM_WRITE_ONLY, n * sizeof(float));
@@ -257,8 +258,9 @@ kernel void pixels(global const ulong* seed, global const ulong* index, global c
   const size_t i = get_global_id(0);
   const uint4 r = draw((uint2)((uint)seed[i], (uint)(seed[i] >> 32)), index[i], PS_STREAM_PIXEL_NOISE,
                        ((uint)view[i] << PS_PIXEL_NOISE_VIEW_SHIFT) | (uint)(pixel[i] / 2));
-  const float2 g = gauss2(r.x, r.y);
-  out[i] = pixel[i] % 2 == 0 ? g.x : g.y;
+  float g0, g1;
+  box_muller(r.x, r.y, &g0, &g1);
+  out[i] = pixel[i] % 2 == 0 ? g0 : g1;
 })",
       "pixels", n, input(rt, seed), input(rt, index), input(rt, view), input(rt, pixel), out);
   const std::vector<float> got = read<float>(rt, out, n);
@@ -452,7 +454,9 @@ kernel void philox_test(global const ulong* seeds, global const ulong* index, gl
   const size_t i = get_global_id(0);
   const uint4 r = draw((uint2)((uint)seeds[i], (uint)(seeds[i] >> 32)), index[i], stream[i], element[i]);
   out[i] = r;
-  gauss[i] = gauss2(r.x, r.y);
+  float g0, g1;
+  box_muller(r.x, r.y, &g0, &g1);
+  gauss[i] = (float2)(g0, g1);
 })",
       "philox_test", n, input(rt, seeds), input(rt, index), input(rt, stream), input(rt, element), b_out, b_gauss);
   const std::vector<cl_uint4> out = read<cl_uint4>(rt, b_out, n);
@@ -489,6 +493,15 @@ TEST(Philox, GaussTableHoldsTheNormalQuantiles) {
   const double sd = std::sqrt(sq / t.size());
   EXPECT_NEAR(sd, 1.0, 2e-4);
   EXPECT_NEAR(t[0], -3.668, 0.001);
+}
+
+// The table's bits set the physics noise's bytes in every tier, and they come from libm's
+// erfc, log and exp (Newton's method; docs/model/determinism.md, "What the bytes depend
+// on"): pinned here, so that a libm that moves any entry's last bit fails by name.
+TEST(Philox, GaussTableBitsArePinned) {
+  const std::vector<double>& t = gauss_table();
+  EXPECT_EQ(XXH3_64bits(t.data(), t.size() * sizeof(double)), 0x9ffc23d1ccb5da73ull)
+      << "the table Gaussians' bits moved: this libm's erfc, log or exp round differently";
 }
 
 }  // namespace portalsim

@@ -44,12 +44,3 @@ inline double __attribute__((overloadable)) knob_draw(double lo, double hi, uint
 inline int __attribute__((overloadable)) knob_draw(int lo, int hi, uint2 seed, ulong index, uint e) {
   return hi > lo ? lo + (int)below(draw(seed, index, PS_STREAM_KNOB_DRAW, e).x, (uint)(hi - lo) + 1u) : lo;
 }
-
-// Box-Muller from two 24-bit uniforms; u1 is shifted into (0, 1] so log() is finite.
-inline float2 gauss2(uint r0, uint r1) {
-  const float u1 = 1.0f - uniform24(r0);
-  const float u2 = uniform24(r1);
-  const float rad = sqrt(-2.0f * log(u1));
-  const float th = 6.283185307179586f * u2;
-  return (float2)(rad * cos(th), rad * sin(th));
-}
