@@ -62,18 +62,7 @@ std::vector<std::string> split_on(const std::string& text, char sep) {
   return parts;
 }
 
-std::string describe_run(const RunResult& r) {
-  std::ostringstream s;
-  s << "command: " << r.command << "\n";
-  if (r.timed_out)
-    s << "timed out\n";
-  else if (r.signaled)
-    s << "killed by signal " << r.signal << "\n";
-  else
-    s << "exit status " << r.status << "\n";
-  s << "--- stdout ---\n" << r.out.substr(0, 4000) << "--- stderr ---\n" << r.err.substr(0, 4000) << "---";
-  return s.str();
-}
+std::string describe_run(const RunResult& r) { return portalsim::test::describe(r, 4000); }
 
 Started start_program(const GenTempDir& t, const std::string& program, const Args& args) {
   return portalsim::test::start_program(t.cap(), program, args);
@@ -1340,16 +1329,22 @@ TEST(FeaturesCmd, BadInput) {
 
 fs::path case_spec(const std::string& name) { return fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / name; }
 
-TEST(GenerateThesisCases, Case1GunIsBalanced) {
-  const fs::path spec = case_spec("case1-gun.toml");
+// 200 scenarios of scenarios/NAME into t, balanced; their scenarios.csv rows.
+void generate_thesis_case(const GenTempDir& t, const std::string& name, std::vector<std::string>& rows) {
+  const fs::path spec = case_spec(name);
   ASSERT_TRUE(fs::exists(spec)) << spec << " is missing";
-  GenTempDir t;
-  const fs::path out = t.w() / "case1";
+  const fs::path out = t.w() / spec.stem();
   ExpectOk(run_ps(t, gen({"--spec", spec.string(), "--count", "200", "--quiet"}, out)));
   json m = read_json(out / "manifest.json");
   EXPECT_EQ(m["count"], 200);
   EXPECT_EQ(m["classes"]["positive"], m["classes"]["negative"]) << m.dump(1);
-  const std::vector<std::string> sc = csv_rows(read_all(out / "scenarios.csv"));
+  rows = csv_rows(read_all(out / "scenarios.csv"));
+}
+
+TEST(GenerateThesisCases, Case1GunIsBalanced) {
+  GenTempDir t;
+  std::vector<std::string> sc;
+  ASSERT_NO_FATAL_FAILURE(generate_thesis_case(t, "case1-gun.toml", sc));
   ASSERT_EQ(sc.size(), 200u);
   for (const std::string& row : sc) {
     const bool gun = has(row, ",gun");
@@ -1358,17 +1353,11 @@ TEST(GenerateThesisCases, Case1GunIsBalanced) {
 }
 
 TEST(GenerateThesisCases, Case2RodAndPlateUsesItsPoolAndIsBalanced) {
-  const fs::path spec = case_spec("case2-rod-plate.toml");
-  ASSERT_TRUE(fs::exists(spec)) << spec << " is missing";
   GenTempDir t;
-  const fs::path out = t.w() / "case2";
-  ExpectOk(run_ps(t, gen({"--spec", spec.string(), "--count", "200", "--quiet"}, out)));
-  json m = read_json(out / "manifest.json");
-  EXPECT_EQ(m["count"], 200);
-  EXPECT_EQ(m["classes"]["positive"], m["classes"]["negative"]) << m.dump(1);
+  std::vector<std::string> sc;
+  ASSERT_NO_FATAL_FAILURE(generate_thesis_case(t, "case2-rod-plate.toml", sc));
   const std::set<std::string> allowed{"metal-plate", "iron-rod:h",    "iron-rod:v",   "iron-rod", "compact-disk",
                                       "cement-tile", "ceramic-plate", "mobile-phone", "none"};
-  const std::vector<std::string> sc = csv_rows(read_all(out / "scenarios.csv"));
   ASSERT_EQ(sc.size(), 200u);
   int positives = 0;
   for (const std::string& row : sc) {

@@ -135,7 +135,8 @@ inline std::string quoted(const std::string& a) {
   return q + "'";
 }
 
-inline std::string describe(const Result& r) {
+// What a run did, for a failed expectation; `limit`: the most of each stream shown.
+inline std::string describe(const Result& r, size_t limit = std::string::npos) {
   std::ostringstream s;
   s << "command: " << r.command << "\n";
   if (r.timed_out)
@@ -144,7 +145,7 @@ inline std::string describe(const Result& r) {
     s << "killed by signal " << r.signal << "\n";
   else
     s << "exit status " << r.status << "\n";
-  s << "--- stdout ---\n" << r.out << "--- stderr ---\n" << r.err << "---";
+  s << "--- stdout ---\n" << r.out.substr(0, limit) << "--- stderr ---\n" << r.err.substr(0, limit) << "---";
   return s.str();
 }
 
