@@ -28,14 +28,7 @@ ModelSettings physics() {
 }
 
 std::vector<int> zones(Backend& b, const std::vector<std::string>& objects, const ModelSettings& m = physics()) {
-  const Scenario s = parse_object_list(catalogue(), objects);
-  Plan plan;
-  plan.images = 0;
-  plan.features = false;
-  plan.model = m;
-  BatchOutput out;
-  b.run(test::batch_of({s}), plan, out);
-  return std::vector<int>(out.metal.begin(), out.metal.end());
+  return test::metal_zones(b, parse_object_list(catalogue(), objects), m);
 }
 
 // One zone's signal of an isotropic object of 1 cm^3 on the line between the zone's coils,
@@ -151,13 +144,7 @@ TEST(MetalPhysics, LongObjectsAreDipolesAlongTheirLength) {
   }
 }
 
-class MetalPhysicsBothBackends : public ::testing::TestWithParam<std::string> {
- protected:
-  std::unique_ptr<Backend> backend() {
-    if (GetParam() == "reference") return make_reference_backend(catalogue(), assets());
-    return make_opencl_backend(catalogue(), assets(), test::runtime());
-  }
-};
+class MetalPhysicsBothBackends : public test::BothBackends {};
 
 // Signals of separate objects add: where both push a zone the same way and nothing
 // saturates, the pair's deduction is the sum of each one's (each rounded: within 1).

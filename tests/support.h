@@ -187,4 +187,25 @@ inline SceneBatch batch_of(const std::vector<Scenario>& scenes, uint64_t first_i
   return b;
 }
 
+// Scenario s's metal zones from backend b under model m (no images, no features).
+inline std::vector<int> metal_zones(Backend& b, const Scenario& s, const ModelSettings& m) {
+  Plan plan;
+  plan.images = 0;
+  plan.features = false;
+  plan.model = m;
+  BatchOutput out;
+  b.run(batch_of({s}), plan, out);
+  return std::vector<int>(out.metal.begin(), out.metal.end());
+}
+
+// A suite run once per backend, "reference" or "opencl" (INSTANTIATE_TEST_SUITE_P with both
+// names), over the default catalogue.
+class BothBackends : public ::testing::TestWithParam<std::string> {
+ protected:
+  std::unique_ptr<Backend> backend() {
+    if (GetParam() == "reference") return make_reference_backend(catalogue(), assets());
+    return make_opencl_backend(catalogue(), assets(), runtime());
+  }
+};
+
 }  // namespace portalsim::test
