@@ -25,6 +25,7 @@
 #include "base/error.h"
 #include "run_binary.h"
 
+namespace portalsim::test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -37,15 +38,6 @@ constexpr const char* kEmptyMetal = "200,200,200,200,200,200,200,200,200,200,200
 
 using Args = std::vector<std::string>;
 
-using portalsim::test::describe;
-using portalsim::test::finish;
-using portalsim::test::has;
-using portalsim::test::quoted;
-using portalsim::test::Result;
-using portalsim::test::Running;
-using portalsim::test::slurp;
-using portalsim::test::spit;
-using portalsim::test::TempDir;
 
 Running start(const TempDir& t, const Args& args) { return portalsim::test::start(t.cap(), args); }
 
@@ -209,22 +201,6 @@ void ExpectRejected(const TempDir& t, const Args& args, const std::vector<std::s
 void ExpectRejected(const Args& args, const std::vector<std::string>& needles, bool also_existing = false) {
   TempDir t;
   ExpectRejected(t, args, needles, also_existing);
-}
-
-// 1-based line of the first occurrence of `needle` in `text` (0 when absent).
-int line_of(const std::string& text, const std::string& needle) {
-  const size_t at = text.find(needle);
-  if (at == std::string::npos) return 0;
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
-}
-
-std::string replace_once(std::string text, const std::string& from, const std::string& to) {
-  const size_t at = text.find(from);
-  if (at == std::string::npos) {
-    ADD_FAILURE() << "scenarios/catalogue.toml no longer contains \"" << from << "\"; update the test";
-    return text;
-  }
-  return text.replace(at, from.size(), to);
 }
 
 std::string default_catalogue_text() { return slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "catalogue.toml"); }
@@ -1005,3 +981,4 @@ TEST(CliCatalogueCmd, ImagesIntoAFileIsRejected) {
 }
 
 }  // namespace
+}  // namespace portalsim::test

@@ -20,6 +20,8 @@ namespace {
 
 using test::assets;
 using test::catalogue;
+using test::line_of;
+using test::replace_once;
 
 ModelSettings physics() {
   ModelSettings m;
@@ -294,22 +296,10 @@ std::string catalogue_text() {
   return s.str();
 }
 
-std::string replace_once(std::string text, const std::string& from, const std::string& to) {
-  const size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
-
 // "key = [first," as it stands in the text.
 std::string first_element(const std::string& text, const std::string& key) {
   const size_t at = text.find(key);
   return text.substr(at, text.find(',', at) + 1 - at);
-}
-
-int line_of(const std::string& text, const std::string& needle) {
-  const size_t at = text.find(needle);
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
 }
 
 // Each bad value is rejected naming file, line and field.

@@ -71,6 +71,23 @@ inline Scenario random_scenario(const Catalogue& cat, uint64_t k, int max_object
   return s;
 }
 
+// `text` with the first `from` replaced by `to`; a test failure where it holds none.
+inline std::string replace_once(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  if (at == std::string::npos) {
+    ADD_FAILURE() << "the text no longer contains \"" << from << "\"; update the test";
+    return text;
+  }
+  return text.replace(at, from.size(), to);
+}
+
+// 1-based line of the first occurrence of `needle` in `text` (0 when absent).
+inline int line_of(const std::string& text, const std::string& needle) {
+  const size_t at = text.find(needle);
+  if (at == std::string::npos) return 0;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+}
+
 // Catalogue text `text` with `line` added to subject k's table (0-based), right after its
 // build line; *at gets the added line's number.
 inline std::string with_subject_line(std::string text, int k, const std::string& line, int* at = nullptr) {
