@@ -47,20 +47,7 @@ using GenTempDir = portalsim::test::TempDir;
 
 using portalsim::test::has;
 
-std::vector<std::string> split_on(const std::string& text, char sep) {
-  std::vector<std::string> parts;
-  std::string cur;
-  for (char c : text) {
-    if (c == sep) {
-      parts.push_back(cur);
-      cur.clear();
-    } else {
-      cur += c;
-    }
-  }
-  parts.push_back(cur);
-  return parts;
-}
+const auto& split_on = portalsim::test::split;
 
 std::string describe_run(const RunResult& r) { return portalsim::test::describe(r, 4000); }
 
@@ -82,22 +69,10 @@ RunResult wait_for(const Started& r, int limit_s = 120) { return portalsim::test
 
 RunResult run_ps(const GenTempDir& t, const Args& args) { return wait_for(start_ps(t, args)); }
 
-std::vector<RunResult> run_ps_all(const GenTempDir& t, const std::vector<Args>& commands) {
-  std::vector<Started> running;
-  for (const Args& a : commands) running.push_back(start_ps(t, a));
-  std::vector<RunResult> results;
-  for (const Started& r : running) results.push_back(wait_for(r));
-  return results;
-}
+const auto& run_ps_all = portalsim::test::run_all;
 
 // `portalsim generate ARGS --out OUT`.
-Args gen(const Args& args, const fs::path& out) {
-  Args a{"generate"};
-  a.insert(a.end(), args.begin(), args.end());
-  a.push_back("--out");
-  a.push_back(out.string());
-  return a;
-}
+Args gen(const Args& args, const fs::path& out) { return portalsim::test::with_out("generate", args, out); }
 
 Args plus(Args a, const Args& more) {
   a.insert(a.end(), more.begin(), more.end());
@@ -116,20 +91,9 @@ Args with(Args a, const std::string& name, const std::string& value) {
   return a;
 }
 
-void ExpectOk(const RunResult& r) {
-  EXPECT_FALSE(r.timed_out) << describe_run(r);
-  EXPECT_FALSE(r.signaled) << describe_run(r);
-  EXPECT_TRUE(r.exited && r.status == 0) << describe_run(r);
-  EXPECT_FALSE(has(r.err, "error")) << describe_run(r);
-}
+const auto& ExpectOk = portalsim::test::expect_success;
 
-std::vector<std::string> entries_of(const fs::path& dir) {
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
+const auto& entries_of = portalsim::test::names_in;
 
 // Every regular file under `dir`, hidden ones included, as sorted relative paths.
 std::vector<std::string> files_under(const fs::path& dir) {
@@ -167,71 +131,13 @@ void ExpectSameTree(const fs::path& a, const fs::path& b) {
   EXPECT_EQ(differing, 0) << "files differing between " << a << " and " << b;
 }
 
-std::vector<std::string> stderr_messages(const std::string& err) {
-  std::vector<std::string> lines;
-  for (const std::string& l : split_on(err, '\n'))
-    if (!l.empty() && l != "Run with --help for more information.") lines.push_back(l);
-  return lines;
-}
-
-// A rejected command: non-zero exit, no signal, one stderr message naming every needle, nothing
-// on stdout, and the output folder absent (or still empty when it existed before the run).
-void ExpectRefused(const RunResult& r, const fs::path& out, bool out_existed, const std::vector<std::string>& needles) {
-  SCOPED_TRACE(describe_run(r));
-  if (r.exited && r.status == 0) {
-    ADD_FAILURE() << "portalsim accepted a command it must reject";
-    return;
-  }
-  EXPECT_FALSE(r.timed_out);
-  EXPECT_FALSE(r.signaled) << "portalsim was killed by signal " << r.signal;
-  EXPECT_TRUE(r.exited);
-  EXPECT_NE(r.status, 0);
-  EXPECT_EQ(stderr_messages(r.err).size(), 1u) << "stderr should hold exactly one message";
-  for (const std::string& n : needles) EXPECT_TRUE(has(r.err, n)) << "stderr does not name \"" << n << "\"";
-  EXPECT_EQ(r.out, "") << "nothing should be printed on stdout";
-  std::error_code ec;
-  if (out_existed) {
-    EXPECT_TRUE(fs::is_directory(out, ec)) << out << " existed before and must still be there";
-    EXPECT_TRUE(entries_of(out).empty()) << out
-                                         << " must stay empty, holds: " << testing::PrintToString(entries_of(out));
-  } else if (fs::exists(out, ec)) {
-    EXPECT_TRUE(fs::is_directory(out, ec) && entries_of(out).empty())
-        << out << " did not exist before and must not hold anything after a failed run; holds "
-        << testing::PrintToString(entries_of(out));
-  }
-}
-
 // One generate command that must be refused, with OUT absent and (also_existing) OUT empty.
-struct Refusal {
-  Args args;
-  std::vector<std::string> needles;
-  bool also_existing = false;
-};
+using Refusal = portalsim::test::Rejection;
+const auto& ExpectRefused = portalsim::test::expect_clean_failure;
+const auto& stderr_messages = portalsim::test::message_lines;
 
 void ExpectAllRefused(const GenTempDir& t, const std::vector<Refusal>& cases) {
-  static int counter = 0;
-  struct Check {
-    const Refusal* c;
-    fs::path out;
-    bool existed;
-  };
-  std::vector<Check> checks;
-  for (const Refusal& c : cases) {
-    const int n = ++counter;
-    checks.push_back({&c, t.w() / (std::string("out-fresh-") + std::to_string(n)), false});
-    if (c.also_existing) {
-      checks.push_back({&c, t.w() / (std::string("out-existing-") + std::to_string(n)), true});
-      fs::create_directory(checks.back().out);
-    }
-  }
-  std::vector<Args> commands;
-  for (const Check& k : checks) commands.push_back(gen(k.c->args, k.out));
-  const std::vector<RunResult> r = run_ps_all(t, commands);
-  for (size_t i = 0; i < checks.size(); ++i) {
-    SCOPED_TRACE(checks[i].existed ? "output folder existed (empty) before the run"
-                                   : "output folder absent before the run");
-    ExpectRefused(r[i], checks[i].out, checks[i].existed, checks[i].c->needles);
-  }
+  portalsim::test::expect_all_rejected(t, "generate", cases);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1006,13 +912,30 @@ std::string at_line(const fs::path& file, int line) {
   return file.string() + std::string(":") + std::to_string(line) + ":";
 }
 
+// A spec file that must be refused: its text, the line the message names, and what else it
+// names.
+struct SpecCase {
+  std::string text;
+  int line;
+  std::vector<std::string> more;
+};
+
+// Each spec written into t as specN.toml, as a generate --spec command that must be refused
+// naming its file and line; the first also with OUT existing (empty) where `first_existing`.
+std::vector<Refusal> spec_refusals(const GenTempDir& t, const std::vector<SpecCase>& specs, bool first_existing) {
+  std::vector<Refusal> cases;
+  for (size_t i = 0; i < specs.size(); ++i) {
+    const fs::path p = t.w() / (std::string("spec") + std::to_string(i) + ".toml");
+    write_all(p, specs[i].text);
+    std::vector<std::string> needles{at_line(p, specs[i].line)};
+    needles.insert(needles.end(), specs[i].more.begin(), specs[i].more.end());
+    cases.push_back({{"--spec", p.string(), "--quiet"}, needles, first_existing && i == 0});
+  }
+  return cases;
+}
+
 TEST(GenerateBadSpec, SpecFileErrorsNameFileLineAndKey) {
   GenTempDir t;
-  struct SpecCase {
-    std::string text;
-    int line;
-    std::vector<std::string> more;
-  };
   const std::vector<SpecCase> specs{
       {"count = 10\nseed = [1\n", 2, {"syntax"}},
       {"count = 10\ncolour = \"red\"\n", 2, {"colour", "unknown key"}},
@@ -1021,14 +944,7 @@ TEST(GenerateBadSpec, SpecFileErrorsNameFileLineAndKey) {
       {"count = 10\n\npixel_noise = nan\n", 3, {"pixel_noise"}},
       {"count = 10\nobjects = \"5..2\"\n", 2, {"objects", "5..2"}},
   };
-  std::vector<Refusal> cases;
-  for (size_t i = 0; i < specs.size(); ++i) {
-    const fs::path p = t.w() / (std::string("spec") + std::to_string(i) + ".toml");
-    write_all(p, specs[i].text);
-    std::vector<std::string> needles{at_line(p, specs[i].line)};
-    needles.insert(needles.end(), specs[i].more.begin(), specs[i].more.end());
-    cases.push_back({{"--spec", p.string(), "--quiet"}, needles, i == 0});
-  }
+  std::vector<Refusal> cases = spec_refusals(t, specs, true);
   cases.push_back({{"--spec", (t.w() / "missing.toml").string()}, {(t.w() / "missing.toml").string()}});
   ExpectAllRefused(t, cases);
 }
@@ -1061,11 +977,6 @@ TEST(GenerateBadSpec, OptionErrorsNameTheOption) {
 // subjects) must still point at the spec file's line, as the other spec errors do.
 TEST(GenerateBadSpec, SpecValuesCheckedLaterStillNameFileAndLine) {
   GenTempDir t;
-  struct SpecCase {
-    std::string text;
-    int line;
-    std::vector<std::string> more;
-  };
   const std::vector<SpecCase> specs{
       {"count = 10\npool = [\"gun\", \"laser\"]\n", 2, {"pool", "laser"}},
       {"count = 10\nwhat = \"pictures\"\n", 2, {"what", "pictures"}},
@@ -1074,15 +985,7 @@ TEST(GenerateBadSpec, SpecValuesCheckedLaterStillNameFileAndLine) {
       {"count = 10\nwhat = \"images\"\npng_level = 12\n", 3, {"png_level", "12"}},
       {"count = 10\npng_level = 3\n", 2, {"png_level", "image folders"}},
   };
-  std::vector<Refusal> cases;
-  for (size_t i = 0; i < specs.size(); ++i) {
-    const fs::path p = t.w() / (std::string("spec") + std::to_string(i) + ".toml");
-    write_all(p, specs[i].text);
-    std::vector<std::string> needles{at_line(p, specs[i].line)};
-    needles.insert(needles.end(), specs[i].more.begin(), specs[i].more.end());
-    cases.push_back({{"--spec", p.string(), "--quiet"}, needles});
-  }
-  ExpectAllRefused(t, cases);
+  ExpectAllRefused(t, spec_refusals(t, specs, false));
 }
 
 const char* kScenarioHeader =
