@@ -912,31 +912,32 @@ std::string at_line(const fs::path& file, int line) {
   return file.string() + std::string(":") + std::to_string(line) + ":";
 }
 
-// A spec file that must be refused: its text, the line the message names, and what else it
-// names.
-struct SpecCase {
+// A file that must be refused: its text, the line the message names, and what else it names.
+struct FileCase {
   std::string text;
   int line;
   std::vector<std::string> more;
 };
 
-// Each spec written into t as specN.toml, as a generate --spec command that must be refused
-// naming its file and line; the first also with OUT existing (empty) where `first_existing`.
-std::vector<Refusal> spec_refusals(const GenTempDir& t, const std::vector<SpecCase>& specs, bool first_existing) {
+// Each case written into t as NAME<i>.EXT and given to generate as `flag`: a command that must
+// be refused naming its file and line; the first also with OUT existing (empty) where
+// `first_existing`.
+std::vector<Refusal> file_refusals(const GenTempDir& t, const std::string& flag, const std::string& name,
+                                   const std::string& ext, const std::vector<FileCase>& files, bool first_existing) {
   std::vector<Refusal> cases;
-  for (size_t i = 0; i < specs.size(); ++i) {
-    const fs::path p = t.w() / (std::string("spec") + std::to_string(i) + ".toml");
-    write_all(p, specs[i].text);
-    std::vector<std::string> needles{at_line(p, specs[i].line)};
-    needles.insert(needles.end(), specs[i].more.begin(), specs[i].more.end());
-    cases.push_back({{"--spec", p.string(), "--quiet"}, needles, first_existing && i == 0});
+  for (size_t i = 0; i < files.size(); ++i) {
+    const fs::path p = t.w() / (name + std::to_string(i) + ext);
+    write_all(p, files[i].text);
+    std::vector<std::string> needles{at_line(p, files[i].line)};
+    needles.insert(needles.end(), files[i].more.begin(), files[i].more.end());
+    cases.push_back({{flag, p.string(), "--quiet"}, needles, first_existing && i == 0});
   }
   return cases;
 }
 
 TEST(GenerateBadSpec, SpecFileErrorsNameFileLineAndKey) {
   GenTempDir t;
-  const std::vector<SpecCase> specs{
+  const std::vector<FileCase> specs{
       {"count = 10\nseed = [1\n", 2, {"syntax"}},
       {"count = 10\ncolour = \"red\"\n", 2, {"colour", "unknown key"}},
       {"seed = 1\ncount = -5\n", 2, {"count", "-5"}},
@@ -944,7 +945,7 @@ TEST(GenerateBadSpec, SpecFileErrorsNameFileLineAndKey) {
       {"count = 10\n\npixel_noise = nan\n", 3, {"pixel_noise"}},
       {"count = 10\nobjects = \"5..2\"\n", 2, {"objects", "5..2"}},
   };
-  std::vector<Refusal> cases = spec_refusals(t, specs, true);
+  std::vector<Refusal> cases = file_refusals(t, "--spec", "spec", ".toml", specs, true);
   cases.push_back({{"--spec", (t.w() / "missing.toml").string()}, {(t.w() / "missing.toml").string()}});
   ExpectAllRefused(t, cases);
 }
@@ -977,7 +978,7 @@ TEST(GenerateBadSpec, OptionErrorsNameTheOption) {
 // subjects) must still point at the spec file's line, as the other spec errors do.
 TEST(GenerateBadSpec, SpecValuesCheckedLaterStillNameFileAndLine) {
   GenTempDir t;
-  const std::vector<SpecCase> specs{
+  const std::vector<FileCase> specs{
       {"count = 10\npool = [\"gun\", \"laser\"]\n", 2, {"pool", "laser"}},
       {"count = 10\nwhat = \"pictures\"\n", 2, {"what", "pictures"}},
       {"count = 10\nformat = \"xls\"\n", 2, {"format", "xls"}},
@@ -985,7 +986,7 @@ TEST(GenerateBadSpec, SpecValuesCheckedLaterStillNameFileAndLine) {
       {"count = 10\nwhat = \"images\"\npng_level = 12\n", 3, {"png_level", "12"}},
       {"count = 10\npng_level = 3\n", 2, {"png_level", "image folders"}},
   };
-  ExpectAllRefused(t, spec_refusals(t, specs, false));
+  ExpectAllRefused(t, file_refusals(t, "--spec", "spec", ".toml", specs, false));
 }
 
 const char* kScenarioHeader =
@@ -995,12 +996,7 @@ const char* kGunRow = "1,gun,none,none,none,none,none,none,none,none,none,none,n
 
 TEST(GenerateBadSpec, ScenarioFileErrorsNameFileLineAndColumn) {
   GenTempDir t;
-  struct ListCase {
-    std::string text;
-    int line;
-    std::vector<std::string> more;
-  };
-  const std::vector<ListCase> lists{
+  const std::vector<FileCase> lists{
       {std::string(kScenarioHeader) + kGunRow +
            "2,none,laser,none,none,none,none,none,none,none,none,none,none,none,no\n",
        3,
@@ -1018,15 +1014,7 @@ TEST(GenerateBadSpec, ScenarioFileErrorsNameFileLineAndColumn) {
        3,
        {"subject", "9"}},
   };
-  std::vector<Refusal> cases;
-  for (size_t i = 0; i < lists.size(); ++i) {
-    const fs::path p = t.w() / (std::string("list") + std::to_string(i) + ".csv");
-    write_all(p, lists[i].text);
-    std::vector<std::string> needles{at_line(p, lists[i].line)};
-    needles.insert(needles.end(), lists[i].more.begin(), lists[i].more.end());
-    cases.push_back({{"--scenarios", p.string(), "--quiet"}, needles, i == 0});
-  }
-  ExpectAllRefused(t, cases);
+  ExpectAllRefused(t, file_refusals(t, "--scenarios", "list", ".csv", lists, true));
 
   // The well-formed list runs, one row per scenario, the labels as given.
   const fs::path good = t.w() / "good.csv";
