@@ -617,76 +617,49 @@ TEST(CliCatalogueFile, NonexistentFile) {
   ExpectRejected({"--catalogue", "/nonexistent.toml", "gun"}, {"/nonexistent.toml", "catalogue"}, true);
 }
 
-TEST(CliCatalogueFile, SyntaxError) {
+// The default catalogue with `from` replaced by `to`, given to simulate: it must be rejected
+// naming the file and the line of `to`, and `more`.
+void ExpectEditRejected(const std::string& from, const std::string& to, std::vector<std::string> more,
+                        bool also_existing = false) {
   TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "alpha = 0.9", "alpha = = 0.9");
+  const std::string text = replace_once(default_catalogue_text(), from, to);
   const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"}, {at_line(cat, line_of(text, "alpha = = 0.9"))}, true);
+  more.insert(more.begin(), at_line(cat, line_of(text, to)));
+  ExpectRejected(t, {"--catalogue", cat.string(), "gun"}, more, also_existing);
 }
 
+TEST(CliCatalogueFile, SyntaxError) { ExpectEditRejected("alpha = 0.9", "alpha = = 0.9", {}, true); }
+
 TEST(CliCatalogueFile, RegionRectangleWithThreeValues) {
-  TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "upper = [117, 40, 34, 70]", "upper = [1, 2, 3]");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "upper = [1, 2, 3]")), "regions[3].rects.upper", "3"});
+  ExpectEditRejected("upper = [117, 40, 34, 70]", "upper = [1, 2, 3]", {"regions[3].rects.upper", "3"});
 }
 
 TEST(CliCatalogueFile, RegionRectangleOutsideTheView) {
-  TempDir t;
-  const std::string text =
-      replace_once(default_catalogue_text(), "upper = [117, 40, 34, 70]", "upper = [180, 40, 34, 70]");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "upper = [180, 40, 34, 70]")), "regions[3].rects.upper", "outside"});
+  ExpectEditRejected("upper = [117, 40, 34, 70]", "upper = [180, 40, 34, 70]", {"regions[3].rects.upper", "outside"});
 }
 
-TEST(CliCatalogueFile, AlphaNotANumber) {
-  TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "alpha = 0.9", "alpha = nan");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "alpha = nan")), "images.alpha", "NaN"});
-}
+TEST(CliCatalogueFile, AlphaNotANumber) { ExpectEditRejected("alpha = 0.9", "alpha = nan", {"images.alpha", "NaN"}); }
 
-TEST(CliCatalogueFile, AlphaOutOfRange) {
-  TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "alpha = 0.9", "alpha = 1.5");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "alpha = 1.5")), "images.alpha", "1.5"});
-}
+TEST(CliCatalogueFile, AlphaOutOfRange) { ExpectEditRejected("alpha = 0.9", "alpha = 1.5", {"images.alpha", "1.5"}); }
+
+// The first subject's base zones in the default catalogue.
+const char* const kZones19 =
+    "base_zones = [200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200]";
 
 TEST(CliCatalogueFile, BaseZonesWithEighteenValues) {
-  TempDir t;
-  const std::string zones19 =
-      "base_zones = [200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200]";
   const std::string zones18 =
       "base_zones = [200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200]";
-  const std::string text = replace_once(default_catalogue_text(), zones19, zones18);
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, zones18)), "subjects[1].base_zones", "18"});
+  ExpectEditRejected(kZones19, zones18, {"subjects[1].base_zones", "18"});
 }
 
 TEST(CliCatalogueFile, BaseZoneValueAbove200) {
-  TempDir t;
-  const std::string zones19 =
-      "base_zones = [200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200]";
   const std::string bad =
       "base_zones = [200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 201, 200]";
-  const std::string text = replace_once(default_catalogue_text(), zones19, bad);
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, bad)), "subjects[1].base_zones", "201"});
+  ExpectEditRejected(kZones19, bad, {"subjects[1].base_zones", "201"});
 }
 
 TEST(CliCatalogueFile, UnknownMetalCategory) {
-  TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "metal = \"heavy\"", "metal = \"plutonium\"");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "metal = \"plutonium\"")), "objects[1].metal", "plutonium"});
+  ExpectEditRejected("metal = \"heavy\"", "metal = \"plutonium\"", {"objects[1].metal", "plutonium"});
 }
 
 TEST(CliCatalogueFile, DuplicateObjectName) {
@@ -714,60 +687,44 @@ TEST(CliCatalogueFile, MissingMetalTable) {
   ExpectRejected(t, {"--catalogue", cat.string(), "gun"}, {cat.string() + ":", "metal", "missing"});
 }
 
+// `line` added after the object's `name_line` in the default catalogue, the image `file` in
+// t's workspace: simulate must be rejected naming the catalogue's line, `field` and the image.
+void ExpectImageRejected(const TempDir& t, const std::string& name_line, const std::string& line,
+                         const std::string& field, const std::string& file) {
+  const std::string text = replace_once(default_catalogue_text(), name_line + "\n", name_line + "\n" + line + "\n");
+  const fs::path cat = write_catalogue(t, text);
+  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
+                 {at_line(cat, line_of(text, line)), field, (t.w() / file).string()}, true);
+}
+
 // The first object (gun) has two drawings; `mmw` names the image for every drawing it does
 // not give an mmw_h / mmw_v for. A file that cannot be used must be reported, not ignored.
 TEST(CliCatalogueImage, MissingImageOnFirstObject) {
   TempDir t;
-  const std::string text =
-      replace_once(default_catalogue_text(), "name = \"gun\"\n", "name = \"gun\"\nmmw = \"missing.png\"\n");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(
-      t, {"--catalogue", cat.string(), "gun"},
-      {at_line(cat, line_of(text, "mmw = \"missing.png\"")), "objects[1].mmw", (t.w() / "missing.png").string()}, true);
+  ExpectImageRejected(t, "name = \"gun\"", "mmw = \"missing.png\"", "objects[1].mmw", "missing.png");
 }
 
 TEST(CliCatalogueImage, TruncatedPngOnFirstObject) {
   TempDir t;
   spit(t.w() / "corrupt.png", truncated_png(t));
-  const std::string text =
-      replace_once(default_catalogue_text(), "name = \"gun\"\n", "name = \"gun\"\nmmw = \"corrupt.png\"\n");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(
-      t, {"--catalogue", cat.string(), "gun"},
-      {at_line(cat, line_of(text, "mmw = \"corrupt.png\"")), "objects[1].mmw", (t.w() / "corrupt.png").string()}, true);
+  ExpectImageRejected(t, "name = \"gun\"", "mmw = \"corrupt.png\"", "objects[1].mmw", "corrupt.png");
 }
 
 TEST(CliCatalogueImage, MissingVariantImage) {
   TempDir t;
-  const std::string text =
-      replace_once(default_catalogue_text(), "name = \"gun\"\n", "name = \"gun\"\nmmw_h = \"missing.png\"\n");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(
-      t, {"--catalogue", cat.string(), "gun"},
-      {at_line(cat, line_of(text, "mmw_h = \"missing.png\"")), "objects[1].mmw_h", (t.w() / "missing.png").string()},
-      true);
+  ExpectImageRejected(t, "name = \"gun\"", "mmw_h = \"missing.png\"", "objects[1].mmw_h", "missing.png");
 }
 
 TEST(CliCatalogueImage, GarbageImageOnSingleDrawingObject) {
   TempDir t;
   spit(t.w() / "corrupt.png", "this is not an image, only some garbage bytes \x01\x02\x03\xff\n");
-  const std::string text = replace_once(default_catalogue_text(), "name = \"iron-handle\"\n",
-                                        "name = \"iron-handle\"\nmmw = \"corrupt.png\"\n");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(
-      t, {"--catalogue", cat.string(), "gun"},
-      {at_line(cat, line_of(text, "mmw = \"corrupt.png\"")), "objects[2].mmw", (t.w() / "corrupt.png").string()}, true);
+  ExpectImageRejected(t, "name = \"iron-handle\"", "mmw = \"corrupt.png\"", "objects[2].mmw", "corrupt.png");
 }
 
 TEST(CliCatalogueImage, TruncatedPngOnSingleDrawingObject) {
   TempDir t;
   spit(t.w() / "corrupt.png", truncated_png(t));
-  const std::string text = replace_once(default_catalogue_text(), "name = \"iron-handle\"\n",
-                                        "name = \"iron-handle\"\nmmw = \"corrupt.png\"\n");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(
-      t, {"--catalogue", cat.string(), "gun"},
-      {at_line(cat, line_of(text, "mmw = \"corrupt.png\"")), "objects[2].mmw", (t.w() / "corrupt.png").string()}, true);
+  ExpectImageRejected(t, "name = \"iron-handle\"", "mmw = \"corrupt.png\"", "objects[2].mmw", "corrupt.png");
 }
 
 // ---------------------------------------------------------------------------------------------
