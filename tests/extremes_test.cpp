@@ -234,7 +234,6 @@ World& default_world() {
   return *w;
 }
 
-
 // Every region holding an object: variants rotate from `first`.
 Scenario crowded(const Catalogue& c, int subject, size_t first = 0) {
   Scenario s;
@@ -622,7 +621,6 @@ void check_opaque(const Image& sprite, const Rect& rect, const uint8_t* img, con
 
 // ---------------------------------------------------------------------------------------------
 // Running the binary (as tests/cli_test.cpp does).
-
 
 struct Rejection {
   std::vector<std::string> args;  // without --out
