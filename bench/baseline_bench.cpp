@@ -17,6 +17,29 @@ using Clock = std::chrono::steady_clock;
 
 double seconds(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+// Each iteration runs `kernel` (its time is the iteration's) then `loop` on n scenarios;
+// the counters give both rates and their ratio.
+template <class Kernel, class Loop>
+void time_against_baseline(benchmark::State& state, size_t n, Kernel kernel, Loop loop) {
+  double t_kernel = 0, t_loop = 0;
+  for (auto _ : state) {
+    auto t0 = Clock::now();
+    kernel();
+    const double k = seconds(t0);
+    t0 = Clock::now();
+    loop();
+    const double b = seconds(t0);
+    state.SetIterationTime(k);
+    t_kernel += k;
+    t_loop += b;
+  }
+  const double scenarios = static_cast<double>(state.iterations() * n);
+  state.counters["kernel_per_s"] = scenarios / t_kernel;
+  state.counters["baseline_per_s"] = scenarios / t_loop;
+  state.counters["kernel_vs_baseline"] = t_loop / t_kernel;
+  state.SetItemsProcessed(static_cast<int64_t>(scenarios));
+}
+
 // Arg: per-pixel noise sigma (0 = images, 2 = noisy images, as in issue 14's table).
 void BM_ImagesVsBaseline(benchmark::State& state) {
   auto cl = make_opencl_backend(fx().cat, fx().assets, fx().rt);
@@ -27,24 +50,12 @@ void BM_ImagesVsBaseline(benchmark::State& state) {
   cl->run(batch, plan, kernel);
   prepare_output(loop, fx().cat, plan, n);
   baseline::render_images(fx().cat, fx().assets, batch, plan.model, loop);
-  double t_kernel = 0, t_loop = 0;
-  for (auto _ : state) {
-    auto t0 = Clock::now();
-    cl->run(batch, plan, kernel);
-    const double k = seconds(t0);
-    t0 = Clock::now();
-    baseline::render_images(fx().cat, fx().assets, batch, plan.model, loop);
-    const double b = seconds(t0);
-    state.SetIterationTime(k);
-    t_kernel += k;
-    t_loop += b;
-    benchmark::DoNotOptimize(loop.views.data());
-  }
-  const double scenarios = static_cast<double>(state.iterations() * n);
-  state.counters["kernel_per_s"] = scenarios / t_kernel;
-  state.counters["baseline_per_s"] = scenarios / t_loop;
-  state.counters["kernel_vs_baseline"] = t_loop / t_kernel;
-  state.SetItemsProcessed(static_cast<int64_t>(scenarios));
+  time_against_baseline(
+      state, n, [&] { cl->run(batch, plan, kernel); },
+      [&] {
+        baseline::render_images(fx().cat, fx().assets, batch, plan.model, loop);
+        benchmark::DoNotOptimize(loop.views.data());
+      });
   state.SetLabel(state.range(0) ? "noisy images" : "images");
 }
 BENCHMARK(BM_ImagesVsBaseline)->Arg(0)->Arg(2)->Unit(benchmark::kMillisecond)->UseManualTime();
@@ -70,24 +81,12 @@ void BM_FeaturesVsBaseline(benchmark::State& state) {
   FeaturesPair fp;
   auto& [cl, plan, batch, kernel, loop, features] = fp;
   const size_t n = FeaturesPair::n;
-  double t_kernel = 0, t_loop = 0;
-  for (auto _ : state) {
-    auto t0 = Clock::now();
-    cl->run(batch, plan, kernel);
-    const double k = seconds(t0);
-    t0 = Clock::now();
-    features.run(batch, loop);
-    const double b = seconds(t0);
-    state.SetIterationTime(k);
-    t_kernel += k;
-    t_loop += b;
-    benchmark::DoNotOptimize(loop.features.data());
-  }
-  const double scenarios = static_cast<double>(state.iterations() * n);
-  state.counters["kernel_per_s"] = scenarios / t_kernel;
-  state.counters["baseline_per_s"] = scenarios / t_loop;
-  state.counters["kernel_vs_baseline"] = t_loop / t_kernel;
-  state.SetItemsProcessed(static_cast<int64_t>(scenarios));
+  time_against_baseline(
+      state, n, [&] { cl->run(batch, plan, kernel); },
+      [&] {
+        features.run(batch, loop);
+        benchmark::DoNotOptimize(loop.features.data());
+      });
 }
 BENCHMARK(BM_FeaturesVsBaseline)->Unit(benchmark::kMillisecond)->UseManualTime();
 

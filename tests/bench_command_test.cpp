@@ -14,18 +14,12 @@
 #include "run_binary.h"
 #include "speed/availability.h"
 
+namespace portalsim::test {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using portalsim::OpenCLDeviceInfo;
-using portalsim::speed::Measure;
-using portalsim::test::describe;
-using portalsim::test::finish;
-using portalsim::test::has;
-using portalsim::test::Result;
-using portalsim::test::start;
-using portalsim::test::TempDir;
+using speed::Measure;
 
 bool positive(const json& v) { return v.is_number() && std::isfinite(v.get<double>()) && v.get<double>() > 0; }
 
@@ -149,3 +143,4 @@ TEST(BenchAvailability, WithFp64EverythingButThePhysicsLoopRuns) {
 }
 
 }  // namespace
+}  // namespace portalsim::test

@@ -25,6 +25,7 @@
 #include "base/error.h"
 #include "run_binary.h"
 
+namespace portalsim::test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -37,59 +38,12 @@ constexpr const char* kEmptyMetal = "200,200,200,200,200,200,200,200,200,200,200
 
 using Args = std::vector<std::string>;
 
-using portalsim::test::describe;
-using portalsim::test::finish;
-using portalsim::test::has;
-using portalsim::test::quoted;
-using portalsim::test::Result;
-using portalsim::test::Running;
-using portalsim::test::slurp;
-using portalsim::test::spit;
-using portalsim::test::TempDir;
-
 Running start(const TempDir& t, const Args& args) { return portalsim::test::start(t.cap(), args); }
 
 Result run(const TempDir& t, const Args& args) { return finish(start(t, args)); }
 
-// Runs several commands at once (they must write to different folders).
-std::vector<Result> run_all(const TempDir& t, const std::vector<Args>& commands) {
-  std::vector<Running> running;
-  for (const Args& a : commands) running.push_back(start(t, a));
-  std::vector<Result> results;
-  for (const Running& r : running) results.push_back(finish(r));
-  return results;
-}
-
-Args simulate(Args objects_and_options, const fs::path& out) {
-  Args a{"simulate"};
-  a.insert(a.end(), objects_and_options.begin(), objects_and_options.end());
-  a.push_back("--out");
-  a.push_back(out.string());
-  return a;
-}
-
-// Every name in a folder, hidden ones included, sorted.
-std::vector<std::string> names_in(const fs::path& dir) {
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
-std::vector<std::string> split(const std::string& text, char sep) {
-  std::vector<std::string> parts;
-  std::string cur;
-  for (char c : text) {
-    if (c == sep) {
-      parts.push_back(cur);
-      cur.clear();
-    } else {
-      cur += c;
-    }
-  }
-  parts.push_back(cur);
-  return parts;
+Args simulate(const Args& objects_and_options, const fs::path& out) {
+  return with_out("simulate", objects_and_options, out);
 }
 
 struct ImageShape {
@@ -118,82 +72,11 @@ ImageShape shape_of(const fs::path& p) {
   return s;
 }
 
-void ExpectSuccess(const Result& r) {
-  EXPECT_FALSE(r.timed_out) << describe(r);
-  EXPECT_FALSE(r.signaled) << describe(r);
-  EXPECT_TRUE(r.exited && r.status == 0) << describe(r);
-  EXPECT_FALSE(has(r.err, "error")) << describe(r);
-}
-
-// The lines of stderr that carry a message (CLI11's "Run with --help" hint is not one).
-std::vector<std::string> message_lines(const std::string& err) {
-  std::vector<std::string> lines;
-  for (const std::string& l : split(err, '\n'))
-    if (!l.empty() && l != "Run with --help for more information.") lines.push_back(l);
-  return lines;
-}
-
-// A rejected command: non-zero exit, no signal, one stderr message naming every needle, nothing
-// on stdout, and the output folder absent (or still empty when it existed before the run).
-void ExpectCleanFailure(const Result& r, const fs::path& out, bool out_existed,
-                        const std::vector<std::string>& needles) {
-  if (r.exited && r.status == 0) {
-    ADD_FAILURE() << "portalsim accepted a command it must reject\n" << describe(r);
-    std::error_code ec;
-    if (fs::exists(out, ec) && !out_existed) ADD_FAILURE() << out << " was created";
-    return;
-  }
-  SCOPED_TRACE(describe(r));
-  EXPECT_FALSE(r.timed_out);
-  EXPECT_FALSE(r.signaled) << "portalsim was killed by signal " << r.signal << " (" << strsignal(r.signal) << ")";
-  EXPECT_TRUE(r.exited);
-  EXPECT_NE(r.status, 0) << "a rejected command must exit non-zero";
-  EXPECT_EQ(message_lines(r.err).size(), 1u) << "stderr should hold exactly one message";
-  for (const std::string& n : needles) EXPECT_TRUE(has(r.err, n)) << "stderr does not name \"" << n << "\"";
-  EXPECT_EQ(r.out, "") << "nothing should be printed on stdout";
-  std::error_code ec;
-  if (out_existed) {
-    EXPECT_TRUE(fs::is_directory(out, ec)) << out << " existed before the run and must still be there";
-    EXPECT_TRUE(names_in(out).empty()) << out << " must stay empty, holds: " << testing::PrintToString(names_in(out));
-  } else if (fs::exists(out, ec)) {
-    EXPECT_TRUE(fs::is_directory(out, ec) && names_in(out).empty())
-        << out << " did not exist before and must not hold anything after a failed run";
-  }
-}
-
-// One command that must be rejected: `portalsim simulate ARGS --out OUT` with OUT absent, and
-// (also_existing) once more with OUT an empty folder made beforehand.
-struct Rejection {
-  Args args;
-  std::vector<std::string> needles;
-  bool also_existing = false;
-};
+const auto& ExpectSuccess = expect_success;
 
 // Runs every case at once; each must be rejected cleanly with a message naming its needles.
 void ExpectAllRejected(const TempDir& t, const std::vector<Rejection>& cases) {
-  static int counter = 0;
-  struct Check {
-    const Rejection* c;
-    fs::path out;
-    bool existed;
-  };
-  std::vector<Check> checks;
-  std::vector<Args> commands;
-  for (const Rejection& c : cases) {
-    const int n = ++counter;
-    checks.push_back({&c, t.w() / (std::string("out-fresh-") + std::to_string(n)), false});
-    if (c.also_existing) {
-      checks.push_back({&c, t.w() / (std::string("out-existing-") + std::to_string(n)), true});
-      fs::create_directory(checks.back().out);
-    }
-  }
-  for (const Check& k : checks) commands.push_back(simulate(k.c->args, k.out));
-  const std::vector<Result> r = run_all(t, commands);
-  for (size_t i = 0; i < checks.size(); ++i) {
-    SCOPED_TRACE(checks[i].existed ? "output folder existed (empty) before the run"
-                                   : "output folder absent before the run");
-    ExpectCleanFailure(r[i], checks[i].out, checks[i].existed, checks[i].c->needles);
-  }
+  expect_all_rejected(t, "simulate", cases);
 }
 
 void ExpectAllRejected(const std::vector<Rejection>& cases) {
@@ -209,22 +92,6 @@ void ExpectRejected(const TempDir& t, const Args& args, const std::vector<std::s
 void ExpectRejected(const Args& args, const std::vector<std::string>& needles, bool also_existing = false) {
   TempDir t;
   ExpectRejected(t, args, needles, also_existing);
-}
-
-// 1-based line of the first occurrence of `needle` in `text` (0 when absent).
-int line_of(const std::string& text, const std::string& needle) {
-  const size_t at = text.find(needle);
-  if (at == std::string::npos) return 0;
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
-}
-
-std::string replace_once(std::string text, const std::string& from, const std::string& to) {
-  const size_t at = text.find(from);
-  if (at == std::string::npos) {
-    ADD_FAILURE() << "scenarios/catalogue.toml no longer contains \"" << from << "\"; update the test";
-    return text;
-  }
-  return text.replace(at, from.size(), to);
 }
 
 std::string default_catalogue_text() { return slurp(fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / "catalogue.toml"); }
@@ -477,7 +344,7 @@ TEST(CliLabels, RuleAllOf) {
   EXPECT_TRUE(has(slurp(t.w() / "rod" / "features.csv"), ",negative\n"));
   EXPECT_EQ(slurp(t.w() / "both" / "threat.txt"), "yes\n") << "rod and plate: the rule holds";
   EXPECT_TRUE(has(slurp(t.w() / "both" / "features.csv"), ",positive\n"));
-  ExpectCleanFailure(r[2], t.w() / "conflict", false, {"--rule", "--threat"});
+  expect_clean_failure(r[2], t.w() / "conflict", false, {"--rule", "--threat"});
 }
 
 TEST(CliLabels, RuleAndThreatTogetherAreRejected) {
@@ -622,7 +489,7 @@ TEST(CliOutput, ParentIsARegularFile) {
   spit(file, "keep me\n");
   const fs::path out = file / "out";
   const Result r = run(t, simulate({"gun"}, out));
-  ExpectCleanFailure(r, out, false, {out.string()});
+  expect_clean_failure(r, out, false, {out.string()});
   EXPECT_EQ(slurp(file), "keep me\n");
   EXPECT_EQ(names_in(t.w()), (std::vector<std::string>{"afile"}));
 }
@@ -674,7 +541,7 @@ TEST(CliOutput, ReadOnlyParent) {
   TempDir t;
   const fs::path out = t.w() / "mnt" / "out";
   const TmpfsRun x = run_on_tmpfs(t, "1m", true, "", simulate({"gun"}, out));
-  ExpectCleanFailure(x.r, out, false, {out.string()});
+  expect_clean_failure(x.r, out, false, {out.string()});
   EXPECT_EQ(x.r.status, 4) << "an output problem exits 4";
   EXPECT_TRUE(x.left.empty()) << testing::PrintToString(x.left);
 }
@@ -683,7 +550,7 @@ TEST(CliOutput, ReadOnlyOutFolder) {
   TempDir t;
   const fs::path out = t.w() / "mnt" / "out";
   const TmpfsRun x = run_on_tmpfs(t, "1m", true, "mkdir " + quoted(out.string()), simulate({"gun"}, out));
-  ExpectCleanFailure(x.r, out, false, {out.string()});  // out lived on the tmpfs, gone now
+  expect_clean_failure(x.r, out, false, {out.string()});  // out lived on the tmpfs, gone now
   EXPECT_EQ(x.r.status, 4) << "an output problem exits 4";
   EXPECT_EQ(x.left, std::vector<std::string>{"./out"});
 }
@@ -694,7 +561,7 @@ TEST(CliOutput, NoFoldersLeftWhenTheDiskFillsAfterCreatingThem) {
   TempDir t;
   const fs::path out = t.w() / "mnt" / "a" / "b" / "out";
   const TmpfsRun x = run_on_tmpfs(t, "16k", false, "", simulate({"gun"}, out));
-  ExpectCleanFailure(x.r, out, false, {});
+  expect_clean_failure(x.r, out, false, {});
   EXPECT_EQ(x.r.status, 4) << "a full disk is an output problem\n" << describe(x.r);
   EXPECT_TRUE(x.left.empty()) << "left behind: " << testing::PrintToString(x.left);
 }
@@ -710,7 +577,7 @@ TEST(CliOutput, NothingLeftWhenTheDiskIsFullFromTheStart) {
     const std::string fill = "(dd if=/dev/zero of=" + quoted((mnt / "fill").string()) + " bs=4k 2>/dev/null; true)";
     const TmpfsRun x = run_on_tmpfs(
         t, "64k", false, out_exists ? "mkdir " + quoted(out.string()) + " && " + fill : fill, simulate({"gun"}, out));
-    ExpectCleanFailure(x.r, out, false, {});
+    expect_clean_failure(x.r, out, false, {});
     EXPECT_EQ(x.r.status, 4) << "a full disk is an output problem\n" << describe(x.r);
     std::vector<std::string> left = x.left;
     std::sort(left.begin(), left.end());
@@ -750,76 +617,49 @@ TEST(CliCatalogueFile, NonexistentFile) {
   ExpectRejected({"--catalogue", "/nonexistent.toml", "gun"}, {"/nonexistent.toml", "catalogue"}, true);
 }
 
-TEST(CliCatalogueFile, SyntaxError) {
+// The default catalogue with `from` replaced by `to`, given to simulate: it must be rejected
+// naming the file and the line of `to`, and `more`.
+void ExpectEditRejected(const std::string& from, const std::string& to, std::vector<std::string> more,
+                        bool also_existing = false) {
   TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "alpha = 0.9", "alpha = = 0.9");
+  const std::string text = replace_once(default_catalogue_text(), from, to);
   const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"}, {at_line(cat, line_of(text, "alpha = = 0.9"))}, true);
+  more.insert(more.begin(), at_line(cat, line_of(text, to)));
+  ExpectRejected(t, {"--catalogue", cat.string(), "gun"}, more, also_existing);
 }
 
+TEST(CliCatalogueFile, SyntaxError) { ExpectEditRejected("alpha = 0.9", "alpha = = 0.9", {}, true); }
+
 TEST(CliCatalogueFile, RegionRectangleWithThreeValues) {
-  TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "upper = [117, 40, 34, 70]", "upper = [1, 2, 3]");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "upper = [1, 2, 3]")), "regions[3].rects.upper", "3"});
+  ExpectEditRejected("upper = [117, 40, 34, 70]", "upper = [1, 2, 3]", {"regions[3].rects.upper", "3"});
 }
 
 TEST(CliCatalogueFile, RegionRectangleOutsideTheView) {
-  TempDir t;
-  const std::string text =
-      replace_once(default_catalogue_text(), "upper = [117, 40, 34, 70]", "upper = [180, 40, 34, 70]");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "upper = [180, 40, 34, 70]")), "regions[3].rects.upper", "outside"});
+  ExpectEditRejected("upper = [117, 40, 34, 70]", "upper = [180, 40, 34, 70]", {"regions[3].rects.upper", "outside"});
 }
 
-TEST(CliCatalogueFile, AlphaNotANumber) {
-  TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "alpha = 0.9", "alpha = nan");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "alpha = nan")), "images.alpha", "NaN"});
-}
+TEST(CliCatalogueFile, AlphaNotANumber) { ExpectEditRejected("alpha = 0.9", "alpha = nan", {"images.alpha", "NaN"}); }
 
-TEST(CliCatalogueFile, AlphaOutOfRange) {
-  TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "alpha = 0.9", "alpha = 1.5");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "alpha = 1.5")), "images.alpha", "1.5"});
-}
+TEST(CliCatalogueFile, AlphaOutOfRange) { ExpectEditRejected("alpha = 0.9", "alpha = 1.5", {"images.alpha", "1.5"}); }
+
+// The first subject's base zones in the default catalogue.
+const char* const kZones19 =
+    "base_zones = [200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200]";
 
 TEST(CliCatalogueFile, BaseZonesWithEighteenValues) {
-  TempDir t;
-  const std::string zones19 =
-      "base_zones = [200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200]";
   const std::string zones18 =
       "base_zones = [200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200]";
-  const std::string text = replace_once(default_catalogue_text(), zones19, zones18);
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, zones18)), "subjects[1].base_zones", "18"});
+  ExpectEditRejected(kZones19, zones18, {"subjects[1].base_zones", "18"});
 }
 
 TEST(CliCatalogueFile, BaseZoneValueAbove200) {
-  TempDir t;
-  const std::string zones19 =
-      "base_zones = [200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200]";
   const std::string bad =
       "base_zones = [200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 200, 201, 200]";
-  const std::string text = replace_once(default_catalogue_text(), zones19, bad);
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, bad)), "subjects[1].base_zones", "201"});
+  ExpectEditRejected(kZones19, bad, {"subjects[1].base_zones", "201"});
 }
 
 TEST(CliCatalogueFile, UnknownMetalCategory) {
-  TempDir t;
-  const std::string text = replace_once(default_catalogue_text(), "metal = \"heavy\"", "metal = \"plutonium\"");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
-                 {at_line(cat, line_of(text, "metal = \"plutonium\"")), "objects[1].metal", "plutonium"});
+  ExpectEditRejected("metal = \"heavy\"", "metal = \"plutonium\"", {"objects[1].metal", "plutonium"});
 }
 
 TEST(CliCatalogueFile, DuplicateObjectName) {
@@ -830,7 +670,7 @@ TEST(CliCatalogueFile, DuplicateObjectName) {
   const int name_line = line_of(text, "name = \"gun\"\naliases = [\"handle\"]");
   ASSERT_GT(name_line, 1);
   const Result r = run(t, simulate({"--catalogue", cat.string(), "gun"}, t.w() / "out"));
-  ExpectCleanFailure(r, t.w() / "out", false, {cat.string() + ":", "objects[2]", "gun"});
+  expect_clean_failure(r, t.w() / "out", false, {cat.string() + ":", "objects[2]", "gun"});
   EXPECT_TRUE(has(r.err, at_line(cat, name_line)) || has(r.err, at_line(cat, name_line - 1)))
       << "the message must give the line of the duplicate entry (" << name_line << " or " << name_line - 1
       << "): " << r.err;
@@ -847,60 +687,44 @@ TEST(CliCatalogueFile, MissingMetalTable) {
   ExpectRejected(t, {"--catalogue", cat.string(), "gun"}, {cat.string() + ":", "metal", "missing"});
 }
 
+// `line` added after the object's `name_line` in the default catalogue, the image `file` in
+// t's workspace: simulate must be rejected naming the catalogue's line, `field` and the image.
+void ExpectImageRejected(const TempDir& t, const std::string& name_line, const std::string& line,
+                         const std::string& field, const std::string& file) {
+  const std::string text = replace_once(default_catalogue_text(), name_line + "\n", name_line + "\n" + line + "\n");
+  const fs::path cat = write_catalogue(t, text);
+  ExpectRejected(t, {"--catalogue", cat.string(), "gun"},
+                 {at_line(cat, line_of(text, line)), field, (t.w() / file).string()}, true);
+}
+
 // The first object (gun) has two drawings; `mmw` names the image for every drawing it does
 // not give an mmw_h / mmw_v for. A file that cannot be used must be reported, not ignored.
 TEST(CliCatalogueImage, MissingImageOnFirstObject) {
   TempDir t;
-  const std::string text =
-      replace_once(default_catalogue_text(), "name = \"gun\"\n", "name = \"gun\"\nmmw = \"missing.png\"\n");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(
-      t, {"--catalogue", cat.string(), "gun"},
-      {at_line(cat, line_of(text, "mmw = \"missing.png\"")), "objects[1].mmw", (t.w() / "missing.png").string()}, true);
+  ExpectImageRejected(t, "name = \"gun\"", "mmw = \"missing.png\"", "objects[1].mmw", "missing.png");
 }
 
 TEST(CliCatalogueImage, TruncatedPngOnFirstObject) {
   TempDir t;
   spit(t.w() / "corrupt.png", truncated_png(t));
-  const std::string text =
-      replace_once(default_catalogue_text(), "name = \"gun\"\n", "name = \"gun\"\nmmw = \"corrupt.png\"\n");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(
-      t, {"--catalogue", cat.string(), "gun"},
-      {at_line(cat, line_of(text, "mmw = \"corrupt.png\"")), "objects[1].mmw", (t.w() / "corrupt.png").string()}, true);
+  ExpectImageRejected(t, "name = \"gun\"", "mmw = \"corrupt.png\"", "objects[1].mmw", "corrupt.png");
 }
 
 TEST(CliCatalogueImage, MissingVariantImage) {
   TempDir t;
-  const std::string text =
-      replace_once(default_catalogue_text(), "name = \"gun\"\n", "name = \"gun\"\nmmw_h = \"missing.png\"\n");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(
-      t, {"--catalogue", cat.string(), "gun"},
-      {at_line(cat, line_of(text, "mmw_h = \"missing.png\"")), "objects[1].mmw_h", (t.w() / "missing.png").string()},
-      true);
+  ExpectImageRejected(t, "name = \"gun\"", "mmw_h = \"missing.png\"", "objects[1].mmw_h", "missing.png");
 }
 
 TEST(CliCatalogueImage, GarbageImageOnSingleDrawingObject) {
   TempDir t;
   spit(t.w() / "corrupt.png", "this is not an image, only some garbage bytes \x01\x02\x03\xff\n");
-  const std::string text = replace_once(default_catalogue_text(), "name = \"iron-handle\"\n",
-                                        "name = \"iron-handle\"\nmmw = \"corrupt.png\"\n");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(
-      t, {"--catalogue", cat.string(), "gun"},
-      {at_line(cat, line_of(text, "mmw = \"corrupt.png\"")), "objects[2].mmw", (t.w() / "corrupt.png").string()}, true);
+  ExpectImageRejected(t, "name = \"iron-handle\"", "mmw = \"corrupt.png\"", "objects[2].mmw", "corrupt.png");
 }
 
 TEST(CliCatalogueImage, TruncatedPngOnSingleDrawingObject) {
   TempDir t;
   spit(t.w() / "corrupt.png", truncated_png(t));
-  const std::string text = replace_once(default_catalogue_text(), "name = \"iron-handle\"\n",
-                                        "name = \"iron-handle\"\nmmw = \"corrupt.png\"\n");
-  const fs::path cat = write_catalogue(t, text);
-  ExpectRejected(
-      t, {"--catalogue", cat.string(), "gun"},
-      {at_line(cat, line_of(text, "mmw = \"corrupt.png\"")), "objects[2].mmw", (t.w() / "corrupt.png").string()}, true);
+  ExpectImageRejected(t, "name = \"iron-handle\"", "mmw = \"corrupt.png\"", "objects[2].mmw", "corrupt.png");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1005,3 +829,4 @@ TEST(CliCatalogueCmd, ImagesIntoAFileIsRejected) {
 }
 
 }  // namespace
+}  // namespace portalsim::test

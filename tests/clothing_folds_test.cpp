@@ -5,18 +5,16 @@
 #include <gtest/gtest.h>
 
 #include "backend/compare.h"
+#include "parity_support.h"
 #include "plan/knobs.h"
 #include "run_binary.h"
 #include "sink/h5_file.h"
 #include "support.h"
 
-namespace portalsim {
+namespace portalsim::test {
 namespace {
 
 namespace fs = std::filesystem;
-using test::assets;
-using test::catalogue;
-using test::kImageScenes;
 
 Plan folded_plan(const std::string& clothing, const std::string& folds, Tier tier, bool fused) {
   Plan plan = test::physics_plan(61);
@@ -74,43 +72,14 @@ TEST(ClothingFolds, FoldsAreTheReferencesOnEveryPath) {
   const SceneBatch batch = test::batch_of(scenes, 900);
   auto ref = make_reference_backend(catalogue(), assets());
   auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
-  for (Tier tier : {Tier::standard, Tier::exact})
-    for (bool fused : {true, false})
-      for (bool scene : {false, true}) {
-        SCOPED_TRACE(std::string(tier_name(tier)) + (fused ? " fused" : " stage chain") +
-                     (scene ? ", illumination and worn time drawn" : ""));
-        Plan plan = folded_plan("random", "0..1", tier, fused);
-        if (scene) {
-          set_knob(plan, *find_knob("illumination"), "280..310", "--illumination");
-          set_knob(plan, *find_knob("worn_minutes"), "0..60", "--worn-minutes");
-        }
-        BatchOutput r, k;
-        ref->run(batch, plan, r);
-        ocl->run(batch, plan, k);
-        const OutputDiff d = compare_outputs(k, r);
-        EXPECT_GT(d.mmw.pixels, 0u);
-        EXPECT_GT(d.ir.pixels, 0u);
-        test::expect_camera_parity(d.mmw);
-        test::expect_camera_parity(d.ir);
-        BatchOutput smooth;
-        Plan smooth_plan = plan;
-        set_knob(smooth_plan, *find_knob("clothing_folds"), "0", "--clothing-folds");
-        ocl->run(batch, smooth_plan, smooth);
-        for (size_t v = 0; v < k.views.size(); ++v) EXPECT_NE(k.views[v].pixels, smooth.views[v].pixels) << v;
-      }
+  expect_drawn_images_parity(
+      *ref, *ocl, batch, [](Tier tier, bool fused) { return folded_plan("random", "0..1", tier, fused); },
+      [](Plan& p) { set_knob(p, *find_knob("clothing_folds"), "0", "--clothing-folds"); });
   // Features only, in a window no outfit's body leaves.
-  Plan with_images = folded_plan("random", "0..1", Tier::fast, true);
-  with_images.model.window_lo = 250;
-  with_images.model.window_hi = 340;
-  Plan features = with_images;
-  features.images = 0;
-  ASSERT_EQ(test::features_path(*ocl, features), "physics_raw_features");
-  BatchOutput r, k, smooth;
-  ref->run(batch, with_images, r);
-  ocl->run(batch, features, k);
-  const OutputDiff d = compare_outputs(k, r);
-  ASSERT_TRUE(d.features_only);
-  EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, Tier::fast)), "");
+  Plan features;
+  BatchOutput k, smooth;
+  ASSERT_NO_FATAL_FAILURE(expect_raw_features_parity(*ref, *ocl, batch, folded_plan("random", "0..1", Tier::fast, true),
+                                                     "untabulated", features, k));
   set_knob(features, *find_knob("clothing_folds"), "0", "--clothing-folds");
   ocl->run(batch, features, smooth);
   EXPECT_NE(k.features, smooth.features);
@@ -271,4 +240,4 @@ TEST(ClothingFolds, BadValuesAreRefusedNamingTheFlagOrTheLine) {
 }
 
 }  // namespace
-}  // namespace portalsim
+}  // namespace portalsim::test

@@ -8,18 +8,16 @@
 #include <sstream>
 
 #include "backend/compare.h"
+#include "parity_support.h"
 #include "plan/knobs.h"
 #include "run_binary.h"
 #include "sink/h5_file.h"
 #include "support.h"
 
-namespace portalsim {
+namespace portalsim::test {
 namespace {
 
 namespace fs = std::filesystem;
-using test::assets;
-using test::catalogue;
-using test::kImageScenes;
 
 Plan clothed_plan(const std::string& clothing, Tier tier, bool fused) {
   Plan plan = test::physics_plan(53);
@@ -74,46 +72,14 @@ TEST(Clothing, OutfitsAreTheReferencesOnEveryPath) {
   const SceneBatch batch = test::batch_of(scenes, 700);
   auto ref = make_reference_backend(catalogue(), assets());
   auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
-  for (Tier tier : {Tier::standard, Tier::exact})
-    for (bool fused : {true, false})
-      for (bool scene : {false, true}) {
-        SCOPED_TRACE(std::string(tier_name(tier)) + (fused ? " fused" : " stage chain") +
-                     (scene ? ", illumination and worn time drawn" : ""));
-        Plan plan = clothed_plan("random", tier, fused);
-        if (scene) {
-          set_knob(plan, *find_knob("illumination"), "280..310", "--illumination");
-          set_knob(plan, *find_knob("worn_minutes"), "0..60", "--worn-minutes");
-        }
-        BatchOutput r, k;
-        ref->run(batch, plan, r);
-        ocl->run(batch, plan, k);
-        const OutputDiff d = compare_outputs(k, r);
-        EXPECT_GT(d.mmw.pixels, 0u);
-        EXPECT_GT(d.ir.pixels, 0u);
-        test::expect_camera_parity(d.mmw);
-        test::expect_camera_parity(d.ir);
-        // The outfits reach the images: the catalogue's clothing gives others.
-        BatchOutput plain;
-        Plan catalogue_plan = plan;
-        set_knob(catalogue_plan, *find_knob("clothing"), "catalogue", "--clothing");
-        ocl->run(batch, catalogue_plan, plain);
-        for (size_t v = 0; v < k.views.size(); ++v) EXPECT_NE(k.views[v].pixels, plain.views[v].pixels) << v;
-      }
+  // The outfits reach the images: the catalogue's clothing gives others.
+  expect_drawn_images_parity(
+      *ref, *ocl, batch, [](Tier tier, bool fused) { return clothed_plan("random", tier, fused); },
+      [](Plan& p) { set_knob(p, *find_knob("clothing"), "catalogue", "--clothing"); });
   // Features only, in a window no outfit's body leaves.
-  Plan with_images = clothed_plan("random", Tier::fast, true);
-  with_images.model.window_lo = 250;
-  with_images.model.window_hi = 340;
-  Plan features = with_images;
-  features.images = 0;
-  ASSERT_EQ(test::features_path(*ocl, features), "physics_raw_features");
-  const std::vector<std::string> paths = ocl->paths(features);
-  EXPECT_NE(std::find(paths.begin(), paths.end(), "features: physics_raw_features (untabulated)"), paths.end());
-  BatchOutput r, k;
-  ref->run(batch, with_images, r);
-  ocl->run(batch, features, k);
-  const OutputDiff d = compare_outputs(k, r);
-  ASSERT_TRUE(d.features_only);
-  EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, Tier::fast)), "");
+  Plan features;
+  BatchOutput k;
+  expect_raw_features_parity(*ref, *ocl, batch, clothed_plan("random", Tier::fast, true), "untabulated", features, k);
 }
 
 // The extremes: no clothing (the base image's skin, every shadow at full depth) and the
@@ -249,4 +215,4 @@ TEST(Clothing, BadValuesAreRefusedNamingTheFlagOrTheLine) {
 }
 
 }  // namespace
-}  // namespace portalsim
+}  // namespace portalsim::test

@@ -53,7 +53,7 @@ namespace portalsim::embedded {
 extern const std::string_view default_catalogue;
 }
 
-namespace portalsim {
+namespace portalsim::test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -65,22 +65,6 @@ constexpr uint64_t kMaxU64 = std::numeric_limits<uint64_t>::max();
 // Catalogue text edits.
 
 std::string default_text() { return std::string(embedded::default_catalogue); }
-
-std::string replace_once(std::string text, const std::string& from, const std::string& to) {
-  const size_t at = text.find(from);
-  if (at == std::string::npos) {
-    ADD_FAILURE() << "the default catalogue no longer contains \"" << from << "\"; update the test";
-    return text;
-  }
-  return text.replace(at, from.size(), to);
-}
-
-// 1-based line of the first occurrence of `needle` (0 when absent).
-int line_of(const std::string& text, const std::string& needle) {
-  const size_t at = text.find(needle);
-  if (at == std::string::npos) return 0;
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
-}
 
 // Rewrites the text line by line: `f` gets each line and returns its replacement, or nothing
 // to keep it.
@@ -249,8 +233,6 @@ World& default_world() {
   static std::unique_ptr<World> w = make_world(default_text());
   return *w;
 }
-
-using test::coverage;
 
 // Every region holding an object: variants rotate from `first`.
 Scenario crowded(const Catalogue& c, int subject, size_t first = 0) {
@@ -639,14 +621,6 @@ void check_opaque(const Image& sprite, const Rect& rect, const uint8_t* img, con
 
 // ---------------------------------------------------------------------------------------------
 // Running the binary (as tests/cli_test.cpp does).
-
-using portalsim::test::describe;
-using portalsim::test::has;
-using portalsim::test::Result;
-using portalsim::test::Running;
-using portalsim::test::slurp;
-using portalsim::test::spit;
-using portalsim::test::start;
 
 struct Rejection {
   std::vector<std::string> args;  // without --out
@@ -1755,4 +1729,4 @@ TEST(PortalViews, EvaluateReportsAPooledIrViewAndRefusesAnotherCatalogue) {
 }
 
 }  // namespace
-}  // namespace portalsim
+}  // namespace portalsim::test

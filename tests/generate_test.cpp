@@ -47,33 +47,9 @@ using GenTempDir = portalsim::test::TempDir;
 
 using portalsim::test::has;
 
-std::vector<std::string> split_on(const std::string& text, char sep) {
-  std::vector<std::string> parts;
-  std::string cur;
-  for (char c : text) {
-    if (c == sep) {
-      parts.push_back(cur);
-      cur.clear();
-    } else {
-      cur += c;
-    }
-  }
-  parts.push_back(cur);
-  return parts;
-}
+const auto& split_on = portalsim::test::split;
 
-std::string describe_run(const RunResult& r) {
-  std::ostringstream s;
-  s << "command: " << r.command << "\n";
-  if (r.timed_out)
-    s << "timed out\n";
-  else if (r.signaled)
-    s << "killed by signal " << r.signal << "\n";
-  else
-    s << "exit status " << r.status << "\n";
-  s << "--- stdout ---\n" << r.out.substr(0, 4000) << "--- stderr ---\n" << r.err.substr(0, 4000) << "---";
-  return s.str();
-}
+std::string describe_run(const RunResult& r) { return portalsim::test::describe(r, 4000); }
 
 Started start_program(const GenTempDir& t, const std::string& program, const Args& args) {
   return portalsim::test::start_program(t.cap(), program, args);
@@ -93,22 +69,10 @@ RunResult wait_for(const Started& r, int limit_s = 120) { return portalsim::test
 
 RunResult run_ps(const GenTempDir& t, const Args& args) { return wait_for(start_ps(t, args)); }
 
-std::vector<RunResult> run_ps_all(const GenTempDir& t, const std::vector<Args>& commands) {
-  std::vector<Started> running;
-  for (const Args& a : commands) running.push_back(start_ps(t, a));
-  std::vector<RunResult> results;
-  for (const Started& r : running) results.push_back(wait_for(r));
-  return results;
-}
+const auto& run_ps_all = portalsim::test::run_all;
 
 // `portalsim generate ARGS --out OUT`.
-Args gen(const Args& args, const fs::path& out) {
-  Args a{"generate"};
-  a.insert(a.end(), args.begin(), args.end());
-  a.push_back("--out");
-  a.push_back(out.string());
-  return a;
-}
+Args gen(const Args& args, const fs::path& out) { return portalsim::test::with_out("generate", args, out); }
 
 Args plus(Args a, const Args& more) {
   a.insert(a.end(), more.begin(), more.end());
@@ -127,20 +91,9 @@ Args with(Args a, const std::string& name, const std::string& value) {
   return a;
 }
 
-void ExpectOk(const RunResult& r) {
-  EXPECT_FALSE(r.timed_out) << describe_run(r);
-  EXPECT_FALSE(r.signaled) << describe_run(r);
-  EXPECT_TRUE(r.exited && r.status == 0) << describe_run(r);
-  EXPECT_FALSE(has(r.err, "error")) << describe_run(r);
-}
+const auto& ExpectOk = portalsim::test::expect_success;
 
-std::vector<std::string> entries_of(const fs::path& dir) {
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
+const auto& entries_of = portalsim::test::names_in;
 
 // Every regular file under `dir`, hidden ones included, as sorted relative paths.
 std::vector<std::string> files_under(const fs::path& dir) {
@@ -178,71 +131,13 @@ void ExpectSameTree(const fs::path& a, const fs::path& b) {
   EXPECT_EQ(differing, 0) << "files differing between " << a << " and " << b;
 }
 
-std::vector<std::string> stderr_messages(const std::string& err) {
-  std::vector<std::string> lines;
-  for (const std::string& l : split_on(err, '\n'))
-    if (!l.empty() && l != "Run with --help for more information.") lines.push_back(l);
-  return lines;
-}
-
-// A rejected command: non-zero exit, no signal, one stderr message naming every needle, nothing
-// on stdout, and the output folder absent (or still empty when it existed before the run).
-void ExpectRefused(const RunResult& r, const fs::path& out, bool out_existed, const std::vector<std::string>& needles) {
-  SCOPED_TRACE(describe_run(r));
-  if (r.exited && r.status == 0) {
-    ADD_FAILURE() << "portalsim accepted a command it must reject";
-    return;
-  }
-  EXPECT_FALSE(r.timed_out);
-  EXPECT_FALSE(r.signaled) << "portalsim was killed by signal " << r.signal;
-  EXPECT_TRUE(r.exited);
-  EXPECT_NE(r.status, 0);
-  EXPECT_EQ(stderr_messages(r.err).size(), 1u) << "stderr should hold exactly one message";
-  for (const std::string& n : needles) EXPECT_TRUE(has(r.err, n)) << "stderr does not name \"" << n << "\"";
-  EXPECT_EQ(r.out, "") << "nothing should be printed on stdout";
-  std::error_code ec;
-  if (out_existed) {
-    EXPECT_TRUE(fs::is_directory(out, ec)) << out << " existed before and must still be there";
-    EXPECT_TRUE(entries_of(out).empty()) << out
-                                         << " must stay empty, holds: " << testing::PrintToString(entries_of(out));
-  } else if (fs::exists(out, ec)) {
-    EXPECT_TRUE(fs::is_directory(out, ec) && entries_of(out).empty())
-        << out << " did not exist before and must not hold anything after a failed run; holds "
-        << testing::PrintToString(entries_of(out));
-  }
-}
-
 // One generate command that must be refused, with OUT absent and (also_existing) OUT empty.
-struct Refusal {
-  Args args;
-  std::vector<std::string> needles;
-  bool also_existing = false;
-};
+using Refusal = portalsim::test::Rejection;
+const auto& ExpectRefused = portalsim::test::expect_clean_failure;
+const auto& stderr_messages = portalsim::test::message_lines;
 
 void ExpectAllRefused(const GenTempDir& t, const std::vector<Refusal>& cases) {
-  static int counter = 0;
-  struct Check {
-    const Refusal* c;
-    fs::path out;
-    bool existed;
-  };
-  std::vector<Check> checks;
-  for (const Refusal& c : cases) {
-    const int n = ++counter;
-    checks.push_back({&c, t.w() / (std::string("out-fresh-") + std::to_string(n)), false});
-    if (c.also_existing) {
-      checks.push_back({&c, t.w() / (std::string("out-existing-") + std::to_string(n)), true});
-      fs::create_directory(checks.back().out);
-    }
-  }
-  std::vector<Args> commands;
-  for (const Check& k : checks) commands.push_back(gen(k.c->args, k.out));
-  const std::vector<RunResult> r = run_ps_all(t, commands);
-  for (size_t i = 0; i < checks.size(); ++i) {
-    SCOPED_TRACE(checks[i].existed ? "output folder existed (empty) before the run"
-                                   : "output folder absent before the run");
-    ExpectRefused(r[i], checks[i].out, checks[i].existed, checks[i].c->needles);
-  }
+  portalsim::test::expect_all_rejected(t, "generate", cases);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1017,14 +912,32 @@ std::string at_line(const fs::path& file, int line) {
   return file.string() + std::string(":") + std::to_string(line) + ":";
 }
 
+// A file that must be refused: its text, the line the message names, and what else it names.
+struct FileCase {
+  std::string text;
+  int line;
+  std::vector<std::string> more;
+};
+
+// Each case written into t as NAME<i>.EXT and given to generate as `flag`: a command that must
+// be refused naming its file and line; the first also with OUT existing (empty) where
+// `first_existing`.
+std::vector<Refusal> file_refusals(const GenTempDir& t, const std::string& flag, const std::string& name,
+                                   const std::string& ext, const std::vector<FileCase>& files, bool first_existing) {
+  std::vector<Refusal> cases;
+  for (size_t i = 0; i < files.size(); ++i) {
+    const fs::path p = t.w() / (name + std::to_string(i) + ext);
+    write_all(p, files[i].text);
+    std::vector<std::string> needles{at_line(p, files[i].line)};
+    needles.insert(needles.end(), files[i].more.begin(), files[i].more.end());
+    cases.push_back({{flag, p.string(), "--quiet"}, needles, first_existing && i == 0});
+  }
+  return cases;
+}
+
 TEST(GenerateBadSpec, SpecFileErrorsNameFileLineAndKey) {
   GenTempDir t;
-  struct SpecCase {
-    std::string text;
-    int line;
-    std::vector<std::string> more;
-  };
-  const std::vector<SpecCase> specs{
+  const std::vector<FileCase> specs{
       {"count = 10\nseed = [1\n", 2, {"syntax"}},
       {"count = 10\ncolour = \"red\"\n", 2, {"colour", "unknown key"}},
       {"seed = 1\ncount = -5\n", 2, {"count", "-5"}},
@@ -1032,14 +945,7 @@ TEST(GenerateBadSpec, SpecFileErrorsNameFileLineAndKey) {
       {"count = 10\n\npixel_noise = nan\n", 3, {"pixel_noise"}},
       {"count = 10\nobjects = \"5..2\"\n", 2, {"objects", "5..2"}},
   };
-  std::vector<Refusal> cases;
-  for (size_t i = 0; i < specs.size(); ++i) {
-    const fs::path p = t.w() / (std::string("spec") + std::to_string(i) + ".toml");
-    write_all(p, specs[i].text);
-    std::vector<std::string> needles{at_line(p, specs[i].line)};
-    needles.insert(needles.end(), specs[i].more.begin(), specs[i].more.end());
-    cases.push_back({{"--spec", p.string(), "--quiet"}, needles, i == 0});
-  }
+  std::vector<Refusal> cases = file_refusals(t, "--spec", "spec", ".toml", specs, true);
   cases.push_back({{"--spec", (t.w() / "missing.toml").string()}, {(t.w() / "missing.toml").string()}});
   ExpectAllRefused(t, cases);
 }
@@ -1072,12 +978,7 @@ TEST(GenerateBadSpec, OptionErrorsNameTheOption) {
 // subjects) must still point at the spec file's line, as the other spec errors do.
 TEST(GenerateBadSpec, SpecValuesCheckedLaterStillNameFileAndLine) {
   GenTempDir t;
-  struct SpecCase {
-    std::string text;
-    int line;
-    std::vector<std::string> more;
-  };
-  const std::vector<SpecCase> specs{
+  const std::vector<FileCase> specs{
       {"count = 10\npool = [\"gun\", \"laser\"]\n", 2, {"pool", "laser"}},
       {"count = 10\nwhat = \"pictures\"\n", 2, {"what", "pictures"}},
       {"count = 10\nformat = \"xls\"\n", 2, {"format", "xls"}},
@@ -1085,15 +986,7 @@ TEST(GenerateBadSpec, SpecValuesCheckedLaterStillNameFileAndLine) {
       {"count = 10\nwhat = \"images\"\npng_level = 12\n", 3, {"png_level", "12"}},
       {"count = 10\npng_level = 3\n", 2, {"png_level", "image folders"}},
   };
-  std::vector<Refusal> cases;
-  for (size_t i = 0; i < specs.size(); ++i) {
-    const fs::path p = t.w() / (std::string("spec") + std::to_string(i) + ".toml");
-    write_all(p, specs[i].text);
-    std::vector<std::string> needles{at_line(p, specs[i].line)};
-    needles.insert(needles.end(), specs[i].more.begin(), specs[i].more.end());
-    cases.push_back({{"--spec", p.string(), "--quiet"}, needles});
-  }
-  ExpectAllRefused(t, cases);
+  ExpectAllRefused(t, file_refusals(t, "--spec", "spec", ".toml", specs, false));
 }
 
 const char* kScenarioHeader =
@@ -1103,12 +996,7 @@ const char* kGunRow = "1,gun,none,none,none,none,none,none,none,none,none,none,n
 
 TEST(GenerateBadSpec, ScenarioFileErrorsNameFileLineAndColumn) {
   GenTempDir t;
-  struct ListCase {
-    std::string text;
-    int line;
-    std::vector<std::string> more;
-  };
-  const std::vector<ListCase> lists{
+  const std::vector<FileCase> lists{
       {std::string(kScenarioHeader) + kGunRow +
            "2,none,laser,none,none,none,none,none,none,none,none,none,none,none,no\n",
        3,
@@ -1126,15 +1014,7 @@ TEST(GenerateBadSpec, ScenarioFileErrorsNameFileLineAndColumn) {
        3,
        {"subject", "9"}},
   };
-  std::vector<Refusal> cases;
-  for (size_t i = 0; i < lists.size(); ++i) {
-    const fs::path p = t.w() / (std::string("list") + std::to_string(i) + ".csv");
-    write_all(p, lists[i].text);
-    std::vector<std::string> needles{at_line(p, lists[i].line)};
-    needles.insert(needles.end(), lists[i].more.begin(), lists[i].more.end());
-    cases.push_back({{"--scenarios", p.string(), "--quiet"}, needles, i == 0});
-  }
-  ExpectAllRefused(t, cases);
+  ExpectAllRefused(t, file_refusals(t, "--scenarios", "list", ".csv", lists, true));
 
   // The well-formed list runs, one row per scenario, the labels as given.
   const fs::path good = t.w() / "good.csv";
@@ -1340,16 +1220,22 @@ TEST(FeaturesCmd, BadInput) {
 
 fs::path case_spec(const std::string& name) { return fs::path(PORTALSIM_SOURCE_DIR) / "scenarios" / name; }
 
-TEST(GenerateThesisCases, Case1GunIsBalanced) {
-  const fs::path spec = case_spec("case1-gun.toml");
+// 200 scenarios of scenarios/NAME into t, balanced; their scenarios.csv rows.
+void generate_thesis_case(const GenTempDir& t, const std::string& name, std::vector<std::string>& rows) {
+  const fs::path spec = case_spec(name);
   ASSERT_TRUE(fs::exists(spec)) << spec << " is missing";
-  GenTempDir t;
-  const fs::path out = t.w() / "case1";
+  const fs::path out = t.w() / spec.stem();
   ExpectOk(run_ps(t, gen({"--spec", spec.string(), "--count", "200", "--quiet"}, out)));
   json m = read_json(out / "manifest.json");
   EXPECT_EQ(m["count"], 200);
   EXPECT_EQ(m["classes"]["positive"], m["classes"]["negative"]) << m.dump(1);
-  const std::vector<std::string> sc = csv_rows(read_all(out / "scenarios.csv"));
+  rows = csv_rows(read_all(out / "scenarios.csv"));
+}
+
+TEST(GenerateThesisCases, Case1GunIsBalanced) {
+  GenTempDir t;
+  std::vector<std::string> sc;
+  ASSERT_NO_FATAL_FAILURE(generate_thesis_case(t, "case1-gun.toml", sc));
   ASSERT_EQ(sc.size(), 200u);
   for (const std::string& row : sc) {
     const bool gun = has(row, ",gun");
@@ -1358,17 +1244,11 @@ TEST(GenerateThesisCases, Case1GunIsBalanced) {
 }
 
 TEST(GenerateThesisCases, Case2RodAndPlateUsesItsPoolAndIsBalanced) {
-  const fs::path spec = case_spec("case2-rod-plate.toml");
-  ASSERT_TRUE(fs::exists(spec)) << spec << " is missing";
   GenTempDir t;
-  const fs::path out = t.w() / "case2";
-  ExpectOk(run_ps(t, gen({"--spec", spec.string(), "--count", "200", "--quiet"}, out)));
-  json m = read_json(out / "manifest.json");
-  EXPECT_EQ(m["count"], 200);
-  EXPECT_EQ(m["classes"]["positive"], m["classes"]["negative"]) << m.dump(1);
+  std::vector<std::string> sc;
+  ASSERT_NO_FATAL_FAILURE(generate_thesis_case(t, "case2-rod-plate.toml", sc));
   const std::set<std::string> allowed{"metal-plate", "iron-rod:h",    "iron-rod:v",   "iron-rod", "compact-disk",
                                       "cement-tile", "ceramic-plate", "mobile-phone", "none"};
-  const std::vector<std::string> sc = csv_rows(read_all(out / "scenarios.csv"));
   ASSERT_EQ(sc.size(), 200u);
   int positives = 0;
   for (const std::string& row : sc) {

@@ -21,16 +21,10 @@
 #include "io/toml_input.h"
 #include "run_binary.h"
 
+namespace portalsim::test {
 namespace {
 
 namespace fs = std::filesystem;
-using portalsim::InputError;
-using portalsim::test::describe;
-using portalsim::test::has;
-using portalsim::test::Result;
-using portalsim::test::slurp;
-using portalsim::test::spit;
-using portalsim::test::TempDir;
 using Args = std::vector<std::string>;
 
 Result run(const TempDir& t, const Args& args, int limit_s = 60) {
@@ -531,3 +525,4 @@ TEST(Environment, MissingPoclCacheOnAReadOnlyFileSystemIsNamed) {
 }
 
 }  // namespace
+}  // namespace portalsim::test

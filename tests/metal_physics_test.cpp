@@ -20,6 +20,8 @@ namespace {
 
 using test::assets;
 using test::catalogue;
+using test::line_of;
+using test::replace_once;
 
 ModelSettings physics() {
   ModelSettings m;
@@ -28,14 +30,7 @@ ModelSettings physics() {
 }
 
 std::vector<int> zones(Backend& b, const std::vector<std::string>& objects, const ModelSettings& m = physics()) {
-  const Scenario s = parse_object_list(catalogue(), objects);
-  Plan plan;
-  plan.images = 0;
-  plan.features = false;
-  plan.model = m;
-  BatchOutput out;
-  b.run(test::batch_of({s}), plan, out);
-  return std::vector<int>(out.metal.begin(), out.metal.end());
+  return test::metal_zones(b, parse_object_list(catalogue(), objects), m);
 }
 
 // One zone's signal of an isotropic object of 1 cm^3 on the line between the zone's coils,
@@ -151,13 +146,7 @@ TEST(MetalPhysics, LongObjectsAreDipolesAlongTheirLength) {
   }
 }
 
-class MetalPhysicsBothBackends : public ::testing::TestWithParam<std::string> {
- protected:
-  std::unique_ptr<Backend> backend() {
-    if (GetParam() == "reference") return make_reference_backend(catalogue(), assets());
-    return make_opencl_backend(catalogue(), assets(), test::runtime());
-  }
-};
+class MetalPhysicsBothBackends : public test::BothBackends {};
 
 // Signals of separate objects add: where both push a zone the same way and nothing
 // saturates, the pair's deduction is the sum of each one's (each rounded: within 1).
@@ -307,22 +296,10 @@ std::string catalogue_text() {
   return s.str();
 }
 
-std::string replace_once(std::string text, const std::string& from, const std::string& to) {
-  const size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
-
 // "key = [first," as it stands in the text.
 std::string first_element(const std::string& text, const std::string& key) {
   const size_t at = text.find(key);
   return text.substr(at, text.find(',', at) + 1 - at);
-}
-
-int line_of(const std::string& text, const std::string& needle) {
-  const size_t at = text.find(needle);
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
 }
 
 // Each bad value is rejected naming file, line and field.

@@ -14,22 +14,10 @@ std::vector<int> zones(Backend& b, const std::vector<std::string>& objects, int 
                        const ModelSettings& m = {}) {
   Scenario s = parse_object_list(catalogue(), objects);
   s.subject = subject;
-  Plan plan;
-  plan.images = 0;
-  plan.features = false;
-  plan.model = m;
-  BatchOutput out;
-  b.run(test::batch_of({s}), plan, out);
-  return std::vector<int>(out.metal.begin(), out.metal.end());
+  return test::metal_zones(b, s, m);
 }
 
-class MetalBothBackends : public ::testing::TestWithParam<std::string> {
- protected:
-  std::unique_ptr<Backend> backend() {
-    if (GetParam() == "reference") return make_reference_backend(catalogue(), assets());
-    return make_opencl_backend(catalogue(), assets(), test::runtime());
-  }
-};
+class MetalBothBackends : public test::BothBackends {};
 
 TEST_P(MetalBothBackends, ThesisGunInRightAbdomen) {
   auto b = backend();

@@ -11,6 +11,7 @@
 
 #include "backend/compare.h"
 #include "base/error.h"
+#include "parity_support.h"
 #include "plan/tolerance.h"
 #include "run_binary.h"
 #include "scene/generator.h"
@@ -213,18 +214,9 @@ TEST(Objects, CrowdsOfEveryObjectAreTheReferences) {
   fast.fidelity = tier_fidelity(Tier::fast);
   fast.model.netd = 0;
   fast.model.ir_netd = 0;
-  fast.model.window_lo = 250;
-  fast.model.window_hi = 340;
-  Plan features = fast;
-  features.images = 0;
-  const std::vector<std::string> paths = ocl->paths(features);
-  ASSERT_NE(std::find(paths.begin(), paths.end(), "features: physics_raw_features (tabulated)"), paths.end());
-  BatchOutput r, k;
-  ref->run(batch, fast, r);
-  ocl->run(batch, features, k);
-  const OutputDiff d = compare_outputs(k, r);
-  ASSERT_TRUE(d.features_only);
-  EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, Tier::fast)), "");
+  Plan features;
+  BatchOutput k;
+  test::expect_raw_features_parity(*ref, *ocl, batch, fast, "tabulated", features, k);
 }
 
 // The features paths tabulate the drawings their batches carry, and tabulate again with

@@ -13,13 +13,10 @@
 #include "sink/h5_file.h"
 #include "support.h"
 
-namespace portalsim {
+namespace portalsim::test {
 namespace {
 
 namespace fs = std::filesystem;
-using test::assets;
-using test::catalogue;
-using test::kImageScenes;
 
 const char* const kGrids = "14x14,28x28,40x40";
 
@@ -281,4 +278,4 @@ TEST(RawGridDrawn, BadListsAreRefusedNamingTheFlagOrTheLine) {
 }
 
 }  // namespace
-}  // namespace portalsim
+}  // namespace portalsim::test

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
@@ -135,7 +136,8 @@ inline std::string quoted(const std::string& a) {
   return q + "'";
 }
 
-inline std::string describe(const Result& r) {
+// What a run did, for a failed expectation; `limit`: the most of each stream shown.
+inline std::string describe(const Result& r, size_t limit = std::string::npos) {
   std::ostringstream s;
   s << "command: " << r.command << "\n";
   if (r.timed_out)
@@ -144,7 +146,7 @@ inline std::string describe(const Result& r) {
     s << "killed by signal " << r.signal << "\n";
   else
     s << "exit status " << r.status << "\n";
-  s << "--- stdout ---\n" << r.out << "--- stderr ---\n" << r.err << "---";
+  s << "--- stdout ---\n" << r.out.substr(0, limit) << "--- stderr ---\n" << r.err.substr(0, limit) << "---";
   return s.str();
 }
 
@@ -282,6 +284,129 @@ inline Result run_on_tmpfs(const std::filesystem::path& cap, const std::filesyst
   const std::string mount = "mount -t tmpfs -o size=" + size + " tmpfs " + quoted(mount_point.string());
   const std::string ro = read_only ? " && mount -o remount,ro " + quoted(mount_point.string()) : "";
   return finish(start_program(cap, "/usr/bin/unshare", {"-m", "sh", "-c", mount + ro + " && " + script}));
+}
+
+// Runs several commands at once (they must write to different folders).
+inline std::vector<Result> run_all(const TempDir& t, const std::vector<std::vector<std::string>>& commands) {
+  std::vector<Running> running;
+  for (const std::vector<std::string>& a : commands) running.push_back(start(t.cap(), a));
+  std::vector<Result> results;
+  for (const Running& r : running) results.push_back(finish(r));
+  return results;
+}
+
+// `portalsim COMMAND ARGS --out OUT`.
+inline std::vector<std::string> with_out(const std::string& command, const std::vector<std::string>& args,
+                                         const std::filesystem::path& out) {
+  std::vector<std::string> a{command};
+  a.insert(a.end(), args.begin(), args.end());
+  a.push_back("--out");
+  a.push_back(out.string());
+  return a;
+}
+
+// Every name in a folder, hidden ones included, sorted.
+inline std::vector<std::string> names_in(const std::filesystem::path& dir) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+inline std::vector<std::string> split(const std::string& text, char sep) {
+  std::vector<std::string> parts;
+  std::string cur;
+  for (char c : text) {
+    if (c == sep) {
+      parts.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  parts.push_back(cur);
+  return parts;
+}
+
+// The lines of stderr that carry a message (CLI11's "Run with --help" hint is not one).
+inline std::vector<std::string> message_lines(const std::string& err) {
+  std::vector<std::string> lines;
+  for (const std::string& l : split(err, '\n'))
+    if (!l.empty() && l != "Run with --help for more information.") lines.push_back(l);
+  return lines;
+}
+
+// A command that succeeded: exit 0, no signal, no time-out, no error on stderr.
+inline void expect_success(const Result& r) {
+  EXPECT_FALSE(r.timed_out) << describe(r, 4000);
+  EXPECT_FALSE(r.signaled) << describe(r, 4000);
+  EXPECT_TRUE(r.exited && r.status == 0) << describe(r, 4000);
+  EXPECT_FALSE(has(r.err, "error")) << describe(r, 4000);
+}
+
+// A rejected command: non-zero exit, no signal, one stderr message naming every needle, nothing
+// on stdout, and the output folder absent (or still empty when it existed before the run).
+inline void expect_clean_failure(const Result& r, const std::filesystem::path& out, bool out_existed,
+                                 const std::vector<std::string>& needles) {
+  std::error_code ec;
+  if (r.exited && r.status == 0) {
+    ADD_FAILURE() << "portalsim accepted a command it must reject\n" << describe(r, 4000);
+    if (std::filesystem::exists(out, ec) && !out_existed) ADD_FAILURE() << out << " was created";
+    return;
+  }
+  SCOPED_TRACE(describe(r, 4000));
+  EXPECT_FALSE(r.timed_out);
+  EXPECT_FALSE(r.signaled) << "portalsim was killed by signal " << r.signal << " (" << strsignal(r.signal) << ")";
+  EXPECT_TRUE(r.exited);
+  EXPECT_NE(r.status, 0) << "a rejected command must exit non-zero";
+  EXPECT_EQ(message_lines(r.err).size(), 1u) << "stderr should hold exactly one message";
+  for (const std::string& n : needles) EXPECT_TRUE(has(r.err, n)) << "stderr does not name \"" << n << "\"";
+  EXPECT_EQ(r.out, "") << "nothing should be printed on stdout";
+  if (out_existed) {
+    EXPECT_TRUE(std::filesystem::is_directory(out, ec)) << out << " existed before the run and must still be there";
+    EXPECT_TRUE(names_in(out).empty()) << out << " must stay empty, holds: " << testing::PrintToString(names_in(out));
+  } else if (std::filesystem::exists(out, ec)) {
+    EXPECT_TRUE(std::filesystem::is_directory(out, ec) && names_in(out).empty())
+        << out << " did not exist before and must not hold anything after a failed run; holds "
+        << testing::PrintToString(names_in(out));
+  }
+}
+
+// One command that must be rejected: `portalsim COMMAND ARGS --out OUT` with OUT absent, and
+// (also_existing) once more with OUT an empty folder made beforehand.
+struct Rejection {
+  std::vector<std::string> args;
+  std::vector<std::string> needles;
+  bool also_existing = false;
+};
+
+// Runs every case of `command` at once; each must be rejected cleanly with a message naming
+// its needles.
+inline void expect_all_rejected(const TempDir& t, const std::string& command, const std::vector<Rejection>& cases) {
+  static int counter = 0;
+  struct Check {
+    const Rejection* c;
+    std::filesystem::path out;
+    bool existed;
+  };
+  std::vector<Check> checks;
+  for (const Rejection& c : cases) {
+    const int n = ++counter;
+    checks.push_back({&c, t.w() / (std::string("out-fresh-") + std::to_string(n)), false});
+    if (c.also_existing) {
+      checks.push_back({&c, t.w() / (std::string("out-existing-") + std::to_string(n)), true});
+      std::filesystem::create_directory(checks.back().out);
+    }
+  }
+  std::vector<std::vector<std::string>> commands;
+  for (const Check& k : checks) commands.push_back(with_out(command, k.c->args, k.out));
+  const std::vector<Result> r = run_all(t, commands);
+  for (size_t i = 0; i < checks.size(); ++i) {
+    SCOPED_TRACE(checks[i].existed ? "output folder existed (empty) before the run"
+                                   : "output folder absent before the run");
+    expect_clean_failure(r[i], checks[i].out, checks[i].existed, checks[i].c->needles);
+  }
 }
 
 }  // namespace portalsim::test

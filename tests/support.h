@@ -71,6 +71,23 @@ inline Scenario random_scenario(const Catalogue& cat, uint64_t k, int max_object
   return s;
 }
 
+// `text` with the first `from` replaced by `to`; a test failure where it holds none.
+inline std::string replace_once(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  if (at == std::string::npos) {
+    ADD_FAILURE() << "the text no longer contains \"" << from << "\"; update the test";
+    return text;
+  }
+  return text.replace(at, from.size(), to);
+}
+
+// 1-based line of the first occurrence of `needle` in `text` (0 when absent).
+inline int line_of(const std::string& text, const std::string& needle) {
+  const size_t at = text.find(needle);
+  if (at == std::string::npos) return 0;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+}
+
 // Catalogue text `text` with `line` added to subject k's table (0-based), right after its
 // build line; *at gets the added line's number.
 inline std::string with_subject_line(std::string text, int k, const std::string& line, int* at = nullptr) {
@@ -186,5 +203,26 @@ inline SceneBatch batch_of(const std::vector<Scenario>& scenes, uint64_t first_i
   }
   return b;
 }
+
+// Scenario s's metal zones from backend b under model m (no images, no features).
+inline std::vector<int> metal_zones(Backend& b, const Scenario& s, const ModelSettings& m) {
+  Plan plan;
+  plan.images = 0;
+  plan.features = false;
+  plan.model = m;
+  BatchOutput out;
+  b.run(batch_of({s}), plan, out);
+  return std::vector<int>(out.metal.begin(), out.metal.end());
+}
+
+// A suite run once per backend, "reference" or "opencl" (INSTANTIATE_TEST_SUITE_P with both
+// names), over the default catalogue.
+class BothBackends : public ::testing::TestWithParam<std::string> {
+ protected:
+  std::unique_ptr<Backend> backend() {
+    if (GetParam() == "reference") return make_reference_backend(catalogue(), assets());
+    return make_opencl_backend(catalogue(), assets(), runtime());
+  }
+};
 
 }  // namespace portalsim::test

@@ -11,13 +11,10 @@
 #include "cli/validate_stats.h"
 #include "run_binary.h"
 
+namespace portalsim::test {
 namespace {
 
 namespace fs = std::filesystem;
-using portalsim::test::finish;
-using portalsim::test::slurp;
-using portalsim::test::spit;
-using portalsim::test::start;
 
 // Two attributes; `a` separates the classes: guns near `gun_at`, the rest near 0.
 std::string table(int n, unsigned seed, double gun_at, const std::string& second = "b") {
@@ -236,3 +233,4 @@ TEST(Transfer, BadArgumentsAreRefusedBeforeAnythingIsWritten) {
 }
 
 }  // namespace
+}  // namespace portalsim::test

@@ -19,13 +19,10 @@
 #include "sink/feature_rows.h"
 #include "sink/h5_file.h"
 
+namespace portalsim::test {
 namespace {
 
 namespace fs = std::filesystem;
-using portalsim::test::finish;
-using portalsim::test::slurp;
-using portalsim::test::spit;
-using portalsim::test::start;
 
 fs::path fresh_dir() { return portalsim::test::make_temp_dir("portalsim-validate"); }
 
@@ -619,3 +616,4 @@ TEST(TableFields, CsvAndArffQuoting) {
 }
 
 }  // namespace
+}  // namespace portalsim::test

@@ -369,6 +369,147 @@ struct Work {
   std::vector<std::vector<uint8_t>> scratch;
 };
 
+// Each view's masks for n scenarios. Masks left by the last batch are cleared where they
+// were painted (paint_mask); new ones come zeroed.
+void size_masks(const Catalogue& cat, size_t n, std::vector<ViewAnnotations>& out) {
+  out.resize(cat.sensors.size());
+  for (size_t k = 0; k < cat.sensors.size(); ++k) {
+    const Sensor& sensor = cat.sensors[k];
+    ViewAnnotations& va = out[k];
+    const size_t px = sensor.pixels();
+    if (va.width == sensor.width && va.height == sensor.height && va.painted.size() * px == va.masks.size() &&
+        n * px <= va.masks.capacity()) {
+      va.masks.resize(n * px);
+      va.painted.resize(n);
+    } else {
+      va.masks = {};
+      va.masks.reserve(n * px);
+      huge_pages(va.masks.data(), n * px);
+      va.masks.assign(n * px, 0);
+      va.painted.assign(n, {});
+    }
+    va.width = sensor.width;
+    va.height = sensor.height;
+  }
+}
+
+// Where sprites that do not move sit, by view, then body (one subject of each shape), variant
+// and region: placed from one scene per body, view and variant that holds the variant in
+// every region.
+std::vector<std::vector<Fixed>> place_fixed(const Catalogue& cat, const AssetSet& assets, const ModelSettings& model,
+                                            const std::vector<int>& shape, const std::vector<std::vector<Runs>>& runs) {
+  const size_t V = cat.variant_list.size();
+  const int R = cat.region_count();
+  std::vector<std::vector<Fixed>> fixed(cat.sensors.size());
+  for (size_t k = 0; k < cat.sensors.size(); ++k) {
+    const Sensor& sensor = cat.sensors[k];
+    fixed[k].resize(shape.size() * V * R);
+    for (size_t b = 0; b < shape.size(); ++b)
+      for (size_t v = 0; v < V; ++v) {
+        Scenario every;
+        every.subject = shape[b];
+        every.objects.fill(static_cast<int16_t>(v));
+        const reference::ViewScene vs = reference::view_scene(cat, assets, model, static_cast<int>(k), every, 0);
+        size_t p = 0;
+        for (int r = 0; r < R; ++r) {
+          if (!sensor.sees(r)) continue;
+          Fixed& f = fixed[k][(b * V + v) * R + r];
+          f.placed = vs.placed[p++];
+          f.at.emplace(f.placed, runs[k][v], model, sensor.width, sensor.height);
+        }
+      }
+  }
+  return fixed;
+}
+
+// Paints the m objects of scenario i (at, by region, lowest first) into the scratch mask scr,
+// then into the view's mask, and zeroes scr again. kept gets each object's painted box and area.
+void paint_mask(const Placement* const* at, const int* regions, size_t m, Painted* kept, uint8_t* scr, int W,
+                size_t pixels, ViewAnnotations& va, size_t i) {
+  // Highest region first, so that each object paints only the pixels it keeps and
+  // its box and area come from that one pass; one that may reach a pixel an object
+  // above it kept paints over 0s only.
+  for (size_t t = m; t-- > 0;) {
+    bool under = false;
+    for (size_t u = t + 1; u < m && !under; ++u) under = kept[u].area && meets(at[t]->reach, kept[u]);
+    const uint8_t id = static_cast<uint8_t>(regions[t] + 1);
+    kept[t] = under ? at[t]->paint<true>(id, scr) : at[t]->paint<false>(id, scr);
+  }
+  // The mask's non-zero pixels lie in the boxes painted last time: copying the lines
+  // of those (unless a new box holds one) and of the new boxes from the scratch mask
+  // clears the old and writes the new.
+  ViewAnnotations::Painted& dirty = va.painted[i];
+  const Lines lines(va.masks.data() + i * pixels, scr, W, pixels);
+  for (int b = 0; b < dirty.count; ++b) {
+    const auto& [x0, y0, x1, y1] = dirty.box[b];
+    bool held = false;
+    for (size_t t = 0; t < m && !held; ++t)
+      held = kept[t].area && kept[t].x0 <= x0 && kept[t].y0 <= y0 && x1 <= kept[t].x1 && y1 <= kept[t].y1;
+    if (!held) lines.copy(x0, y0, x1, y1);
+  }
+  dirty.count = 0;
+  for (size_t t = 0; t < m; ++t)
+    if (const Painted& d = kept[t]; d.area) {
+      lines.copy(d.x0, d.y0, d.x1, d.y1);
+      dirty.box[dirty.count++] = {static_cast<int16_t>(d.x0), static_cast<int16_t>(d.y0), static_cast<int16_t>(d.x1),
+                                  static_cast<int16_t>(d.y1)};
+    }
+  for (size_t t = 0; t < m; ++t)
+    for (int y = kept[t].y0; y <= kept[t].y1; ++y)
+      fill(scr + static_cast<size_t>(y) * W + kept[t].x0, 0, kept[t].x1 - kept[t].x0 + 1);
+}
+
+// Scenario i's annotations of one view, one per visible object; returns how many.
+size_t append_annotations(const Catalogue& cat, const ModelSettings& model, const reference::Placed* const* placed,
+                          const int* regions, const Painted* kept, size_t m, size_t i, std::vector<Annotation>& mine) {
+  size_t kept_count = 0;
+  for (size_t t = 0; t < m; ++t) {
+    if (!kept[t].area) continue;  // nothing visible: no annotation
+    const reference::Placed& pl = *placed[t];
+    const VariantRef& v = cat.variant_list[pl.variant];
+    Annotation& an = mine.emplace_back();
+    an.scenario = static_cast<uint32_t>(i);
+    an.region = static_cast<uint8_t>(regions[t]);
+    an.object = static_cast<int16_t>(v.object);
+    an.drawing = static_cast<int16_t>(v.variant);
+    an.x = kept[t].x0;
+    an.y = kept[t].y0;
+    an.w = kept[t].x1 - kept[t].x0 + 1;
+    an.h = kept[t].y1 - kept[t].y0 + 1;
+    an.area = kept[t].area;
+    an.dx = model.bilinear ? pl.dx : std::floor(pl.dx + 0.5);
+    an.dy = model.bilinear ? pl.dy : std::floor(pl.dy + 0.5);
+    an.rotation = pl.transform.rotation;
+    an.scale = pl.transform.scale;
+    an.flip = pl.transform.flip;
+    ++kept_count;
+  }
+  return kept_count;
+}
+
+// The workers' lists (by first scenario), joined into each view's items by scenario.
+void join_work(std::vector<std::pair<size_t, Work>>& done, const std::vector<uint8_t>& count, size_t n,
+               std::vector<ViewAnnotations>& out) {
+  const size_t views = out.size();
+  std::sort(done.begin(), done.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (ViewAnnotations& va : out) {
+    va.items.clear();
+    va.first.assign(n + 1, 0);
+  }
+  size_t part = 0, at = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (part + 1 < done.size() && done[part + 1].first == i) ++part, at = 0;
+    for (size_t k = 0; k < views; ++k) {
+      ViewAnnotations& va = out[k];
+      va.first[i] = static_cast<uint32_t>(va.items.size());
+      const auto from = done[part].second.items.begin() + static_cast<ptrdiff_t>(at);
+      va.items.insert(va.items.end(), from, from + count[i * views + k]);
+      at += count[i * views + k];
+    }
+  }
+  for (ViewAnnotations& va : out) va.first[n] = static_cast<uint32_t>(va.items.size());
+}
+
 }  // namespace
 
 // Each view's sprites' covered texels (by variant), where unmoved sprites sit (built on
@@ -415,56 +556,15 @@ void Annotator::operator()(const ModelSettings& model, const SceneBatch& batch, 
   const AssetSet& assets = kept_->assets;
   const std::vector<std::vector<Runs>>& runs = kept_->runs;
   const size_t n = batch.size(), views = cat.sensors.size();
-  out.resize(views);
-  for (size_t k = 0; k < views; ++k) {
-    const Sensor& sensor = cat.sensors[k];
-    ViewAnnotations& va = out[k];
-    // Masks left by the last batch are cleared where they were painted (below); new
-    // ones come zeroed.
-    const size_t px = sensor.pixels();
-    if (va.width == sensor.width && va.height == sensor.height && va.painted.size() * px == va.masks.size() &&
-        n * px <= va.masks.capacity()) {
-      va.masks.resize(n * px);
-      va.painted.resize(n);
-    } else {
-      va.masks = {};
-      va.masks.reserve(n * px);
-      huge_pages(va.masks.data(), n * px);
-      va.masks.assign(n * px, 0);
-      va.painted.assign(n, {});
-    }
-    va.width = sensor.width;
-    va.height = sensor.height;
-  }
+  size_masks(cat, n, out);
   // Sprites that do not move sit where their variant, region, view and subject's body put
-  // them, the same in every scenario and for any model that does not move them: placed
-  // once, from one scene per body, view and variant that holds the variant in every region.
+  // them, the same in every scenario and for any model that does not move them: placed once.
   std::vector<std::vector<Fixed>>& fixed = kept_->fixed;
   const std::vector<int>& body = kept_->body;
   const size_t V = cat.variant_list.size();
   const int R = cat.region_count();
   const bool moves = model.moves_sprites();
-  if (!moves && fixed.empty()) {
-    fixed.resize(views);
-    for (size_t k = 0; k < views; ++k) {
-      const Sensor& sensor = cat.sensors[k];
-      fixed[k].resize(kept_->shape.size() * V * R);
-      for (size_t b = 0; b < kept_->shape.size(); ++b)
-        for (size_t v = 0; v < V; ++v) {
-          Scenario every;
-          every.subject = kept_->shape[b];
-          every.objects.fill(static_cast<int16_t>(v));
-          const reference::ViewScene vs = reference::view_scene(cat, assets, model, static_cast<int>(k), every, 0);
-          size_t p = 0;
-          for (int r = 0; r < R; ++r) {
-            if (!sensor.sees(r)) continue;
-            Fixed& f = fixed[k][(b * V + v) * R + r];
-            f.placed = vs.placed[p++];
-            f.at.emplace(f.placed, runs[k][v], model, sensor.width, sensor.height);
-          }
-        }
-    }
-  }
+  if (!moves && fixed.empty()) fixed = place_fixed(cat, assets, model, kept_->shape, runs);
   // Each worker's annotations in a list of its own, by scenario, then view (count says how
   // many each image has), joined below in the order of the workers' first scenarios.
   std::vector<uint8_t> count(n * views, 0);
@@ -520,84 +620,16 @@ void Annotator::operator()(const ModelSettings& model, const SceneBatch& batch, 
           }
           regions[m++] = r;
         }
-        // Highest region first, so that each object paints only the pixels it keeps and
-        // its box and area come from that one pass; one that may reach a pixel an object
-        // above it kept paints over 0s only.
-        for (size_t t = m; t-- > 0;) {
-          bool under = false;
-          for (size_t u = t + 1; u < m && !under; ++u) under = kept[u].area && meets(at[t]->reach, kept[u]);
-          const uint8_t id = static_cast<uint8_t>(regions[t] + 1);
-          kept[t] = under ? at[t]->paint<true>(id, scr) : at[t]->paint<false>(id, scr);
-        }
-        // The mask's non-zero pixels lie in the boxes painted last time: copying the lines
-        // of those (unless a new box holds one) and of the new boxes from the scratch mask
-        // clears the old and writes the new.
-        ViewAnnotations::Painted& dirty = out[k].painted[i];
-        const Lines lines(out[k].masks.data() + i * sensor.pixels(), scr, W, sensor.pixels());
-        for (int b = 0; b < dirty.count; ++b) {
-          const auto& [x0, y0, x1, y1] = dirty.box[b];
-          bool held = false;
-          for (size_t t = 0; t < m && !held; ++t)
-            held = kept[t].area && kept[t].x0 <= x0 && kept[t].y0 <= y0 && x1 <= kept[t].x1 && y1 <= kept[t].y1;
-          if (!held) lines.copy(x0, y0, x1, y1);
-        }
-        dirty.count = 0;
-        for (size_t t = 0; t < m; ++t)
-          if (const Painted& d = kept[t]; d.area) {
-            lines.copy(d.x0, d.y0, d.x1, d.y1);
-            dirty.box[dirty.count++] = {static_cast<int16_t>(d.x0), static_cast<int16_t>(d.y0),
-                                        static_cast<int16_t>(d.x1), static_cast<int16_t>(d.y1)};
-          }
-        for (size_t t = 0; t < m; ++t)
-          for (int y = kept[t].y0; y <= kept[t].y1; ++y)
-            fill(scr + static_cast<size_t>(y) * W + kept[t].x0, 0, kept[t].x1 - kept[t].x0 + 1);
-
-        size_t kept_count = 0;
-        for (size_t t = 0; t < m; ++t) {
-          if (!kept[t].area) continue;  // nothing visible: no annotation
-          const reference::Placed& pl = *placed[t];
-          const VariantRef& v = cat.variant_list[pl.variant];
-          Annotation& an = mine.emplace_back();
-          an.scenario = static_cast<uint32_t>(i);
-          an.region = static_cast<uint8_t>(regions[t]);
-          an.object = static_cast<int16_t>(v.object);
-          an.drawing = static_cast<int16_t>(v.variant);
-          an.x = kept[t].x0;
-          an.y = kept[t].y0;
-          an.w = kept[t].x1 - kept[t].x0 + 1;
-          an.h = kept[t].y1 - kept[t].y0 + 1;
-          an.area = kept[t].area;
-          an.dx = model.bilinear ? pl.dx : std::floor(pl.dx + 0.5);
-          an.dy = model.bilinear ? pl.dy : std::floor(pl.dy + 0.5);
-          an.rotation = pl.transform.rotation;
-          an.scale = pl.transform.scale;
-          an.flip = pl.transform.flip;
-          ++kept_count;
-        }
-        count[i * views + k] = static_cast<uint8_t>(kept_count);
+        paint_mask(at.data(), regions.data(), m, kept.data(), scr, W, sensor.pixels(), out[k], i);
+        count[i * views + k] = static_cast<uint8_t>(
+            append_annotations(cat, model, placed.data(), regions.data(), kept.data(), m, i, mine));
       }
     }
     Lines::fence();
     const std::lock_guard<std::mutex> lock(work_mutex);
     done.emplace_back(lo, std::move(work));
   });
-  std::sort(done.begin(), done.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (ViewAnnotations& va : out) {
-    va.items.clear();
-    va.first.assign(n + 1, 0);
-  }
-  size_t part = 0, at = 0;
-  for (size_t i = 0; i < n; ++i) {
-    if (part + 1 < done.size() && done[part + 1].first == i) ++part, at = 0;
-    for (size_t k = 0; k < views; ++k) {
-      ViewAnnotations& va = out[k];
-      va.first[i] = static_cast<uint32_t>(va.items.size());
-      const auto from = done[part].second.items.begin() + static_cast<ptrdiff_t>(at);
-      va.items.insert(va.items.end(), from, from + count[i * views + k]);
-      at += count[i * views + k];
-    }
-  }
-  for (ViewAnnotations& va : out) va.first[n] = static_cast<uint32_t>(va.items.size());
+  join_work(done, count, n, out);
   for (auto& d : done) spare.push_back(std::move(d.second));
 }
 

@@ -224,21 +224,9 @@ Evaluation evaluate(const Problem& p, double fwhm) {
   return e;
 }
 
-}  // namespace
-
-double aperture_for_fwhm(const Catalogue& cat, int width, double fwhm_pixels) {
-  // reference::psf_fwhm_pixels is inversely proportional to the aperture.
-  Catalogue one = cat;
-  one.physics.aperture_m = 1.0;
-  Sensor view;
-  view.width = width;
-  return reference::psf_fwhm_pixels(one, view) / fwhm_pixels;
-}
-
-CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const AssetSet& assets,
-                     const ModelSettings& model) {
-  check_captures(captures);
-  CameraFit fit;
+// Each view's raw grid from its own captures (a portal's cameras may differ), and which
+// views' cameras the run's raw grid and noise come from.
+void fit_view_grids(const Captures& captures, const Catalogue& cat, CameraFit& fit) {
   const ViewCaptures& v0 = captures.views[0];
   bool raw_view_found = false, noise_view_found = false;
   for (size_t k = 0; k < captures.views.size(); ++k) {
@@ -252,7 +240,6 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
                        std::to_string(sensor.height));
     if (v.width != v0.width || v.height != v0.height)
       throw InputError(v.files.front() + ": the views differ in size from " + v0.files.front());
-    // Each view's raw grid from its own captures: a portal's cameras may differ.
     ViewFit vf;
     vf.name = v.name;
     std::vector<const std::vector<uint8_t>*> imgs;
@@ -274,7 +261,12 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
   }
   fit.raw_w = fit.views[fit.raw_view].raw_w;
   fit.raw_h = fit.views[fit.raw_view].raw_h;
+}
 
+// What the fit compares: each subject's bare radiometry per view, and up to about 1,024 valid
+// raw cells per view of each capture.
+Problem fit_problem(const Captures& captures, const Catalogue& cat, const AssetSet& assets, const ModelSettings& model,
+                    const CameraFit& fit) {
   Problem p{captures, {}, {}, {}};
   for (const ViewFit& vf : fit.views) p.raw.push_back({vf.raw_w, vf.raw_h});
   ModelSettings m = model;
@@ -310,9 +302,13 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
       p.cells[c].push_back(std::move(cells));
     }
 
-  // The blur: a scan over the PSF's FWHM from a third of a pixel to 8 views wide, then a
-  // golden-section search around the best.
-  const double lo = std::log(0.3), hi = std::log(8.0 * v0.width);
+  return p;
+}
+
+// The blur: a scan over the PSF's FWHM from a third of a pixel to 8 views wide, then a
+// golden-section search around the best. Returns the evaluation at the best.
+Evaluation fit_blur(const Problem& p, int width, CameraFit& fit) {
+  const double lo = std::log(0.3), hi = std::log(8.0 * width);
   const int scan = 12;
   int best = 0;
   std::vector<double> us;
@@ -349,8 +345,11 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
   // than the best, and the best is not at the scan's end: otherwise the captures say only
   // that the blur is at least about this wide.
   fit.blur_told = fit.blur_cost.back() > 1.05 * e.cost + 1e-9 && best < scan - 1;
-  fit.aperture_m = aperture_for_fwhm(cat, v0.width, fit.fwhm_pixels);
+  return e;
+}
 
+// The window's gain and level against the evaluation e; returns the fitted offset.
+double fit_window(const Evaluation& e, const ModelSettings& model, CameraFit& fit) {
   // The window's gain is told by the body against the room. Where the captures hardly
   // show that contrast (a blur wider than the view, a 1x1 raw grid), the model's window
   // width (its `window` knob) is kept and only its level is fitted.
@@ -366,6 +365,10 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
   }
   fit.display_min = -offset / fit.gain;
   fit.display_max = fit.display_min + 255.0 / fit.gain;
+  return offset;
+}
+
+void fit_noise(const Captures& captures, const Catalogue& cat, const Evaluation& e, double offset, CameraFit& fit) {
   // The noise: each view's robust spread of what the bare subject leaves, less its grid's
   // rounding; and each capture's alone, whose scatter gives the figure's standard error.
   const size_t V = captures.views.size(), n = captures.count();
@@ -419,6 +422,29 @@ CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const Asset
     vf.own_raw = vf.raw_w != fit.raw_w || vf.raw_h != fit.raw_h || sensor.raw.has_value();
     vf.own_netd = !vf.noise_agrees || sensor.netd.has_value();
   }
+}
+
+}  // namespace
+
+double aperture_for_fwhm(const Catalogue& cat, int width, double fwhm_pixels) {
+  // reference::psf_fwhm_pixels is inversely proportional to the aperture.
+  Catalogue one = cat;
+  one.physics.aperture_m = 1.0;
+  Sensor view;
+  view.width = width;
+  return reference::psf_fwhm_pixels(one, view) / fwhm_pixels;
+}
+
+CameraFit fit_camera(const Captures& captures, const Catalogue& cat, const AssetSet& assets,
+                     const ModelSettings& model) {
+  check_captures(captures);
+  CameraFit fit;
+  fit_view_grids(captures, cat, fit);
+  const Problem p = fit_problem(captures, cat, assets, model, fit);
+  const Evaluation e = fit_blur(p, captures.views[0].width, fit);
+  fit.aperture_m = aperture_for_fwhm(cat, captures.views[0].width, fit.fwhm_pixels);
+  const double offset = fit_window(e, model, fit);
+  fit_noise(captures, cat, e, offset, fit);
   fit.subject = e.subject;
   fit.cells = static_cast<int>(e.pairs);
   return fit;

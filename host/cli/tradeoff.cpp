@@ -187,6 +187,311 @@ void put_distribution(json& r, const std::vector<double>& draws) {
   r["noise_max_abs"] = max_abs;
 }
 
+// One row's runs: the timed features-only and images runs of a tier (none: the reference)
+// and their errors against the model's reference. img_feats, img_feats2: the features of the
+// images runs of cases 1 and 2 where they are not the features-only run's (the block-mean
+// noise model), for J48 on them.
+struct RowRuns {
+  std::string name;
+  std::optional<Tier> tier;
+  double feat_rate = 0, img_rate = 0;
+  OutputDiff img_err, feat_err;
+  const BatchOutput* feats = nullptr;
+  BatchOutput feats2;
+  const BatchOutput* img_feats = nullptr;
+  const BatchOutput* img_feats2 = nullptr;
+  const BatchOutput* img_out = nullptr;
+};
+
+// What one model's rows share: the options, both scenario sets, the staging folder of
+// J48's ARFFs and the model's reference backend.
+struct ModelRows {
+  ModelRows(const TradeoffOptions& o, const Catalogue& cat, const SceneBatch& batch, const SceneBatch& case2,
+            StagedFolder& folder, const ModelSettings& model, Backend& reference)
+      : o(o), cat(cat), batch(batch), case2(case2), folder(folder), model(model), reference(reference) {}
+  const TradeoffOptions& o;
+  const Catalogue& cat;
+  const SceneBatch& batch;
+  const SceneBatch& case2;
+  StagedFolder& folder;
+  ModelSettings model;
+  Backend& reference;
+  std::string mname = model_name(model.model);
+  // The reference following a tier's approximate pixel draws (Fidelity::draw), made once
+  // per draw: the tier's images are held to it (the reference's Box-Muller draws are
+  // other numbers, value by value).
+  std::map<NoiseDraw, BatchOutput> same_draw_refs;
+
+  const BatchOutput& same_draw_ref(NoiseDraw d) {
+    auto it = same_draw_refs.find(d);
+    if (it != same_draw_refs.end()) return it->second;
+    Plan p = images_plan(model);
+    p.fidelity.draw = d;
+    reference.run(batch, p, same_draw_refs[d]);
+    return same_draw_refs[d];
+  }
+
+  // J48's 10-fold accuracy on one tier's features of one case, or null (with a note).
+  void j48(json& r, const std::string& key, const std::string& arff, const SceneBatch& scenes,
+           const BatchOutput& feats) {
+    r[key] = nullptr;
+    write_arff(folder.dir(), arff, scenes, feats, cat);
+    std::string why;
+    if (auto acc = j48_cv_accuracy((std::filesystem::path(folder.dir()) / arff).string(), why))
+      r[key] = *acc;
+    else
+      r["j48_note"] = why;
+    folder.path(arff);  // keep it
+  }
+
+  // Case 2's features, one untimed pass (only the classifier reads them).
+  BatchOutput case2_features(Backend& b, const Plan& plan) {
+    BatchOutput out;
+    if (o.classifier) b.run(case2, plan, out);
+    return out;
+  }
+
+  // Fills the row `r` (which holds the noise's distribution columns already) and prints it.
+  void add_row(json& r, const RowRuns& run) {
+    const Model m = model.model;
+    r["model"] = mname;
+    r["name"] = run.name;
+    // What the noise's distribution columns sample (put_distribution).
+    const bool irwin_hall = run.tier && tier_fidelity(*run.tier).draw == NoiseDraw::irwin_hall;
+    r["noise_draw"] = irwin_hall ? "irwin-hall" : m == Model::physics ? "table Gaussian" : "box-muller";
+    r["features_per_s"] = run.feat_rate;
+    r["images_per_s"] = run.img_rate;
+    r["mmw_max_abs"] = run.img_err.mmw.max_abs;
+    r["mmw_rmse_mean"] = run.img_err.mmw.rmse_mean;
+    r["mmw_rmse_max"] = run.img_err.mmw.rmse_max;
+    r["mmw_psnr_db"] = run.img_err.mmw.psnr;
+    r["mmw_share_off_by_more_than_1"] = run.img_err.mmw.share_off_by_more_than_1;
+    r["mmw_share_differing"] = run.img_err.mmw.share_differing;
+    r["ir_max_abs"] = run.img_err.ir.max_abs;
+    r["ir_rmse_mean"] = run.img_err.ir.rmse_mean;
+    r["ir_psnr_db"] = run.img_err.ir.psnr;
+    r["ir_share_off_by_more_than_1"] = run.img_err.ir.share_off_by_more_than_1;
+    r["feature_max_abs"] = run.feat_err.feature_max_abs;
+    r["feature_mean_abs"] = run.feat_err.feature_mean_abs;
+    r["metal_exact_rate"] = run.feat_err.metal_exact;
+    r["label_exact_rate"] = 1.0;  // labels come from the scenes, which every tier shares
+    std::string why;
+    if (run.tier)
+      why = tier_columns(r, *run.tier, run);
+    else
+      r["precision"] = "fp64 (CPU reference)";
+    r["within_tolerance"] = why.empty();
+    if (!why.empty()) r["tolerance_note"] = why;
+    j48_columns(r, run);
+    print_row(r, run, why);
+  }
+
+  // A tier's fidelity columns and whether its runs are within the tier's stated tolerance for
+  // this model (plan/tolerance.h), on images and features: empty, or what broke.
+  std::string tier_columns(json& r, Tier tier, const RowRuns& run) {
+    const Model m = model.model;
+    const Fidelity f = tier_fidelity(tier);
+    r["precision"] = precision_name(f.precision);
+    r["pooling"] = f.pooling == Pooling::sparse ? "sparse" : "dense";
+    r["fast_math"] = f.fast_math;
+    r["noise_model"] = f.noise == NoiseModel::block_mean ? "block-mean" : "per-pixel";
+    const Tolerance tol = model_tolerance(m, tier);
+    // The features-only run holds no images. Its feature bounds hold without the
+    // block-mean noise model, which draws each mean's noise directly (the thesis's
+    // pixel noise; the physics model's NETD in feature space).
+    OutputDiff feat_checked;
+    feat_checked.metal_exact = run.feat_err.metal_exact;
+    const bool noise_per_mean = model.pixel_sigma > 0 || (m == Model::physics && model.netd > 0);
+    if (f.noise != NoiseModel::block_mean || !noise_per_mean) {
+      feat_checked.feature_max_abs = run.feat_err.feature_max_abs;
+      feat_checked.feature_mean_abs = run.feat_err.feature_mean_abs;
+    }
+    // A tier that draws the camera's frames as one approximate draw (Plan::frames_approximated)
+    // has other noise than the reference's, value by value: its images are held to the
+    // distribution instead (tests/camera_test.cpp); the error columns still show the cost.
+    Plan tier_images = images_plan(model);
+    tier_images.fidelity = f;
+    // The thesis model has no camera frames (the frames knob is the physics camera's).
+    const bool frames_approximated = m == Model::physics && tier_images.frames_approximated();
+    r["frames_approximated"] = frames_approximated;
+    // A tier with other pixel draws than the reference's is held to the reference
+    // following them; its error columns stay against the model's reference.
+    const bool other_draws = m == Model::thesis && model.pixel_sigma > 0 && f.draw != NoiseDraw::box_muller;
+    r["images_held_to"] = other_draws ? "the reference with the tier's noise_draw" : "the model's reference";
+    std::string why;
+    if (!frames_approximated) {
+      const OutputDiff held = other_draws ? compare_outputs(*run.img_out, same_draw_ref(f.draw)) : run.img_err;
+      if (other_draws) {
+        r["same_draw_mmw_max_abs"] = held.mmw.max_abs;
+        r["same_draw_mmw_rmse_mean"] = held.mmw.rmse_mean;
+        r["same_draw_mmw_share_differing"] = held.mmw.share_differing;
+      }
+      if (const std::string broke = check_tolerance(held, tol); !broke.empty()) why += "images run: " + broke;
+    }
+    if (const std::string broke = check_tolerance(feat_checked, tol); !broke.empty()) why += "features run: " + broke;
+    return why;
+  }
+
+  void j48_columns(json& r, const RowRuns& run) {
+    r["j48_accuracy"] = nullptr;
+    r["j48_case2_accuracy"] = nullptr;
+    r["j48_images_accuracy"] = nullptr;
+    r["j48_images_case2_accuracy"] = nullptr;
+    if (!o.classifier) return;
+    const std::string stem = mname + "-" + run.name;
+    j48(r, "j48_accuracy", stem + "-case1.arff", batch, *run.feats);
+    j48(r, "j48_case2_accuracy", stem + "-case2.arff", case2, run.feats2);
+    // Features pooled from the images run: the features-only run's own where they are
+    // the same numbers, else J48 on them.
+    if (run.img_feats) {
+      j48(r, "j48_images_accuracy", stem + "-images-case1.arff", batch, *run.img_feats);
+      j48(r, "j48_images_case2_accuracy", stem + "-images-case2.arff", case2, *run.img_feats2);
+    } else {
+      r["j48_images_accuracy"] = r["j48_accuracy"];
+      r["j48_images_case2_accuracy"] = r["j48_case2_accuracy"];
+    }
+  }
+
+  static void print_row(const json& r, const RowRuns& run, const std::string& why) {
+    auto pct = [&](const char* key) {
+      char text[32] = "-";
+      if (!r[key].is_null()) std::snprintf(text, sizeof text, "%.1f%%", r[key].get<double>());
+      return std::string(text);
+    };
+    std::printf(
+        "  %-9s features %10.0f/s  images %8.0f/s  MMW max %d rmse %.4f  feature max %.4g  metal %.4f  noise sd %.4f "
+        "kurtosis %+.3f KS %.4f  J48 case 1 %s case 2 %s (from images %s, %s)%s\n",
+        run.name.c_str(), run.feat_rate, run.img_rate, run.img_err.mmw.max_abs, run.img_err.mmw.rmse_mean,
+        run.feat_err.feature_max_abs, run.feat_err.metal_exact, r["noise_sd"].get<double>(),
+        r["noise_excess_kurtosis"].get<double>(), r["noise_ks"].get<double>(), pct("j48_accuracy").c_str(),
+        pct("j48_case2_accuracy").c_str(), pct("j48_images_accuracy").c_str(), pct("j48_images_case2_accuracy").c_str(),
+        why.empty() ? "" : ("  OUT OF TOLERANCE: " + why).c_str());
+    std::fflush(stdout);
+  }
+};
+
+void print_model_header(const TradeoffOptions& o, const ModelSettings& model, const Catalogue& cat) {
+  std::printf("tradeoff, %s model: %llu scenarios (case 1, balanced), pixel noise %.3g, block %d",
+              model_name(model.model), static_cast<unsigned long long>(o.count), model.pixel_sigma, model.block);
+  if (model.model == Model::physics) {
+    std::printf(", NETD %.3g K, raw grid %dx%d, illumination %.4g K", model.netd, model.raw_width, model.raw_height,
+                model.illumination);
+    // The views whose camera keeps its own numbers over those (ModelSettings::for_view).
+    for (const Sensor& v : cat.sensors) {
+      if (v.netd) std::printf("; %s: NETD %.3g K", v.name.c_str(), *v.netd);
+      if (v.raw) std::printf("; %s: raw grid %dx%d", v.name.c_str(), (*v.raw)[0], (*v.raw)[1]);
+    }
+  }
+  std::printf("\n");
+  std::fflush(stdout);
+}
+
+// The reference's row, then one row per tier, of one model.
+void model_rows(ModelRows& mr, json& rows, const std::shared_ptr<OpenCLRuntime>& rt, const AssetSet& assets) {
+  const TradeoffOptions& o = mr.o;
+  const ModelSettings& model = mr.model;
+  const Model m = model.model;
+  const size_t draw_scenarios = std::min<size_t>(o.count, kDrawScenarios);
+  const Timed ref = run_timed(mr.reference, mr.batch, images_plan(model), 256, 0.0);
+  const OutputDiff self = compare_outputs(ref.out, ref.out);
+  // The reference renders every image for features too: one rate serves both, and its
+  // features come from its images: the same numbers either way.
+  put_distribution(rows.emplace_back(), reference_draws(m, model.seed, draw_scenarios));
+  mr.add_row(rows.back(), {.name = "reference",
+                           .tier = std::nullopt,
+                           .feat_rate = ref.rate,
+                           .img_rate = ref.rate,
+                           .img_err = self,
+                           .feat_err = self,
+                           .feats = &ref.out,
+                           .feats2 = mr.case2_features(mr.reference, features_plan(model)),
+                           .img_feats = nullptr,
+                           .img_feats2 = nullptr,
+                           .img_out = &ref.out});
+  for (Tier t : {Tier::exact, Tier::standard, Tier::fast}) {
+    const Fidelity f = tier_fidelity(t);
+    auto cl = make_opencl_backend(mr.cat, assets, rt);
+    Plan ip = images_plan(model), fp = features_plan(model);
+    ip.fidelity = fp.fidelity = f;
+    const Timed img = run_timed(*cl, mr.batch, ip, 1024, o.timed_seconds);
+    const Timed feat = run_timed(*cl, mr.batch, fp, 16384, o.timed_seconds);
+    put_distribution(rows.emplace_back(), opencl::noise_draws(*rt, f, opencl::KernelCounts::of(mr.cat), m, model.seed,
+                                                              0, draw_scenarios, kDrawCells));
+    const bool images_own_features = o.classifier && img.out.features != feat.out.features;
+    BatchOutput img2;
+    if (images_own_features) cl->run(mr.case2, ip, img2);
+    mr.add_row(rows.back(), {.name = tier_name(t),
+                             .tier = t,
+                             .feat_rate = feat.rate,
+                             .img_rate = img.rate,
+                             .img_err = compare_outputs(img.out, ref.out),
+                             .feat_err = compare_outputs(feat.out, ref.out),
+                             .feats = &feat.out,
+                             .feats2 = mr.case2_features(*cl, fp),
+                             .img_feats = images_own_features ? &img.out : nullptr,
+                             .img_feats2 = images_own_features ? &img2 : nullptr,
+                             .img_out = &img.out});
+  }
+}
+
+json tradeoff_report(const TradeoffOptions& o, const ModelSettings& base, const std::vector<Model>& models,
+                     const Catalogue& cat, const OpenCLRuntime& rt, const json& rows) {
+  json report;
+  report["count"] = o.count;
+  report["seed"] = std::to_string(base.seed);
+  report["pixel_noise"] = base.pixel_sigma;
+  report["pattern_noise"] = base.pattern_noise;
+  report["block"] = base.block;
+  report["timed_seconds"] = o.timed_seconds;
+  report["models"] = json::array();
+  for (Model m : models) report["models"].push_back(model_name(m));
+  report["physics"] = {{"netd_k", base.netd},
+                       {"mmw_raw", std::to_string(base.raw_width) + "x" + std::to_string(base.raw_height)},
+                       {"illumination_k", base.illumination},
+                       {"worn_minutes", base.worn_minutes}};
+  for (const Sensor& v : cat.sensors) {  // a view's own camera, where it has one
+    if (v.netd) report["physics"]["views"][v.name]["netd_k"] = *v.netd;
+    if (v.raw)
+      report["physics"]["views"][v.name]["mmw_raw"] = std::to_string((*v.raw)[0]) + "x" + std::to_string((*v.raw)[1]);
+  }
+  report["scenario_set"] = "thesis case 1: rule gun, balanced, 0..4 objects from every object";
+  report["case2_scenario_set"] =
+      "thesis case 2: rule iron-rod & metal-plate, balanced, 0..4 objects from metal-plate, iron-rod, compact-disk, "
+      "cement-tile, ceramic-plate, mobile-phone (classifier only)";
+  report["errors_against"] = "the fp64 CPU reference of the row's own model";
+  report["machine"] = std::to_string(::sysconf(_SC_NPROCESSORS_ONLN)) + " cores, " + rt.device_name();
+  report["rows"] = rows;
+  return report;
+}
+
+std::string tradeoff_csv(const json& rows) {
+  std::string csv =
+      "model,tier,precision,features_per_s,images_per_s,mmw_max_abs,mmw_rmse_mean,mmw_psnr_db,"
+      "mmw_share_off_by_more_than_1,ir_max_abs,feature_max_abs,feature_mean_abs,metal_exact_rate,label_exact_rate,"
+      "j48_accuracy,j48_case2_accuracy,within_tolerance,noise_draw,noise_sd,noise_skewness,noise_excess_kurtosis,"
+      "noise_ks,noise_max_abs,j48_images_accuracy,j48_images_case2_accuracy\n";
+  auto opt = [](const json& v) { return v.is_null() ? std::string() : std::to_string(v.get<double>()); };
+  for (const json& r : rows) {
+    char line[768];
+    std::snprintf(
+        line, sizeof line,
+        "%s,%s,%s,%.0f,%.0f,%d,%.6f,%.3f,%.8f,%d,%.6g,%.6g,%.6f,%.6f,%s,%s,%s,%s,%.6f,%.6f,%.6f,%.6f,%.4f,%s,"
+        "%s\n",
+        r["model"].get<std::string>().c_str(), r["name"].get<std::string>().c_str(),
+        r["precision"].get<std::string>().c_str(), r["features_per_s"].get<double>(), r["images_per_s"].get<double>(),
+        r["mmw_max_abs"].get<int>(), r["mmw_rmse_mean"].get<double>(), r["mmw_psnr_db"].get<double>(),
+        r["mmw_share_off_by_more_than_1"].get<double>(), r["ir_max_abs"].get<int>(), r["feature_max_abs"].get<double>(),
+        r["feature_mean_abs"].get<double>(), r["metal_exact_rate"].get<double>(), r["label_exact_rate"].get<double>(),
+        opt(r["j48_accuracy"]).c_str(), opt(r["j48_case2_accuracy"]).c_str(),
+        r["within_tolerance"].get<bool>() ? "yes" : "no", r["noise_draw"].get<std::string>().c_str(),
+        r["noise_sd"].get<double>(), r["noise_skewness"].get<double>(), r["noise_excess_kurtosis"].get<double>(),
+        r["noise_ks"].get<double>(), r["noise_max_abs"].get<double>(), opt(r["j48_images_accuracy"]).c_str(),
+        opt(r["j48_images_case2_accuracy"]).c_str());
+    csv += line;
+  }
+  return csv;
+}
+
 int tradeoff(TradeoffOptions& o) {
   if (o.count < 10 || o.count > 1000000) throw InputError("--count: must be between 10 and 1000000");
   if (o.out.empty()) throw InputError("--out: empty folder name");
@@ -212,245 +517,22 @@ int tradeoff(TradeoffOptions& o) {
   StagedFolder folder(o.out);
 
   auto rt = std::make_shared<OpenCLRuntime>(OpenCLOptions{o.common.device, ""});
-  const std::string staging = folder.dir();
-  // J48's 10-fold accuracy on one tier's features of one case, or null (with a note).
-  auto j48 = [&](json& r, const std::string& key, const std::string& arff, const SceneBatch& scenes,
-                 const BatchOutput& feats) {
-    r[key] = nullptr;
-    write_arff(staging, arff, scenes, feats, cat);
-    std::string why;
-    if (auto acc = j48_cv_accuracy((std::filesystem::path(staging) / arff).string(), why))
-      r[key] = *acc;
-    else
-      r["j48_note"] = why;
-    folder.path(arff);  // keep it
-  };
-
   json rows = json::array();
   for (Model m : models) {
     ModelSettings model = base;
     model.model = m;
-    const std::string mname = model_name(m);
-    std::printf("tradeoff, %s model: %llu scenarios (case 1, balanced), pixel noise %.3g, block %d", mname.c_str(),
-                static_cast<unsigned long long>(o.count), model.pixel_sigma, model.block);
-    if (m == Model::physics) {
-      std::printf(", NETD %.3g K, raw grid %dx%d, illumination %.4g K", model.netd, model.raw_width, model.raw_height,
-                  model.illumination);
-      // The views whose camera keeps its own numbers over those (ModelSettings::for_view).
-      for (const Sensor& v : cat.sensors) {
-        if (v.netd) std::printf("; %s: NETD %.3g K", v.name.c_str(), *v.netd);
-        if (v.raw) std::printf("; %s: raw grid %dx%d", v.name.c_str(), (*v.raw)[0], (*v.raw)[1]);
-      }
-    }
-    std::printf("\n");
-    std::fflush(stdout);
+    print_model_header(o, model, cat);
     auto reference = make_reference_backend(cat, s.assets);
-    const Timed ref = run_timed(*reference, batch, images_plan(model), 256, 0.0);
-    const size_t draw_scenarios = std::min<size_t>(o.count, kDrawScenarios);
-    // The reference following a tier's approximate pixel draws (Fidelity::draw), made once
-    // per draw: the tier's images are held to it (the reference's Box-Muller draws are
-    // other numbers, value by value).
-    std::map<NoiseDraw, BatchOutput> same_draw_refs;
-    auto same_draw_ref = [&](NoiseDraw d) -> const BatchOutput& {
-      auto it = same_draw_refs.find(d);
-      if (it != same_draw_refs.end()) return it->second;
-      Plan p = images_plan(model);
-      p.fidelity.draw = d;
-      reference->run(batch, p, same_draw_refs[d]);
-      return same_draw_refs[d];
-    };
-    // The reference renders every image for features too: one rate serves both.
-    // img_feats, img_feats2: the features of the images runs of cases 1 and 2 where they are
-    // not the features-only run's (the block-mean noise model), for J48 on them.
-    auto add_row = [&](const std::string& name, std::optional<Tier> tier, double feat_rate, double img_rate,
-                       const OutputDiff& img_err, const OutputDiff& feat_err, const BatchOutput& feats,
-                       const BatchOutput& feats2, const BatchOutput* img_feats, const BatchOutput* img_feats2,
-                       const BatchOutput* img_out) {
-      json& r = rows.back();  // holds the noise's distribution columns already
-      r["model"] = mname;
-      r["name"] = name;
-      // What the noise's distribution columns sample (put_distribution).
-      const bool irwin_hall = tier && tier_fidelity(*tier).draw == NoiseDraw::irwin_hall;
-      r["noise_draw"] = irwin_hall ? "irwin-hall" : m == Model::physics ? "table Gaussian" : "box-muller";
-      r["features_per_s"] = feat_rate;
-      r["images_per_s"] = img_rate;
-      r["mmw_max_abs"] = img_err.mmw.max_abs;
-      r["mmw_rmse_mean"] = img_err.mmw.rmse_mean;
-      r["mmw_rmse_max"] = img_err.mmw.rmse_max;
-      r["mmw_psnr_db"] = img_err.mmw.psnr;
-      r["mmw_share_off_by_more_than_1"] = img_err.mmw.share_off_by_more_than_1;
-      r["mmw_share_differing"] = img_err.mmw.share_differing;
-      r["ir_max_abs"] = img_err.ir.max_abs;
-      r["ir_rmse_mean"] = img_err.ir.rmse_mean;
-      r["ir_psnr_db"] = img_err.ir.psnr;
-      r["ir_share_off_by_more_than_1"] = img_err.ir.share_off_by_more_than_1;
-      r["feature_max_abs"] = feat_err.feature_max_abs;
-      r["feature_mean_abs"] = feat_err.feature_mean_abs;
-      r["metal_exact_rate"] = feat_err.metal_exact;
-      r["label_exact_rate"] = 1.0;  // labels come from the scenes, which every tier shares
-      std::string why;
-      if (tier) {
-        const Fidelity f = tier_fidelity(*tier);
-        r["precision"] = precision_name(f.precision);
-        r["pooling"] = f.pooling == Pooling::sparse ? "sparse" : "dense";
-        r["fast_math"] = f.fast_math;
-        r["noise_model"] = f.noise == NoiseModel::block_mean ? "block-mean" : "per-pixel";
-        // The tier's stated tolerance for this model (plan/tolerance.h), on images and features.
-        const Tolerance tol = model_tolerance(m, *tier);
-        // The features-only run holds no images. Its feature bounds hold without the
-        // block-mean noise model, which draws each mean's noise directly (the thesis's
-        // pixel noise; the physics model's NETD in feature space).
-        OutputDiff feat_checked;
-        feat_checked.metal_exact = feat_err.metal_exact;
-        const bool noise_per_mean = model.pixel_sigma > 0 || (m == Model::physics && model.netd > 0);
-        if (f.noise != NoiseModel::block_mean || !noise_per_mean) {
-          feat_checked.feature_max_abs = feat_err.feature_max_abs;
-          feat_checked.feature_mean_abs = feat_err.feature_mean_abs;
-        }
-        // A tier that draws the camera's frames as one approximate draw (Plan::frames_approximated)
-        // has other noise than the reference's, value by value: its images are held to the
-        // distribution instead (tests/camera_test.cpp); the error columns still show the cost.
-        Plan tier_images = images_plan(model);
-        tier_images.fidelity = f;
-        // The thesis model has no camera frames (the frames knob is the physics camera's).
-        const bool frames_approximated = m == Model::physics && tier_images.frames_approximated();
-        r["frames_approximated"] = frames_approximated;
-        // A tier with other pixel draws than the reference's is held to the reference
-        // following them; its error columns stay against the model's reference.
-        const bool other_draws = m == Model::thesis && model.pixel_sigma > 0 && f.draw != NoiseDraw::box_muller;
-        r["images_held_to"] = other_draws ? "the reference with the tier's noise_draw" : "the model's reference";
-        if (!frames_approximated) {
-          const OutputDiff held = other_draws ? compare_outputs(*img_out, same_draw_ref(f.draw)) : img_err;
-          if (other_draws) {
-            r["same_draw_mmw_max_abs"] = held.mmw.max_abs;
-            r["same_draw_mmw_rmse_mean"] = held.mmw.rmse_mean;
-            r["same_draw_mmw_share_differing"] = held.mmw.share_differing;
-          }
-          if (const std::string broke = check_tolerance(held, tol); !broke.empty()) why += "images run: " + broke;
-        }
-        if (const std::string broke = check_tolerance(feat_checked, tol); !broke.empty())
-          why += "features run: " + broke;
-      } else {
-        r["precision"] = "fp64 (CPU reference)";
-      }
-      r["within_tolerance"] = why.empty();
-      if (!why.empty()) r["tolerance_note"] = why;
-      r["j48_accuracy"] = nullptr;
-      r["j48_case2_accuracy"] = nullptr;
-      r["j48_images_accuracy"] = nullptr;
-      r["j48_images_case2_accuracy"] = nullptr;
-      if (o.classifier) {
-        j48(r, "j48_accuracy", mname + "-" + name + "-case1.arff", batch, feats);
-        j48(r, "j48_case2_accuracy", mname + "-" + name + "-case2.arff", case2, feats2);
-        // Features pooled from the images run: the features-only run's own where they are
-        // the same numbers, else J48 on them.
-        if (img_feats) {
-          j48(r, "j48_images_accuracy", mname + "-" + name + "-images-case1.arff", batch, *img_feats);
-          j48(r, "j48_images_case2_accuracy", mname + "-" + name + "-images-case2.arff", case2, *img_feats2);
-        } else {
-          r["j48_images_accuracy"] = r["j48_accuracy"];
-          r["j48_images_case2_accuracy"] = r["j48_case2_accuracy"];
-        }
-      }
-      auto pct = [&](const char* key) {
-        char text[32] = "-";
-        if (!r[key].is_null()) std::snprintf(text, sizeof text, "%.1f%%", r[key].get<double>());
-        return std::string(text);
-      };
-      std::printf(
-          "  %-9s features %10.0f/s  images %8.0f/s  MMW max %d rmse %.4f  feature max %.4g  metal %.4f  noise sd %.4f "
-          "kurtosis %+.3f KS %.4f  J48 case 1 %s case 2 %s (from images %s, %s)%s\n",
-          name.c_str(), feat_rate, img_rate, img_err.mmw.max_abs, img_err.mmw.rmse_mean, feat_err.feature_max_abs,
-          feat_err.metal_exact, r["noise_sd"].get<double>(), r["noise_excess_kurtosis"].get<double>(),
-          r["noise_ks"].get<double>(), pct("j48_accuracy").c_str(), pct("j48_case2_accuracy").c_str(),
-          pct("j48_images_accuracy").c_str(), pct("j48_images_case2_accuracy").c_str(),
-          why.empty() ? "" : ("  OUT OF TOLERANCE: " + why).c_str());
-      std::fflush(stdout);
-    };
-    // Case 2's features, one untimed pass (only the classifier reads them).
-    auto case2_features = [&](Backend& b, const Plan& plan) {
-      BatchOutput out;
-      if (o.classifier) b.run(case2, plan, out);
-      return out;
-    };
-    const OutputDiff self = compare_outputs(ref.out, ref.out);
-    // The reference's features come from its images: the same numbers either way.
-    put_distribution(rows.emplace_back(), reference_draws(m, model.seed, draw_scenarios));
-    add_row("reference", std::nullopt, ref.rate, ref.rate, self, self, ref.out,
-            case2_features(*reference, features_plan(model)), nullptr, nullptr, &ref.out);
-    for (Tier t : {Tier::exact, Tier::standard, Tier::fast}) {
-      const Fidelity f = tier_fidelity(t);
-      auto cl = make_opencl_backend(cat, s.assets, rt);
-      Plan ip = images_plan(model), fp = features_plan(model);
-      ip.fidelity = fp.fidelity = f;
-      const Timed img = run_timed(*cl, batch, ip, 1024, o.timed_seconds);
-      const Timed feat = run_timed(*cl, batch, fp, 16384, o.timed_seconds);
-      put_distribution(rows.emplace_back(), opencl::noise_draws(*rt, f, opencl::KernelCounts::of(cat), m, model.seed, 0,
-                                                                draw_scenarios, kDrawCells));
-      const bool images_own_features = o.classifier && img.out.features != feat.out.features;
-      BatchOutput img2;
-      if (images_own_features) cl->run(case2, ip, img2);
-      add_row(tier_name(t), t, feat.rate, img.rate, compare_outputs(img.out, ref.out),
-              compare_outputs(feat.out, ref.out), feat.out, case2_features(*cl, fp),
-              images_own_features ? &img.out : nullptr, images_own_features ? &img2 : nullptr, &img.out);
-    }
+    ModelRows mr(o, cat, batch, case2, folder, model, *reference);
+    model_rows(mr, rows, rt, s.assets);
   }
-
-  json report;
-  report["count"] = o.count;
-  report["seed"] = std::to_string(base.seed);
-  report["pixel_noise"] = base.pixel_sigma;
-  report["pattern_noise"] = base.pattern_noise;
-  report["block"] = base.block;
-  report["timed_seconds"] = o.timed_seconds;
-  report["models"] = json::array();
-  for (Model m : models) report["models"].push_back(model_name(m));
-  report["physics"] = {{"netd_k", base.netd},
-                       {"mmw_raw", std::to_string(base.raw_width) + "x" + std::to_string(base.raw_height)},
-                       {"illumination_k", base.illumination},
-                       {"worn_minutes", base.worn_minutes}};
-  for (const Sensor& v : cat.sensors) {  // a view's own camera, where it has one
-    if (v.netd) report["physics"]["views"][v.name]["netd_k"] = *v.netd;
-    if (v.raw)
-      report["physics"]["views"][v.name]["mmw_raw"] = std::to_string((*v.raw)[0]) + "x" + std::to_string((*v.raw)[1]);
-  }
-  report["scenario_set"] = "thesis case 1: rule gun, balanced, 0..4 objects from every object";
-  report["case2_scenario_set"] =
-      "thesis case 2: rule iron-rod & metal-plate, balanced, 0..4 objects from metal-plate, iron-rod, compact-disk, "
-      "cement-tile, ceramic-plate, mobile-phone (classifier only)";
-  report["errors_against"] = "the fp64 CPU reference of the row's own model";
-  report["machine"] = std::to_string(::sysconf(_SC_NPROCESSORS_ONLN)) + " cores, " + rt->device_name();
-  report["rows"] = rows;
-  write_text_atomic(folder.path("tradeoff.json"), report.dump(2) + "\n");
-  std::string csv =
-      "model,tier,precision,features_per_s,images_per_s,mmw_max_abs,mmw_rmse_mean,mmw_psnr_db,"
-      "mmw_share_off_by_more_than_1,ir_max_abs,feature_max_abs,feature_mean_abs,metal_exact_rate,label_exact_rate,"
-      "j48_accuracy,j48_case2_accuracy,within_tolerance,noise_draw,noise_sd,noise_skewness,noise_excess_kurtosis,"
-      "noise_ks,noise_max_abs,j48_images_accuracy,j48_images_case2_accuracy\n";
-  auto opt = [](const json& v) { return v.is_null() ? std::string() : std::to_string(v.get<double>()); };
-  for (const json& r : rows) {
-    char line[768];
-    std::snprintf(
-        line, sizeof line,
-        "%s,%s,%s,%.0f,%.0f,%d,%.6f,%.3f,%.8f,%d,%.6g,%.6g,%.6f,%.6f,%s,%s,%s,%s,%.6f,%.6f,%.6f,%.6f,%.4f,%s,"
-        "%s\n",
-        r["model"].get<std::string>().c_str(), r["name"].get<std::string>().c_str(),
-        r["precision"].get<std::string>().c_str(), r["features_per_s"].get<double>(), r["images_per_s"].get<double>(),
-        r["mmw_max_abs"].get<int>(), r["mmw_rmse_mean"].get<double>(), r["mmw_psnr_db"].get<double>(),
-        r["mmw_share_off_by_more_than_1"].get<double>(), r["ir_max_abs"].get<int>(), r["feature_max_abs"].get<double>(),
-        r["feature_mean_abs"].get<double>(), r["metal_exact_rate"].get<double>(), r["label_exact_rate"].get<double>(),
-        opt(r["j48_accuracy"]).c_str(), opt(r["j48_case2_accuracy"]).c_str(),
-        r["within_tolerance"].get<bool>() ? "yes" : "no", r["noise_draw"].get<std::string>().c_str(),
-        r["noise_sd"].get<double>(), r["noise_skewness"].get<double>(), r["noise_excess_kurtosis"].get<double>(),
-        r["noise_ks"].get<double>(), r["noise_max_abs"].get<double>(), opt(r["j48_images_accuracy"]).c_str(),
-        opt(r["j48_images_case2_accuracy"]).c_str());
-    csv += line;
-  }
-  write_text_atomic(folder.path("tradeoff.csv"), csv);
+  write_text_atomic(folder.path("tradeoff.json"), tradeoff_report(o, base, models, cat, *rt, rows).dump(2) + "\n");
+  write_text_atomic(folder.path("tradeoff.csv"), tradeoff_csv(rows));
 
   // The plot, drawn by the embedded matplotlib script; --no-plot for machines without it
   // (tools/device-check.sh on a GPU machine).
   if (o.plot) {
+    const std::string staging = folder.dir();
     run_plot_script(embedded::plot_tradeoff, staging, {staging}, "tradeoff.png");
     folder.path("tradeoff.png");
   }

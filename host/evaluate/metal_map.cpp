@@ -250,47 +250,18 @@ MetalWalks metal_map_walks(const Catalogue& cat, const MetalMapSettings& s) {
   return w;
 }
 
-json metal_map(const Catalogue& cat, const MetalMapSettings& s, OpenCLRuntime* rt) {
-  check_metal_map(cat, s);
+namespace {
+
+double clean_rate(const std::vector<std::vector<uint8_t>>& clean, int level) {
+  double sum = 0;
+  for (const auto& v : clean) sum += alarm_rate(v, level);
+  return sum / static_cast<double>(clean.size());
+}
+
+// What was mapped and how: the object, its carrier, the grid, the coils, the walk and the alarm rule.
+void describe_map(json& report, const Catalogue& cat, const MetalMapSettings& s, const TestObject& t, const Grid& g,
+                  const MetalWalks& w) {
   const MetalPhysics& mp = cat.metal_physics;
-  const Grid g = grid_of(mp, s.grid_step);
-  const TestObject t = test_object(cat, s.object);
-  const MetalWalks w = metal_map_walks(cat, s);
-  const opencl::MetalResponses r = responses(cat, w, rt);
-  const int Z = cat.zones, R = cat.region_count();
-
-  // Each walk's lowest reading per pass: the test object carried by the first subject, each
-  // clean tester on its own body.
-  std::vector<std::string> missing;
-  const std::vector<int> benign = benign_present(cat, &missing);
-  const size_t map_walks = 3 * g.cells();
-  auto base_of = [&](size_t walk) -> const std::vector<int>& {
-    const size_t subject = walk < map_walks ? 0 : (walk - map_walks) / (benign.size() * R);
-    return cat.subjects[subject].base_zones;
-  };
-  std::vector<std::vector<uint8_t>> lowest(w.walks);
-  parallel_for(w.walks, s.threads ? s.threads : default_threads(), [&](size_t begin, size_t end) {
-    for (size_t k = begin; k < end; ++k)
-      lowest[k] = lowest_readings(&r.deduction[k * w.samples * Z], w.samples, base_of(k), s, k);
-  });
-  // Clean testers without metal read their bases on every pass (no deduction, so no noise);
-  // with benign_clean, the benign items' carriers count as clean too.
-  std::vector<std::vector<uint8_t>> clean;
-  if (s.benign_clean) clean.assign(lowest.begin() + static_cast<std::ptrdiff_t>(map_walks), lowest.end());
-  for (const Subject& subject : cat.subjects)
-    clean.emplace_back(s.passes,
-                       static_cast<uint8_t>(*std::min_element(subject.base_zones.begin(), subject.base_zones.end())));
-  auto clean_rate = [&](int level) {
-    double sum = 0;
-    for (const auto& v : clean) sum += alarm_rate(v, level);
-    return sum / static_cast<double>(clean.size());
-  };
-  // The operating level: the most sensitive (highest) whose clean false-alarm rate is within Pfa.
-  int level = 0;
-  for (int v = 199; v >= 1 && level == 0; --v)
-    if (clean_rate(v) <= s.pfa) level = v;
-
-  json report;
   const Object& object = cat.objects[t.object];
   report["object"] = object.name;
   report["metal_category"] = cat.metal_categories[object.metal];
@@ -322,17 +293,13 @@ json metal_map(const Catalogue& cat, const MetalMapSettings& s, OpenCLRuntime* r
   report["alarm_rule"] =
       "a pass alarms at sensitivity S when any zone's reading, at any sample, is S or below "
       "(200 reads no metal; a higher S is more sensitive)";
-  report["threshold"] = {{"pfa", s.pfa},
-                         {"sensitivity", level},
-                         {"clean_false_alarm_rate", clean_rate(level)},
-                         {"clean_testers", clean.size()},
-                         {"clean_testers_are", s.benign_clean ? "each subject without metal, and with each benign "
-                                                                "item in each region"
-                                                              : "each subject without metal"}};
-  report["benign"] = {{"present", json::array()}, {"missing", missing}};
-  for (int o : benign) report["benign"]["present"].push_back(cat.objects[o].name);
+}
 
-  // The map: per orientation, rows of z, columns of x; null where the object cannot be.
+// The map, per orientation (rows of z, columns of x; null where the object cannot be), and the
+// critical orientation.
+void map_orientations(json& report, const MetalPhysics& mp, const Grid& g, const TestObject& t, const MetalWalks& w,
+                      const opencl::MetalResponses& r, const std::vector<std::vector<uint8_t>>& lowest, int Z,
+                      int level) {
   json orientations = json::array();
   double best_mean = 2, all_max = 0, all_min = std::numeric_limits<double>::infinity();
   json critical;
@@ -407,9 +374,16 @@ json metal_map(const Catalogue& cat, const MetalMapSettings& s, OpenCLRuntime* r
   report["orientations"] = orientations;
   report["critical"] = critical;
   report["sensitivity_ratio"] = all_min > 0 && std::isfinite(all_min) ? json(all_max / all_min) : json(nullptr);
+}
 
-  // Each sensitivity setting (and the operating level): clean false alarms, each benign item's
-  // nuisance-alarm rate over subjects and regions, and the test object's Pd.
+// Each sensitivity setting (and the operating level): clean false alarms, each benign item's
+// nuisance-alarm rate over subjects and regions, and the test object's Pd.
+json sensitivity_settings(const Catalogue& cat, const MetalMapSettings& s, const Grid& g, const TestObject& t,
+                          const std::vector<int>& benign, const std::vector<std::vector<uint8_t>>& lowest,
+                          const std::vector<std::vector<uint8_t>>& clean, int level) {
+  const MetalPhysics& mp = cat.metal_physics;
+  const int R = cat.region_count();
+  const size_t map_walks = 3 * g.cells();
   std::vector<int> levels = s.settings;
   if (level > 0) levels.push_back(level);
   std::sort(levels.begin(), levels.end());
@@ -445,13 +419,66 @@ json metal_map(const Catalogue& cat, const MetalMapSettings& s, OpenCLRuntime* r
     }
     settings.push_back({{"sensitivity", v},
                         {"operating", v == level},
-                        {"clean_false_alarm_rate", clean_rate(v)},
+                        {"clean_false_alarm_rate", clean_rate(clean, v)},
                         {"nuisance_alarm_rate", nuisance},
                         {"pd_mean", cells ? pd_sum / static_cast<double>(cells) : 0.0},
                         {"pd_mean_by_orientation", by_axis},
                         {"pd_min", cells ? pd_min : 0.0}});
   }
-  report["sensitivity_settings"] = settings;
+  return settings;
+}
+
+}  // namespace
+
+json metal_map(const Catalogue& cat, const MetalMapSettings& s, OpenCLRuntime* rt) {
+  check_metal_map(cat, s);
+  const MetalPhysics& mp = cat.metal_physics;
+  const Grid g = grid_of(mp, s.grid_step);
+  const TestObject t = test_object(cat, s.object);
+  const MetalWalks w = metal_map_walks(cat, s);
+  const opencl::MetalResponses r = responses(cat, w, rt);
+  const int Z = cat.zones, R = cat.region_count();
+
+  // Each walk's lowest reading per pass: the test object carried by the first subject, each
+  // clean tester on its own body.
+  std::vector<std::string> missing;
+  const std::vector<int> benign = benign_present(cat, &missing);
+  const size_t map_walks = 3 * g.cells();
+  auto base_of = [&](size_t walk) -> const std::vector<int>& {
+    const size_t subject = walk < map_walks ? 0 : (walk - map_walks) / (benign.size() * R);
+    return cat.subjects[subject].base_zones;
+  };
+  std::vector<std::vector<uint8_t>> lowest(w.walks);
+  parallel_for(w.walks, s.threads ? s.threads : default_threads(), [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k)
+      lowest[k] = lowest_readings(&r.deduction[k * w.samples * Z], w.samples, base_of(k), s, k);
+  });
+  // Clean testers without metal read their bases on every pass (no deduction, so no noise);
+  // with benign_clean, the benign items' carriers count as clean too.
+  std::vector<std::vector<uint8_t>> clean;
+  if (s.benign_clean) clean.assign(lowest.begin() + static_cast<std::ptrdiff_t>(map_walks), lowest.end());
+  for (const Subject& subject : cat.subjects)
+    clean.emplace_back(s.passes,
+                       static_cast<uint8_t>(*std::min_element(subject.base_zones.begin(), subject.base_zones.end())));
+  // The operating level: the most sensitive (highest) whose clean false-alarm rate is within Pfa.
+  int level = 0;
+  for (int v = 199; v >= 1 && level == 0; --v)
+    if (clean_rate(clean, v) <= s.pfa) level = v;
+
+  json report;
+  describe_map(report, cat, s, t, g, w);
+  report["threshold"] = {{"pfa", s.pfa},
+                         {"sensitivity", level},
+                         {"clean_false_alarm_rate", clean_rate(clean, level)},
+                         {"clean_testers", clean.size()},
+                         {"clean_testers_are", s.benign_clean ? "each subject without metal, and with each benign "
+                                                                "item in each region"
+                                                              : "each subject without metal"}};
+  report["benign"] = {{"present", json::array()}, {"missing", missing}};
+  for (int o : benign) report["benign"]["present"].push_back(cat.objects[o].name);
+
+  map_orientations(report, mp, g, t, w, r, lowest, Z, level);
+  report["sensitivity_settings"] = sensitivity_settings(cat, s, g, t, benign, lowest, clean, level);
   return report;
 }
 

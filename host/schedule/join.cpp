@@ -280,230 +280,228 @@ std::vector<Part> read_parts(const std::vector<std::string>& dirs) {
   return kept;
 }
 
-JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir, Ranks& ranks) {
-  const fs::path out(out_dir), work = out / kStateDir / "join";
-  const int me = ranks.rank(), size = ranks.size();
-  const auto mine = [&](size_t k) { return static_cast<int>(k % static_cast<size_t>(size)) == me; };
-  const json& first = parts[0].manifest;
-  const uint64_t total = parts.back().end;
+namespace {
 
-  JoinResult res;
-  res.count = total;
-  for (const Part& p : parts) {
-    res.positive += p.manifest.at("classes").at("positive").get<uint64_t>();
-    res.negative += p.manifest.at("classes").at("negative").get<uint64_t>();
-  }
-  json identity = shared_identity(first);
-  identity["shard"] = {{"index", 0}, {"count", 1}, {"begin", 0}, {"end", total}};
+// Which parts (and which outputs' hashes) a rank handles: every size-th from its rank.
+struct Share {
+  int me = 0, size = 1;
+  bool mine(size_t k) const { return static_cast<int>(k % static_cast<size_t>(size)) == me; }
+};
 
-  // The plan, the same on every rank: per output, the whole header and where each part's
-  // rows go. data.h5 is joined as one .npy per dataset, then built by rank 0.
-  struct Piece {
-    std::string src;
-    json recorded;                         // the part manifest's entry for the file
-    uint64_t from = 0, bytes = 0, to = 0;  // for h5: rows [from, from + bytes) of `to`'s first row
-  };
-  struct Output {
-    std::string name, path, header;
-    uint64_t bytes = 0;
-    int dataset = -1;           // h5.datasets index, for a dataset of data.h5
-    std::vector<Piece> pieces;  // one per part
-  };
-  std::map<std::string, std::pair<uint64_t, uint64_t>> written;  // output -> (bytes, XXH3-64) hashed while written
-  const auto recorded = [&](size_t k, const std::string& name) {
-    for (const json& o : parts[k].manifest["outputs"])
-      if (o.value("name", "") == name) return o;
-    throw InputError(parts[k].dir + "/manifest.json: no entry for " + name);
-  };
-  std::vector<Output> outputs;
+struct JoinedPiece {
+  std::string src;
+  json recorded;                         // the part manifest's entry for the file
+  uint64_t from = 0, bytes = 0, to = 0;  // for h5: rows [from, from + bytes) of `to`'s first row
+};
+struct JoinedOutput {
+  std::string name, path, header;
+  uint64_t bytes = 0;
+  int dataset = -1;                 // h5.datasets index, for a dataset of data.h5
+  std::vector<JoinedPiece> pieces;  // one per part
+};
+
+// The plan, the same on every rank: per output, the whole header and where each part's
+// rows go. data.h5 is joined as one .npy per dataset, then built by rank 0.
+struct JoinPlan {
+  std::vector<JoinedOutput> outputs;
   std::vector<std::string> dataset_paths;
   H5Layout h5;
   bool has_h5 = false;
-  // A part's data.h5 must be what its manifest records before HDF5 opens it.
-  ranks.together([&] {
-    for (size_t k = 0; k < parts.size(); ++k)
-      if (mine(k))
-        for (const json& o : parts[k].manifest["outputs"])
-          if (o["name"] == "data.h5") {
-            io::check_regular_file((fs::path(parts[k].dir) / "data.h5").string(), "part's data.h5", SIZE_MAX);
-            const FileState f = hash_file(parts[k].dir, "data.h5");
-            check_recorded((fs::path(parts[k].dir) / "data.h5").string(), o, f.bytes, f.xxh3);
-          }
-  });
-  ranks.together([&] {
-    for (const json& o : first["outputs"]) {
-      const std::string name = o.at("name").get<std::string>();
-      const JoinAs kind = join_of(name, parts[0].dir);
-      if (kind == JoinAs::h5) {
-        has_h5 = true;
-        std::vector<H5Layout> layouts;
-        for (const Part& p : parts) layouts.push_back(read_h5_layout((fs::path(p.dir) / name).string()));
-        h5 = layouts[0];
-        for (size_t k = 0; k < parts.size(); ++k) {
-          H5Layout& l = layouts[k];
-          const std::string path = (fs::path(parts[k].dir) / name).string();
-          if (l.rows != parts[k].end - parts[k].begin)
-            throw InputError(path + ": holds " + std::to_string(l.rows) + " rows; its manifest says " +
-                             std::to_string(parts[k].end - parts[k].begin));
-          bool same = l.compress == h5.compress && l.datasets.size() == h5.datasets.size() &&
-                      l.attributes.size() == h5.attributes.size();
-          for (size_t d = 0; same && d < l.datasets.size(); ++d)
-            same = l.datasets[d].name == h5.datasets[d].name && l.datasets[d].type == h5.datasets[d].type &&
-                   l.datasets[d].dims == h5.datasets[d].dims && l.datasets[d].columns == h5.datasets[d].columns;
-          for (size_t a = 0; same && a < l.attributes.size(); ++a)
-            same = l.attributes[a].name == h5.attributes[a].name &&
-                   (l.attributes[a].name == "identity" || l.attributes[a].values == h5.attributes[a].values);
-          if (!same) throw InputError(path + ": its datasets or attributes differ from " + parts[0].dir + "/data.h5");
+};
+
+json recorded_entry(const Part& part, const std::string& name) {
+  for (const json& o : part.manifest["outputs"])
+    if (o.value("name", "") == name) return o;
+  throw InputError(part.dir + "/manifest.json: no entry for " + name);
+}
+
+// A part's data.h5 must be what its manifest records before HDF5 opens it.
+void check_part_h5s(const std::vector<Part>& parts, Share share) {
+  for (size_t k = 0; k < parts.size(); ++k)
+    if (share.mine(k))
+      for (const json& o : parts[k].manifest["outputs"])
+        if (o["name"] == "data.h5") {
+          io::check_regular_file((fs::path(parts[k].dir) / "data.h5").string(), "part's data.h5", SIZE_MAX);
+          const FileState f = hash_file(parts[k].dir, "data.h5");
+          check_recorded((fs::path(parts[k].dir) / "data.h5").string(), o, f.bytes, f.xxh3);
         }
-        h5.rows = total;
-        for (H5Attribute& a : h5.attributes)
-          if (a.name == "identity") a.values = {identity.dump()};
-        for (size_t di = 0; di < h5.datasets.size(); ++di) {
-          const H5Dataset& d = h5.datasets[di];
-          Output t;
-          t.name = "data.h5:" + d.name;
-          t.dataset = static_cast<int>(di);
-          t.path = (work / (d.name + ".npy")).string();
-          std::vector<uint64_t> shape{total};
-          shape.insert(shape.end(), d.dims.begin(), d.dims.end());
-          t.header = npy_array_header(npy_descr(d.type), shape);
-          t.bytes = t.header.size() + total * d.row_bytes();
-          for (const Part& p : parts)
-            t.pieces.push_back(Piece{(fs::path(p.dir) / name).string(), json(), 0, p.end - p.begin,
+}
+
+// data.h5's datasets, each joined as one .npy under `work`: every part's layout must be the
+// first's, and its rows what its manifest says.
+void plan_h5(JoinPlan& plan, const std::vector<Part>& parts, const std::string& name, const json& identity,
+             const fs::path& work) {
+  const uint64_t total = parts.back().end;
+  H5Layout& h5 = plan.h5;
+  plan.has_h5 = true;
+  std::vector<H5Layout> layouts;
+  for (const Part& p : parts) layouts.push_back(read_h5_layout((fs::path(p.dir) / name).string()));
+  h5 = layouts[0];
+  for (size_t k = 0; k < parts.size(); ++k) {
+    H5Layout& l = layouts[k];
+    const std::string path = (fs::path(parts[k].dir) / name).string();
+    if (l.rows != parts[k].end - parts[k].begin)
+      throw InputError(path + ": holds " + std::to_string(l.rows) + " rows; its manifest says " +
+                       std::to_string(parts[k].end - parts[k].begin));
+    bool same = l.compress == h5.compress && l.datasets.size() == h5.datasets.size() &&
+                l.attributes.size() == h5.attributes.size();
+    for (size_t d = 0; same && d < l.datasets.size(); ++d)
+      same = l.datasets[d].name == h5.datasets[d].name && l.datasets[d].type == h5.datasets[d].type &&
+             l.datasets[d].dims == h5.datasets[d].dims && l.datasets[d].columns == h5.datasets[d].columns;
+    for (size_t a = 0; same && a < l.attributes.size(); ++a)
+      same = l.attributes[a].name == h5.attributes[a].name &&
+             (l.attributes[a].name == "identity" || l.attributes[a].values == h5.attributes[a].values);
+    if (!same) throw InputError(path + ": its datasets or attributes differ from " + parts[0].dir + "/data.h5");
+  }
+  h5.rows = total;
+  for (H5Attribute& a : h5.attributes)
+    if (a.name == "identity") a.values = {identity.dump()};
+  for (size_t di = 0; di < h5.datasets.size(); ++di) {
+    const H5Dataset& d = h5.datasets[di];
+    JoinedOutput t;
+    t.name = "data.h5:" + d.name;
+    t.dataset = static_cast<int>(di);
+    t.path = (work / (d.name + ".npy")).string();
+    std::vector<uint64_t> shape{total};
+    shape.insert(shape.end(), d.dims.begin(), d.dims.end());
+    t.header = npy_array_header(npy_descr(d.type), shape);
+    t.bytes = t.header.size() + total * d.row_bytes();
+    for (const Part& p : parts)
+      t.pieces.push_back(JoinedPiece{(fs::path(p.dir) / name).string(), json(), 0, p.end - p.begin,
                                      t.header.size() + p.begin * d.row_bytes()});
-          dataset_paths.push_back(t.path);
-          outputs.push_back(std::move(t));
-        }
-        continue;
-      }
-      Output t;
-      t.name = name;
-      t.path = (out / (name + ".partial")).string();
-      uint64_t to = 0;
-      std::vector<uint64_t> dims;
-      for (size_t k = 0; k < parts.size(); ++k) {
-        const std::string src = (fs::path(parts[k].dir) / name).string();
-        std::error_code ec;
-        const uint64_t size = fs::file_size(src, ec);
-        if (ec) throw InputError(src + ": cannot read: " + ec.message());
-        if (const uint64_t want = recorded(k, name).value("bytes", uint64_t(0)); size != want)
-          throw InputError(src + ": " + std::to_string(size) + " bytes; its manifest.json records " +
-                           std::to_string(want) + " (changed or damaged since)");
-        std::string header;
-        if (kind == JoinAs::text) {
-          const size_t h = text_header_bytes(src, header);
-          if (k == 0) t.header = header;
-          if (header != t.header) throw InputError(src + ": its header differs from " + parts[0].dir + "/" + name);
-          t.pieces.push_back(Piece{src, recorded(k, name), h, size - h, 0});
-        } else {
-          const NpyHeader h = read_npy_header(src);
-          std::vector<uint64_t> rest(h.shape.begin() + 1, h.shape.end());
-          if (k == 0) {
-            dims = rest;
-            std::vector<uint64_t> shape{total};
-            shape.insert(shape.end(), rest.begin(), rest.end());
-            t.header = npy_array_header(h.descr, shape);
-          }
-          if (rest != dims || h.shape[0] != parts[k].end - parts[k].begin ||
-              npy_array_header(h.descr, h.shape).size() != h.bytes)
-            throw InputError(src + ": its shape does not fit the part's " +
-                             std::to_string(parts[k].end - parts[k].begin) + " rows or " + parts[0].dir + "/" + name);
-          t.pieces.push_back(Piece{src, recorded(k, name), h.bytes, size - h.bytes, 0});
-        }
-      }
-      to = t.header.size();
-      for (Piece& p : t.pieces) {
-        p.to = to;
-        to += p.bytes;
-      }
-      t.bytes = to;
-      outputs.push_back(std::move(t));
-    }
-  });
+    plan.dataset_paths.push_back(t.path);
+    plan.outputs.push_back(std::move(t));
+  }
+}
 
-  // Rank 0 makes every file at its size with its header; then each rank writes its parts.
-  ranks.together([&] {
-    if (me != 0) return;
+// A text or .npy output, joined under out as name.partial: each part's file must be the size
+// its manifest records, and its header (text) or shape (.npy) the first part's.
+JoinedOutput plan_file(const std::vector<Part>& parts, const std::string& name, JoinAs kind, const fs::path& out) {
+  const uint64_t total = parts.back().end;
+  JoinedOutput t;
+  t.name = name;
+  t.path = (out / (name + ".partial")).string();
+  std::vector<uint64_t> dims;
+  for (size_t k = 0; k < parts.size(); ++k) {
+    const std::string src = (fs::path(parts[k].dir) / name).string();
     std::error_code ec;
-    if (has_h5) {
-      fs::create_directories(work, ec);
-      if (ec) throw OutputError(work.string() + ": cannot create: " + ec.message());
-    }
-    if (first.contains("images")) {
-      fs::create_directories(out / "images", ec);
-      if (ec) throw OutputError((out / "images").string() + ": cannot create: " + ec.message());
-    }
-    for (const Output& t : outputs) create_sized(t.path, t.header, t.bytes);
-    // Small files beside the outputs (an npy table's column names) are the same in every part.
-    for (const auto& e : fs::directory_iterator(parts[0].dir)) {
-      const std::string n = e.path().filename().string();
-      if (!e.is_regular_file() || n == "manifest.json" || n == "README.md" || n == "croissant.json" ||
-          n.starts_with(kStateDir))
-        continue;  // each part's own; the whole gets its own card
-      bool listed = false;
-      for (const json& o : first["outputs"]) listed = listed || o["name"] == n;
-      if (listed) continue;
-      const std::string text = read_whole(e.path());
-      for (const Part& p : parts)
-        if (read_whole(fs::path(p.dir) / n) != text)
-          throw InputError(p.dir + "/" + n + ": differs from " + parts[0].dir + "/" + n);
-      write_text_atomic((out / n).string(), text);
-    }
-  });
-  ranks.together([&] {
-    std::vector<char> buf;
-    for (Output& t : outputs) {
-      RangeWriter w(t.path);
-      // Alone, this rank writes every byte in order: hash as it goes, saving a read.
-      Xxh3 whole(nullptr, XXH3_freeState);
-      if (size == 1 && t.dataset < 0) {
-        whole = new_xxh3();
-        XXH3_64bits_update(whole.get(), t.header.data(), t.header.size());
+    const uint64_t size = fs::file_size(src, ec);
+    if (ec) throw InputError(src + ": cannot read: " + ec.message());
+    const json recorded = recorded_entry(parts[k], name);
+    if (const uint64_t want = recorded.value("bytes", uint64_t(0)); size != want)
+      throw InputError(src + ": " + std::to_string(size) + " bytes; its manifest.json records " + std::to_string(want) +
+                       " (changed or damaged since)");
+    std::string header;
+    if (kind == JoinAs::text) {
+      const size_t h = text_header_bytes(src, header);
+      if (k == 0) t.header = header;
+      if (header != t.header) throw InputError(src + ": its header differs from " + parts[0].dir + "/" + name);
+      t.pieces.push_back(JoinedPiece{src, recorded, h, size - h, 0});
+    } else {
+      const NpyHeader h = read_npy_header(src);
+      std::vector<uint64_t> rest(h.shape.begin() + 1, h.shape.end());
+      if (k == 0) {
+        dims = rest;
+        std::vector<uint64_t> shape{total};
+        shape.insert(shape.end(), rest.begin(), rest.end());
+        t.header = npy_array_header(h.descr, shape);
       }
-      for (size_t k = 0; k < parts.size(); ++k) {
-        if (!mine(k)) continue;
-        const Piece& p = t.pieces[k];
-        if (t.dataset >= 0) {
-          const H5Dataset& d = h5.datasets[static_cast<size_t>(t.dataset)];
-          const uint64_t row = d.row_bytes(), block = std::max<uint64_t>(1, kIoPieceBytes / std::max<uint64_t>(1, row));
-          for (uint64_t r = 0; r < p.bytes; r += block) {
-            const uint64_t n = std::min(block, p.bytes - r);
-            buf.resize(static_cast<size_t>(n * row));
-            read_h5_rows(p.src, d, r, n, buf.data());
-            w.write(buf.data(), buf.size(), p.to + r * row);
-          }
-        } else {
-          copy_range(p.src, p.recorded, p.from, p.bytes, w, p.to, whole.get());
-        }
-      }
-      w.finish();
-      if (whole) written[t.name] = {t.bytes, XXH3_64bits_digest(whole.get())};
+      if (rest != dims || h.shape[0] != parts[k].end - parts[k].begin ||
+          npy_array_header(h.descr, h.shape).size() != h.bytes)
+        throw InputError(src + ": its shape does not fit the part's " + std::to_string(parts[k].end - parts[k].begin) +
+                         " rows or " + parts[0].dir + "/" + name);
+      t.pieces.push_back(JoinedPiece{src, recorded, h.bytes, size - h.bytes, 0});
     }
-    if (first.contains("images"))
-      for (size_t k = 0; k < parts.size(); ++k) {
-        if (!mine(k)) continue;
-        for (uint64_t i = parts[k].begin; i < parts[k].end; ++i) {
-          const std::string name = image_folder_name(i);
-          link_folder(fs::path(parts[k].dir) / "images" / name, out / "images" / name);
-        }
-      }
-  });
+  }
+  uint64_t to = t.header.size();
+  for (JoinedPiece& p : t.pieces) {
+    p.to = to;
+    to += p.bytes;
+  }
+  t.bytes = to;
+  return t;
+}
 
-  // data.h5 from the joined datasets (one writer: HDF5 without MPI is serial).
-  ranks.together([&] {
-    if (me != 0 || !has_h5) return;
-    write_h5(out_dir, h5, dataset_paths);
-    std::error_code ec;
-    fs::remove_all(work, ec);
-  });
+// Rank 0's share: every file at its size with its header, and the small files beside the
+// outputs (an npy table's column names), which are the same in every part.
+void create_outputs(const JoinPlan& plan, const std::vector<Part>& parts, const fs::path& out, const fs::path& work) {
+  const json& first = parts[0].manifest;
+  std::error_code ec;
+  if (plan.has_h5) {
+    fs::create_directories(work, ec);
+    if (ec) throw OutputError(work.string() + ": cannot create: " + ec.message());
+  }
+  if (first.contains("images")) {
+    fs::create_directories(out / "images", ec);
+    if (ec) throw OutputError((out / "images").string() + ": cannot create: " + ec.message());
+  }
+  for (const JoinedOutput& t : plan.outputs) create_sized(t.path, t.header, t.bytes);
+  for (const auto& e : fs::directory_iterator(parts[0].dir)) {
+    const std::string n = e.path().filename().string();
+    if (!e.is_regular_file() || n == "manifest.json" || n == "README.md" || n == "croissant.json" ||
+        n.starts_with(kStateDir))
+      continue;  // each part's own; the whole gets its own card
+    bool listed = false;
+    for (const json& o : first["outputs"]) listed = listed || o["name"] == n;
+    if (listed) continue;
+    const std::string text = read_whole(e.path());
+    for (const Part& p : parts)
+      if (read_whole(fs::path(p.dir) / n) != text)
+        throw InputError(p.dir + "/" + n + ": differs from " + parts[0].dir + "/" + n);
+    write_text_atomic((out / n).string(), text);
+  }
+}
 
-  // Hashes for the manifest, the outputs shared out among the ranks.
-  std::vector<std::string> names;
-  for (const json& o : first["outputs"]) names.push_back(o["name"]);
+// This rank's parts of every output and of the images; `written` gets the (bytes, XXH3-64)
+// of each output a lone rank wrote whole, hashed as it went.
+void write_pieces(const JoinPlan& plan, const std::vector<Part>& parts, Share share, const fs::path& out,
+                  std::map<std::string, std::pair<uint64_t, uint64_t>>& written) {
+  std::vector<char> buf;
+  for (const JoinedOutput& t : plan.outputs) {
+    RangeWriter w(t.path);
+    // Alone, this rank writes every byte in order: hash as it goes, saving a read.
+    Xxh3 whole(nullptr, XXH3_freeState);
+    if (share.size == 1 && t.dataset < 0) {
+      whole = new_xxh3();
+      XXH3_64bits_update(whole.get(), t.header.data(), t.header.size());
+    }
+    for (size_t k = 0; k < parts.size(); ++k) {
+      if (!share.mine(k)) continue;
+      const JoinedPiece& p = t.pieces[k];
+      if (t.dataset >= 0) {
+        const H5Dataset& d = plan.h5.datasets[static_cast<size_t>(t.dataset)];
+        const uint64_t row = d.row_bytes(), block = std::max<uint64_t>(1, kIoPieceBytes / std::max<uint64_t>(1, row));
+        for (uint64_t r = 0; r < p.bytes; r += block) {
+          const uint64_t n = std::min(block, p.bytes - r);
+          buf.resize(static_cast<size_t>(n * row));
+          read_h5_rows(p.src, d, r, n, buf.data());
+          w.write(buf.data(), buf.size(), p.to + r * row);
+        }
+      } else {
+        copy_range(p.src, p.recorded, p.from, p.bytes, w, p.to, whole.get());
+      }
+    }
+    w.finish();
+    if (whole) written[t.name] = {t.bytes, XXH3_64bits_digest(whole.get())};
+  }
+  if (parts[0].manifest.contains("images"))
+    for (size_t k = 0; k < parts.size(); ++k) {
+      if (!share.mine(k)) continue;
+      for (uint64_t i = parts[k].begin; i < parts[k].end; ++i) {
+        const std::string name = image_folder_name(i);
+        link_folder(fs::path(parts[k].dir) / "images" / name, out / "images" / name);
+      }
+    }
+}
+
+// Each output's bytes and hash for the manifest, the outputs shared out among the ranks.
+std::vector<FileState> output_states(const std::vector<std::string>& names,
+                                     const std::map<std::string, std::pair<uint64_t, uint64_t>>& written,
+                                     const std::string& out_dir, Ranks& ranks, Share share) {
   json hashes = json::object(), mine_h = json::object();
   ranks.together([&] {
     for (size_t i = 0; i < names.size(); ++i) {
-      if (!mine(i)) continue;
+      if (!share.mine(i)) continue;
       if (const auto it = written.find(names[i]); it != written.end()) {
         mine_h[names[i]] = {it->second.first, it->second.second};
         continue;
@@ -517,15 +515,64 @@ JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir
     const json theirs = json::parse(g);
     for (const auto& [k, v] : theirs.items()) hashes[k] = v;
   }
-
   std::vector<FileState> states;
-  for (const std::string& n : names) {
+  for (const std::string& n : names)
     states.push_back(FileState{n, hashes.at(n)[0].get<uint64_t>(), hashes.at(n)[1].get<uint64_t>()});
-    res.bytes += states.back().bytes;
+  return states;
+}
+
+}  // namespace
+
+JoinResult join_parts(const std::vector<Part>& parts, const std::string& out_dir, Ranks& ranks) {
+  const fs::path out(out_dir), work = out / kStateDir / "join";
+  const Share share{ranks.rank(), ranks.size()};
+  const json& first = parts[0].manifest;
+  const uint64_t total = parts.back().end;
+
+  JoinResult res;
+  res.count = total;
+  for (const Part& p : parts) {
+    res.positive += p.manifest.at("classes").at("positive").get<uint64_t>();
+    res.negative += p.manifest.at("classes").at("negative").get<uint64_t>();
   }
+  json identity = shared_identity(first);
+  identity["shard"] = {{"index", 0}, {"count", 1}, {"begin", 0}, {"end", total}};
+
+  std::map<std::string, std::pair<uint64_t, uint64_t>> written;  // output -> (bytes, XXH3-64) hashed while written
+  JoinPlan plan;
+  ranks.together([&] { check_part_h5s(parts, share); });
+  ranks.together([&] {
+    for (const json& o : first["outputs"]) {
+      const std::string name = o.at("name").get<std::string>();
+      const JoinAs kind = join_of(name, parts[0].dir);
+      if (kind == JoinAs::h5)
+        plan_h5(plan, parts, name, identity, work);
+      else
+        plan.outputs.push_back(plan_file(parts, name, kind, out));
+    }
+  });
+
+  // Rank 0 makes every file at its size with its header; then each rank writes its parts.
+  ranks.together([&] {
+    if (share.me == 0) create_outputs(plan, parts, out, work);
+  });
+  ranks.together([&] { write_pieces(plan, parts, share, out, written); });
+
+  // data.h5 from the joined datasets (one writer: HDF5 without MPI is serial).
+  ranks.together([&] {
+    if (share.me != 0 || !plan.has_h5) return;
+    write_h5(out_dir, plan.h5, plan.dataset_paths);
+    std::error_code ec;
+    fs::remove_all(work, ec);
+  });
+
+  std::vector<std::string> names;
+  for (const json& o : first["outputs"]) names.push_back(o["name"]);
+  const std::vector<FileState> states = output_states(names, written, out_dir, ranks, share);
+  for (const FileState& f : states) res.bytes += f.bytes;
 
   ranks.together([&] {
-    if (me != 0) return;
+    if (share.me != 0) return;
     for (const std::string& n : names) {
       if (n == "data.h5") continue;
       std::error_code ec;

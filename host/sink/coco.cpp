@@ -1,5 +1,6 @@
 #include "sink/coco.h"
 
+#include <array>
 #include <charconv>
 #include <cstdio>
 #include <filesystem>
@@ -149,6 +150,14 @@ class CocoSink final : public Sink {
       const auto r = std::to_chars(b, b + sizeof b, v);
       s.append(b, r.ptr);
     };
+    const auto list = [&num](std::string& s, const auto& values) {  // [a,b,...]
+      s += '[';
+      for (auto v : values) {
+        num(s, v);
+        s += ',';
+      }
+      s.back() = ']';
+    };
     for (size_t k = 0; k < views; ++k) {
       const ViewAnnotations& a = out.annotations[k];
       const Sensor& s = cat.sensors[k];
@@ -170,21 +179,12 @@ class CocoSink final : public Sink {
         num(an, image_id);
         an += ",\"category_id\":";
         num(an, x.object + 1);
-        an += ",\"bbox\":[";
-        for (int v : {x.x, x.y, x.w, x.h}) {
-          num(an, v);
-          an += ',';
-        }
-        an.back() = ']';
+        an += ",\"bbox\":";
+        list(an, std::array{x.x, x.y, x.w, x.h});
         an += ",\"area\":";
         num(an, x.area);
-        an += ",\"iscrowd\":0,\"segmentation\":{\"counts\":[";
-        for (uint32_t c :
-             coco_rle(a.mask_of(i), a.width, a.height, static_cast<uint8_t>(x.region + 1), x.x, x.y, x.w, x.h)) {
-          num(an, c);
-          an += ',';
-        }
-        an.back() = ']';
+        an += ",\"iscrowd\":0,\"segmentation\":{\"counts\":";
+        list(an, coco_rle(a.mask_of(i), a.width, a.height, static_cast<uint8_t>(x.region + 1), x.x, x.y, x.w, x.h));
         an += ",\"size\":[";
         num(an, a.height);
         an += ',';

@@ -81,12 +81,12 @@ std::string_view per_transform(const ModelSettings& model, const SceneBatch& b, 
   return {dst, (hi - lo) * R * sizeof(T)};
 }
 
-}  // namespace
-
-std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOptions& opt) {
+// The columns being made: each one a dataset of `type` and `dims` per scenario, filled by
+// `fill`; `view` where its rows are the outputs' own bytes.
+struct ColumnList {
+  const SinkContext& ctx;
   std::vector<TensorColumn> columns;
-  const auto add = [&](const std::string& name, TensorType type, std::vector<uint64_t> dims, Fill fill,
-                       bool view = false) {
+  void operator()(const std::string& name, TensorType type, std::vector<uint64_t> dims, Fill fill, bool view = false) {
     TensorColumn c;
     c.ds.name = name;
     c.ds.type = type;
@@ -98,10 +98,12 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
     c.fill = std::move(fill);
     c.view = view;
     columns.push_back(std::move(c));
-  };
+  }
+};
+
+// Each view's images (through its palette where it has one), masks, and the features.
+void add_image_columns(ColumnList& add, const SinkContext& ctx, const TensorOptions& opt) {
   const Catalogue* cat = ctx.cat;
-  const ThreatRule* rule = opt.rule;
-  const ModelSettings model = ctx.model;
   if (opt.images)
     for (size_t k = 0; k < cat->sensors.size(); ++k) {
       const Sensor& s = cat->sensors[k];
@@ -151,8 +153,70 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
           return rows_of(o.features, static_cast<size_t>(o.layout.image_features()), lo, hi);
         },
         true);
+}
+
+// Each region's object, drawing and label (by the threat rule, the object alone on the subject).
+void add_region_columns(ColumnList& add, const SinkContext& ctx, const ThreatRule* rule) {
+  const Catalogue* cat = ctx.cat;
+  const uint64_t regions = static_cast<uint64_t>(cat->region_count());
+  add("region_object", TensorType::i16, {regions},
+      [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+        return per_region(b, lo, hi, dst, [&](int16_t v) {
+          return v == kNoObject ? int16_t(-1) : int16_t(cat->variant_list[v].object);
+        });
+      });
+  add("region_orientation", TensorType::i16, {regions},
+      [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+        return per_region(b, lo, hi, dst, [&](int16_t v) {
+          return v == kNoObject ? int16_t(-1) : int16_t(cat->variant_list[v].variant);
+        });
+      });
+  add("region_label", TensorType::u8, {regions},
+      [rule](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+        const int R = b.regions;
+        const std::string_view rows(dst, (hi - lo) * R);
+        std::memset(dst, 0, rows.size());
+        if (!rule) return rows;
+        for (size_t i = lo; i < hi; ++i)
+          for (int r = 0; r < R; ++r) {
+            const int16_t v = b.objects[i * R + r];
+            if (v == kNoObject) continue;
+            Scenario alone;
+            alone.subject = b.subject[i];
+            alone.objects[r] = v;
+            dst[(i - lo) * R + r] = (*rule)(alone) ? 1 : 0;
+          }
+        return rows;
+      });
+}
+
+// Each object's randomised draw (plan.h, object_transform), the numbers scenarios.csv
+// records: float64 so they are the same doubles; identity where a region is empty.
+void add_transform_columns(ColumnList& add, const SinkContext& ctx) {
+  const ModelSettings model = ctx.model;
+  const uint64_t regions = static_cast<uint64_t>(ctx.cat->region_count());
+  add("region_rotation", TensorType::f64, {regions},
+      [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+        return per_transform<double>(model, b, lo, hi, dst, 0.0, [](const ObjectTransform& x) { return x.rotation; });
+      });
+  add("region_scale", TensorType::f64, {regions},
+      [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+        return per_transform<double>(model, b, lo, hi, dst, 1.0, [](const ObjectTransform& x) { return x.scale; });
+      });
+  add("region_flip", TensorType::u8, {regions},
+      [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
+        return per_transform<uint8_t>(model, b, lo, hi, dst, 0,
+                                      [](const ObjectTransform& x) { return uint8_t(x.flip); });
+      });
+}
+
+}  // namespace
+
+std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOptions& opt) {
+  ColumnList add{ctx, {}};
+  const ModelSettings model = ctx.model;
+  add_image_columns(add, ctx, opt);
   if (opt.scenario) {
-    const uint64_t regions = static_cast<uint64_t>(ctx.cat->region_count());
     add(
         "metal", TensorType::u8, {static_cast<uint64_t>(ctx.cat->zones)},
         [](const SceneBatch&, const BatchOutput& o, size_t lo, size_t hi, char*) {
@@ -170,53 +234,8 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
       for (size_t i = lo; i < hi; ++i) dst[i - lo] = static_cast<char>(b.own_bodies() ? 0 : b.subject[i] + 1);
       return std::string_view(dst, hi - lo);
     });
-    add("region_object", TensorType::i16, {regions},
-        [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
-          return per_region(b, lo, hi, dst, [&](int16_t v) {
-            return v == kNoObject ? int16_t(-1) : int16_t(cat->variant_list[v].object);
-          });
-        });
-    add("region_orientation", TensorType::i16, {regions},
-        [cat](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
-          return per_region(b, lo, hi, dst, [&](int16_t v) {
-            return v == kNoObject ? int16_t(-1) : int16_t(cat->variant_list[v].variant);
-          });
-        });
-    add("region_label", TensorType::u8, {regions},
-        [rule](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
-          const int R = b.regions;
-          const std::string_view rows(dst, (hi - lo) * R);
-          std::memset(dst, 0, rows.size());
-          if (!rule) return rows;
-          for (size_t i = lo; i < hi; ++i)
-            for (int r = 0; r < R; ++r) {
-              const int16_t v = b.objects[i * R + r];
-              if (v == kNoObject) continue;
-              Scenario alone;
-              alone.subject = b.subject[i];
-              alone.objects[r] = v;
-              dst[(i - lo) * R + r] = (*rule)(alone) ? 1 : 0;
-            }
-          return rows;
-        });
-    if (ctx.model.transforms()) {
-      // Each object's randomised draw (plan.h, object_transform), the numbers scenarios.csv
-      // records: float64 so they are the same doubles; identity where a region is empty.
-      add("region_rotation", TensorType::f64, {regions},
-          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
-            return per_transform<double>(model, b, lo, hi, dst, 0.0,
-                                         [](const ObjectTransform& x) { return x.rotation; });
-          });
-      add("region_scale", TensorType::f64, {regions},
-          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
-            return per_transform<double>(model, b, lo, hi, dst, 1.0, [](const ObjectTransform& x) { return x.scale; });
-          });
-      add("region_flip", TensorType::u8, {regions},
-          [model](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
-            return per_transform<uint8_t>(model, b, lo, hi, dst, 0,
-                                          [](const ObjectTransform& x) { return uint8_t(x.flip); });
-          });
-    }
+    add_region_columns(add, ctx, opt.rule);
+    if (ctx.model.transforms()) add_transform_columns(add, ctx);
     // Each knob drawn per scenario (plan.h, drawn_knob_at): float64, the doubles
     // scenarios.csv records.
     for (unsigned e = 0; e < kDrawnKnobKeys.size(); ++e)
@@ -262,7 +281,7 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
             });
     }
   }
-  return columns;
+  return std::move(add.columns);
 }
 
 namespace {

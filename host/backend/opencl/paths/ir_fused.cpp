@@ -13,11 +13,7 @@ namespace {
 
 class IrFused final : public ViewPath {
  public:
-  const char* name() const override { return "ir_fused"; }
-  const std::vector<std::string>& chain() const override {
-    static const std::vector<std::string> stages = {"contact_shadow", "heat_spread", "ir_surface"};
-    return stages;
-  }
+  IrFused() : ViewPath("ir_fused", {"contact_shadow", "heat_spread", "ir_surface"}, true) {}
   enum Variant { kThenStages, kDisplayFused, kNoiseDisplayFused };
   Gate gate(const Plan& plan, const Sensor& sensor) const override {
     const std::vector<std::string>& c = sensor.chain_for(plan.model.model);
@@ -33,7 +29,6 @@ class IrFused final : public ViewPath {
       return {.runs = true, .variant = kNoiseDisplayFused, .variant_name = "surface, noise and display fused"};
     return {.runs = true, .variant = kThenStages, .variant_name = "surface fused, then the stage kernels"};
   }
-  bool uses_field() const override { return true; }
   void render(ViewLaunch& v, const Gate& g) const override {
     if (g.variant == kDisplayFused) return v.run("ir_surface_display_fused", v.batch.n);
     if (g.variant == kNoiseDisplayFused) return v.run("ir_surface_noise_display_fused", v.batch.n);

@@ -8,6 +8,7 @@
 #include <CL/opencl.hpp>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "backend/backend.h"
@@ -27,16 +28,24 @@ struct Gate {
 
 class ViewPath {
  public:
+  // chain: the stages it implements, in order (the IR path: the chain's first stages);
+  // uses_field: whether its kernels pass a field of reals between them (else they write
+  // the pixels).
+  ViewPath(const char* name, std::vector<std::string> chain, bool uses_field)
+      : name_(name), chain_(std::move(chain)), uses_field_(uses_field) {}
   virtual ~ViewPath() = default;
-  virtual const char* name() const = 0;
-  // The stages it implements, in order (the IR path: the chain's first stages).
-  virtual const std::vector<std::string>& chain() const = 0;
+  const char* name() const { return name_; }
+  const std::vector<std::string>& chain() const { return chain_; }
+  bool uses_field() const { return uses_field_; }
   virtual Gate gate(const Plan& plan, const Sensor& sensor) const = 0;
   bool applies(const Plan& plan, const Sensor& sensor) const { return gate(plan, sensor).runs; }
-  // Whether its kernels pass a field of reals between them (else they write the pixels).
-  virtual bool uses_field() const = 0;
   // Renders the view as its gate decided, after place_view has written its records.
   virtual void render(ViewLaunch& v, const Gate& g) const = 0;
+
+ private:
+  const char* name_;
+  std::vector<std::string> chain_;
+  bool uses_field_;
 };
 
 // A view's path and its gate's decision.

@@ -10,11 +10,7 @@ namespace {
 
 class PhysicsRaw final : public ViewPath {
  public:
-  const char* name() const override { return "physics_raw"; }
-  const std::vector<std::string>& chain() const override {
-    static const std::vector<std::string> stages = {"radiometry", "optics", "sample", "netd", "window", "mmw_display"};
-    return stages;
-  }
+  PhysicsRaw() : ViewPath("physics_raw", {"radiometry", "optics", "sample", "netd", "window", "mmw_display"}, false) {}
   enum Variant { kFixedWindow, kAutoWindow, kDrawnWindow };
   Gate gate(const Plan& plan, const Sensor& sensor) const override {
     if (!plan.fidelity.fused || sensor.chain_for(plan.model.model) != chain()) return {};
@@ -22,7 +18,6 @@ class PhysicsRaw final : public ViewPath {
     if (plan.model.window_drawn()) return {.runs = true, .variant = kDrawnWindow, .variant_name = "drawn window"};
     return {.runs = true, .variant = kFixedWindow, .variant_name = "fixed window"};
   }
-  bool uses_field() const override { return false; }
   void render(ViewLaunch& v, const Gate& g) const override {
     run_raw_grid(v);
     if (g.variant != kFixedWindow) v.run("stage_window", v.batch.n);

@@ -9,13 +9,8 @@ namespace {
 
 class StageChain final : public ViewPath {
  public:
-  const char* name() const override { return "stage_chain"; }
-  const std::vector<std::string>& chain() const override {
-    static const std::vector<std::string> any;  // whatever the view's chain is
-    return any;
-  }
+  StageChain() : ViewPath("stage_chain", {}, true) {}  // no chain of its own: whatever the view's is
   Gate gate(const Plan&, const Sensor&) const override { return {.runs = true}; }
-  bool uses_field() const override { return true; }
   void render(ViewLaunch& v, const Gate&) const override { run_stages(v, 0); }
 };
 

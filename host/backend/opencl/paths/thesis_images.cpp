@@ -9,15 +9,10 @@ namespace {
 
 class ThesisImages final : public ViewPath {
  public:
-  const char* name() const override { return "thesis_images"; }
-  const std::vector<std::string>& chain() const override {
-    static const std::vector<std::string> stages = {"composite", "pattern_noise", "sensor_noise", "display"};
-    return stages;
-  }
+  ThesisImages() : ViewPath("thesis_images", {"composite", "pattern_noise", "sensor_noise", "display"}, false) {}
   Gate gate(const Plan& plan, const Sensor& sensor) const override {
     return {.runs = plan.fidelity.fused && sensor.chain_for(plan.model.model) == chain()};
   }
-  bool uses_field() const override { return false; }
   void render(ViewLaunch& v, const Gate&) const override { v.run("render_view", v.batch.n); }
 };
 
