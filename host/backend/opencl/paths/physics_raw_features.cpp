@@ -28,6 +28,32 @@ bool boxes_meet(const Rect& a, const Rect& b) {
   return a.x - 2 < b.x + b.w + 2 && b.x - 2 < a.x + a.w + 2 && a.y - 2 < b.y + b.h + 2 && b.y - 2 < a.y + a.h + 2;
 }
 
+// The pairs (va, ra, vb, rb), ra < rb, of wanted variants in regions the view sees whose
+// sprites' boxes meet on any of the S subjects (places move with the height), numbered in
+// pair_index by (va R + ra) (V R) + vb R + rb.
+std::vector<std::array<int, 4>> meeting_pairs(const AssetSet& assets, const Sensor& sv, int S, int V, int R,
+                                              const std::vector<char>& want, std::vector<cl_int>& pair_index) {
+  const size_t combos = static_cast<size_t>(V) * R;
+  const auto meet = [&](int va, int ra, int vb, int rb) {
+    const Image &a = assets.sprite(sv, va), &b = assets.sprite(sv, vb);
+    for (int s = 0; s < S; ++s)
+      if (boxes_meet(sprite_box(sv.place(s, ra), a), sprite_box(sv.place(s, rb), b))) return true;
+    return false;
+  };
+  std::vector<std::array<int, 4>> pairs;
+  for (int ra = 0; ra < R; ++ra)
+    for (int rb = ra + 1; rb < R; ++rb)
+      if (sv.sees(ra) && sv.sees(rb))
+        for (int va = 0; va < V; ++va)
+          for (int vb = 0; vb < V; ++vb)
+            if (want[va] && want[vb] && meet(va, ra, vb, rb)) {
+              pair_index[(static_cast<size_t>(va) * R + ra) * combos + static_cast<size_t>(vb) * R + rb] =
+                  static_cast<cl_int>(pairs.size());
+              pairs.push_back({va, ra, vb, rb});
+            }
+  return pairs;
+}
+
 class PhysicsRawFeatures final : public FeaturePath {
  public:
   explicit PhysicsRawFeatures(Device& d) : d_(d) {}
@@ -185,25 +211,8 @@ PhysicsRawFeatures::Tables& PhysicsRawFeatures::tables(Kernels& K, const Plan& p
   if (tabulated) {
     // One scenario per subject bare, per (subject, variant, region seen) alone, and per
     // pair of those whose boxes meet.
-    // A pair counts where its boxes meet on any subject (places move with the height).
-    const auto meet = [&](int va, int ra, int vb, int rb) {
-      const Image &a = d_.assets.sprite(sv, va), &b = d_.assets.sprite(sv, vb);
-      for (int s = 0; s < S; ++s)
-        if (boxes_meet(sprite_box(sv.place(s, ra), a), sprite_box(sv.place(s, rb), b))) return true;
-      return false;
-    };
     SceneBatch b(R);
-    std::vector<std::array<int, 4>> pairs;  // va, ra, vb, rb with ra < rb
-    for (int ra = 0; ra < R; ++ra)
-      for (int rb = ra + 1; rb < R; ++rb)
-        if (sv.sees(ra) && sv.sees(rb))
-          for (int va = 0; va < V; ++va)
-            for (int vb = 0; vb < V; ++vb)
-              if (want[va] && want[vb] && meet(va, ra, vb, rb)) {
-                pair_index[(static_cast<size_t>(va) * R + ra) * combos + static_cast<size_t>(vb) * R + rb] =
-                    static_cast<cl_int>(pairs.size());
-                pairs.push_back({va, ra, vb, rb});
-              }
+    const std::vector<std::array<int, 4>> pairs = meeting_pairs(d_.assets, sv, S, V, R, want, pair_index);
     t.dims.s[6] = static_cast<cl_int>(pairs.size());
     object_range.resize(S * combos + S * pairs.size(), cl_int2{{0, 0}});
     for (int s = 0; s < S; ++s) {
