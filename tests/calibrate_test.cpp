@@ -10,6 +10,7 @@
 
 #include "assets/assets.h"
 #include "assets/image_io.h"
+#include "base/embedded.h"
 #include "base/error.h"
 #include "calibrate/camera_files.h"
 #include "calibrate/captures.h"
@@ -17,10 +18,6 @@
 #include "run_binary.h"
 #include "scene/catalogue.h"
 #include "support.h"
-
-namespace portalsim::embedded {
-extern const std::string_view default_catalogue;
-}
 
 namespace {
 

@@ -43,15 +43,12 @@
 #include "backend/compare.h"
 #include "backend/reference/draws.h"
 #include "backend/reference/stages.h"
+#include "base/embedded.h"
 #include "base/error.h"
 #include "plan/plan.h"
 #include "plan/tolerance.h"
 #include "run_binary.h"
 #include "support.h"
-
-namespace portalsim::embedded {
-extern const std::string_view default_catalogue;
-}
 
 namespace portalsim::test {
 namespace {

@@ -11,14 +11,11 @@
 #include "backend/compare.h"
 #include "backend/reference/stages.h"
 #include "backend/stages.h"
+#include "base/embedded.h"
 #include "base/error.h"
 #include "plan/knobs.h"
 #include "run_binary.h"
 #include "support.h"
-
-namespace portalsim::embedded {
-extern const std::string_view default_catalogue;
-}
 
 namespace portalsim {
 namespace {

@@ -9,13 +9,11 @@
 #include <sstream>
 
 #include "backend/reference/stages.h"
+#include "base/embedded.h"
 #include "base/error.h"
 #include "support.h"
 
 namespace portalsim {
-namespace embedded {
-extern const std::string_view default_catalogue;
-}
 namespace {
 
 using test::assets;

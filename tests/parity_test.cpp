@@ -13,6 +13,7 @@
 #include <string>
 
 #include "backend/compare.h"
+#include "base/embedded.h"
 #include "plan/tolerance.h"
 #include "support.h"
 
@@ -314,10 +315,6 @@ TEST(Parity, PlacementJitterIntegerAndBilinear) {
 
 }  // namespace
 }  // namespace portalsim
-
-namespace portalsim::embedded {
-extern const std::string_view default_catalogue;
-}
 
 namespace portalsim {
 namespace {

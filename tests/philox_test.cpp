@@ -18,14 +18,11 @@
 #include "backend/opencl/noise_draws.h"
 #include "backend/opencl/runtime.h"
 #include "backend/reference/draws.h"
+#include "base/embedded.h"
 #include "plan/tolerance.h"
 #include "scene/catalogue.h"
 
 namespace portalsim {
-namespace embedded {
-extern const std::string_view kernel_program;
-}
-
 namespace {
 
 struct Kat {

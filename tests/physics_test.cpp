@@ -15,14 +15,11 @@
 #include "backend/reference/draws.h"
 #include "backend/reference/stages.h"
 #include "backend/stages.h"
+#include "base/embedded.h"
 #include "base/error.h"
 #include "plan/knobs.h"
 #include "run_binary.h"
 #include "support.h"
-
-namespace portalsim::embedded {
-extern const std::string_view default_catalogue;
-}
 
 namespace portalsim {
 namespace {

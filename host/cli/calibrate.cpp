@@ -13,17 +13,13 @@
 #include <sstream>
 
 #include "assets/assets.h"
+#include "base/embedded.h"
 #include "base/error.h"
 #include "base/spoken_list.h"
 #include "calibrate/camera_files.h"
 #include "calibrate/compare.h"
 #include "cli/commands.h"
 #include "sink/staging.h"
-
-namespace portalsim::embedded {
-extern const std::string_view default_catalogue;
-extern const std::string_view plot_calibrate;
-}  // namespace portalsim::embedded
 
 namespace portalsim::cli {
 

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "assets/image_io.h"
+#include "base/embedded.h"
 #include "base/error.h"
 #include "base/parallel.h"
 #include "cli/commands.h"
@@ -26,10 +27,6 @@
 #include "sink/staging.h"
 
 namespace portalsim {
-namespace embedded {
-extern const std::string_view plot_evaluate;
-}
-
 namespace cli {
 
 namespace fs = std::filesystem;

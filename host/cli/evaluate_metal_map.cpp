@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "backend/opencl/runtime.h"
+#include "base/embedded.h"
 #include "base/error.h"
 #include "cli/common.h"
 #include "evaluate/metal_map.h"
@@ -14,10 +15,6 @@
 #include "sink/staging.h"
 
 namespace portalsim {
-namespace embedded {
-extern const std::string_view plot_metal_map;
-}
-
 namespace cli {
 
 namespace {

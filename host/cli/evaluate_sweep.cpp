@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "base/embedded.h"
 #include "base/error.h"
 #include "cli/python_requests.h"
 #include "evaluate/report.h"
@@ -17,10 +18,6 @@
 #include "sink/staging.h"
 
 namespace portalsim {
-namespace embedded {
-extern const std::string_view plot_sweep;
-}
-
 namespace cli {
 
 namespace fs = std::filesystem;

@@ -16,6 +16,7 @@
 #include "backend/opencl/noise_draws.h"
 #include "backend/opencl/opencl_backend.h"
 #include "backend/reference/draws.h"
+#include "base/embedded.h"
 #include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
@@ -28,10 +29,6 @@
 #include "sink/staging.h"
 
 namespace portalsim {
-namespace embedded {
-extern const std::string_view plot_tradeoff;
-}
-
 namespace cli {
 
 namespace {

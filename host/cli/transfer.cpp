@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "base/embedded.h"
 #include "base/error.h"
 #include "base/spoken_list.h"
 #include "cli/commands.h"
@@ -27,10 +28,6 @@
 #include "sink/staging.h"
 
 namespace portalsim {
-namespace embedded {
-extern const std::string_view transfer_cnn;
-}
-
 namespace cli {
 
 namespace {

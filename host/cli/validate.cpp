@@ -18,6 +18,7 @@
 #include <sstream>
 #include <vector>
 
+#include "base/embedded.h"
 #include "base/error.h"
 #include "cli/commands.h"
 #include "cli/common.h"
@@ -29,11 +30,6 @@
 #include "sink/feature_rows.h"
 #include "sink/h5_file.h"
 #include "sink/staging.h"
-
-namespace portalsim::embedded {
-extern const std::string_view weka_validate;
-extern const std::string_view plot_validate;
-}  // namespace portalsim::embedded
 
 namespace portalsim::cli {
 

@@ -5,14 +5,10 @@
 #include <random>
 
 #include "assets/image_io.h"
+#include "base/embedded.h"
 #include "base/error.h"
 #include "cli/common.h"
 #include "schedule/pipeline.h"
-
-namespace portalsim::embedded {
-extern const std::string_view default_catalogue;
-extern const std::string_view case2_spec;
-}  // namespace portalsim::embedded
 
 namespace portalsim::cli {
 

@@ -11,16 +11,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "base/embedded.h"
 #include "base/error.h"
 #include "io/input_file.h"
 #include "io/toml_input.h"
 #include "scene/builtin_images.h"
 
 namespace portalsim {
-
-namespace embedded {
-extern const std::string_view default_catalogue;
-}
 
 namespace {
 

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <thread>
 
+#include "base/embedded.h"
 #include "base/error.h"
 #include "base/sizes.h"
 #include "io/input_file.h"
@@ -31,10 +32,6 @@
 extern char** environ;
 
 namespace portalsim {
-namespace embedded {
-extern const std::string_view serve_index_html, serve_app_js, serve_style_css;
-}
-
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 

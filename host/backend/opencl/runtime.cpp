@@ -13,15 +13,12 @@
 #include <string_view>
 
 #include "backend/opencl/drivers.h"
+#include "base/embedded.h"
 #include "base/error.h"
 
 namespace portalsim {
 
 namespace fs = std::filesystem;
-
-namespace embedded {
-extern const std::string_view kernel_program;
-}
 
 // PORTALSIM_KERNEL_PROGRAM names a file that replaces the built-in program as a whole:
 // tools/mutate.sh runs the suites on mutated kernels this way, without a relink.
