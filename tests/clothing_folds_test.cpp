@@ -170,7 +170,7 @@ test::Result gen(const test::TempDir& t, std::vector<std::string> args, const fs
   return test::generate(t, args, out);
 }
 
-// Each row records its share (as clothing_folds_at draws it), the same for any batch, in
+// Each row records its share (as drawn_knob_at draws it), the same for any batch, in
 // scenarios.csv and data.h5; a fixed share keeps the columns out; the list re-runs.
 TEST(ClothingFolds, EachRowsShareIsRecorded) {
   test::TempDir t;
@@ -197,7 +197,7 @@ TEST(ClothingFolds, EachRowsShareIsRecorded) {
   set_knob(plan, *find_knob("clothing"), "random", "--clothing");
   set_knob(plan, *find_knob("clothing_folds"), "0..1", "--clothing-folds");
   for (size_t i = 1; i < rows.size(); ++i)
-    EXPECT_NEAR(std::stod(rows[i][c]), clothing_folds_at(plan.model, i - 1), 1e-6) << i;
+    EXPECT_NEAR(std::stod(rows[i][c]), drawn_knob_at(plan.model, PS_DRAWN_CLOTHING_FOLDS, i - 1), 1e-6) << i;
   EXPECT_NE(test::slurp(t.w() / "a" / "manifest.json").find("\"clothing_folds\": \"0..1\""), std::string::npos);
   std::vector<std::string> c_args = folded;
   c_args.insert(c_args.end(), {"--scenarios", (t.w() / "a" / "scenarios.csv").string()});

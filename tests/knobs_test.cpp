@@ -5,11 +5,17 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+#include <regex>
+
 #include "base/error.h"
 #include "run_binary.h"
 #include "schedule/run_spec.h"
 
 namespace portalsim {
+namespace embedded {
+extern const std::string_view kernel_program;
+}
 namespace {
 
 using namespace test;
@@ -144,6 +150,44 @@ TEST(Knobs, TheReferenceTableIsTheDeclaredOne) {
   EXPECT_NE(page.find(table), std::string::npos)
       << "docs/reference/knobs.md must hold the knob table exactly as `portalsim knobs` prints it:\n"
       << table;
+}
+
+// The knobs' declarations are the one list of the numbers and choices drawn per scenario
+// (DrawnKnob): each element of PS_STREAM_KNOB_DRAW claimed by one declaration, and the element
+// constants of the kernels' program, PS_DRAWN_<KEY>, the declared ones, by name and number.
+TEST(Knobs, TheDrawnElementsAreTheDeclaredOnesAndTheKernels) {
+  const std::vector<DrawnKnob>& drawn = drawn_knobs();
+  ASSERT_EQ(drawn.size(), size_t{PS_DRAWN_KNOBS});
+  std::map<std::string, unsigned> declared;
+  for (unsigned e = 0; e < drawn.size(); ++e) {
+    EXPECT_EQ(drawn[e].element, e);
+    std::string name = "PS_DRAWN_" + drawn[e].key;
+    for (char& c : name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    declared[name] = e;
+  }
+  std::map<std::string, unsigned> kernels;
+  const std::string program(embedded::kernel_program);
+  const std::regex define(R"(#define (PS_DRAWN_\w+) (\d+)u?\b)");
+  for (auto m = std::sregex_iterator(program.begin(), program.end(), define); m != std::sregex_iterator(); ++m)
+    if ((*m)[1] != "PS_DRAWN_KNOBS") kernels[(*m)[1]] = static_cast<unsigned>(std::stoul((*m)[2]));
+  EXPECT_EQ(kernels, declared);
+  // Two declarations of one element, or an element none declares, are refused.
+  const auto refusal = [](const std::vector<Knob>& list) -> std::string {
+    try {
+      index_draws(list);
+    } catch (const std::logic_error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  std::vector<Knob> twice = knobs(), none = knobs();
+  for (Knob& k : twice)
+    if (k.key == "netd") k.draws = find_knob("frames")->draws;
+  EXPECT_EQ(refusal(twice), "knobs netd and frames both claim drawn element " + std::to_string(PS_DRAWN_FRAMES));
+  for (Knob& k : none)
+    if (k.key == "frames") k.draws.clear();
+  EXPECT_EQ(refusal(none), "no knob declares drawn element " + std::to_string(PS_DRAWN_FRAMES));
+  EXPECT_EQ(index_draws(knobs()).size(), drawn.size());
 }
 
 }  // namespace

@@ -96,11 +96,12 @@ Knob range(std::string key, std::string def, double lo, double hi, bool symmetri
   return k;
 }
 
-// `k` drawn per scenario where given A..B (Knob::drawn).
-Knob drawable(Knob k, unsigned element) {
-  if (element >= kDrawnKnobKeys.size() || k.key != kDrawnKnobKeys[element])
-    throw std::logic_error("knob " + k.key + ": not drawn knob " + std::to_string(element) + " (scene.h)");
+// `k`, an integer or number knob, drawn per scenario where given A..B (Knob::drawn): element
+// `element`, setting `field` (DrawnKnob).
+template <class T>
+Knob drawable(Knob k, unsigned element, T ModelSettings::*field) {
   k.drawn = static_cast<int>(element);
+  k.draws = {{.element = element, .key = k.key, .field = field}};
   k.get = [get = std::move(k.get), element](const Plan& p) -> nlohmann::json {
     const DrawnRange& d = p.model.drawn[element];
     if (d.varies()) return format_number(d.lo) + ".." + format_number(d.hi);
@@ -110,13 +111,12 @@ Knob drawable(Knob k, unsigned element) {
 }
 
 // `k`, a range knob, with its ends drawn per scenario where given L1..L2/H1..H2
-// (Knob::drawn_ends): elements `lo` and `hi`, keyed as the knob's key and _lo, _hi. A fixed
-// end's drawn range is that one value.
-Knob drawable_ends(Knob k, unsigned lo, unsigned hi) {
-  if (hi >= kDrawnKnobKeys.size() || k.key + "_lo" != kDrawnKnobKeys[lo] || k.key + "_hi" != kDrawnKnobKeys[hi])
-    throw std::logic_error("knob " + k.key + ": not drawn ends " + std::to_string(lo) + ", " + std::to_string(hi) +
-                           " (scene.h)");
+// (Knob::drawn_ends): elements `lo` and `hi`, keyed as the knob's key and _lo, _hi, setting
+// `lo_field` and `hi_field`. A fixed end's drawn range is that one value.
+Knob drawable_ends(Knob k, unsigned lo, unsigned hi, double ModelSettings::*lo_field, double ModelSettings::*hi_field) {
   k.drawn_ends = {static_cast<int>(lo), static_cast<int>(hi)};
+  k.draws = {{.element = lo, .key = k.key + "_lo", .field = lo_field},
+             {.element = hi, .key = k.key + "_hi", .field = hi_field}};
   k.get = [get = std::move(k.get), lo, hi](const Plan& p) -> nlohmann::json {
     const DrawnRange &a = p.model.drawn[lo], &b = p.model.drawn[hi];
     if (!a.varies() && !b.varies()) return get(p);
@@ -125,6 +125,13 @@ Knob drawable_ends(Knob k, unsigned lo, unsigned hi) {
     };
     return end(a) + "/" + end(b);
   };
+  return k;
+}
+
+// `k`, whose value per scenario is a draw of its own from element `element` (the outfit:
+// outfit_at; the raw grid: raw_grid_at), no number.
+Knob drawn_by(Knob k, unsigned element) {
+  k.draws = {{.element = element, .key = k.key}};
   return k;
 }
 
@@ -142,11 +149,11 @@ std::vector<Knob> declare() {
           "illumination", "293", 1, 1000, "K",
           "physics: the temperature the scene reflects (the room indoors; about 50 K for a clear sky outdoors)",
           [](Plan& p, double v) { p.model.illumination = v; }, [](const Plan& p) { return p.model.illumination; }),
-      PS_DRAWN_ILLUMINATION));
+      PS_DRAWN_ILLUMINATION, &ModelSettings::illumination));
   k.push_back(drawable(number(
                            "netd", "3", 0, 100, "K", "physics: MMW sensor noise, rms per raw pixel (Vela 125: 3 K)",
                            [](Plan& p, double v) { p.model.netd = v; }, [](const Plan& p) { return p.model.netd; }),
-                       PS_DRAWN_NETD));
+                       PS_DRAWN_NETD, &ModelSettings::netd));
   k.push_back(grid(
       "mmw_raw", "28x28", 1, 4096, "raw pixels",
       "physics: the MMW camera's raw grid over each view, at most the view's size",
@@ -165,6 +172,7 @@ std::vector<Knob> declare() {
         }
         return list;
       }));
+  k.back() = drawn_by(std::move(k.back()), PS_DRAWN_MMW_RAW);
   k.back().set_list = [](Plan& p, const std::vector<double>& grids) {
     p.model.raw_grids.clear();
     for (const double v : grids)
@@ -175,7 +183,7 @@ std::vector<Knob> declare() {
           "worn_minutes", "5", 0, 1440, "minutes",
           "physics: how long the objects have been carried; they warm from the room towards the skin",
           [](Plan& p, double v) { p.model.worn_minutes = v; }, [](const Plan& p) { return p.model.worn_minutes; }),
-      PS_DRAWN_WORN_MINUTES));
+      PS_DRAWN_WORN_MINUTES, &ModelSettings::worn_minutes));
   {
     Knob c = choice(
         "clothing", "catalogue", {kClothingNames.begin(), kClothingNames.end()},
@@ -185,7 +193,7 @@ std::vector<Knob> declare() {
         false, true, [](Plan& p, double v) { p.model.clothing = static_cast<Clothing>(v); },
         [](const Plan& p) { return kClothingNames[static_cast<size_t>(p.model.clothing)]; });
     c.omit_default = true;
-    k.push_back(std::move(c));
+    k.push_back(drawn_by(std::move(c), PS_DRAWN_CLOTHING));
   }
   {
     Knob f = drawable(number(
@@ -194,7 +202,7 @@ std::vector<Knob> declare() {
                           "where it lies doubled, in both cameras (docs/model/clothing.md); 0: smooth layers",
                           [](Plan& p, double v) { p.model.clothing_folds = v; },
                           [](const Plan& p) { return p.model.clothing_folds; }),
-                      PS_DRAWN_CLOTHING_FOLDS);
+                      PS_DRAWN_CLOTHING_FOLDS, &ModelSettings::clothing_folds);
     f.omit_default = true;
     k.push_back(std::move(f));
   }
@@ -206,7 +214,7 @@ std::vector<Knob> declare() {
           "(the fast tier: one draw of NETD/sqrt(frames))",
           [](Plan& p, double v) { p.model.frames = static_cast<int>(v); },
           [](const Plan& p) { return p.model.frames; }),
-      PS_DRAWN_FRAMES));
+      PS_DRAWN_FRAMES, &ModelSettings::frames));
   {
     Knob w = range(
         "window", "290..302", 0, 1000, false, "K",
@@ -219,7 +227,8 @@ std::vector<Knob> declare() {
         [](const Plan& p) { return std::pair(p.model.window_lo, p.model.window_hi); });
     w.word = "auto";
     w.get = [get = w.get](const Plan& p) -> nlohmann::json { return p.model.window_auto ? "auto" : get(p); };
-    k.push_back(drawable_ends(std::move(w), PS_DRAWN_WINDOW_LO, PS_DRAWN_WINDOW_HI));
+    k.push_back(drawable_ends(std::move(w), PS_DRAWN_WINDOW_LO, PS_DRAWN_WINDOW_HI, &ModelSettings::window_lo,
+                              &ModelSettings::window_hi));
   }
   k.push_back(choice(
       "display_filter", "bilinear", {"bilinear", "bicubic"},
@@ -235,7 +244,7 @@ std::vector<Knob> declare() {
       number(
           "ir_netd", "0.05", 0, 10, "K", "physics: IR sensor noise, rms per pixel (thermal cameras: about 0.05 K)",
           [](Plan& p, double v) { p.model.ir_netd = v; }, [](const Plan& p) { return p.model.ir_netd; }),
-      PS_DRAWN_IR_NETD));
+      PS_DRAWN_IR_NETD, &ModelSettings::ir_netd));
   k.push_back(integer(
       "block", "10", 1, 65536, "pixels", "side of the averaged pixel blocks of the features (thesis 5.6)",
       [](Plan& p, double v) { p.model.block = static_cast<int>(v); }, [](const Plan& p) { return p.model.block; }));
@@ -246,13 +255,13 @@ std::vector<Knob> declare() {
       number(
           "pixel_noise", "0", 0, 1000, "gray levels", "per-pixel Gaussian sensor noise sigma (MMW and IR)",
           [](Plan& p, double v) { p.model.pixel_sigma = v; }, [](const Plan& p) { return p.model.pixel_sigma; }),
-      PS_DRAWN_PIXEL_NOISE));
+      PS_DRAWN_PIXEL_NOISE, &ModelSettings::pixel_sigma));
   k.push_back(drawable(
       integer(
           "metal_noise", "0", 0, 199, "counts", "metal detector noise: triangular integer noise of this half-width",
           [](Plan& p, double v) { p.model.metal_noise = static_cast<int>(v); },
           [](const Plan& p) { return p.model.metal_noise; }),
-      PS_DRAWN_METAL_NOISE));
+      PS_DRAWN_METAL_NOISE, &ModelSettings::metal_noise));
   k.push_back(choice(
       "placement", "integer", {"integer", "bilinear"},
       "sprite placement: whole pixels, or sub-pixel with bilinear sampling", false, true,
@@ -377,6 +386,34 @@ const Knob* find_knob(std::string_view key) {
   for (const Knob& k : knobs())
     if (k.key == key) return &k;
   return nullptr;
+}
+
+std::vector<DrawnKnob> index_draws(const std::vector<Knob>& list) {
+  std::vector<DrawnKnob> by_element(PS_DRAWN_KNOBS);
+  std::vector<const Knob*> claimed(PS_DRAWN_KNOBS);
+  for (const Knob& k : list)
+    for (const DrawnKnob& d : k.draws) {
+      if (d.element >= PS_DRAWN_KNOBS)
+        throw std::logic_error("knob " + k.key + ": drawn element " + std::to_string(d.element) +
+                               " is not below PS_DRAWN_KNOBS (kernels/contract.h)");
+      if (claimed[d.element])
+        throw std::logic_error("knobs " + claimed[d.element]->key + " and " + k.key + " both claim drawn element " +
+                               std::to_string(d.element));
+      // A scenario list skips a drawn number's column by this key (scene.h), where plan/ is out of reach.
+      if (const std::string key = d.number() ? d.key : ""; key != kDrawnKnobKeys[d.element])
+        throw std::logic_error("knob " + k.key + ": drawn element " + std::to_string(d.element) + " is keyed \"" +
+                               kDrawnKnobKeys[d.element] + "\" in scene.h's kDrawnKnobKeys, not \"" + key + "\"");
+      claimed[d.element] = &k;
+      by_element[d.element] = d;
+    }
+  for (unsigned e = 0; e < PS_DRAWN_KNOBS; ++e)
+    if (!claimed[e]) throw std::logic_error("no knob declares drawn element " + std::to_string(e));
+  return by_element;
+}
+
+const std::vector<DrawnKnob>& drawn_knobs() {
+  static const std::vector<DrawnKnob> d = index_draws(knobs());
+  return d;
 }
 
 namespace {

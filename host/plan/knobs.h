@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 #include "plan/plan.h"
@@ -14,6 +15,19 @@
 namespace portalsim {
 
 enum class KnobKind { integer, number, on_off, choice, grid, range };
+
+// A value drawn per scenario from its element of PS_STREAM_KNOB_DRAW (docs/model/drawn-knobs.md),
+// declared with its knob (knobs.cpp: drawable, drawable_ends, drawn_by): the declarations are
+// the one list of elements, keys, columns and draws.
+struct DrawnKnob {
+  unsigned element = 0;  // its PS_DRAWN_* (the Philox counter's element: bytes depend on it)
+  std::string key{};     // a number's column: scenarios.csv's <key>, data.h5's param_<key>
+  // The field a number's draw sets (at_scenario, drawn_knob_at): a real one lo + (hi - lo)
+  // uniform24(word 0), a whole one lo + below(word 0, hi - lo + 1). None for a draw of its own
+  // (the outfit: outfit_at; the raw grid: raw_grid_at).
+  std::variant<std::monostate, double ModelSettings::*, int ModelSettings::*> field{};
+  bool number() const { return field.index() != 0; }
+};
 
 // Filled by field name (designated initializers): each field left out takes its default.
 struct Knob {
@@ -55,6 +69,9 @@ struct Knob {
   // A grid knob that may be drawn per scenario from a list ("WxH,WxH,..."): sets the list,
   // each grid as set takes it, after set has set the first; null where the grid is one.
   std::function<void(Plan&, const std::vector<double>&)> set_list{};
+  // What the knob draws per scenario (one number, each end of the window, the outfit or the
+  // raw grid); empty where nothing is drawn.
+  std::vector<DrawnKnob> draws{};
 
   std::string flag() const;
   // "0 .. 1000 gray levels", "on, off", "fp32, fp64, fixed16", "X or A..B, each 0.1 .. 10".
@@ -62,6 +79,11 @@ struct Knob {
 };
 
 const std::vector<Knob>& knobs();
+// The draws of knobs(), by element: entry e is PS_DRAWN_KNOBS's element e.
+const std::vector<DrawnKnob>& drawn_knobs();
+// The draws of `list`, by element; throws std::logic_error where two claim one element or an
+// element below PS_DRAWN_KNOBS has none (drawn_knobs checks knobs() so).
+std::vector<DrawnKnob> index_draws(const std::vector<Knob>& list);
 // Null when no knob has this key.
 const Knob* find_knob(std::string_view key);
 

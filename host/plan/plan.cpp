@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 
 #include "base/error.h"
 #include "plan/knobs.h"
@@ -22,43 +24,23 @@ ObjectTransform object_transform(const ModelSettings& m, uint64_t index, int reg
 
 namespace {
 
-// Element e's draw over [lo, hi] (docs/model/drawn-knobs.md): lo + (hi - lo) uniform24(word 0)
-// for a real knob, lo + below(word 0, hi - lo + 1) for a whole one.
-double drawn_real(const ModelSettings& m, unsigned e, uint64_t index) {
+// Scenario `index`'s value of the field that drawn element `e` sets (docs/model/drawn-knobs.md):
+// the field's own where the element is not drawn; else over [lo, hi] lo + (hi - lo)
+// uniform24(word 0) for a real field, lo + below(word 0, hi - lo + 1) for a whole one.
+template <class T>
+T drawn_value(const ModelSettings& m, T ModelSettings::*field, unsigned e, uint64_t index) {
   const DrawnRange& d = m.drawn[e];
-  return d.lo + (d.hi - d.lo) * uniform24(draw(m.seed, index, kStreamKnobDraw, e)[0]);
-}
-
-int drawn_whole(const ModelSettings& m, unsigned e, uint64_t index) {
-  const int lo = static_cast<int>(m.drawn[e].lo), span = static_cast<int>(m.drawn[e].hi) - lo + 1;
-  return lo + static_cast<int>(below(draw(m.seed, index, kStreamKnobDraw, e)[0], static_cast<uint32_t>(span)));
+  if (!d.varies()) return m.*field;
+  const uint32_t word = draw(m.seed, index, kStreamKnobDraw, e)[0];
+  if constexpr (std::is_same_v<T, int>) {
+    const int lo = static_cast<int>(d.lo), span = static_cast<int>(d.hi) - lo + 1;
+    return lo + static_cast<int>(below(word, static_cast<uint32_t>(span)));
+  } else {
+    return d.lo + (d.hi - d.lo) * uniform24(word);
+  }
 }
 
 }  // namespace
-
-int metal_noise_at(const ModelSettings& m, uint64_t index) {
-  return m.drawn[PS_DRAWN_METAL_NOISE].varies() ? drawn_whole(m, PS_DRAWN_METAL_NOISE, index) : m.metal_noise;
-}
-
-double ir_netd_at(const ModelSettings& m, uint64_t index) {
-  return m.drawn[PS_DRAWN_IR_NETD].varies() ? drawn_real(m, PS_DRAWN_IR_NETD, index) : m.ir_netd;
-}
-
-double netd_at(const ModelSettings& m, uint64_t index) {
-  return m.drawn[PS_DRAWN_NETD].varies() ? drawn_real(m, PS_DRAWN_NETD, index) : m.netd;
-}
-
-int frames_at(const ModelSettings& m, uint64_t index) {
-  return m.drawn[PS_DRAWN_FRAMES].varies() ? drawn_whole(m, PS_DRAWN_FRAMES, index) : m.frames;
-}
-
-double illumination_at(const ModelSettings& m, uint64_t index) {
-  return m.drawn[PS_DRAWN_ILLUMINATION].varies() ? drawn_real(m, PS_DRAWN_ILLUMINATION, index) : m.illumination;
-}
-
-double pixel_noise_at(const ModelSettings& m, uint64_t index) {
-  return m.drawn[PS_DRAWN_PIXEL_NOISE].varies() ? drawn_real(m, PS_DRAWN_PIXEL_NOISE, index) : m.pixel_sigma;
-}
 
 int outfit_at(const ModelSettings& m, uint64_t index) {
   if (m.clothing == Clothing::catalogue) return -1;
@@ -70,22 +52,6 @@ int outfit_at(const ModelSettings& m, uint64_t index) {
 
 const Outfit& outfit_of(const ModelSettings& m, uint64_t index) {
   return outfit_table(m.clothing).outfits.at(static_cast<size_t>(outfit_at(m, index)));
-}
-
-double window_lo_at(const ModelSettings& m, uint64_t index) {
-  return m.drawn[PS_DRAWN_WINDOW_LO].varies() ? drawn_real(m, PS_DRAWN_WINDOW_LO, index) : m.window_lo;
-}
-
-double window_hi_at(const ModelSettings& m, uint64_t index) {
-  return m.drawn[PS_DRAWN_WINDOW_HI].varies() ? drawn_real(m, PS_DRAWN_WINDOW_HI, index) : m.window_hi;
-}
-
-double worn_minutes_at(const ModelSettings& m, uint64_t index) {
-  return m.drawn[PS_DRAWN_WORN_MINUTES].varies() ? drawn_real(m, PS_DRAWN_WORN_MINUTES, index) : m.worn_minutes;
-}
-
-double clothing_folds_at(const ModelSettings& m, uint64_t index) {
-  return m.drawn[PS_DRAWN_CLOTHING_FOLDS].varies() ? drawn_real(m, PS_DRAWN_CLOTHING_FOLDS, index) : m.clothing_folds;
 }
 
 std::array<int, 2> raw_grid_at(const ModelSettings& m, uint64_t index) {
@@ -101,45 +67,23 @@ ModelSettings ModelSettings::at_scenario(uint64_t index) const {
   m.raw_width = raw[0];
   m.raw_height = raw[1];
   m.raw_grids.clear();
-  m.metal_noise = metal_noise_at(*this, index);
-  m.pixel_sigma = pixel_noise_at(*this, index);
-  m.ir_netd = ir_netd_at(*this, index);
-  m.netd = netd_at(*this, index);
-  m.frames = frames_at(*this, index);
-  m.illumination = illumination_at(*this, index);
-  m.worn_minutes = worn_minutes_at(*this, index);
-  m.window_lo = window_lo_at(*this, index);
-  m.window_hi = window_hi_at(*this, index);
   m.outfit = outfit_at(*this, index);
-  m.clothing_folds = clothing_folds_at(*this, index);
+  for (const DrawnKnob& d : drawn_knobs())
+    std::visit(
+        [&](auto field) {
+          if constexpr (!std::is_same_v<decltype(field), std::monostate>)
+            m.*field = drawn_value(*this, field, d.element, index);
+        },
+        d.field);
   m.drawn = {};
   return m;
 }
 
 double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index) {
-  switch (element) {
-    case PS_DRAWN_METAL_NOISE:
-      return metal_noise_at(m, index);
-    case PS_DRAWN_IR_NETD:
-      return ir_netd_at(m, index);
-    case PS_DRAWN_PIXEL_NOISE:
-      return pixel_noise_at(m, index);
-    case PS_DRAWN_NETD:
-      return netd_at(m, index);
-    case PS_DRAWN_FRAMES:
-      return frames_at(m, index);
-    case PS_DRAWN_ILLUMINATION:
-      return illumination_at(m, index);
-    case PS_DRAWN_WORN_MINUTES:
-      return worn_minutes_at(m, index);
-    case PS_DRAWN_WINDOW_LO:
-      return window_lo_at(m, index);
-    case PS_DRAWN_WINDOW_HI:
-      return window_hi_at(m, index);
-    case PS_DRAWN_CLOTHING_FOLDS:
-      return clothing_folds_at(m, index);
-  }
-  throw std::logic_error("no drawn knob " + std::to_string(element));
+  const auto& field = drawn_knobs().at(element).field;
+  if (const auto* real = std::get_if<double ModelSettings::*>(&field)) return drawn_value(m, *real, element, index);
+  if (const auto* whole = std::get_if<int ModelSettings::*>(&field)) return drawn_value(m, *whole, element, index);
+  throw std::logic_error("drawn element " + std::to_string(element) + " is no number (outfit_at, raw_grid_at)");
 }
 
 FeatureLayout FeatureLayout::of(const Catalogue& cat, int block) {

@@ -68,7 +68,7 @@ struct ModelSettings {
   int outfit = -1;
   // The outer garment's folds and seams (--clothing-folds): the share of the view's fold
   // pattern (AssetSet::folds) where it lies doubled, 0 (none) .. 1; each scenario's is
-  // clothing_folds_at's. Only under a drawn outfit.
+  // drawn_knob_at's. Only under a drawn outfit.
   double clothing_folds{};
   // The MMW camera's own processing (docs/model/physics-mmw.md, "The camera's defaults"):
   // raw frames at 10 Hz averaged, each with its own NETD draw (the default 10: one second,
@@ -86,13 +86,14 @@ struct ModelSettings {
   // Knobs drawn per scenario (docs/model/drawn-knobs.md), indexed by PS_DRAWN_*: a knob
   // given A..B takes in each scenario a value uniform in [A, B] (whole numbers for an
   // integer knob) from the counter generator, the same in every view, batch and backend.
-  // Its field above then holds A; each knob's value of a scenario is its *_at function.
+  // Its field above then holds A; its value in a scenario is drawn_knob_at's. Its knob's
+  // declaration (plan/knobs.cpp, drawable) names its element and field.
   std::array<DrawnRange, PS_DRAWN_KNOBS> drawn{};
   // The knobs as view `s` takes them: its own camera parameters (Sensor::netd, raw) over
   // the run's. Both backends read a view's knobs through this, and nothing else.
   ModelSettings for_view(const Sensor& s) const;
-  // The knobs of scenario `index`: each drawn knob at its value there (its *_at), nothing
-  // drawn. The CPU reference computes each scenario from these.
+  // The knobs of scenario `index`: each drawn knob at its value there (drawn_knob_at,
+  // outfit_at, raw_grid_at), nothing drawn. The CPU reference computes each scenario from these.
   ModelSettings at_scenario(uint64_t index) const;
   // The pixel noise's highest sigma: the knob's, or its drawn range's upper end.
   double pixel_sigma_hi() const {
@@ -111,48 +112,24 @@ struct ModelSettings {
 // kernels/composite.cl's place_view draws the same numbers on its own.
 ObjectTransform object_transform(const ModelSettings& m, uint64_t index, int region);
 
-// Scenario `index`'s metal detector noise (the knob metal_noise): the knob's value, or where
-// it is drawn (A..B), A + below(word 0, B - A + 1) of PS_STREAM_KNOB_DRAW, element
-// PS_DRAWN_METAL_NOISE. kernels/metal.cl and metal_physics.cl draw the same on their own.
-int metal_noise_at(const ModelSettings& m, uint64_t index);
-// Scenario `index`'s IR NETD (the knob ir_netd, K): the knob's value, or where it is drawn
-// (A..B), A + (B - A) uniform24(word 0) of PS_STREAM_KNOB_DRAW, element PS_DRAWN_IR_NETD.
-// kernels/ir_surface.cl's ir_netd_of draws the same at the kernels' precision.
-double ir_netd_at(const ModelSettings& m, uint64_t index);
-// Scenario `index`'s MMW NETD (the knob netd, K) and raw frames (frames): as ir_netd_at and
-// metal_noise_at, elements PS_DRAWN_NETD and PS_DRAWN_FRAMES. kernels/netd.cl's
-// mmw_noise_of draws the same.
-double netd_at(const ModelSettings& m, uint64_t index);
-int frames_at(const ModelSettings& m, uint64_t index);
-// Scenario `index`'s illumination (K) and worn time (minutes), as ir_netd_at, elements
-// PS_DRAWN_ILLUMINATION and PS_DRAWN_WORN_MINUTES. kernels/radiometry.cl's scene_draw.
-double illumination_at(const ModelSettings& m, uint64_t index);
-double worn_minutes_at(const ModelSettings& m, uint64_t index);
-// Scenario `index`'s MMW display window's ends (K), as ir_netd_at, elements
-// PS_DRAWN_WINDOW_LO and PS_DRAWN_WINDOW_HI. kernels/window.cl's stage_window draws the same.
-double window_lo_at(const ModelSettings& m, uint64_t index);
-double window_hi_at(const ModelSettings& m, uint64_t index);
+// Scenario `index`'s value of the drawn number `element` (PS_DRAWN_*; knobs.h, DrawnKnob): its
+// knob's value, or where it is drawn (A..B) A + (B - A) uniform24(word 0) of PS_STREAM_KNOB_DRAW,
+// element `element`, for a real knob, A + below(word 0, B - A + 1) for a whole one (metal_noise,
+// frames). The kernels draw the same on their own (kernels/lib/philox.cl, knob_draw).
+double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index);
 // Scenario `index`'s outfit, an index into outfit_table(m.clothing), -1 for the catalogue's
 // clothing: its class below(word 0, classes), then its outfit in the class below(word 1,
-// the class's outfits), of PS_STREAM_KNOB_DRAW element PS_DRAWN_CLOTHING. kernels/radiometry.cl's
+// the class's outfits), of PS_STREAM_KNOB_DRAW element PS_DRAWN_CLOTHING. kernels/lib/physics.cl's
 // scene_draw draws the same.
 int outfit_at(const ModelSettings& m, uint64_t index);
 // That outfit itself, for a run whose clothing is drawn (m.clothing not the catalogue's).
 const Outfit& outfit_of(const ModelSettings& m, uint64_t index);
-// Scenario `index`'s folds (the knob clothing_folds), as ir_netd_at, element
-// PS_DRAWN_CLOTHING_FOLDS. kernels/radiometry.cl's scene_draw draws the same.
-double clothing_folds_at(const ModelSettings& m, uint64_t index);
-// Scenario `index`'s pixel noise sigma (the knob pixel_noise, gray levels), as ir_netd_at,
-// element PS_DRAWN_PIXEL_NOISE. kernels/sensor_noise.cl's pixel_sigma_of.
-double pixel_noise_at(const ModelSettings& m, uint64_t index);
 // The most raw grids a list may hold (--mmw-raw WxH,WxH,...): each is a part of every batch.
 constexpr size_t kMaxRawGrids = 16;
 // Scenario `index`'s MMW raw grid, {width, height}: the run's, or where a list is drawn
 // (ModelSettings::raw_grids) its entry below(word 0, size) of PS_STREAM_KNOB_DRAW element
 // PS_DRAWN_MMW_RAW. The OpenCL backend runs each grid's scenarios as a batch of their own.
 std::array<int, 2> raw_grid_at(const ModelSettings& m, uint64_t index);
-// Scenario `index`'s value of the drawn knob `element` (PS_DRAWN_*), as its *_at gives it.
-double drawn_knob_at(const ModelSettings& m, unsigned element, uint64_t index);
 
 // How block and region means are computed. Both give the same numbers to the bit
 // (under -cl-fast-relaxed-math, to the division's approximation); sparse is used for

@@ -11,11 +11,11 @@ namespace portalsim {
 
 constexpr int16_t kNoObject = -1;
 
-// The keys of the numbers a run may draw per scenario, by their PS_DRAWN_* element: each is
-// its knob's key, or for the window's ends (--window L1..L2/H1..H2) the knob's key and the
-// end (plan/knobs.cpp checks), and, where drawn, a column of scenarios.csv and data.h5's
-// param_<key>. PS_DRAWN_CLOTHING's element draws an outfit and PS_DRAWN_MMW_RAW's a raw
-// grid, no number: their keys are empty (each has columns of its own).
+// The keys of the numbers a run may draw per scenario, by their PS_DRAWN_* element, by which
+// a scenario list takes their columns as records. The knobs' declarations are the list
+// (plan/knobs.cpp, drawn_knobs: keys, columns, draws); scene/ cannot read plan/, so it keeps
+// this copy, which drawn_knobs() refuses where it differs. PS_DRAWN_CLOTHING's element draws
+// an outfit and PS_DRAWN_MMW_RAW's a raw grid, no number: their keys are empty here.
 inline constexpr std::array<const char*, PS_DRAWN_KNOBS> kDrawnKnobKeys = {
     "metal_noise",  "ir_netd", "pixel_noise", "netd",      "frames", "illumination",
     "worn_minutes", "",        "window_lo",   "window_hi", "",       "clothing_folds"};

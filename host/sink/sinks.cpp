@@ -9,6 +9,7 @@
 #include "assets/image_io.h"
 #include "base/error.h"
 #include "base/parallel.h"
+#include "plan/knobs.h"
 #include "scene/bodies.h"
 #include "sink/feature_rows.h"
 #include "sink/scenario_folder.h"
@@ -121,8 +122,8 @@ class ScenarioListSink final : public Sink {
       if (ctx.model.transforms())
         for (const char* what : {",rotation", ",scale", ",flip"})
           for (int r = 1; r <= R; ++r) h += what + std::to_string(r);
-      for (unsigned e = 0; e < kDrawnKnobKeys.size(); ++e)
-        if (ctx.model.drawn[e].varies()) h += std::string(",") + kDrawnKnobKeys[e];
+      for (const DrawnKnob& d : drawn_knobs())
+        if (d.number() && ctx.model.drawn[d.element].varies()) h += "," + d.key;
       if (ctx.model.raw_grid_drawn())
         for (const char* c : kRawGridColumns) h += std::string(",") + c;
       if (drawn_bodies(*ctx.cat))
@@ -169,10 +170,11 @@ class ScenarioListSink final : public Sink {
       }
       // Each knob drawn per scenario (plan.h, drawn_knob_at): the shortest text that reads
       // back as the same double.
-      for (unsigned e = 0; e < kDrawnKnobKeys.size(); ++e)
-        if (ctx_.model.drawn[e].varies()) {
+      for (const DrawnKnob& d : drawn_knobs())
+        if (d.number() && ctx_.model.drawn[d.element].varies()) {
           char buf[32];
-          const auto res = std::to_chars(buf, buf + sizeof buf, drawn_knob_at(ctx_.model, e, scenes.first_index + i));
+          const auto res =
+              std::to_chars(buf, buf + sizeof buf, drawn_knob_at(ctx_.model, d.element, scenes.first_index + i));
           s += ',';
           s.append(buf, res.ptr);
         }

@@ -19,6 +19,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "plan/knobs.h"
 #include "plan/plan.h"
 #include "sink/file_order_hash.h"
 #include "sink/h5_file.h"
@@ -238,9 +239,9 @@ std::vector<TensorColumn> tensor_columns(const SinkContext& ctx, const TensorOpt
     if (ctx.model.transforms()) add_transform_columns(add, ctx);
     // Each knob drawn per scenario (plan.h, drawn_knob_at): float64, the doubles
     // scenarios.csv records.
-    for (unsigned e = 0; e < kDrawnKnobKeys.size(); ++e)
-      if (ctx.model.drawn[e].varies())
-        add(std::string("param_") + kDrawnKnobKeys[e], TensorType::f64, {},
+    for (const DrawnKnob& d : drawn_knobs())
+      if (const unsigned e = d.element; d.number() && ctx.model.drawn[e].varies())
+        add("param_" + d.key, TensorType::f64, {},
             [model, e](const SceneBatch& b, const BatchOutput&, size_t lo, size_t hi, char* dst) {
               for (size_t i = lo; i < hi; ++i) {
                 const double v = drawn_knob_at(model, e, b.first_index + i);

@@ -4,14 +4,14 @@
 // used by a stage kernel and a fast path.
 
 // The illumination, worn time and outfit of a scenario where drawn per scenario (PS_PHYS_SCENE,
-// PS_PHYS_CLOTHING; host: illumination_at, worn_minutes_at, outfit_at): at, the scene
+// PS_PHYS_CLOTHING; host: drawn_knob_at, outfit_at): at, the scene
 // block's offset (0: neither drawn); t, the illumination's place in its range (uniform24 of
 // PS_DRAWN_ILLUMINATION's word 0); w, the worn time in minutes; outfit, the outfit's index
 // (-1: the catalogue's clothing); head, each subject's (gain, offset) then each variant's
 // value under it; moves, each subject's then each variant's moves with the scene; shadow,
 // its factor of every IR shadow; fold and fold_t, its folds' f k and T (0: no folds), so that
 // a value v where the fold pattern's share is m turns into fold_t + (1 + fold m)(v - fold_t)
-// (host: clothing_folds_at; PS_OUTFIT_FOLD_K).
+// (host: drawn_knob_at; PS_OUTFIT_FOLD_K).
 typedef struct {
   int at, outfit;
   preal t, w, shadow, fold, fold_t;
@@ -129,7 +129,7 @@ inline global const param* psf_taps(global const param* phys, const PsViewLaunch
 inline uint frame_stream(int k) { return k == 0 ? PS_STREAM_RAW_NOISE : PS_STREAM_FRAME_NOISE + (uint)k; }
 
 // Scenario index's MMW noise where the NETD or the frames are drawn per scenario (host:
-// netd_at, frames_at): NETD in [lo, hi] (PS_STREAM_KNOB_DRAW, PS_DRAWN_NETD, real), frames
+// drawn_knob_at): NETD in [lo, hi] (PS_STREAM_KNOB_DRAW, PS_DRAWN_NETD, real), frames
 // in [flo, fhi] (PS_DRAWN_FRAMES, whole); *frames frames of the returned sd each, or under
 // the block-mean noise model (as_one) one of NETD / sqrt(frames).
 inline preal mmw_noise_drawn(preal lo, preal hi, int flo, int fhi, bool as_one, uint2 seed, ulong index,
@@ -205,7 +205,7 @@ inline void netd_frames(global preal* restrict v, int cells, preal sd, int frame
 #endif
 }
 
-// Scenario `index`'s drawn window ends (PS_WINDOW_DRAWN; host: window_lo_at, window_hi_at),
+// Scenario `index`'s drawn window ends (PS_WINDOW_DRAWN; host: drawn_knob_at),
 // each uniform over its range: from PS_PHYS_WINDOW_MIN to _MIN_HI, and _MAX to _MAX_HI.
 inline void drawn_window(global const param* phys, uint2 seed, ulong index, preal* lo, preal* hi) {
   *lo = knob_draw((preal)phys[PS_PHYS_WINDOW_MIN], (preal)phys[PS_PHYS_WINDOW_MIN_HI], seed, index, PS_DRAWN_WINDOW_LO);
@@ -266,7 +266,7 @@ inline void shadow_values(const Layers* Ly, const PsViewLaunch* L, global const 
 
 // The scenario's IR NETD: the knob's, or where it is drawn per scenario (PS_PHYS_NETD_HI
 // above PS_PHYS_NETD), NETD + (hi - NETD) uniform24(word 0) of PS_STREAM_KNOB_DRAW (host:
-// ir_netd_at).
+// drawn_knob_at).
 inline preal ir_netd_of(global const param* phys, uint2 seed, ulong index) {
   return knob_draw((preal)phys[PS_PHYS_NETD], (preal)phys[PS_PHYS_NETD_HI], seed, index, PS_DRAWN_IR_NETD);
 }

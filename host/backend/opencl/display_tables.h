@@ -25,7 +25,7 @@ double kernel_netd(const Plan& plan, const ModelSettings& m);
 
 // The MMW noise the kernels draw per scenario (kernels/netd.cl, mmw_noise_of): where
 // neither the NETD nor the frames is drawn, netd_lo = netd_hi = kernel_netd and one frame
-// count; else the knobs' ranges (netd_at, frames_at), as_one under the block-mean model.
+// count; else the knobs' ranges (drawn_knob_at), as_one under the block-mean model.
 struct MmwNoise {
   double netd_lo = 0, netd_hi = 0;
   int frames_lo = 1, frames_hi = 1;

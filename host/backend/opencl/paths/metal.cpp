@@ -48,7 +48,7 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
   const Catalogue& cat = d_.cat;
   cl::Buffer& metal = out_.at_least(d_.ctx(), b.n * cat.zones);
   const cl_uint n = static_cast<cl_uint>(b.n);
-  // The detector noise's range: the kernels draw each scenario's from it (metal_noise_at).
+  // The detector noise's range: the kernels draw each scenario's from it (drawn_knob_at).
   const DrawnRange& drawn = plan.model.drawn[PS_DRAWN_METAL_NOISE];
   const cl_int noise_hi = drawn.varies() ? static_cast<cl_int>(drawn.hi) : plan.model.metal_noise;
   if (plan.model.model == Model::physics) {
