@@ -86,7 +86,7 @@
 #define PS_DRAWN_ILLUMINATION 5u
 #define PS_DRAWN_WORN_MINUTES 6u
 /* The outfit of a run whose clothing is drawn (--clothing): its class from word 0, its
- * outfit in the class from word 1 (PS_PHYS_CLOTHING). Not a numeric knob (host/scene/scene.h
+ * outfit in the class from word 1 (PsPhys clothing). Not a numeric knob (host/scene/scene.h
  * lists the numeric ones). */
 #define PS_DRAWN_CLOTHING 7u
 /* physics: the MMW display window's ends (--window L1..L2/H1..H2), each drawn from its range. */
@@ -157,8 +157,7 @@
 #define PS_FP_SPRITE_PADDED 16 /* atlas offset of the sprite's padded copy (PS_PAD) */
 #define PS_FP_LEN 17
 
-/* One camera view's launch of a render stage, passed by value to every stage kernel.
- * 4-byte fields only, so host and device lay it out alike. */
+/* The launch's records: 4-byte fields only, so host and device lay them out alike. */
 #ifdef __OPENCL_VERSION__
 #define PS_U32 uint
 #define PS_I32 int
@@ -169,6 +168,33 @@
 #define PS_I32 int32_t
 #define PS_F32 float
 #endif
+/* Where the physics model's tables lie in a launch's `phys` (PsViewLaunch.tables), derived
+ * with them (host: physics_tables) and set in the launch as one. */
+typedef struct {
+  PS_I32 stride; /* stage_mmw_display's row stride of dx */
+  /* stage_mmw_display's weights of each raw column for each view column (raw_width rows of
+   * stride, zero past width), the first and last raw column of each run of 16 view columns
+   * (2 per run), the weights of each raw row for each view row (height rows of raw_height),
+   * and each view row's first and last raw row. */
+  PS_I32 dx, dxband, dy, dyband;
+} PsDisplayTables;
+typedef struct {
+  PS_I32 psf_radius; /* taps either side of the centre */
+  PS_I32 gauss;      /* the PS_GAUSS_TABLE values of Phi^-1((k + 1/2) / PS_GAUSS_TABLE) */
+  /* The IR contact shadow off the body (IR views): per subject, the lowest base image index
+   * that is body (warmer than halfway from the room to the skin), then per variant its
+   * shadow against the room, -coupling (room - object), where the object is not on the body,
+   * then per subject the factor of every shadow on it: (its skin - room) / (skin - room). */
+  PS_I32 off_body;
+  /* The MMW physics fast path's tables: the raw grid's weights of each view column
+   * (raw_width x width) and row (raw_height x height), optics and sampling folded in; the
+   * first and last raw column of each view column and raw row of each view row (2 per);
+   * and each subject's bare raw grid (subjects x raw_height x raw_width). */
+  PS_I32 wx, wy, cband, rband, base;
+  PsDisplayTables display;
+} PsPhysTables;
+
+/* One camera view's launch of a render stage, passed by value to every stage kernel. */
 typedef struct {
   PS_U32 n;           /* scenarios in the batch */
   PS_I32 view;        /* camera view: base image slot, pixel noise element */
@@ -184,71 +210,83 @@ typedef struct {
   PS_F32 jitter_x, jitter_y; /* in this view's pixels */
   /* The physics model: the raw grid, and where its parameters lie in `phys`. */
   PS_I32 raw_width, raw_height;
-  PS_I32 psf_radius; /* taps either side of the centre */
-  PS_I32 subjects;   /* subjects in the catalogue (the layout of phys) */
-  /* The physics fast path's tables in phys: the raw grid's weights of each view column
-   * (raw_width x width) and row (raw_height x height), optics and sampling folded in; the
-   * first and last raw column of each view column and raw row of each view row (2 per);
-   * and each subject's bare raw grid (subjects x raw_height x raw_width). */
-  PS_I32 phys_wx, phys_wy, phys_cband, phys_rband, phys_base;
-  PS_I32 phys_gauss; /* the PS_GAUSS_TABLE values of Phi^-1((k + 1/2) / PS_GAUSS_TABLE) in phys */
-  /* The IR contact shadow off the body (IR views): per subject, the lowest base image index
-   * that is body (warmer than halfway from the room to the skin), then per variant its
-   * shadow against the room, -coupling (room - object), where the object is not on the body,
-   * then per subject the factor of every shadow on it: (its skin - room) / (skin - room). */
-  PS_I32 phys_off_body;
-  /* The MMW camera's processing: frames averaged (each its own NETD draw), the window
-   * (PS_WINDOW_FIXED, _AUTO or _DRAWN), and stage_mmw_display's weights of each raw column for
-   * each view column (raw_width rows of display_stride, zero past width), the first and last
-   * raw column of each run of 16 view columns (2 per run), the weights of each raw row for
-   * each view row (height rows of raw_height), and each view row's first and last raw row. */
+  PS_I32 subjects; /* subjects in the catalogue (the layout of phys) */
+  PsPhysTables tables;
+  /* The MMW camera's processing: frames averaged (each its own NETD draw) and the window
+   * (PS_WINDOW_FIXED, _AUTO or _DRAWN). */
   PS_I32 frames, window_auto;
-  PS_I32 display_stride, phys_dx, phys_dxband, phys_dy, phys_dyband;
   /* Randomised objects (PS_FLAG_AFFINE): the ranges of the angle (degrees) and the scale,
    * as floats, and the same four as doubles (low word, high word) for fp64 builds. */
   PS_F32 rotate_lo, rotate_hi, scale_lo, scale_hi;
   PS_U32 ranges_fp64[8];
 } PsViewLaunch;
 
-/* The physics model's parameters for one launch (kernels' `phys`, at the build's parameter
- * precision): these scalars, then a (gain, offset) pair per subject turning its base
- * image's gray into kelvin, then each variant's apparent temperature under clothing, then
- * the PSF's 2 psf_radius + 1 normalised taps (kernels/shared.h: PS_PHYS_VARIANTS, PS_PHYS_TAPS). */
-#define PS_PHYS_BACKGROUND 0 /* K */
-#define PS_PHYS_WINDOW_MIN 1 /* K shown as gray 0 */
-#define PS_PHYS_WINDOW_MAX 2 /* K shown as gray 255 */
-#define PS_PHYS_NETD 3       /* K rms per raw pixel (MMW: over the frames, kernel_netd, where neither is drawn) */
-#define PS_PHYS_NETD_HI 4    /* the view's NETD drawn per scenario: its upper end; NETD where fixed */
-/* MMW: the frames drawn per scenario, lowest and highest (both the knob's where fixed), and
- * 1 where the frames' mean is one draw of NETD / sqrt(frames) (Plan::frames_approximated). */
-#define PS_PHYS_FRAMES_LO 5
-#define PS_PHYS_FRAMES_HI 6
-#define PS_PHYS_FRAMES_AS_ONE 7
-/* Where the illumination or the worn time is drawn per scenario, the offset of the scene
- * block (0: neither is): whether the illumination is drawn, the worn time's ends (minutes),
- * then per subject the change of its (gain, offset) over the illumination's range, per
- * variant its value's change over that range, its change per unit of exp(-worn / tau), 1 / tau
- * and exp(-worn_lo / tau) (PS_SCENE_*), then (MMW) each subject's bare raw grid's change over
- * the illumination's range (kernels/lib/physics.cl, scene_draw). */
-#define PS_PHYS_SCENE 8
-/* Where the clothing is drawn per scenario (--clothing), the offset of the clothing block (0:
- * the catalogue's clothing): its classes C, each outfit's stride, the offset of the MMW gray
- * grids (0 for IR), the folds' range (--clothing-folds), the offset of the MMW fold grids (0
- * where the folds are off or for IR), then per class its first outfit, then per class its
- * outfits' count (PS_CLOTHING_*), then each outfit's entry (PS_OUTFIT_*): its factor of every IR
- * shadow, the offset in the entry of its scene moves, its folds' factor k and reference
- * temperature T (a fold of share m turns a value v into T + (1 + f k m)(v - T)), then each
- * subject's (gain, offset) and each variant's value as at PS_PHYS_SUBJECTS, and where the
- * scene block is, each subject's and variant's moves as at its PS_SCENE_SUBJECTS. The gray grids (MMW): each subject's
- * base image's gray through the raw grid's weights, so that its bare grid is gain G + offset (each raw cell's weights
- * sum to 1; kernels/physics_raw.cl). The fold grids (MMW): each subject's fold share m times its gray, then each
- * subject's m alone, through the same weights. */
-#define PS_PHYS_CLOTHING 9
-/* MMW: the display window's ends drawn per scenario (PS_WINDOW_DRAWN): the upper ends of their
- * ranges (the lower ends are PS_PHYS_WINDOW_MIN and PS_PHYS_WINDOW_MAX); the window's ends where fixed. */
-#define PS_PHYS_WINDOW_MIN_HI 10
-#define PS_PHYS_WINDOW_MAX_HI 11
-#define PS_PHYS_SUBJECTS 12
+/* The physics model's parameters for one launch (kernels' `phys`): the camera kind's
+ * scalars (PsPhysMmw, PsPhysIr), then from PS_PHYS_SUBJECTS a (gain, offset) pair per
+ * subject turning its base image's gray into kelvin, then each variant's value (MMW: its
+ * apparent temperature under clothing; IR: its contact shadow), then the PSF's
+ * 2 psf_radius + 1 normalised taps (kernels/shared.h: PS_PHYS_VARIANTS, PS_PHYS_TAPS), then
+ * the tables PsViewLaunch.tables places. Every value is a PS_PARAM, the kernels' parameter
+ * precision: the host fills doubles and converts each (backend/opencl/buffers.h, params), so
+ * a scalar's index is its place in its struct on both sides (tests/contract_layout_test.cpp). */
+#ifdef __OPENCL_VERSION__
+#if defined(PRECISION_FP64)
+#define PS_PARAM double
+#else
+#define PS_PARAM float
+#endif
+#else
+#define PS_PARAM double
+#endif
+/* Both kinds' first scalars (kernels/lib/physics.cl reads them for either). */
+typedef struct {
+  PS_PARAM window_min; /* K shown as gray 0 (MMW, drawn window: the lower end of its range) */
+  PS_PARAM window_max; /* K shown as gray 255 (likewise) */
+  /* Where the illumination or the worn time is drawn per scenario, the offset of the scene
+   * block (0: neither is): whether the illumination is drawn, the worn time's ends (minutes),
+   * then per subject the change of its (gain, offset) over the illumination's range, per
+   * variant its value's change over that range, its change per unit of exp(-worn / tau), 1 / tau
+   * and exp(-worn_lo / tau) (PS_SCENE_*), then (MMW) each subject's bare raw grid's change over
+   * the illumination's range (kernels/lib/physics.cl, scene_draw). */
+  PS_PARAM scene;
+  /* Where the clothing is drawn per scenario (--clothing), the offset of the clothing block (0:
+   * the catalogue's clothing): its classes C, each outfit's stride, the offset of the MMW gray
+   * grids (0 for IR), the folds' range (--clothing-folds), the offset of the MMW fold grids (0
+   * where the folds are off or for IR), then per class its first outfit, then per class its
+   * outfits' count (PS_CLOTHING_*), then each outfit's entry (PS_OUTFIT_*): its factor of every
+   * IR shadow, the offset in the entry of its scene moves, its folds' factor k and reference
+   * temperature T (a fold of share m turns a value v into T + (1 + f k m)(v - T)), then each
+   * subject's (gain, offset) and each variant's value as at PS_PHYS_SUBJECTS, and where the scene
+   * block is, each subject's and variant's moves as at its PS_SCENE_SUBJECTS. The gray grids
+   * (MMW): each subject's base image's gray through the raw grid's weights, so that its bare grid
+   * is gain G + offset (each raw cell's weights sum to 1; kernels/physics_raw.cl). The fold grids
+   * (MMW): each subject's fold share m times its gray, then each subject's m alone, through the
+   * same weights. */
+  PS_PARAM clothing;
+} PsPhys;
+typedef struct {
+  PsPhys common;
+  /* K rms per raw pixel over the frames (kernel_netd) where neither the NETD nor the frames
+   * is drawn; else the NETD's range drawn per scenario (its ends, equal where fixed). */
+  PS_PARAM netd_lo, netd_hi;
+  /* The frames drawn per scenario, lowest and highest (both the knob's where fixed), and 1
+   * where the frames' mean is one draw of NETD / sqrt(frames) (Plan::frames_approximated). */
+  PS_PARAM frames_lo, frames_hi, frames_as_one;
+  /* The display window's ends drawn per scenario (PS_WINDOW_DRAWN): the upper ends of their
+   * ranges (the lower ends are window_min and window_max); the window's ends where fixed. */
+  PS_PARAM window_min_hi, window_max_hi;
+} PsPhysMmw;
+typedef struct {
+  PsPhys common;
+  /* K rms per pixel, and where drawn per scenario the upper end of its range (NETD where fixed). */
+  PS_PARAM netd, netd_hi;
+} PsPhysIr;
+/* A third kind joins this union; the tails begin past the largest kind's scalars. */
+typedef union {
+  PsPhysMmw mmw;
+  PsPhysIr ir;
+} PsPhysKinds;
+#define PS_PHYS_SUBJECTS ((int)(sizeof(PsPhysKinds) / sizeof(PS_PARAM)))
 #define PS_CLOTHING_CLASSES 0
 #define PS_CLOTHING_STRIDE 1
 #define PS_CLOTHING_GRIDS 2

@@ -2,14 +2,14 @@
 // the field is each object's surface dT alone, laid by its IR sprite's coverage over 0 K,
 // against the surface it touches: on the body (a base image index of at least the
 // subject's body_from) the skin (host: PS_PHYS_VARIANTS, -coupling (skin - object)), off
-// it the room (phys_off_body), scaled to the subject's own skin (shadow_values); "heat_spread" then blurs it with the optics kernels. Stage "ir_surface": plus the bare body's surface temperature, the
+// it the room (PsPhysTables.off_body), scaled to the subject's own skin (shadow_values); "heat_spread" then blurs it with the optics kernels. Stage "ir_surface": plus the bare body's surface temperature, the
 // base image's index read as kelvin through the subject's (gain, offset).
 
 kernel void stage_contact_shadow(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;
   global preal* dT = (global preal*)field + row0;
   global const uchar* restrict base = base_row(atlas, bases, subject, &L, i, y);
-  const int body_from = (int)phys[L.phys_off_body + subject[i]];
+  const int body_from = (int)phys[L.tables.off_body + subject[i]];
   const SceneDraw scene = scene_draw(phys, seed, index);
   preal on[PS_MAX_LAYERS], off[PS_MAX_LAYERS];
   Layers Ly;
@@ -39,7 +39,7 @@ kernel void stage_ir_netd(VIEW_STAGE_ARGS) {
   const preal sd = ir_netd_of(phys, seed, index);
   if (sd > 0)
     noise_cells((global preal*)field + (size_t)i * L.width * L.height, L.width * L.height, sd, seed, index,
-                PS_STREAM_IR_NOISE, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);
+                PS_STREAM_IR_NOISE, L.view, phys + L.tables.gauss, L.flags & PS_FLAG_FAST_DRAWS);
 }
 
 // Stage "ir_display": the IR display window (ir_window), kelvin to temperature index

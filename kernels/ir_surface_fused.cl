@@ -35,7 +35,7 @@ inline void ir_surface_view(uint i, ulong index, const PsViewLaunch* L, global c
                             global real* field, global uchar* out, global const param* phys, global real* scratch,
                             bool display) {
   global const int* rec = records + (size_t)i * PS_REC_LEN;
-  const int W = L->width, H = L->height, R = L->psf_radius;
+  const int W = L->width, H = L->height, R = L->tables.psf_radius;
   global preal* T = (global preal*)field + (size_t)i * H * W;
   global uchar* o = out + (size_t)i * H * W;
   global preal* S = (global preal*)scratch + (size_t)i * (H * W + 2 * H);
@@ -59,7 +59,7 @@ inline void ir_surface_view(uint i, ulong index, const PsViewLaunch* L, global c
 
   // contact_shadow over each row's span (into T), zero over the rest the row blur reads;
   // then heat_spread along the row (T -> S) as stage_optics_rows, over the span's reach.
-  const int body_from = (int)phys[L->phys_off_body + s];
+  const int body_from = (int)phys[L->tables.off_body + s];
   global const param* taps = psf_taps(phys, L);
   preal on[PS_MAX_LAYERS], off[PS_MAX_LAYERS];
   for (int y = y_lo; y < y_hi; ++y) {
@@ -176,8 +176,8 @@ inline void ir_noisy_block(global const float* restrict T, global uchar* restric
 inline void ir_noisy_window(global const preal* restrict T, global uchar* restrict o, global const param* phys,
                             int pixels, preal sd, uint2 seed, ulong index, int view, global const param* table,
                             bool fast) {
-  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
-  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
+  const preal lo = (preal)phys_common(phys)->window_min;
+  const preal scale = (preal)255 / ((preal)phys_common(phys)->window_max - lo);
 #if defined(PRECISION_FP64)
   for (int p = 0; p < pixels; ++p) {
     const preal g = fast ? ih_cell(seed, index, PS_STREAM_IR_NOISE, view, p)
@@ -233,7 +233,7 @@ kernel void ir_surface_noise_display_fused(VIEW_STAGE_ARGS) {
   global uchar* o = out + (size_t)i * pixels;
   const preal sd = ir_netd_of(phys, seed, index);
   if (sd > 0)
-    ir_noisy_window(T, o, phys, pixels, sd, seed, index, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);
+    ir_noisy_window(T, o, phys, pixels, sd, seed, index, L.view, phys + L.tables.gauss, L.flags & PS_FLAG_FAST_DRAWS);
   else
     ir_window(T, o, phys, 0, pixels);
 }

@@ -2,7 +2,7 @@
 // the display window [min, max] kelvin mapped to gray 0..255, rounded half up and clamped.
 // The interpolation (bilinear or bicubic, raw pixel centres at (c + 1/2) W / raw_width,
 // edges held) and any Gaussian smoothing after it are linear and separable, so the host
-// gives them as weight tables (L.phys_dx, L.phys_dy and their bands: derived once per
+// gives them as weight tables (L.tables.display: dx, dy and their bands, derived once per
 // launch from the knobs): view pixel (x, y) is sum_r dy[y][r] sum_c dx[c][x] raw[r][c]. One
 // work-item per scenario draws the whole view.
 
@@ -95,13 +95,13 @@ inline uchar16 level16_fast(float16 t) { return convert_uchar16(convert_int16(fm
 
 inline void mmw_display_fast(global const float* restrict grid, global float* restrict hr, global uchar* restrict o,
                              global const param* phys, const PsViewLaunch* L) {
-  const int W = L->width, H = L->height, RW = L->raw_width, RH = L->raw_height, stride = L->display_stride;
-  global const param* dx = phys + L->phys_dx;
-  global const param* dxband = phys + L->phys_dxband;
-  global const param* dy = phys + L->phys_dy;
-  global const param* dyband = phys + L->phys_dyband;
-  const float lo = (float)phys[PS_PHYS_WINDOW_MIN];
-  const float scale = 255.0f / ((float)phys[PS_PHYS_WINDOW_MAX] - lo);
+  const int W = L->width, H = L->height, RW = L->raw_width, RH = L->raw_height, stride = L->tables.display.stride;
+  global const param* dx = phys + L->tables.display.dx;
+  global const param* dxband = phys + L->tables.display.dxband;
+  global const param* dy = phys + L->tables.display.dy;
+  global const param* dyband = phys + L->tables.display.dyband;
+  const float lo = (float)phys_common(phys)->window_min;
+  const float scale = 255.0f / ((float)phys_common(phys)->window_max - lo);
   const int runs = stride / 16;
   for (int b = 0; b < runs; ++b) {
     const int c_lo = (int)dxband[2 * b], c_hi = (int)dxband[2 * b + 1];
@@ -181,13 +181,13 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
   if (i >= L.n) return;
   (void)atlas, (void)bases, (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)subject,
       (void)objects, (void)alpha, (void)sigma, (void)records, (void)field;
-  const int W = L.width, H = L.height, RW = L.raw_width, RH = L.raw_height, stride = L.display_stride;
+  const int W = L.width, H = L.height, RW = L.raw_width, RH = L.raw_height, stride = L.tables.display.stride;
   global const preal* grid = (global const preal*)raw + (size_t)i * RH * RW;
   global uchar* o = out + (size_t)i * H * W;
-  global const param* dx = phys + L.phys_dx;
-  global const param* dxband = phys + L.phys_dxband;
-  global const param* dy = phys + L.phys_dy;
-  global const param* dyband = phys + L.phys_dyband;
+  global const param* dx = phys + L.tables.display.dx;
+  global const param* dxband = phys + L.tables.display.dxband;
+  global const param* dy = phys + L.tables.display.dy;
+  global const param* dyband = phys + L.tables.display.dyband;
   // Scratch (host: mmw_display_scratch): each view row's raw values weighted along y,
   // H x RW, 32 values of room, then (fp32, raw rows of at most 32) the raw grid in rows of 32.
   global preal* restrict rows = (global preal*)scratch + (size_t)i * PS_MMW_DISPLAY_SCRATCH(W, H, RW, RH);
@@ -227,8 +227,8 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
     }
   }
 #if defined(PRECISION_FP64)
-  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
-  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
+  const preal lo = (preal)phys_common(phys)->window_min;
+  const preal scale = (preal)255 / ((preal)phys_common(phys)->window_max - lo);
   for (int y = 0; y < H; ++y) {
     global const preal* r = rows + (size_t)y * RW;
     for (int x = 0; x < W; ++x) {
@@ -239,8 +239,8 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
     }
   }
 #else
-  const float lo = (float)phys[PS_PHYS_WINDOW_MIN];
-  const float scale = 255.0f / ((float)phys[PS_PHYS_WINDOW_MAX] - lo);
+  const float lo = (float)phys_common(phys)->window_min;
+  const float scale = 255.0f / ((float)phys_common(phys)->window_max - lo);
   // Bands of 32 view rows (6 KB of levels at 200 pixels a row, which stay in the L1
   // cache while each run is stored): four whole runs (64 pixels, one store64) at a time,
   // then single runs, then the last W % 16 pixels as one run ending at the view's edge

@@ -14,5 +14,5 @@ kernel void stage_netd(VIEW_STAGE_ARGS) {
   for (int k = 0; k < frames; ++k)
     for (int c = 0; c < L.raw_width; ++c)
       r[c] += sd * (fast ? ih_cell(seed, index, frame_stream(k), L.view, j * L.raw_width + c)
-                         : gauss_cell(seed, index, frame_stream(k), L.view, j * L.raw_width + c, phys + L.phys_gauss));
+                         : gauss_cell(seed, index, frame_stream(k), L.view, j * L.raw_width + c, phys + L.tables.gauss));
 }

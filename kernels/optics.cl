@@ -12,7 +12,7 @@ kernel void stage_optics_rows(VIEW_STAGE_ARGS) {
   global const preal* restrict src = (global const preal*)field + row0;
   global preal* restrict dst = (global preal*)scratch + row0;
   global const param* taps = psf_taps(phys, &L);
-  const int R = L.psf_radius, W = L.width;
+  const int R = L.tables.psf_radius, W = L.width;
   const int lo = min(R, W), hi = max(lo, W - R);
   for (int x = 0; x < W; ++x) dst[x] = 0;
   for (int d = -R; d <= R; ++d) {
@@ -28,7 +28,7 @@ kernel void stage_optics_columns(VIEW_STAGE_ARGS) {
   global const preal* restrict src = (global const preal*)scratch + (size_t)i * L.height * L.width;
   global preal* restrict dst = (global preal*)field + row0;
   global const param* taps = psf_taps(phys, &L);
-  const int R = L.psf_radius, W = L.width;
+  const int R = L.tables.psf_radius, W = L.width;
   for (int x = 0; x < W; ++x) dst[x] = 0;
   for (int d = -R; d <= R; ++d) {
     const preal w = (preal)taps[d];

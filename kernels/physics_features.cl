@@ -116,8 +116,8 @@ FEATURE_NOISE(private)
     }                                                                                                          \
     if (sd > 0)                                                                                                \
       feature_noise_##SPACE(acc, z, w, dims, noise, sd, (uint2)(L->seed_lo, L->seed_hi),                       \
-                            index, L->view, phys + L->phys_gauss);            \
-    preal lo = (preal)phys[PS_PHYS_WINDOW_MIN], hi = (preal)phys[PS_PHYS_WINDOW_MAX];                          \
+                            index, L->view, phys + L->tables.gauss);            \
+    preal lo = (preal)phys_common(phys)->window_min, hi = (preal)phys_common(phys)->window_max;                          \
     if (L->window_auto == PS_WINDOW_DRAWN) /* the scenario's window, as stage_window draws it */              \
       drawn_window(phys, (uint2)(L->seed_lo, L->seed_hi), index, &lo, &hi);  \
     const preal scale = (preal)255 / (hi - lo);                                                                \

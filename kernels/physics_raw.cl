@@ -20,7 +20,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   global preal* restrict acc = (global preal*)scratch + (size_t)i * (RW + W);
   global preal* restrict d = acc + RW;
   const int s = subject[i];
-  global const param* bare = phys + L.phys_base + (size_t)s * cells;
+  global const param* bare = phys + L.tables.base + (size_t)s * cells;
   // The scenario's illumination moves the bare grid along its change (PS_SCENE_BARE); its
   // outfit makes it from its gray grid (PS_CLOTHING_GRIDS): gain G + offset, every raw cell's
   // weights summing to 1.
@@ -28,12 +28,12 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   preal gain, offset, lv[PS_MAX_LAYERS];
   subject_kelvin(&scene, s, &gain, &offset);
   if (scene.outfit >= 0) {
-    global const param* gray = phys + (int)phys[(int)phys[PS_PHYS_CLOTHING] + PS_CLOTHING_GRIDS] + (size_t)s * cells;
+    global const param* gray = phys + (int)phys[(int)phys_common(phys)->clothing + PS_CLOTHING_GRIDS] + (size_t)s * cells;
     for (int k = 0; k < cells; ++k) r[k] = gray_kelvin(gain, (preal)gray[k], offset);
     // Its folds: the fold grids' share-weighted gray A and share B (PS_CLOTHING_FOLD_GRIDS) add
     // fold (gain A + (offset - fold_t) B), the raw grid of fold m (v - fold_t) over the bare body.
     if (scene.fold != 0) {
-      const int grids = (int)phys[(int)phys[PS_PHYS_CLOTHING] + PS_CLOTHING_FOLD_GRIDS];
+      const int grids = (int)phys[(int)phys_common(phys)->clothing + PS_CLOTHING_FOLD_GRIDS];
       global const param* fa = phys + grids + (size_t)s * cells;
       global const param* fb = fa + (size_t)L.subjects * cells;
       for (int k = 0; k < cells; ++k)
@@ -54,10 +54,10 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
     y_hi = max(y_hi, min(rows.y, H));
   }
   global const param* object_t = variant_values(&scene, L.subjects);
-  global const param* wx = phys + L.phys_wx;
-  global const param* wy = phys + L.phys_wy;
-  global const param* cband = phys + L.phys_cband;
-  global const param* rband = phys + L.phys_rband;
+  global const param* wx = phys + L.tables.wx;
+  global const param* wy = phys + L.tables.wy;
+  global const param* cband = phys + L.tables.cband;
+  global const param* rband = phys + L.tables.rband;
   for (int y = y_lo; y < y_hi; ++y) {
     Layers Ly;
     composite_layers(&Ly, rec, &L, y);
@@ -105,5 +105,5 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   // The netd stage: the scenario's frames averaged (kernels/lib/physics.cl, netd_frames).
   int frames;
   const preal sd = mmw_noise_of(phys, L.frames, seed, index, &frames);
-  if (sd > 0) netd_frames(r, cells, sd, frames, seed, index, L.view, phys + L.phys_gauss, L.flags & PS_FLAG_FAST_DRAWS);
+  if (sd > 0) netd_frames(r, cells, sd, frames, seed, index, L.view, phys + L.tables.gauss, L.flags & PS_FLAG_FAST_DRAWS);
 }

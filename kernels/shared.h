@@ -42,10 +42,10 @@
 /* The metal detector under --model physics. */
 #define PS_METAL_MAX_DEDUCTION 199          /* most one zone's response takes off its base value */
 #define PS_METAL_FOUR_PI 12.566370614359172 /* 4 pi, the dipole field's denominator */
-/* Offsets in the physics parameters (kernels/contract.h, PS_PHYS_*). */
+/* Offsets of the physics parameters' tails, past the kind's scalars (kernels/contract.h). */
 #define PS_PHYS_VARIANTS(S) (PS_PHYS_SUBJECTS + 2 * (S))
 #define PS_PHYS_TAPS(S, V) (PS_PHYS_VARIANTS(S) + (V))
-/* The scene block's per-variant entries and bare grids' changes (PS_PHYS_SCENE). */
+/* The scene block's per-variant entries and bare grids' changes (PsPhys.scene). */
 #define PS_SCENE_VARIANTS(S) (PS_SCENE_SUBJECTS + 2 * (S))
 #define PS_SCENE_BARE(S, V) (PS_SCENE_VARIANTS(S) + 4 * (V))
 /* The clothing block's first outfit entry, after C classes' first outfits and counts. */

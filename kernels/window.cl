@@ -38,7 +38,7 @@ kernel void stage_window(VIEW_STAGE_ARGS) {
       (void)objects, (void)alpha, (void)sigma, (void)records, (void)field, (void)out;
   const int cells = L.raw_width * L.raw_height;
   global preal* restrict r = (global preal*)raw + (size_t)i * cells;
-  const preal w0 = (preal)phys[PS_PHYS_WINDOW_MIN];
+  const preal w0 = (preal)phys_common(phys)->window_min;
   preal lo, hi;
   if (L.window_auto == PS_WINDOW_DRAWN) {
     drawn_window(phys, (uint2)(L.seed_lo, L.seed_hi), scenario_index(indices, L.first_lo, L.first_hi, i), &lo, &hi);
@@ -48,6 +48,6 @@ kernel void stage_window(VIEW_STAGE_ARGS) {
     lo = select_rank(a, cells, PS_WINDOW_RANK(PS_WINDOW_LOW_PERMILLE, cells));
     hi = fmax(select_rank(a, cells, PS_WINDOW_RANK(PS_WINDOW_HIGH_PERMILLE, cells)), lo + (preal)PS_WINDOW_MIN_SPAN);
   }
-  const preal gain = ((preal)phys[PS_PHYS_WINDOW_MAX] - w0) / (hi - lo);
+  const preal gain = ((preal)phys_common(phys)->window_max - w0) / (hi - lo);
   for (int k = 0; k < cells; ++k) r[k] = w0 + (r[k] - lo) * gain;
 }

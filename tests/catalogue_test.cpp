@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "base/error.h"
+#include "scene/camera_kind.h"
 #include "scene/rules.h"
 #include "support.h"
 
@@ -114,6 +115,20 @@ TEST(Rules, ThesisCasesAndCombinations) {
   for (const std::string& deep : {nest(kMaxRuleDepth + 1, "(", ")"), nest(kMaxRuleDepth + 1, "!", ""),
                                   nest(100000, "(", ")"), nest(100000, "!(", ")")})
     EXPECT_THROW(ThreatRule(c, deep), InputError) << deep.size();
+}
+
+// Each camera kind is listed at its Camera's index, under a name of its own, so that a
+// view's camera and its name in the catalogue find the same kind.
+TEST(CameraKinds, ListedInCameraOrderUnderDistinctNames) {
+  const std::vector<const CameraKind*>& kinds = camera_kinds();
+  for (size_t k = 0; k < kinds.size(); ++k) {
+    SCOPED_TRACE(kinds[k]->name);
+    EXPECT_EQ(static_cast<size_t>(kinds[k]->camera), k);
+    EXPECT_EQ(camera_kind_named(kinds[k]->name), kinds[k]);
+    EXPECT_EQ(&camera_kind(kinds[k]->camera), kinds[k]);
+  }
+  EXPECT_EQ(camera_kind_names(), "\"mmw\" or \"ir\"");
+  EXPECT_EQ(camera_kind_named("thermal"), nullptr);
 }
 
 }  // namespace

@@ -350,9 +350,9 @@ void read_views(const Reader& rd, const toml::table& root, Catalogue& cat) {
     if (!name_ok) rd.fail(t.get("name"), f + ".name", "\"" + s.name + "\": expected 1 to 32 of a-z, 0-9 and _");
     if (cat.sensor_index(s.name) >= 0) rd.fail(t.get("name"), f + ".name", "\"" + s.name + "\" is named twice");
     const std::string camera = rd.string(t, "camera", f);
-    if (camera != "mmw" && camera != "ir")
-      rd.fail(t.get("camera"), f + ".camera", "expected \"mmw\" or \"ir\", got \"" + camera + "\"");
-    s.camera = camera == "ir" ? Camera::ir : Camera::mmw;
+    const CameraKind* kind = camera_kind_named(camera);
+    if (!kind) rd.fail(t.get("camera"), f + ".camera", "expected " + camera_kind_names() + ", got \"" + camera + "\"");
+    s.camera = kind->camera;
     const std::string side = rd.string(t, "side", f, "front");
     if (side != "front" && side != "back")
       rd.fail(t.get("side"), f + ".side", "expected \"front\" or \"back\", got \"" + side + "\"");
@@ -373,9 +373,10 @@ void read_views(const Reader& rd, const toml::table& root, Catalogue& cat) {
       s.pooled = pn->as_boolean()->get();
     }
     // The camera's own numbers where they differ from the run's knobs (the knobs' ranges).
-    if (t.get("netd")) s.netd = rd.number(t, "netd", f, 0.0, s.camera == Camera::ir ? 10.0 : 100.0);
+    if (t.get("netd")) s.netd = rd.number(t, "netd", f, 0.0, kind->netd_max);
     if (const toml::node* rn = t.get("raw")) {
-      if (s.camera != Camera::mmw) rd.fail(rn, f + ".raw", "a raw grid is an MMW camera's; this view's camera is ir");
+      if (!kind->raw_grid)
+        rd.fail(rn, f + ".raw", std::string("a raw grid is an MMW camera's; this view's camera is ") + kind->name);
       const std::vector<int> raw = rd.ints(rn, f + ".raw", 2, 1, 4096);
       if (raw[0] > s.width || raw[1] > s.height)
         rd.fail(rn, f + ".raw",

@@ -10,12 +10,10 @@ namespace portalsim {
 const char* model_name(Model m) { return m == Model::physics ? "physics" : "thesis"; }
 
 void derive_view(Catalogue& cat, Sensor& s) {
-  const bool mmw = s.camera == Camera::mmw;
-  s.pattern_noise = mmw;
-  s.palette = !mmw;
-  s.physics_chain =
-      mmw ? std::vector<std::string>{"radiometry", "optics", "sample", "netd", "window", "mmw_display"}
-          : std::vector<std::string>{"contact_shadow", "heat_spread", "ir_surface", "ir_netd", "ir_display"};
+  const CameraKind& kind = camera_kind(s.camera);
+  s.pattern_noise = kind.pattern_noise;
+  s.palette = kind.palette;
+  s.physics_chain = kind.physics_chain;
   s.jitter_scale_x = s.width / s.field.w;
   s.jitter_scale_y = s.height / s.field.h;
   s.floor_row = (kFieldHeight - s.field.y) * s.height / s.field.h;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "contract.h"
+#include "scene/camera_kind.h"
 
 namespace portalsim {
 
@@ -22,8 +23,6 @@ struct Rect {
   int x = 0, y = 0, w = 0, h = 0;
 };
 
-// Which sprites and palette a view uses: the camera it belongs to.
-enum class Camera : int { mmw = 0, ir = 1 };
 // Which side of the body a view sees: a back view sees the body from behind, mirrored.
 enum class Side : int { front = 0, back = 1 };
 inline const char* side_name(Side s) { return s == Side::back ? "back" : "front"; }
@@ -39,7 +38,6 @@ struct Frame {
 // one (docs/model/physics-mmw.md). Each camera view has a stage chain per model.
 enum class Model { thesis = 0, physics = 1 };
 const char* model_name(Model m);
-inline const char* camera_name(Camera c) { return c == Camera::ir ? "ir" : "mmw"; }
 
 // The objects' drawings one or more views share: one camera's sprites at one scale (view
 // pixels per field unit), mirrored for back views.

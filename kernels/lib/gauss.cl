@@ -163,7 +163,7 @@ __attribute__((always_inline)) inline void gauss64(uint2 seed, ulong index, uint
 
 // The physics model's sensor noise (kernels/shared.h, PS_GAUSS_ELEMENT): a table Gaussian
 // per cell, eight cells to one draw of the generator where Box-Muller takes two, and no
-// log or sincos. The table (phys + L.phys_gauss, built on the host) holds the 4,096
+// log or sincos. The table (phys + L.tables.gauss, built on the host) holds the 4,096
 // equally likely values Phi^-1((k + 1/2) / 4096): |g| <= 3.67, sd 1 - 1.6e-4.
 // Cell p's word of its draw in the table Gaussians' layout (PS_GAUSS_ELEMENT, PS_GAUSS_WORD).
 inline uint cell_word(uint2 seed, ulong index, uint stream, int view, int p) {

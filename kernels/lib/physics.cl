@@ -3,8 +3,14 @@
 // window, the tabulated-features test, and the IR camera's shadows, NETD and window: each
 // used by a stage kernel and a fast path.
 
-// The illumination, worn time and outfit of a scenario where drawn per scenario (PS_PHYS_SCENE,
-// PS_PHYS_CLOTHING; host: drawn_knob_at, outfit_at): at, the scene
+// The view's scalars (kernels/contract.h): either kind's first ones, the MMW camera's, the
+// IR camera's.
+inline global const PsPhys* phys_common(global const param* phys) { return (global const PsPhys*)phys; }
+inline global const PsPhysMmw* phys_mmw(global const param* phys) { return (global const PsPhysMmw*)phys; }
+inline global const PsPhysIr* phys_ir(global const param* phys) { return (global const PsPhysIr*)phys; }
+
+// The illumination, worn time and outfit of a scenario where drawn per scenario (PsPhys's scene
+// and clothing; host: drawn_knob_at, outfit_at): at, the scene
 // block's offset (0: neither drawn); t, the illumination's place in its range (uniform24 of
 // PS_DRAWN_ILLUMINATION's word 0); w, the worn time in minutes; outfit, the outfit's index
 // (-1: the catalogue's clothing); head, each subject's (gain, offset) then each variant's
@@ -21,7 +27,7 @@ typedef struct {
 
 inline SceneDraw scene_draw(global const param* phys, uint2 seed, ulong index) {
   SceneDraw d;
-  d.at = (int)phys[PS_PHYS_SCENE];
+  d.at = (int)phys_common(phys)->scene;
   d.t = 0;
   d.w = 0;
   d.outfit = -1;
@@ -30,7 +36,7 @@ inline SceneDraw scene_draw(global const param* phys, uint2 seed, ulong index) {
   d.fold_t = 0;
   d.head = phys + PS_PHYS_SUBJECTS;
   d.moves = phys + d.at + PS_SCENE_SUBJECTS;
-  const int clothing = (int)phys[PS_PHYS_CLOTHING];
+  const int clothing = (int)phys_common(phys)->clothing;
   if (clothing != 0) {
     global const param* c = phys + clothing;
     const uint classes = (uint)c[PS_CLOTHING_CLASSES];
@@ -122,7 +128,7 @@ inline void fold_values(const SceneDraw* d, global const uchar* restrict m, glob
 
 // The optics stage's PSF taps, centred: taps[-R .. R] (stage_optics_*, heat_spread).
 inline global const param* psf_taps(global const param* phys, const PsViewLaunch* L) {
-  return phys + PS_PHYS_TAPS(L->subjects, L->variants) + L->psf_radius;
+  return phys + PS_PHYS_TAPS(L->subjects, L->variants) + L->tables.psf_radius;
 }
 
 // The stream of MMW frame k's noise (stage_netd, netd_frames).
@@ -143,13 +149,14 @@ inline preal mmw_noise_drawn(preal lo, preal hi, int flo, int fhi, bool as_one, 
 // Scenario index's MMW noise from the view's parameters: *frames frames (the launch's
 // kframes where nothing is drawn) of the returned sd each.
 inline preal mmw_noise_of(global const param* phys, int kframes, uint2 seed, ulong index, int* frames) {
-  const preal lo = (preal)phys[PS_PHYS_NETD], hi = (preal)phys[PS_PHYS_NETD_HI];
-  const int flo = (int)phys[PS_PHYS_FRAMES_LO], fhi = (int)phys[PS_PHYS_FRAMES_HI];
+  global const PsPhysMmw* p = phys_mmw(phys);
+  const preal lo = (preal)p->netd_lo, hi = (preal)p->netd_hi;
+  const int flo = (int)p->frames_lo, fhi = (int)p->frames_hi;
   if (hi <= lo && fhi <= flo) {
     *frames = kframes;
     return lo / (preal)kframes;
   }
-  return mmw_noise_drawn(lo, hi, flo, fhi, phys[PS_PHYS_FRAMES_AS_ONE] != 0, seed, index, frames);
+  return mmw_noise_drawn(lo, hi, flo, fhi, p->frames_as_one != 0, seed, index, frames);
 }
 
 // The netd stage over a scenario's whole raw grid v (physics_raw): L.frames frames of sd
@@ -206,10 +213,12 @@ inline void netd_frames(global preal* restrict v, int cells, preal sd, int frame
 }
 
 // Scenario `index`'s drawn window ends (PS_WINDOW_DRAWN; host: drawn_knob_at),
-// each uniform over its range: from PS_PHYS_WINDOW_MIN to _MIN_HI, and _MAX to _MAX_HI.
+// each uniform over its range: from PsPhysMmw's window_min to window_min_hi, and window_max
+// to window_max_hi.
 inline void drawn_window(global const param* phys, uint2 seed, ulong index, preal* lo, preal* hi) {
-  *lo = knob_draw((preal)phys[PS_PHYS_WINDOW_MIN], (preal)phys[PS_PHYS_WINDOW_MIN_HI], seed, index, PS_DRAWN_WINDOW_LO);
-  *hi = knob_draw((preal)phys[PS_PHYS_WINDOW_MAX], (preal)phys[PS_PHYS_WINDOW_MAX_HI], seed, index, PS_DRAWN_WINDOW_HI);
+  global const PsPhysMmw* p = phys_mmw(phys);
+  *lo = knob_draw((preal)p->common.window_min, (preal)p->window_min_hi, seed, index, PS_DRAWN_WINDOW_LO);
+  *hi = knob_draw((preal)p->common.window_max, (preal)p->window_max_hi, seed, index, PS_DRAWN_WINDOW_HI);
 }
 
 // Kelvin t through a display window (lo, scale = 255 / (max - lo)) to a level 0..255,
@@ -254,7 +263,7 @@ inline bool physics_tabulated(global const int* rec, const PsViewLaunch* L) {
 // times the outfit's factor (its insulation over the catalogue clothing's).
 inline void shadow_values(const Layers* Ly, const PsViewLaunch* L, global const param* phys, const SceneDraw* d, int s,
                           preal* on, preal* off) {
-  global const param* off_body = phys + L->phys_off_body;
+  global const param* off_body = phys + L->tables.off_body;
   layer_values(Ly, variant_values(d, L->subjects), d, L->subjects, on);
   layer_values(Ly, off_body + L->subjects, d, L->subjects, off);
   const preal skin = (preal)off_body[L->subjects + L->variants + s] * d->shadow;
@@ -264,19 +273,19 @@ inline void shadow_values(const Layers* Ly, const PsViewLaunch* L, global const 
   }
 }
 
-// The scenario's IR NETD: the knob's, or where it is drawn per scenario (PS_PHYS_NETD_HI
-// above PS_PHYS_NETD), NETD + (hi - NETD) uniform24(word 0) of PS_STREAM_KNOB_DRAW (host:
+// The scenario's IR NETD: the knob's, or where it is drawn per scenario (PsPhysIr netd_hi
+// above netd), NETD + (hi - NETD) uniform24(word 0) of PS_STREAM_KNOB_DRAW (host:
 // drawn_knob_at).
 inline preal ir_netd_of(global const param* phys, uint2 seed, ulong index) {
-  return knob_draw((preal)phys[PS_PHYS_NETD], (preal)phys[PS_PHYS_NETD_HI], seed, index, PS_DRAWN_IR_NETD);
+  return knob_draw((preal)phys_ir(phys)->netd, (preal)phys_ir(phys)->netd_hi, seed, index, PS_DRAWN_IR_NETD);
 }
 
 // The IR display window, kelvin to temperature index 0..255 (window_level), over pixels
 // [a, b) of a view's T into o; fp32 builds 64 at a time (stage_ir_display, ir_surface_fused).
 inline void ir_window(global const preal* restrict T, global uchar* restrict o, global const param* phys, int a,
                       int b) {
-  const preal lo = (preal)phys[PS_PHYS_WINDOW_MIN];
-  const preal scale = (preal)255 / ((preal)phys[PS_PHYS_WINDOW_MAX] - lo);
+  const preal lo = (preal)phys_common(phys)->window_min;
+  const preal scale = (preal)255 / ((preal)phys_common(phys)->window_max - lo);
   int p = a;
 #if !defined(PRECISION_FP64)
   for (; p + 64 <= b; p += 64)

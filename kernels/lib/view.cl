@@ -10,7 +10,7 @@
 //            subject's height (Sensor::subject_dy)
 //   records: the view's placement record per scenario (kernels/contract.h, PS_REC_*)
 //   field:   the view's values before display, n * height * width, at the build's precision
-//   phys:    the physics model's parameters (kernels/shared.h, PS_PHYS_*)
+//   phys:    the physics model's parameters (kernels/contract.h, PsPhysMmw and PsPhysIr)
 //   raw:     physics: the MMW raw grid, n * raw_height * raw_width
 //   scratch: physics: a second field, for stages that cannot work in place
 //   indices: each scenario's global index where the batch is not contiguous, else null

@@ -68,7 +68,7 @@ DisplayTables append_display_tables(std::vector<double>& p, const ModelSettings&
     p.insert(p.end(), v.begin(), v.end());
     return at;
   };
-  DisplayTables t;
+  DisplayTables t{};
   t.stride = (W + 15) / 16 * 16;
   const std::vector<double> wx = axis(W, RW, m.display_filter, m.smooth);
   const std::vector<double> wy = axis(H, RH, m.display_filter, m.smooth);

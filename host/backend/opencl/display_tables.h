@@ -5,14 +5,13 @@
 #include <cstdint>
 #include <vector>
 
+#include "contract.h"
 #include "plan/plan.h"
 
 namespace portalsim::opencl {
 
-// Where the tables lie in the launch's parameters (PsViewLaunch's display fields).
-struct DisplayTables {
-  int32_t stride = 0, dx = 0, dxband = 0, dy = 0, dyband = 0;
-};
+// Where the tables lie in the launch's parameters (PsPhysTables::display).
+using DisplayTables = PsDisplayTables;
 
 // Appends stage_mmw_display's tables for a W x H view over an RW x RH raw grid to `p`.
 DisplayTables append_display_tables(std::vector<double>& p, const ModelSettings& m, int W, int H, int RW, int RH);

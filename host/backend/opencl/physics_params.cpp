@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include "backend/opencl/gauss_table.h"
@@ -89,172 +90,206 @@ OutfitPhysics outfit_physics(const PhysicsConfig& pc, const Outfit& o) {
   return r;
 }
 
-}  // namespace
-
-size_t mmw_display_scratch(const Sensor& s, int raw_width, int raw_height) {
-  return PS_MMW_DISPLAY_SCRATCH(s.width, s.height, raw_width, raw_height);
+// Appends v to the parameters; its offset.
+int32_t append(std::vector<double>& p, const std::vector<double>& v) {
+  if (p.size() + v.size() > 0x7fffffffu) throw std::runtime_error("physics tables exceed 2^31 values");
+  const auto at = static_cast<int32_t>(p.size());
+  p.insert(p.end(), v.begin(), v.end());
+  return at;
 }
 
-PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const Plan& plan, const ModelSettings& m,
-                             int view) {
-  const Sensor& s = cat.sensors[view];
-  const PhysicsConfig& pc = cat.physics;
-  const bool ir = s.camera == Camera::ir;
-  const auto seen = [&](double e, double t) { return pc.seen_through_clothing(e, t, m.illumination); };
-  PhysicsTables t;
-  std::vector<double>& p = t.values;
-  p.assign(PS_PHYS_SUBJECTS, 0.0);
-  p[PS_PHYS_BACKGROUND] = pc.background_temperature;
-  p[PS_PHYS_WINDOW_MIN] = ir ? pc.ir_display_min : m.window_lo;
-  p[PS_PHYS_WINDOW_MAX] = ir ? pc.ir_display_max : m.window_hi;
+// What the steps below read: the view's catalogue, its knobs and its camera kind.
+struct Derive {
+  const Catalogue& cat;
+  const PhysicsConfig& pc;
+  const ModelSettings& m;
+  bool ir;
+};
+
+// The MMW camera's scalars; scene and clothing are set once their blocks are placed.
+PsPhysMmw mmw_scalars(const Plan& plan, const ModelSettings& m) {
+  PsPhysMmw h{};
+  h.common.window_min = m.window_lo;
+  h.common.window_max = m.window_hi;
   // The window's ends drawn per scenario (stage_window): their ranges' upper ends.
   const DrawnRange &window_lo = m.drawn[PS_DRAWN_WINDOW_LO], &window_hi = m.drawn[PS_DRAWN_WINDOW_HI];
-  p[PS_PHYS_WINDOW_MIN_HI] = !ir && window_lo.varies() ? window_lo.hi : p[PS_PHYS_WINDOW_MIN];
-  p[PS_PHYS_WINDOW_MAX_HI] = !ir && window_hi.varies() ? window_hi.hi : p[PS_PHYS_WINDOW_MAX];
-  // The view's NETD, and its range and the frames' where drawn per scenario (mmw_noise_of,
-  // ir_netd_of).
-  if (ir) {
-    const DrawnRange& drawn_ir_netd = m.drawn[PS_DRAWN_IR_NETD];
-    p[PS_PHYS_NETD] = m.ir_netd;
-    p[PS_PHYS_NETD_HI] = drawn_ir_netd.varies() ? drawn_ir_netd.hi : m.ir_netd;
-    p[PS_PHYS_FRAMES_LO] = p[PS_PHYS_FRAMES_HI] = 1;
-  } else {
-    const MmwNoise noise = mmw_noise(plan, m);
-    p[PS_PHYS_NETD] = noise.netd_lo;
-    p[PS_PHYS_NETD_HI] = noise.netd_hi;
-    p[PS_PHYS_FRAMES_LO] = noise.frames_lo;
-    p[PS_PHYS_FRAMES_HI] = noise.frames_hi;
-    p[PS_PHYS_FRAMES_AS_ONE] = noise.as_one;
-  }
-  // Per subject, its base image's value to kelvin: the IR index map (under an outfit, its
-  // surface's share g of the excess over the room), or the MMW's gray between the room behind
-  // and the bare body under the clothing. Per variant: the IR surface's contact shadow, or the
-  // MMW apparent temperature. `seen_as` is the clothing's (e, T) -> apparent temperature.
-  const auto head = [&](std::vector<double>& out, const auto& seen_as, double g) {
-    for (const Subject& subj : cat.subjects) {
-      const double body = seen_as(pc.skin_emissivity_of(subj), pc.skin_temperature_of(subj));
-      const double gain = ir ? (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0
+  h.window_min_hi = window_lo.varies() ? window_lo.hi : m.window_lo;
+  h.window_max_hi = window_hi.varies() ? window_hi.hi : m.window_hi;
+  // The NETD, and its range and the frames' where drawn per scenario (mmw_noise_of).
+  const MmwNoise noise = mmw_noise(plan, m);
+  h.netd_lo = noise.netd_lo;
+  h.netd_hi = noise.netd_hi;
+  h.frames_lo = noise.frames_lo;
+  h.frames_hi = noise.frames_hi;
+  h.frames_as_one = noise.as_one;
+  return h;
+}
+
+// The IR camera's scalars, likewise.
+PsPhysIr ir_scalars(const PhysicsConfig& pc, const ModelSettings& m) {
+  PsPhysIr h{};
+  h.common.window_min = pc.ir_display_min;
+  h.common.window_max = pc.ir_display_max;
+  // The NETD, and its range's upper end where drawn per scenario (ir_netd_of).
+  const DrawnRange& drawn = m.drawn[PS_DRAWN_IR_NETD];
+  h.netd = m.ir_netd;
+  h.netd_hi = drawn.varies() ? drawn.hi : m.ir_netd;
+  return h;
+}
+
+// Writes a kind's scalars at the parameters' start (PS_PARAM each: the layout's every field
+// is a double on the host, so params() converting each keeps every field's index).
+template <class Scalars>
+void put_scalars(std::vector<double>& p, const Scalars& h) {
+  static_assert(sizeof(Scalars) % sizeof(double) == 0 && sizeof(Scalars) <= sizeof(PsPhysKinds));
+  std::memcpy(p.data(), &h, sizeof h);
+}
+
+// Per subject, its base image's value to kelvin: the IR index map (under an outfit, its
+// surface's share g of the excess over the room), or the MMW's gray between the room behind
+// and the bare body under the clothing. Per variant: the IR surface's contact shadow, or the
+// MMW apparent temperature. `seen_as` is the clothing's (e, T) -> apparent temperature.
+template <class Seen>
+void append_head(std::vector<double>& out, const Derive& d, const Seen& seen_as, double g) {
+  const PhysicsConfig& pc = d.pc;
+  for (const Subject& subj : d.cat.subjects) {
+    const double body = seen_as(pc.skin_emissivity_of(subj), pc.skin_temperature_of(subj));
+    const double gain = d.ir ? (pc.ir_index_max_k - pc.ir_index_min_k) / 255.0
                              : (body - pc.background_temperature) / (subj.mmw_level - pc.base_background_gray);
-      const double offset = ir ? pc.ir_index_min_k : pc.background_temperature - gain * pc.base_background_gray;
-      out.push_back(g * gain);
-      out.push_back(g * offset + (1 - g) * (ir ? pc.room_temperature : 0.0));
-    }
-    for (size_t v = 0; v < cat.variant_list.size(); ++v) {
-      const Material& mat = cat.materials.at(cat.object_of(static_cast<int>(v)).material_id);
-      const double worn = worn_temperature(pc, mat, m.worn_minutes);
-      out.push_back(ir ? -pc.ir_coupling * (pc.skin_temperature - worn) : seen_as(mat.emissivity, worn));
-    }
-  };
-  head(p, seen, 1.0);
-  // MMW: the Airy core's FWHM, 1.02 lambda / D at the range, in this view's pixels, as a
-  // Gaussian of that FWHM. IR: ir_spread_mm over the view's pixel (as wide as an MMW view).
+    const double offset = d.ir ? pc.ir_index_min_k : pc.background_temperature - gain * pc.base_background_gray;
+    out.push_back(g * gain);
+    out.push_back(g * offset + (1 - g) * (d.ir ? pc.room_temperature : 0.0));
+  }
+  for (size_t v = 0; v < d.cat.variant_list.size(); ++v) {
+    const Material& mat = d.cat.materials.at(d.cat.object_of(static_cast<int>(v)).material_id);
+    const double worn = worn_temperature(pc, mat, d.m.worn_minutes);
+    out.push_back(d.ir ? -pc.ir_coupling * (pc.skin_temperature - worn) : seen_as(mat.emissivity, worn));
+  }
+}
+
+// The PSF's sigma in the view's pixels. MMW: the Airy core's FWHM, 1.02 lambda / D at the
+// range, as a Gaussian of that FWHM. IR: ir_spread_mm over the view's pixel (as wide as an
+// MMW view).
+double psf_sigma(const PhysicsConfig& pc, const Sensor& s, bool ir) {
   const double span_m = 2.0 * pc.range_m * std::tan(pc.fov_rad / 2.0);
   const double lambda = 299792458.0 / (pc.frequency_ghz * 1e9);
-  const double sigma = ir ? pc.ir_spread_mm / (1000.0 * span_m / s.width)
-                          : 1.02 * lambda / pc.aperture_m * pc.range_m / (span_m / s.width) / 2.3548200450309493;
-  const size_t taps = p.size();
-  append_gaussian_taps(p, sigma, t.radius);
-  const std::vector<double> psf(p.begin() + static_cast<std::ptrdiff_t>(taps), p.end());
-  const auto append = [&](const std::vector<double>& v) {
-    if (p.size() + v.size() > 0x7fffffffu) throw std::runtime_error("physics tables exceed 2^31 values");
-    const int32_t at = static_cast<int32_t>(p.size());
-    p.insert(p.end(), v.begin(), v.end());
-    return at;
-  };
-  t.gauss = append(gauss_table());  // the sensor noise's table Gaussians
-  // Where the illumination or the worn time is drawn per scenario, the scene block
-  // (PS_PHYS_SCENE): the values above hold at the ranges' low ends, and each scenario's
-  // moves from them, linearly in the illumination and in each material's exp(-worn / tau).
-  const DrawnRange &ill = m.drawn[PS_DRAWN_ILLUMINATION], &worn = m.drawn[PS_DRAWN_WORN_MINUTES];
-  const bool scene_drawn = ill.varies() || worn.varies();
+  return ir ? pc.ir_spread_mm / (1000.0 * span_m / s.width)
+            : 1.02 * lambda / pc.aperture_m * pc.range_m / (span_m / s.width) / 2.3548200450309493;
+}
+
+bool scene_drawn(const ModelSettings& m) {
+  return m.drawn[PS_DRAWN_ILLUMINATION].varies() || m.drawn[PS_DRAWN_WORN_MINUTES].varies();
+}
+
+// The moves of each subject and variant under clothing of MMW transmission tc, linearly in
+// the illumination and in each material's exp(-worn / tau).
+void append_moves(std::vector<double>& out, const Derive& d, double tc) {
+  const PhysicsConfig& pc = d.pc;
+  const DrawnRange& ill = d.m.drawn[PS_DRAWN_ILLUMINATION];
   const double ill_span = ill.varies() ? ill.hi - ill.lo : 0.0;
-  std::vector<double> scene;
-  // The moves of each subject and variant under clothing of MMW transmission tc.
-  const auto moves = [&](std::vector<double>& out, double tc) {
-    // The bare body's apparent temperature moves by tc (1 - e_skin) per kelvin of illumination.
-    for (const Subject& subj : cat.subjects) {
-      const double body_span = ir ? 0.0 : tc * (1 - pc.skin_emissivity_of(subj)) * ill_span;
-      const double dgain = ir ? 0.0 : body_span / (subj.mmw_level - pc.base_background_gray);
-      out.push_back(dgain);
-      out.push_back(-dgain * pc.base_background_gray);
-    }
-    for (size_t v = 0; v < cat.variant_list.size(); ++v) {
-      const Material& mat = cat.materials.at(cat.object_of(static_cast<int>(v)).material_id);
-      // worn = skin - (skin - room) exp(-worn / tau): the IR shadow (against skin or room)
-      // moves by -coupling (skin - room) per unit of it, the MMW value by -tc e (skin - room).
-      const double per_decay = ir ? -pc.ir_coupling * (pc.skin_temperature - pc.room_temperature)
+  // The bare body's apparent temperature moves by tc (1 - e_skin) per kelvin of illumination.
+  for (const Subject& subj : d.cat.subjects) {
+    const double body_span = d.ir ? 0.0 : tc * (1 - pc.skin_emissivity_of(subj)) * ill_span;
+    const double dgain = d.ir ? 0.0 : body_span / (subj.mmw_level - pc.base_background_gray);
+    out.push_back(dgain);
+    out.push_back(-dgain * pc.base_background_gray);
+  }
+  for (size_t v = 0; v < d.cat.variant_list.size(); ++v) {
+    const Material& mat = d.cat.materials.at(d.cat.object_of(static_cast<int>(v)).material_id);
+    // worn = skin - (skin - room) exp(-worn / tau): the IR shadow (against skin or room)
+    // moves by -coupling (skin - room) per unit of it, the MMW value by -tc e (skin - room).
+    const double per_decay = d.ir ? -pc.ir_coupling * (pc.skin_temperature - pc.room_temperature)
                                   : -tc * mat.emissivity * (pc.skin_temperature - pc.room_temperature);
-      out.push_back(ir ? 0.0 : tc * (1 - mat.emissivity) * ill_span);
-      out.push_back(per_decay);
-      out.push_back(1.0 / mat.warm_minutes);
-      out.push_back(std::exp(-m.worn_minutes / mat.warm_minutes));
-    }
-  };
-  if (scene_drawn) {
-    scene = {ill.varies() ? 1.0 : 0.0, m.worn_minutes, worn.varies() ? worn.hi : m.worn_minutes};
-    moves(scene, pc.clothing_transmission);
+    out.push_back(d.ir ? 0.0 : tc * (1 - mat.emissivity) * ill_span);
+    out.push_back(per_decay);
+    out.push_back(1.0 / mat.warm_minutes);
+    out.push_back(std::exp(-d.m.worn_minutes / mat.warm_minutes));
   }
-  // Where the clothing is drawn per scenario, the clothing block (PS_PHYS_CLOTHING): each
-  // outfit's entries as above, under its layers instead of the catalogue's clothing.
-  const OutfitTable& outfits = outfit_table(m.clothing);
-  std::vector<double> clothing;
-  if (!outfits.outfits.empty()) {
-    const size_t C = outfits.class_first.size(), S = cat.subjects.size(), V = cat.variant_list.size();
-    const size_t stride = PS_OUTFIT_HEAD + 2 * S + V + (scene_drawn ? 2 * S + 4 * V : 0);
-    const DrawnRange& folds = m.drawn[PS_DRAWN_CLOTHING_FOLDS];
-    // The kernels read each view's fold pattern from the atlas (fold_row).
-    if (m.has_folds() && assets.folds.empty())
-      throw std::logic_error("--clothing-folds: the assets were built without fold patterns");
-    clothing = {double(C), double(stride), 0.0, m.clothing_folds, folds.varies() ? folds.hi : m.clothing_folds, 0.0};
-    for (int f : outfits.class_first) clothing.push_back(f);
-    for (int n : outfits.class_count) clothing.push_back(n);
-    for (const Outfit& o : outfits.outfits) {
-      const OutfitPhysics op = outfit_physics(pc, o);
-      clothing.push_back(ir ? op.surface / pc.ir_coupling : 1.0);
-      clothing.push_back(double(PS_OUTFIT_HEAD + 2 * S + V));
-      clothing.push_back(ir ? op.ir_fold_k : op.mmw_fold_k);
-      clothing.push_back(ir ? pc.room_temperature : op.mmw_fold_t);
-      head(
-          clothing, [&](double e, double t) { return op.tc * (e * t + (1 - e) * m.illumination) + op.emission; },
-          ir ? op.surface : 1.0);
-      if (scene_drawn) moves(clothing, op.tc);
-    }
+}
+
+// Where the illumination or the worn time is drawn per scenario, the scene block
+// (PsPhys::scene) but its MMW grids: the values above hold at the ranges' low ends, and each
+// scenario's moves from them. Empty where neither is drawn.
+std::vector<double> scene_block(const Derive& d) {
+  if (!scene_drawn(d.m)) return {};
+  const DrawnRange &ill = d.m.drawn[PS_DRAWN_ILLUMINATION], &worn = d.m.drawn[PS_DRAWN_WORN_MINUTES];
+  std::vector<double> scene = {ill.varies() ? 1.0 : 0.0, d.m.worn_minutes, worn.varies() ? worn.hi : d.m.worn_minutes};
+  append_moves(scene, d, d.pc.clothing_transmission);
+  return scene;
+}
+
+// Where the clothing is drawn per scenario, the clothing block (PsPhys::clothing) but its MMW
+// grids: each outfit's entries as above, under its layers instead of the catalogue's
+// clothing. Empty where the clothing is the catalogue's.
+std::vector<double> clothing_block(const Derive& d, const AssetSet& assets) {
+  const OutfitTable& outfits = outfit_table(d.m.clothing);
+  if (outfits.outfits.empty()) return {};
+  const PhysicsConfig& pc = d.pc;
+  const bool scene = scene_drawn(d.m);
+  const size_t C = outfits.class_first.size(), S = d.cat.subjects.size(), V = d.cat.variant_list.size();
+  const size_t stride = PS_OUTFIT_HEAD + 2 * S + V + (scene ? 2 * S + 4 * V : 0);
+  const DrawnRange& folds = d.m.drawn[PS_DRAWN_CLOTHING_FOLDS];
+  // The kernels read each view's fold pattern from the atlas (fold_row).
+  if (d.m.has_folds() && assets.folds.empty())
+    throw std::logic_error("--clothing-folds: the assets were built without fold patterns");
+  std::vector<double> clothing = {
+      double(C), double(stride), 0.0, d.m.clothing_folds, folds.varies() ? folds.hi : d.m.clothing_folds, 0.0};
+  for (int f : outfits.class_first) clothing.push_back(f);
+  for (int n : outfits.class_count) clothing.push_back(n);
+  for (const Outfit& o : outfits.outfits) {
+    const OutfitPhysics op = outfit_physics(pc, o);
+    clothing.push_back(d.ir ? op.surface / pc.ir_coupling : 1.0);
+    clothing.push_back(double(PS_OUTFIT_HEAD + 2 * S + V));
+    clothing.push_back(d.ir ? op.ir_fold_k : op.mmw_fold_k);
+    clothing.push_back(d.ir ? pc.room_temperature : op.mmw_fold_t);
+    append_head(
+        clothing, d, [&](double e, double t) { return op.tc * (e * t + (1 - e) * d.m.illumination) + op.emission; },
+        d.ir ? op.surface : 1.0);
+    if (scene) append_moves(clothing, d, op.tc);
   }
-  if (ir) {
-    // Where an object reaches past the body's outline, its shadow is taken against the room
-    // it touches there, not the skin (PsViewLaunch::phys_off_body).
-    std::vector<double> off_body;
-    for (size_t subj = 0; subj < cat.subjects.size(); ++subj) off_body.push_back(pc.ir_body_index());
-    // Each variant's shadow against the room.
-    for (size_t v = 0; v < cat.variant_list.size(); ++v) {
-      const Material& mat = cat.materials.at(cat.object_of(static_cast<int>(v)).material_id);
-      off_body.push_back(-pc.ir_coupling * (pc.room_temperature - worn_temperature(pc, mat, m.worn_minutes)));
-    }
-    // Each subject's shadows scale with its skin above the room: every shadow above is
-    // -coupling (skin - room) times a factor of the material and the worn time.
-    const double span = pc.skin_temperature - pc.room_temperature;
-    for (const Subject& subj : cat.subjects) {
-      off_body.push_back(span == 0 ? 1.0 : (pc.skin_temperature_of(subj) - pc.room_temperature) / span);
-    }
-    t.off_body = append(off_body);
-    if (scene_drawn) p[PS_PHYS_SCENE] = append(scene);
-    if (!clothing.empty()) p[PS_PHYS_CLOTHING] = append(clothing);
-    return t;
+  return clothing;
+}
+
+// The IR contact shadow's off-body block (PsPhysTables::off_body): where an object reaches
+// past the body's outline, its shadow is taken against the room it touches there, not the skin.
+std::vector<double> off_body_block(const Derive& d) {
+  const PhysicsConfig& pc = d.pc;
+  std::vector<double> off_body;
+  for (size_t subj = 0; subj < d.cat.subjects.size(); ++subj) off_body.push_back(pc.ir_body_index());
+  // Each variant's shadow against the room.
+  for (size_t v = 0; v < d.cat.variant_list.size(); ++v) {
+    const Material& mat = d.cat.materials.at(d.cat.object_of(static_cast<int>(v)).material_id);
+    off_body.push_back(-pc.ir_coupling * (pc.room_temperature - worn_temperature(pc, mat, d.m.worn_minutes)));
   }
-  // The MMW raw-grid path's tables (kernels/physics_raw.cl).
-  const int W = s.width, H = s.height, RW = m.raw_width, RH = m.raw_height;
+  // Each subject's shadows scale with its skin above the room: every shadow above is
+  // -coupling (skin - room) times a factor of the material and the worn time.
+  const double span = pc.skin_temperature - pc.room_temperature;
+  for (const Subject& subj : d.cat.subjects) {
+    off_body.push_back(span == 0 ? 1.0 : (pc.skin_temperature_of(subj) - pc.room_temperature) / span);
+  }
+  return off_body;
+}
+
+// The MMW raw-grid path's tables (kernels/physics_raw.cl) appended to t, with the scene and
+// clothing blocks' grids; sets where the blocks lie in `common`.
+void append_mmw_grids(PhysicsTables& t, const Derive& d, const AssetSet& assets, const Sensor& s, int view,
+                      const std::vector<double>& psf, std::vector<double>& scene, std::vector<double>& clothing,
+                      PsPhys& common) {
+  std::vector<double>& p = t.values;
+  const int W = s.width, H = s.height, RW = d.m.raw_width, RH = d.m.raw_height;
+  const size_t S = d.cat.subjects.size();
   std::vector<double> wx, wy, cband, rband;
-  axis_weights(W, RW, psf.data(), t.radius, wx, cband);
-  axis_weights(H, RH, psf.data(), t.radius, wy, rband);
-  t.wx = append(wx);
-  t.wy = append(wy);
-  t.cband = append(cband);
-  t.rband = append(rband);
-  t.display = append_display_tables(p, m, W, H, RW, RH);
+  axis_weights(W, RW, psf.data(), t.at.psf_radius, wx, cband);
+  axis_weights(H, RH, psf.data(), t.at.psf_radius, wy, rband);
+  t.at.wx = append(p, wx);
+  t.at.wy = append(p, wy);
+  t.at.cband = append(p, cband);
+  t.at.rband = append(p, rband);
+  t.at.display = append_display_tables(p, d.m, W, H, RW, RH);
   // Each subject's grid of a value per view pixel, wy . T . wx^T, T = value(subject, x, y).
   const auto grids_of = [&](const auto& value) {
-    std::vector<double> bare(cat.subjects.size() * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
-    for (size_t subj = 0; subj < cat.subjects.size(); ++subj) {
+    std::vector<double> bare(S * size_t(RW) * RH, 0.0), rows(size_t(H) * RW);
+    for (size_t subj = 0; subj < S; ++subj) {
       std::fill(rows.begin(), rows.end(), 0.0);
       for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
@@ -277,29 +312,61 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
       return gains[2 * subj] * assets.bases[subj][view].at(x, y) + gains[2 * subj + 1];
     });
   };
-  t.base = append(bare_grids(&p[PS_PHYS_SUBJECTS]));
-  if (scene_drawn) {
+  t.at.base = append(p, bare_grids(&p[PS_PHYS_SUBJECTS]));
+  if (!scene.empty()) {
     const std::vector<double> moved = bare_grids(&scene[PS_SCENE_SUBJECTS]);
     scene.insert(scene.end(), moved.begin(), moved.end());
-    p[PS_PHYS_SCENE] = append(scene);
+    common.scene = append(p, scene);
   }
-  if (!clothing.empty()) {
-    // The gray grids: each subject's bare grid at (gain, offset) (1, 0).
-    std::vector<double> unit(2 * cat.subjects.size(), 0.0);
-    for (size_t k = 0; k < cat.subjects.size(); ++k) unit[2 * k] = 1;
-    clothing[PS_CLOTHING_GRIDS] = append(bare_grids(unit.data()));
-    // The fold grids: each subject's fold share m (0 .. 1) times its gray, then m alone.
-    if (clothing[PS_CLOTHING_FOLDS_HI] > 0) {
-      std::vector<double> folds = grids_of([&](size_t subj, int x, int y) {
-        return assets.folds[subj][view].at(x, y) / 255.0 * assets.bases[subj][view].at(x, y);
-      });
-      const std::vector<double> share =
-          grids_of([&](size_t subj, int x, int y) { return assets.folds[subj][view].at(x, y) / 255.0; });
-      folds.insert(folds.end(), share.begin(), share.end());
-      clothing[PS_CLOTHING_FOLD_GRIDS] = append(folds);
-    }
-    p[PS_PHYS_CLOTHING] = append(clothing);
+  if (clothing.empty()) return;
+  // The gray grids: each subject's bare grid at (gain, offset) (1, 0).
+  std::vector<double> unit(2 * S, 0.0);
+  for (size_t k = 0; k < S; ++k) unit[2 * k] = 1;
+  clothing[PS_CLOTHING_GRIDS] = append(p, bare_grids(unit.data()));
+  // The fold grids: each subject's fold share m (0 .. 1) times its gray, then m alone.
+  if (clothing[PS_CLOTHING_FOLDS_HI] > 0) {
+    std::vector<double> folds = grids_of([&](size_t subj, int x, int y) {
+      return assets.folds[subj][view].at(x, y) / 255.0 * assets.bases[subj][view].at(x, y);
+    });
+    const std::vector<double> share =
+        grids_of([&](size_t subj, int x, int y) { return assets.folds[subj][view].at(x, y) / 255.0; });
+    folds.insert(folds.end(), share.begin(), share.end());
+    clothing[PS_CLOTHING_FOLD_GRIDS] = append(p, folds);
   }
+  common.clothing = append(p, clothing);
+}
+
+}  // namespace
+
+size_t mmw_display_scratch(const Sensor& s, int raw_width, int raw_height) {
+  return PS_MMW_DISPLAY_SCRATCH(s.width, s.height, raw_width, raw_height);
+}
+
+PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const Plan& plan, const ModelSettings& m,
+                             int view) {
+  const Sensor& s = cat.sensors[view];
+  const Derive d{cat, cat.physics, m, s.camera == Camera::ir};
+  PhysicsTables t;
+  std::vector<double>& p = t.values;
+  p.assign(PS_PHYS_SUBJECTS, 0.0);
+  append_head(
+      p, d, [&](double e, double k) { return d.pc.seen_through_clothing(e, k, m.illumination); }, 1.0);
+  const size_t taps = p.size();
+  append_gaussian_taps(p, psf_sigma(d.pc, s, d.ir), t.at.psf_radius);
+  const std::vector<double> psf(p.begin() + static_cast<std::ptrdiff_t>(taps), p.end());
+  t.at.gauss = append(p, gauss_table());  // the sensor noise's table Gaussians
+  std::vector<double> scene = scene_block(d), clothing = clothing_block(d, assets);
+  if (d.ir) {
+    PsPhysIr h = ir_scalars(d.pc, m);
+    t.at.off_body = append(p, off_body_block(d));
+    if (!scene.empty()) h.common.scene = append(p, scene);
+    if (!clothing.empty()) h.common.clothing = append(p, clothing);
+    put_scalars(p, h);
+    return t;
+  }
+  PsPhysMmw h = mmw_scalars(plan, m);
+  append_mmw_grids(t, d, assets, s, view, psf, scene, clothing, h.common);
+  put_scalars(p, h);
   return t;
 }
 

@@ -1,5 +1,6 @@
-// The physics model's parameters for a view's launch (kernels/shared.h, PS_PHYS_*), with the
-// MMW raw-grid path's tables; view_derive.h keeps them per (plan, view). The same formulas
+// The physics model's parameters for a view's launch (kernels/contract.h: its camera kind's
+// scalars, PsPhysMmw or PsPhysIr, then the tails and tables), with the MMW raw-grid path's
+// tables; view_derive.h keeps them per (plan, view). The same formulas
 // as the reference's, written again here: the two never share code.
 #pragma once
 #include <cstdint>
@@ -13,11 +14,10 @@
 namespace portalsim::opencl {
 
 // The physics parameters and tables of view `view`, its knobs `m` (ModelSettings::for_view)
-// under `plan`: the values, and where each table starts in them (PsViewLaunch's phys_*).
+// under `plan`: the values, and where each table starts in them (PsViewLaunch's tables).
 struct PhysicsTables {
   std::vector<double> values;
-  int32_t radius = 0, wx = 0, wy = 0, cband = 0, rband = 0, base = 0, gauss = 0, off_body = 0;
-  DisplayTables display;  // stage_mmw_display's (MMW views)
+  PsPhysTables at{};
 };
 PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const Plan& plan, const ModelSettings& m,
                              int view);

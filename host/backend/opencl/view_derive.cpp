@@ -76,19 +76,7 @@ std::shared_ptr<ViewDerived> ViewDerivations::operator()(const Plan& plan, int v
   const bool fp64 = plan.fidelity.precision == Precision::fp64;
   if (plan.model.model == Model::physics) {
     const PhysicsTables t = physics_tables(cat_, assets_, plan, m, view);
-    d->L.psf_radius = t.radius;
-    d->L.phys_wx = t.wx;
-    d->L.phys_wy = t.wy;
-    d->L.phys_cband = t.cband;
-    d->L.phys_rband = t.rband;
-    d->L.phys_base = t.base;
-    d->L.phys_gauss = t.gauss;
-    d->L.phys_off_body = t.off_body;
-    d->L.display_stride = t.display.stride;
-    d->L.phys_dx = t.display.dx;
-    d->L.phys_dxband = t.display.dxband;
-    d->L.phys_dy = t.display.dy;
-    d->L.phys_dyband = t.display.dyband;
+    d->L.tables = t.at;
     d->phys = params(ctx_, fp64, t.values);
     d->raw_values = static_cast<size_t>(m.raw_width) * m.raw_height;
     // A second field for the stage chain; physics_raw's row sums; stage_mmw_display's

@@ -45,7 +45,7 @@ struct ViewDerived {
   ModelSettings model;  // the plan's knobs as this view takes them (ModelSettings::for_view)
   // Every field but the batch's (n, seed, first) and the features path's PS_FLAG_TABULATED.
   PsViewLaunch L{};
-  cl::Buffer phys;            // PS_PHYS_* and the tables L's phys_* fields index (a placeholder: thesis)
+  cl::Buffer phys;            // the kind's scalars, tails and the tables L.tables places (a placeholder: thesis)
   size_t raw_values = 1;      // the MMW raw grid's values per scenario (physics)
   size_t scratch_values = 1;  // the view's scratch values per scenario (physics)
   std::unique_ptr<PathTables> path_tables;
