@@ -325,11 +325,9 @@ __attribute__((always_inline)) inline void gauss128x2(uint2 seed, ulong index, i
 }
 #endif
 
-// The fast tier's draws (PS_FLAG_FAST_DRAWS): the Irwin-Hall draws above (ih_cell,
-// ih128) of the table Gaussians' cells and streams.
-
 // Adds sd times the draws of cells [0, cells) of `stream` to v: table Gaussians, or with
-// `fast` the fast tier's draws. The stage kernels' noise (stage_netd's rows go cell by cell).
+// `fast` the fast tier's (PS_FLAG_FAST_DRAWS: the Irwin-Hall draws of the same cells and
+// streams, ih_cell and ih128). The stage kernels' noise (stage_netd's rows go cell by cell).
 DRAW_CELLS(ih_cells, global, ih_cell(seed, index, stream, view, p), ih128(seed, index, stream, view, p >> 7, g))
 inline void noise_cells(global preal* restrict v, int cells, preal sd, uint2 seed, ulong index, uint stream, int view,
                         global const param* table, bool fast) {
