@@ -14,6 +14,7 @@
 #include "base/error.h"
 #include "cli/validate_stats.h"
 #include "cli/validate_tables.h"
+#include "cli/weka.h"
 #include "io/table_fields.h"
 #include "run_binary.h"
 #include "sink/feature_rows.h"
@@ -120,6 +121,20 @@ TEST(Validate, SameSpecIsNotToldApartAndShuffledLabelsAre) {
   fs::remove_all(d);
 }
 
+// WEKA's command line's count of correctly classified instances in its section `section`.
+long wekas_own_correct(const fs::path& cap, std::vector<std::string> args, const std::string& section) {
+  args.insert(args.begin(), {"java", "-cp", "/usr/share/java/weka.jar"});
+  const auto w = finish(portalsim::test::start_program(cap, "/usr/bin/env", args));
+  EXPECT_TRUE(w.exited && w.status == 0) << portalsim::test::describe(w);
+  const size_t at = w.out.find("Correctly Classified Instances", w.out.find(section));
+  EXPECT_NE(at, std::string::npos) << w.out;
+  if (at == std::string::npos) return -1;
+  std::istringstream in(w.out.substr(at + 30));
+  long correct = -1;
+  in >> correct;
+  return correct;
+}
+
 // The overall accuracy of the folds equals that of WEKA's own command line for the seed.
 TEST(Validate, FoldsAreWekasOwn) {
   const fs::path d = fresh_dir();
@@ -133,16 +148,9 @@ TEST(Validate, FoldsAreWekasOwn) {
   for (const auto& [label, cls] : std::vector<std::pair<std::string, std::string>>{
            {"J48", "weka.classifiers.trees.J48"}, {"SMO", "weka.classifiers.functions.SMO"}}) {
     for (const char* set : {"real", "sim"}) {
-      const auto w =
-          finish(portalsim::test::start_program(d / "cap", "/usr/bin/env",
-                                                {"java", "-cp", "/usr/share/java/weka.jar", cls, "-o", "-t",
-                                                 (d / (std::string(set) + ".arff")).string(), "-x", "5", "-s", "7"}));
-      ASSERT_TRUE(w.exited && w.status == 0) << portalsim::test::describe(w);
-      const size_t at = w.out.find("Correctly Classified Instances", w.out.find("Stratified cross-validation"));
-      ASSERT_NE(at, std::string::npos) << w.out;
-      std::istringstream in(w.out.substr(at + 30));
-      long correct = -1;
-      in >> correct;
+      const long correct = wekas_own_correct(
+          d / "cap", {cls, "-o", "-t", (d / (std::string(set) + ".arff")).string(), "-x", "5", "-s", "7"},
+          "=== Stratified cross-validation ===");
       const auto& run = report["analyses"]["all"]["classifiers"][label][set]["runs"][0];
       EXPECT_EQ(run["correct"].get<long>(), correct) << label << " " << set;
       double sum = 0;
@@ -150,6 +158,41 @@ TEST(Validate, FoldsAreWekasOwn) {
       EXPECT_NEAR(sum, static_cast<double>(correct), 1e-6) << label << " " << set;
     }
   }
+  fs::remove_all(d);
+}
+
+// transfer's and tradeoff's one JVM (cli::weka_scores): a classifier trained once scores each
+// test set as WEKA's command line `-t -T` does, and a cross-validation as `-x -s` does.
+TEST(Weka, OneJvmScoresAsWekasCommandLine) {
+  const fs::path d = fresh_dir();
+  fs::create_directories(d / "cap");
+  spit(d / "train.arff", table(120, 4, false));
+  spit(d / "near.arff", table(90, 5, false));
+  spit(d / "shuffled.arff", table(60, 6, true));
+  const std::string train = (d / "train.arff").string(), near = (d / "near.arff").string(),
+                    shuffled = (d / "shuffled.arff").string();
+  std::string why;
+  const auto got = portalsim::cli::weka_scores(
+      {{.classifier = "j48", .train = train, .tests = {near, shuffled}, .folds = 0, .seed = 0},
+       {.classifier = "svm", .train = shuffled, .tests = {}, .folds = 5, .seed = 7},
+       {.classifier = "j48", .train = near, .tests = {}, .folds = 10, .seed = 1}},
+      why);
+  ASSERT_TRUE(got) << why;
+  ASSERT_EQ(got->size(), 3u);
+  ASSERT_EQ((*got)[0].size(), 2u);
+  const std::string j48 = "weka.classifiers.trees.J48", smo = "weka.classifiers.functions.SMO";
+  const std::string on_test = "=== Error on test data ===", cv = "=== Stratified cross-validation ===";
+  EXPECT_EQ((*got)[0][0].correct, wekas_own_correct(d / "cap", {j48, "-o", "-t", train, "-T", near}, on_test));
+  EXPECT_EQ((*got)[0][0].correct + (*got)[0][0].misclassified, 90);
+  EXPECT_EQ((*got)[0][1].correct, wekas_own_correct(d / "cap", {j48, "-o", "-t", train, "-T", shuffled}, on_test));
+  EXPECT_EQ((*got)[1][0].correct, wekas_own_correct(d / "cap", {smo, "-o", "-t", shuffled, "-x", "5", "-s", "7"}, cv));
+  EXPECT_EQ((*got)[2][0].correct, wekas_own_correct(d / "cap", {j48, "-o", "-t", near}, cv));
+  EXPECT_EQ((*got)[2][0].correct + (*got)[2][0].misclassified, 90);
+  // A test set whose header is not the training set's is WEKA's failure, named.
+  spit(d / "other.arff", "@relation o\n@attribute a numeric\n@attribute class {gun,none}\n@data\n1,gun\n");
+  EXPECT_FALSE(portalsim::cli::weka_scores(
+      {{.classifier = "j48", .train = train, .tests = {(d / "other.arff").string()}, .folds = 0, .seed = 0}}, why));
+  EXPECT_NE(why.find("different headers"), std::string::npos) << why;
   fs::remove_all(d);
 }
 

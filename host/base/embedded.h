@@ -10,7 +10,7 @@ extern const std::string_view kernel_program;     // the kernel program: contrac
 extern const std::string_view default_catalogue;  // scenarios/catalogue.toml
 extern const std::string_view case2_spec;         // scenarios/case2-rod-plate.toml
 extern const std::string_view serve_index_html, serve_app_js, serve_style_css;  // host/serve/page/
-extern const std::string_view weka_validate;                                    // tools/WekaValidate.java
+extern const std::string_view weka_program;                                     // tools/Weka.java
 extern const std::string_view transfer_cnn;                                     // tools/transfer_cnn.py
 // tools/plot_*.py
 extern const std::string_view plot_tradeoff, plot_validate, plot_calibrate, plot_metal_map, plot_evaluate, plot_sweep;

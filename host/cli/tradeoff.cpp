@@ -228,17 +228,43 @@ struct ModelRows {
     return same_draw_refs[d];
   }
 
-  // J48's 10-fold accuracy on one tier's features of one case, or null (with a note).
-  void j48(json& r, const std::string& key, const std::string& arff, const SceneBatch& scenes,
+  // J48's 10-fold accuracies, asked for as the rows are made and run at the model's end in
+  // one JVM (cli/weka.h): row `row`'s column `key` is that of the ARFF `arff`.
+  struct J48Column {
+    size_t row;
+    std::string key, arff;
+  };
+  std::vector<J48Column> j48_asked;
+
+  // Writes one tier's features of one case as the ARFF `arff` for row `row`'s column `key`.
+  void j48(size_t row, const std::string& key, const std::string& arff, const SceneBatch& scenes,
            const BatchOutput& feats) {
-    r[key] = nullptr;
     write_arff(folder.dir(), arff, scenes, feats, cat);
-    std::string why;
-    if (auto acc = j48_cv_accuracy((std::filesystem::path(folder.dir()) / arff).string(), why))
-      r[key] = *acc;
-    else
-      r["j48_note"] = why;
     folder.path(arff);  // keep it
+    j48_asked.push_back({row, key, arff});
+  }
+
+  // The model's J48 columns (or a note where WEKA cannot run), then its rows printed.
+  void finish(json& rows, size_t first_row) {
+    std::vector<WekaJob> jobs;
+    std::map<std::string, size_t> job_of;  // an ARFF asked for twice is scored once
+    for (const J48Column& c : j48_asked)
+      if (job_of.emplace(c.arff, jobs.size()).second)
+        jobs.push_back({.classifier = "j48",
+                        .train = (std::filesystem::path(folder.dir()) / c.arff).string(),
+                        .tests = {},
+                        .folds = 10,
+                        .seed = 1});
+    std::string why;
+    const auto scores = jobs.empty() ? std::vector<std::vector<WekaScore>>() : weka_scores(jobs, why);
+    for (const J48Column& c : j48_asked) {
+      if (scores)
+        rows[c.row][c.key] = (*scores)[job_of[c.arff]][0].percent();
+      else
+        rows[c.row]["j48_note"] = why;
+    }
+    j48_asked.clear();
+    for (size_t row = first_row; row < rows.size(); ++row) print_row(rows[row]);
   }
 
   // Case 2's features, one untimed pass (only the classifier reads them).
@@ -248,8 +274,10 @@ struct ModelRows {
     return out;
   }
 
-  // Fills the row `r` (which holds the noise's distribution columns already) and prints it.
-  void add_row(json& r, const RowRuns& run) {
+  // Fills the last row (which holds the noise's distribution columns already); finish()
+  // prints it.
+  void add_row(json& rows, const RowRuns& run) {
+    json& r = rows.back();
     const Model m = model.model;
     r["model"] = mname;
     r["name"] = run.name;
@@ -279,8 +307,7 @@ struct ModelRows {
       r["precision"] = "fp64 (CPU reference)";
     r["within_tolerance"] = why.empty();
     if (!why.empty()) r["tolerance_note"] = why;
-    j48_columns(r, run);
-    print_row(r, run, why);
+    j48_columns(rows.size() - 1, r, run);
   }
 
   // A tier's fidelity columns and whether its runs are within the tier's stated tolerance for
@@ -329,39 +356,41 @@ struct ModelRows {
     return why;
   }
 
-  void j48_columns(json& r, const RowRuns& run) {
+  void j48_columns(size_t row, json& r, const RowRuns& run) {
     r["j48_accuracy"] = nullptr;
     r["j48_case2_accuracy"] = nullptr;
     r["j48_images_accuracy"] = nullptr;
     r["j48_images_case2_accuracy"] = nullptr;
     if (!o.classifier) return;
     const std::string stem = mname + "-" + run.name;
-    j48(r, "j48_accuracy", stem + "-case1.arff", batch, *run.feats);
-    j48(r, "j48_case2_accuracy", stem + "-case2.arff", case2, run.feats2);
+    j48(row, "j48_accuracy", stem + "-case1.arff", batch, *run.feats);
+    j48(row, "j48_case2_accuracy", stem + "-case2.arff", case2, run.feats2);
     // Features pooled from the images run: the features-only run's own where they are
-    // the same numbers, else J48 on them.
+    // the same numbers (the same ARFF), else J48 on them.
     if (run.img_feats) {
-      j48(r, "j48_images_accuracy", stem + "-images-case1.arff", batch, *run.img_feats);
-      j48(r, "j48_images_case2_accuracy", stem + "-images-case2.arff", case2, *run.img_feats2);
+      j48(row, "j48_images_accuracy", stem + "-images-case1.arff", batch, *run.img_feats);
+      j48(row, "j48_images_case2_accuracy", stem + "-images-case2.arff", case2, *run.img_feats2);
     } else {
-      r["j48_images_accuracy"] = r["j48_accuracy"];
-      r["j48_images_case2_accuracy"] = r["j48_case2_accuracy"];
+      j48_asked.push_back({row, "j48_images_accuracy", stem + "-case1.arff"});
+      j48_asked.push_back({row, "j48_images_case2_accuracy", stem + "-case2.arff"});
     }
   }
 
-  static void print_row(const json& r, const RowRuns& run, const std::string& why) {
+  static void print_row(const json& r) {
     auto pct = [&](const char* key) {
       char text[32] = "-";
       if (!r[key].is_null()) std::snprintf(text, sizeof text, "%.1f%%", r[key].get<double>());
       return std::string(text);
     };
+    const std::string why = r.value("tolerance_note", "");
     std::printf(
         "  %-9s features %10.0f/s  images %8.0f/s  MMW max %d rmse %.4f  feature max %.4g  metal %.4f  noise sd %.4f "
         "kurtosis %+.3f KS %.4f  J48 case 1 %s case 2 %s (from images %s, %s)%s\n",
-        run.name.c_str(), run.feat_rate, run.img_rate, run.img_err.mmw.max_abs, run.img_err.mmw.rmse_mean,
-        run.feat_err.feature_max_abs, run.feat_err.metal_exact, r["noise_sd"].get<double>(),
-        r["noise_excess_kurtosis"].get<double>(), r["noise_ks"].get<double>(), pct("j48_accuracy").c_str(),
-        pct("j48_case2_accuracy").c_str(), pct("j48_images_accuracy").c_str(), pct("j48_images_case2_accuracy").c_str(),
+        r["name"].get<std::string>().c_str(), r["features_per_s"].get<double>(), r["images_per_s"].get<double>(),
+        r["mmw_max_abs"].get<int>(), r["mmw_rmse_mean"].get<double>(), r["feature_max_abs"].get<double>(),
+        r["metal_exact_rate"].get<double>(), r["noise_sd"].get<double>(), r["noise_excess_kurtosis"].get<double>(),
+        r["noise_ks"].get<double>(), pct("j48_accuracy").c_str(), pct("j48_case2_accuracy").c_str(),
+        pct("j48_images_accuracy").c_str(), pct("j48_images_case2_accuracy").c_str(),
         why.empty() ? "" : ("  OUT OF TOLERANCE: " + why).c_str());
     std::fflush(stdout);
   }
@@ -389,22 +418,23 @@ void model_rows(ModelRows& mr, json& rows, const std::shared_ptr<OpenCLRuntime>&
   const ModelSettings& model = mr.model;
   const Model m = model.model;
   const size_t draw_scenarios = std::min<size_t>(o.count, kDrawScenarios);
+  const size_t first_row = rows.size();
   const Timed ref = run_timed(mr.reference, mr.batch, images_plan(model), 256, 0.0);
   const OutputDiff self = compare_outputs(ref.out, ref.out);
   // The reference renders every image for features too: one rate serves both, and its
   // features come from its images: the same numbers either way.
   put_distribution(rows.emplace_back(), reference_draws(m, model.seed, draw_scenarios));
-  mr.add_row(rows.back(), {.name = "reference",
-                           .tier = std::nullopt,
-                           .feat_rate = ref.rate,
-                           .img_rate = ref.rate,
-                           .img_err = self,
-                           .feat_err = self,
-                           .feats = &ref.out,
-                           .feats2 = mr.case2_features(mr.reference, features_plan(model)),
-                           .img_feats = nullptr,
-                           .img_feats2 = nullptr,
-                           .img_out = &ref.out});
+  mr.add_row(rows, {.name = "reference",
+                    .tier = std::nullopt,
+                    .feat_rate = ref.rate,
+                    .img_rate = ref.rate,
+                    .img_err = self,
+                    .feat_err = self,
+                    .feats = &ref.out,
+                    .feats2 = mr.case2_features(mr.reference, features_plan(model)),
+                    .img_feats = nullptr,
+                    .img_feats2 = nullptr,
+                    .img_out = &ref.out});
   for (Tier t : {Tier::exact, Tier::standard, Tier::fast}) {
     const Fidelity f = tier_fidelity(t);
     auto cl = make_opencl_backend(mr.cat, assets, rt);
@@ -417,18 +447,19 @@ void model_rows(ModelRows& mr, json& rows, const std::shared_ptr<OpenCLRuntime>&
     const bool images_own_features = o.classifier && img.out.features != feat.out.features;
     BatchOutput img2;
     if (images_own_features) cl->run(mr.case2, ip, img2);
-    mr.add_row(rows.back(), {.name = tier_name(t),
-                             .tier = t,
-                             .feat_rate = feat.rate,
-                             .img_rate = img.rate,
-                             .img_err = compare_outputs(img.out, ref.out),
-                             .feat_err = compare_outputs(feat.out, ref.out),
-                             .feats = &feat.out,
-                             .feats2 = mr.case2_features(*cl, fp),
-                             .img_feats = images_own_features ? &img.out : nullptr,
-                             .img_feats2 = images_own_features ? &img2 : nullptr,
-                             .img_out = &img.out});
+    mr.add_row(rows, {.name = tier_name(t),
+                      .tier = t,
+                      .feat_rate = feat.rate,
+                      .img_rate = img.rate,
+                      .img_err = compare_outputs(img.out, ref.out),
+                      .feat_err = compare_outputs(feat.out, ref.out),
+                      .feats = &feat.out,
+                      .feats2 = mr.case2_features(*cl, fp),
+                      .img_feats = images_own_features ? &img.out : nullptr,
+                      .img_feats2 = images_own_features ? &img2 : nullptr,
+                      .img_out = &img.out});
   }
+  mr.finish(rows, first_row);
 }
 
 json tradeoff_report(const TradeoffOptions& o, const ModelSettings& base, const std::vector<Model>& models,

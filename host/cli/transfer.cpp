@@ -34,16 +34,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The classifiers by their flag name: WEKA's class (none for the CNN) and the report's name.
+// The classifiers by their flag name (WEKA's, tools/Weka.java, or the CNN) and the report's name.
 struct Classifier {
   const char* key;
-  const char* weka_class;
+  bool weka;
   const char* name;
 };
-constexpr Classifier kClassifiers[] = {{"j48", "weka.classifiers.trees.J48", "J48"},
-                                       {"svm", "weka.classifiers.functions.SMO", "SMO"},
-                                       {"mlp", "weka.classifiers.functions.MultilayerPerceptron", "MLP"},
-                                       {"cnn", nullptr, "CNN"}};
+constexpr Classifier kClassifiers[] = {
+    {"j48", true, "J48"}, {"svm", true, "SMO"}, {"mlp", true, "MLP"}, {"cnn", false, "CNN"}};
 
 struct Options {
   std::string train, out, classifiers = "j48,svm", catalogue, cnn_inputs;  // cnn_inputs: "" is kDefaultCnnInputs
@@ -282,17 +280,18 @@ std::vector<long> cnn_scores(const Options& o, const Cnn& cnn, const std::vector
   return correct;
 }
 
-// A WEKA classifier trained on the first ARFF, scored on each other's: correct per set.
-std::vector<long> weka_scores(const Classifier& c, const std::vector<std::string>& arff, const std::vector<Set>& sets) {
-  std::vector<long> correct(sets.size(), 0);
+// A WEKA classifier trained once on the first ARFF, scored on each other's: correct per set.
+std::vector<long> weka_correct(const Classifier& c, const std::vector<std::string>& arff,
+                               const std::vector<Set>& sets) {
   std::string why;
+  const auto s = weka_scores(
+      {{.classifier = c.key, .train = arff[0], .tests = {arff.begin() + 1, arff.end()}, .folds = 0, .seed = 0}}, why);
+  if (!s) throw EnvironmentError(std::string("WEKA ") + c.name + ": " + why);
+  std::vector<long> correct(sets.size(), 0);
   for (size_t k = 1; k < sets.size(); ++k) {
-    const auto s = weka_score(c.weka_class, arff[0], arff[k], 0, 1, why);
-    if (!s) throw EnvironmentError(std::string("WEKA ") + c.name + ": " + why);
-    const long n = static_cast<long>(sets[k].table.rows.size());
-    correct[k] = n - s->misclassified;
+    correct[k] = (*s)[0][k - 1].correct;
     std::fprintf(stderr, "transfer: %s on %s: %s%%\n", c.name, sets[k].name.c_str(),
-                 percent(double(correct[k]) / n).c_str());
+                 percent(double(correct[k]) / static_cast<double>(sets[k].table.rows.size())).c_str());
   }
   return correct;
 }
@@ -350,10 +349,10 @@ void add_scores(const Options& o, const std::vector<const Classifier*>& chosen, 
 int run_transfer(const Options& o) {
   // Every argument is checked before anything is written or run.
   const std::vector<const Classifier*> chosen = chosen_classifiers(o.classifiers);
-  const bool cnn = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return !c->weka_class; });
+  const bool cnn = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return !c->weka; });
   if (!o.cnn_inputs.empty() && !cnn) throw InputError("--cnn-inputs: only applies with --classifiers cnn");
   const Cnn cnn_in = cnn ? cnn_of(o) : Cnn{};
-  const bool weka = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return c->weka_class; });
+  const bool weka = std::any_of(chosen.begin(), chosen.end(), [](const Classifier* c) { return c->weka; });
   std::vector<Set> sets = sets_of(o, cnn);
   if (const auto missing = weka_missing(); weka && missing) throw EnvironmentError("transfer: " + *missing);
 
@@ -368,7 +367,7 @@ int run_transfer(const Options& o) {
   // Scores: per classifier, per test set, correct of n.
   std::vector<std::vector<long>> correct;
   for (const Classifier* c : chosen)
-    correct.push_back(c->weka_class ? weka_scores(*c, arff, sets) : cnn_scores(o, cnn_in, sets, made, scratch.path));
+    correct.push_back(c->weka ? weka_correct(*c, arff, sets) : cnn_scores(o, cnn_in, sets, made, scratch.path));
 
   nlohmann::json report = {{"train", {{"source", sets[0].source}, {"instances", sets[0].table.rows.size()}}},
                            {"attributes", sets[0].table.names.size() - 1},

@@ -1,7 +1,7 @@
 // `portalsim validate`: the thesis's chapter 6 on a simulated and a real data set. Each is a
 // feature table (ARFF, CSV or a data.h5 of `generate --format h5`) or a folder of scenario
 // folders (turned into a table by the code of `portalsim features`). WEKA's J48, MultilayerPerceptron and SMO (default
-// settings) are scored in one JVM (tools/WekaValidate.java, embedded) by cross-validation on real, simulated and
+// settings) are scored in one JVM (tools/Weka.java, embedded) by cross-validation on real, simulated and
 // combined data over several runs, trained on simulated data and tested on real data, and along a learning curve; the
 // fold accuracies are compared by the thesis's t-test and by the corrected resampled t-test.
 #include <unistd.h>
@@ -137,7 +137,7 @@ FeatureSet feature_set(const std::string& key) {
 
 constexpr const char* kSets[3] = {"real", "sim", "combined"};
 
-// All the WEKA work of one analysis in one JVM; returns WekaValidate's JSON.
+// All the WEKA work of one analysis in one JVM; returns tools/Weka.java's JSON.
 nlohmann::json run_weka(const Options& o, const std::string& classifiers, const std::string& work,
                         const std::string& key, const Table& sim, const Table& real) {
   std::set<std::string> classes = sim.classes;
@@ -146,9 +146,9 @@ nlohmann::json run_weka(const Options& o, const std::string& classifiers, const 
   const std::string real_arff = (fs::path(work) / (".real-" + key + ".arff")).string();
   write_arff(sim, classes, sim_arff);
   write_arff(real, classes, real_arff);
-  const std::string program = (fs::path(work) / "WekaValidate.java").string();
+  const std::string program = (fs::path(work) / "Weka.java").string();
   const std::string weka_out = (fs::path(work) / (".weka-" + key + ".json")).string();
-  write_text_atomic(program, std::string(embedded::weka_validate));
+  write_text_atomic(program, std::string(embedded::weka_program));
   std::fprintf(stderr, "validate: %s (%s, %zu attributes)\n", key.c_str(), feature_set(key).title.c_str(),
                sim.names.size() - 1);
   const std::string cmd = "java -Xmx2g -cp /usr/share/java/weka.jar " + shell_quote(program) + " --real " +

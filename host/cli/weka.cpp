@@ -1,19 +1,26 @@
 #include "cli/weka.h"
 
-#include <sys/wait.h>
-
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <sstream>
+
+#include "base/embedded.h"
+#include "cli/common.h"
+#include "cli/learning_sets.h"
+#include "sink/staging.h"
 
 namespace portalsim::cli {
 
 namespace {
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
+// Whether a line holds more than it should.
+bool one_more(std::istringstream& fields) {
+  std::string rest;
+  return static_cast<bool>(fields >> rest);
 }
 
 }  // namespace
@@ -26,19 +33,25 @@ std::optional<std::string> weka_missing() {
   return std::nullopt;
 }
 
-std::optional<WekaScore> weka_score(const std::string& classifier, const std::string& train, const std::string& test,
-                                    int folds, int seed, std::string& why) {
-  const char* jar = "/usr/share/java/weka.jar";
+std::optional<std::vector<std::vector<WekaScore>>> weka_scores(const std::vector<WekaJob>& jobs, std::string& why) {
   if (const auto missing = weka_missing()) {
     why = *missing;
     return std::nullopt;
   }
-  std::string cmd = "java -Xmx4g -cp " + std::string(jar) + " " + classifier + " -o -t " + quote(train);
-  if (test.empty())
-    cmd += " -x " + std::to_string(folds) + " -s " + std::to_string(seed);
-  else
-    cmd += " -T " + quote(test);
-  cmd += " 2>&1";
+  const WorkDir work;
+  const std::string program = (std::filesystem::path(work.path) / "Weka.java").string();
+  const std::string list = (std::filesystem::path(work.path) / "jobs.tsv").string();
+  write_text_atomic(program, std::string(embedded::weka_program));
+  std::string lines;
+  for (const WekaJob& j : jobs) {
+    lines += j.classifier + "\t" + j.train + "\t" + std::to_string(j.folds) + "\t" + std::to_string(j.seed);
+    for (const std::string& t : j.tests) lines += "\t" + t;
+    lines += "\n";
+  }
+  write_text_atomic(list, lines);
+  const std::string errors = (std::filesystem::path(work.path) / "stderr.txt").string();
+  const std::string cmd = "java -Xmx4g -cp /usr/share/java/weka.jar " + shell_quote(program) + " --jobs " +
+                          shell_quote(list) + " 2>" + shell_quote(errors);
   FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) {
     why = "cannot run java";
@@ -48,35 +61,27 @@ std::optional<WekaScore> weka_score(const std::string& classifier, const std::st
   char buf[4096];
   size_t got;
   while ((got = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, got);
-  const int status = ::pclose(p);
-  if (status != 0) {
-    why = "WEKA " + classifier + " failed: " + out.substr(0, 300);
+  if (::pclose(p) != 0) {
+    std::ifstream err(errors);
+    const std::string text((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
+    why = "WEKA failed: " + text.substr(0, 600);
     return std::nullopt;
   }
-  const char* section = test.empty() ? "=== Stratified cross-validation ===" : "=== Error on test data ===";
-  const size_t at = out.find(section);
-  const size_t ok = at == std::string::npos ? at : out.find("Correctly Classified Instances", at);
-  const size_t bad = at == std::string::npos ? at : out.find("Incorrectly Classified Instances", at);
-  if (ok == std::string::npos || bad == std::string::npos) {
-    why = "no accuracy in WEKA's output";
-    return std::nullopt;
+  // A line per job: "CORRECT MISCLASSIFIED" per test, or once for a cross-validation.
+  std::vector<std::vector<WekaScore>> scores;
+  std::istringstream in(out);
+  for (const WekaJob& j : jobs) {
+    std::string line;
+    std::getline(in, line);
+    std::istringstream fields(line);
+    auto& s = scores.emplace_back(std::max<size_t>(j.tests.size(), 1));
+    for (WekaScore& one : s) fields >> one.correct >> one.misclassified;
+    if (!fields || one_more(fields)) {
+      why = "unreadable scores in WEKA's output: " + out.substr(0, 600);
+      return std::nullopt;
+    }
   }
-  WekaScore score;
-  double count = 0;
-  std::istringstream ok_in(out.substr(ok + 30)), bad_in(out.substr(bad + 32));
-  ok_in >> count >> score.correct_percent;
-  bad_in >> score.misclassified;
-  if (!ok_in || !bad_in) {
-    why = "unreadable accuracy in WEKA's output";
-    return std::nullopt;
-  }
-  return score;
-}
-
-std::optional<double> j48_cv_accuracy(const std::string& arff, std::string& why) {
-  auto s = weka_score("weka.classifiers.trees.J48", arff, "", 10, 1, why);
-  if (!s) return std::nullopt;
-  return s->correct_percent;
+  return scores;
 }
 
 }  // namespace portalsim::cli

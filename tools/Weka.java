@@ -1,13 +1,19 @@
-// All the WEKA work of `portalsim validate` in one JVM (Java 17 single-file source program,
-// run as `java -cp /usr/share/java/weka.jar WekaValidate.java ARGS`). Folds are made exactly
+// All the WEKA work of one portalsim command in one JVM (Java 17 single-file source program,
+// run as `java -cp /usr/share/java/weka.jar Weka.java ARGS`): a JVM's start and its
+// compiling of WEKA cost more than J48 on a small table, and a classifier trained once can
+// score many test sets. Folds are made exactly
 // as weka.classifiers.Evaluation.crossValidateModel makes them (copy, randomize with
 // new Random(seed), stratify, trainCV(k, i, random), testCV(k, i)), so the overall accuracy
 // equals that of WEKA's command line `-x k -s seed`; the accuracy of every fold is kept.
 //
-// Arguments: --real R.arff --sim S.arff --folds K --runs N --seed S --classifiers j48,mlp,svm
-//            --curve-steps C
-// Both tables must share one header (portalsim validate writes them so). Prints one JSON
-// object on stdout; progress on stderr; exit status 2 with a message on bad arguments.
+// `portalsim validate`: --real R.arff --sim S.arff --folds K --runs N --seed S
+//   --classifiers j48,mlp,svm --curve-steps C. Both tables must share one header (validate
+//   writes them so). Prints one JSON object on stdout; progress on stderr.
+// `transfer` and `tradeoff`: --jobs FILE, one job a line, fields separated by tabs:
+//   CLASSIFIER TRAIN.arff FOLDS SEED [TEST.arff ...]. With no test, FOLDS-fold stratified
+//   cross-validation seeded SEED (crossValidate below); else trained once on TRAIN and scored
+//   on each TEST. Prints a line per job: "CORRECT MISCLASSIFIED" for the CV or for each test.
+// Exit status 2 with a message on bad arguments.
 import java.util.ArrayList;
 import java.util.HashMap;
 import java.util.List;
@@ -18,7 +24,7 @@ import weka.classifiers.Evaluation;
 import weka.core.Instances;
 import weka.core.converters.ConverterUtils.DataSource;
 
-public class WekaValidate {
+public class Weka {
   static String json(String s) {
     StringBuilder b = new StringBuilder("\"");
     for (char c : s.toCharArray()) {
@@ -55,12 +61,19 @@ public class WekaValidate {
   // Evaluation.crossValidateModel's folds, scored one by one. Returns the JSON object
   // {"folds":[% correct per fold], "correct":N, "misclassified":N, "percent_correct":P}.
   static String crossValidate(String cls, Instances data, int k, long seed) throws Exception {
+    double[] folds = new double[k];
+    Evaluation all = crossValidated(cls, data, k, seed, folds);
+    return "{\"folds\":" + json(folds) + ",\"correct\":" + (long) all.correct() + ",\"misclassified\":"
+        + (long) all.incorrect() + ",\"percent_correct\":" + all.pctCorrect() + "}";
+  }
+
+  // The folds' evaluation over all of them; each fold's % correct into `folds` where given.
+  static Evaluation crossValidated(String cls, Instances data, int k, long seed, double[] folds) throws Exception {
     Random random = new Random(seed);
     data = new Instances(data);
     data.randomize(random);
     if (data.classAttribute().isNominal()) data.stratify(k);
     Evaluation all = new Evaluation(data);
-    double[] folds = new double[k];
     for (int i = 0; i < k; ++i) {
       Instances train = data.trainCV(k, i, random);
       all.setPriors(train);
@@ -70,19 +83,54 @@ public class WekaValidate {
       Evaluation fold = new Evaluation(train);
       fold.evaluateModel(c, test);
       all.evaluateModel(c, test);
-      folds[i] = fold.pctCorrect();
+      if (folds != null) folds[i] = fold.pctCorrect();
     }
-    return "{\"folds\":" + json(folds) + ",\"correct\":" + (long) all.correct() + ",\"misclassified\":"
-        + (long) all.incorrect() + ",\"percent_correct\":" + all.pctCorrect() + "}";
+    return all;
+  }
+
+  // A classifier trained on `train`, scored on `test` as WEKA's command line `-t -T` scores it.
+  static Evaluation scored(Classifier c, Instances train, Instances test) throws Exception {
+    Evaluation e = new Evaluation(train);
+    e.evaluateModel(c, test);
+    return e;
   }
 
   static String trainTest(String cls, Instances train, Instances test) throws Exception {
     Classifier c = make(cls);
     c.buildClassifier(train);
-    Evaluation e = new Evaluation(train);
-    e.evaluateModel(c, test);
+    Evaluation e = scored(c, train, test);
     return "{\"correct\":" + (long) e.correct() + ",\"misclassified\":" + (long) e.incorrect()
         + ",\"percent_correct\":" + e.pctCorrect() + "}";
+  }
+
+  // One --jobs line's answer (see the top of this file).
+  static String job(String line) throws Exception {
+    String[] f = line.split("\t");
+    if (f.length < 4) throw new IllegalArgumentException("a job needs CLASSIFIER TRAIN FOLDS SEED: " + line);
+    Instances train = load(f[1]);
+    if (f.length == 4) {
+      Evaluation e = crossValidated(f[0], train, Integer.parseInt(f[2]), Long.parseLong(f[3]), null);
+      return (long) e.correct() + " " + (long) e.incorrect();
+    }
+    Classifier c = make(f[0]);
+    c.buildClassifier(train);
+    StringBuilder b = new StringBuilder();
+    for (int t = 4; t < f.length; ++t) {
+      Instances test = load(f[t]);
+      if (!train.equalHeaders(test))
+        throw new IllegalArgumentException(f[t] + " and " + f[1] + " have different headers");
+      Evaluation e = scored(c, train, test);
+      b.append(t > 4 ? " " : "").append((long) e.correct()).append(' ').append((long) e.incorrect());
+    }
+    return b.toString();
+  }
+
+  static void jobs(String path) throws Exception {
+    for (String line : java.nio.file.Files.readAllLines(java.nio.file.Paths.get(path))) {
+      if (line.isEmpty()) continue;
+      System.out.println(job(line));
+      System.out.flush();
+    }
   }
 
   // Real data in K stratified folds (seeded as above); each fold's training part gets the
@@ -116,9 +164,13 @@ public class WekaValidate {
   public static void main(String[] args) throws Exception {
     Map<String, String> a = new HashMap<>();
     for (int i = 0; i + 1 < args.length; i += 2) a.put(args[i], args[i + 1]);
+    if (a.containsKey("--jobs")) {
+      jobs(a.get("--jobs"));
+      return;
+    }
     for (String need : new String[] {"--real", "--sim", "--folds", "--runs", "--seed", "--classifiers"})
       if (!a.containsKey(need)) {
-        System.err.println("WekaValidate: missing " + need);
+        System.err.println("Weka: missing " + need);
         System.exit(2);
       }
     int k = Integer.parseInt(a.get("--folds"));
@@ -130,7 +182,7 @@ public class WekaValidate {
     Instances real = load(a.get("--real"));
     Instances sim = load(a.get("--sim"));
     if (!real.equalHeaders(sim)) {
-      System.err.println("WekaValidate: the real and simulated tables have different headers");
+      System.err.println("Weka: the real and simulated tables have different headers");
       System.exit(2);
     }
     Instances combined = new Instances(real);
