@@ -9,6 +9,7 @@
 #include <string>
 
 #include "backend/compare.h"
+#include "backend/opencl/device.h"
 #include "backend/opencl/launch.h"
 #include "backend/opencl/paths/paths.h"
 #include "backend/opencl/table_key.h"
@@ -44,6 +45,50 @@ TEST(OpenCLPaths, EachViewTakesTheFirstPathWhoseGateApplies) {
   plan.fidelity.fused = true;
   const Catalogue other = without_mmw_optics();
   EXPECT_STREQ(opencl::view_path(plan, other.sensors[0]).name(), "stage_chain");
+}
+
+// The fast paths are listed by name (CMake reads their files), not in an order of their own,
+// so no view may have two whose gates apply: over both models, every tier, the window's
+// variants, IR noise on and off, images and features-only runs, each view of the default
+// catalogue has at most one fast view path, and each plan at most one features path.
+TEST(OpenCLPaths, AtMostOneFastPathAppliesToAView) {
+  const Catalogue& cat = catalogue();
+  opencl::Device device(cat, assets(), *test::runtime());
+  std::vector<std::unique_ptr<opencl::FeaturePath>> features;
+#define PORTALSIM_TEST_FEATURE_PATH(name) features.push_back(opencl::name##_path(device));
+  PORTALSIM_FEATURE_PATHS(PORTALSIM_TEST_FEATURE_PATH)
+#undef PORTALSIM_TEST_FEATURE_PATH
+  ASSERT_EQ(opencl::view_paths().size(), 3u) << "thesis_images, physics_raw and ir_fused";
+  ASSERT_EQ(features.size(), 2u) << "thesis_sparse_features and physics_raw_features";
+  std::set<std::string> seen;
+  for (const Model model : {Model::thesis, Model::physics})
+    for (const Tier tier : {Tier::exact, Tier::standard, Tier::fast})
+      for (int window = 0; window < 3; ++window)
+        for (const double ir_netd : {0.0, 0.05})
+          for (const bool images : {true, false}) {
+            Plan plan;
+            plan.fidelity = tier_fidelity(tier);
+            plan.model.model = model;
+            plan.model.window_auto = window == 1;
+            if (window == 2) plan.model.drawn[PS_DRAWN_WINDOW_LO] = {.lo = 280, .hi = 290};
+            plan.model.ir_netd = ir_netd;
+            if (!images) plan.images = 0;
+            const std::string what = std::string(model_name(model)) + " " + tier_name(tier) + " window " +
+                                     std::to_string(window) + (images ? " images" : " features");
+            for (const Sensor& s : cat.sensors) {
+              int applying = 0;
+              for (const opencl::ViewPath* p : opencl::view_paths())
+                if (p->applies(plan, s)) ++applying, seen.insert(p->name());
+              EXPECT_LE(applying, 1) << what << ", view " << s.name;
+            }
+            int applying = 0;
+            for (const auto& f : features)
+              if (f->applies(plan, cat.sensors[0])) ++applying, seen.insert(f->name());
+            EXPECT_LE(applying, 1) << what;
+          }
+  EXPECT_EQ(seen, (std::set<std::string>{"thesis_images", "physics_raw", "ir_fused", "thesis_sparse_features",
+                                         "physics_raw_features"}))
+      << "each path applies somewhere in this matrix, so the check above means something";
 }
 
 // Each gate decides its path's variant too (render() decides nothing), and the backend's

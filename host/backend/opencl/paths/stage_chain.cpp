@@ -28,7 +28,7 @@ const ViewPath& stage_chain_path() {
 
 const std::vector<const ViewPath*>& view_paths() {
 #define PORTALSIM_VIEW_PATH_ADDRESS(name) &name##_path(),
-  static const std::vector<const ViewPath*> paths = {PORTALSIM_VIEW_PATHS(PORTALSIM_VIEW_PATH_ADDRESS)};
+  static const std::vector<const ViewPath*> paths = {PORTALSIM_FAST_VIEW_PATHS(PORTALSIM_VIEW_PATH_ADDRESS)};
 #undef PORTALSIM_VIEW_PATH_ADDRESS
   return paths;
 }
