@@ -14,23 +14,37 @@ namespace {
 using test::assets;
 using test::catalogue;
 
+// The standard tier's plan without the metal zones, which no baseline draws.
+Plan baseline_plan(uint64_t seed, bool pattern) {
+  Plan plan;
+  plan.metal = false;
+  plan.model.seed = seed;
+  plan.model.pattern_noise = pattern;
+  return plan;
+}
+
+// The kernels' output of `plan`, and an output laid out for a baseline to fill.
+struct Outputs {
+  BatchOutput kernel, loop;
+};
+Outputs run_kernels(Backend& cl, const SceneBatch& batch, const Plan& plan) {
+  Outputs o;
+  cl.run(batch, plan, o.kernel);
+  prepare_output(o.loop, catalogue(), plan, batch.size());
+  return o;
+}
+
 TEST(Baseline, ImagesEqualTheStandardTierBitForBit) {
-  std::vector<Scenario> scenes;
-  for (uint64_t k = 0; k < 300; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 8));
+  const std::vector<Scenario> scenes = test::coverage(catalogue(), 300, 8, false);
   auto cl = make_opencl_backend(catalogue(), assets(), test::runtime());
   for (double sigma : {0.0, 2.0, 7.5}) {
     for (bool pattern : {true, false}) {
       SCOPED_TRACE("sigma " + std::to_string(sigma) + (pattern ? ", pattern noise" : ""));
       const SceneBatch batch = test::batch_of(scenes, 0xfffffffffull);  // indices cross 2^32
-      Plan plan;
+      Plan plan = baseline_plan(0x123456789abcull, pattern);
       plan.features = false;
-      plan.metal = false;
-      plan.model.seed = 0x123456789abcull;
       plan.model.pixel_sigma = sigma;
-      plan.model.pattern_noise = pattern;
-      BatchOutput kernel, loop;
-      cl->run(batch, plan, kernel);
-      prepare_output(loop, catalogue(), plan, batch.size());
+      auto [kernel, loop] = run_kernels(*cl, batch, plan);
       baseline::render_images(catalogue(), assets(), batch, plan.model, loop);
       for (size_t k = 0; k < kernel.views.size(); ++k) {
         ASSERT_FALSE(kernel.views[k].empty());
@@ -44,22 +58,16 @@ TEST(Baseline, ImagesEqualTheStandardTierBitForBit) {
 }
 
 TEST(Baseline, FeaturesEqualTheStandardTierSparsePathBitForBit) {
-  std::vector<Scenario> scenes;
-  for (uint64_t k = 0; k < 400; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 8));
+  const std::vector<Scenario> scenes = test::coverage(catalogue(), 400, 8, false);
   auto cl = make_opencl_backend(catalogue(), assets(), test::runtime());
   for (int block : {10, 7}) {
     for (bool pattern : {true, false}) {
       SCOPED_TRACE("block " + std::to_string(block) + (pattern ? ", pattern noise" : ""));
       const SceneBatch batch = test::batch_of(scenes, 0xfffffff00ull);
-      Plan plan;
+      Plan plan = baseline_plan(0x9e3779b97f4aull, pattern);
       plan.images = 0;
-      plan.metal = false;
-      plan.model.seed = 0x9e3779b97f4aull;
       plan.model.block = block;
-      plan.model.pattern_noise = pattern;
-      BatchOutput kernel, loop;
-      cl->run(batch, plan, kernel);
-      prepare_output(loop, catalogue(), plan, batch.size());
+      auto [kernel, loop] = run_kernels(*cl, batch, plan);
       const baseline::SparseFeatures features(catalogue(), assets(), plan.model);
       features.run(batch, loop);
       ASSERT_EQ(kernel.features.size(), loop.features.size());

@@ -28,22 +28,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string default_text() {
-  std::ifstream in(std::string(PORTALSIM_SOURCE_DIR) + "/scenarios/catalogue.toml", std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string catalogue_error(const std::string& text) {
-  try {
-    parse_catalogue(text, "b.toml", "");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 // The number of body pixels (MMW gray above the room's) in rows [y0, y1) and columns
 // [x0, x1) of an image.
 int body_pixels(const Image& im, int x0, int x1, int y0, int y1) {
@@ -431,7 +415,7 @@ TEST(Bodies, IrShadowFollowsTheSkin) {
 }
 
 TEST(Bodies, CatalogueKeysAndBadValues) {
-  const std::string text = default_text();
+  const std::string text = test::default_catalogue_text();
   const Catalogue c = parse_catalogue(
       test::with_subject_line(text, 2,
                               "shoulders = 1.2\nchest = 0.9\nhips = 1.1\narm_length = 1.05\nleg_length = 0.95\n"
@@ -463,7 +447,7 @@ TEST(Bodies, CatalogueKeysAndBadValues) {
                                        {"skin_emissivity = 0.95", "subjects[2].skin_emissivity", "out of range"},
                                        {"skin_temperature = 250", "subjects[2].skin_temperature", "out of range"}}) {
     int line = 0;
-    const std::string e = catalogue_error(test::with_subject_line(text, 1, b.line, &line));
+    const std::string e = test::catalogue_error(test::with_subject_line(text, 1, b.line, &line), "b.toml");
     EXPECT_NE(e.find("b.toml:" + std::to_string(line) + ": " + b.field + ": "), std::string::npos) << e;
     EXPECT_NE(e.find(b.says), std::string::npos) << e;
   }

@@ -17,12 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 Plan folded_plan(const std::string& clothing, const std::string& folds, Tier tier, bool fused) {
-  Plan plan = test::physics_plan(61);
-  plan.model.netd = 0;
-  plan.model.ir_netd = 0;
-  plan.fidelity = tier_fidelity(tier);
-  plan.fidelity.fused = fused;
-  set_knob(plan, *find_knob("clothing"), clothing, "--clothing");
+  Plan plan = clothed_plan(61, clothing, tier, fused);
   set_knob(plan, *find_knob("clothing_folds"), folds, "--clothing-folds");
   return plan;
 }
@@ -67,11 +62,7 @@ TEST(ClothingFolds, ThePatternLiesOnTheBodyOnly) {
 // worn time drawn too; the features-only path (untabulated, as every drawn outfit) within the
 // tolerance table's. The folds reach the images: a run without them gives others.
 TEST(ClothingFolds, FoldsAreTheReferencesOnEveryPath) {
-  std::vector<Scenario> scenes;
-  for (size_t k = 0; k < kImageScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
-  const SceneBatch batch = test::batch_of(scenes, 900);
-  auto ref = make_reference_backend(catalogue(), assets());
-  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  const auto [batch, ref, ocl] = parity_run(0, 900);
   expect_drawn_images_parity(
       *ref, *ocl, batch, [](Tier tier, bool fused) { return folded_plan("random", "0..1", tier, fused); },
       [](Plan& p) { set_knob(p, *find_knob("clothing_folds"), "0", "--clothing-folds"); });
@@ -89,11 +80,7 @@ TEST(ClothingFolds, FoldsAreTheReferencesOnEveryPath) {
 // and bare skin, which has no garment to fold (its images are those without folds, byte for
 // byte); share 0 is no folds, byte for byte.
 TEST(ClothingFolds, TheExtremesAreTheReferences) {
-  std::vector<Scenario> scenes;
-  for (size_t k = 0; k < kImageScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), 4000 + k, 6));
-  const SceneBatch batch = test::batch_of(scenes, 0);
-  auto ref = make_reference_backend(catalogue(), assets());
-  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  const auto [batch, ref, ocl] = parity_run(4000, 0);
   for (const char* clothing : {"coat", "shirt", "none"}) {
     SCOPED_TRACE(clothing);
     const Plan plan = folded_plan(clothing, "1", Tier::standard, true);
@@ -226,17 +213,9 @@ TEST(ClothingFolds, BadValuesAreRefusedNamingTheFlagOrTheLine) {
       {{"--model", "physics", "--clothing-folds", "0.5"}, "--clothing-folds: folds belong to an outfit"},
       {{"--clothing-folds", "0..1"}, "--clothing-folds: folds belong to an outfit"},
   };
-  for (const auto& [args, says] : cases) {
-    const test::Result r = gen(t, args, t.w() / "o");
-    EXPECT_EQ(r.status, 2) << says;
-    EXPECT_NE(r.err.find(says), std::string::npos) << says << ": " << r.err;
-    EXPECT_FALSE(fs::exists(t.w() / "o")) << says;
-  }
-  const test::Result r = test::generate_spec(
-      t, "count = 10\nmodel = \"physics\"\nclothing = \"coat\"\nclothing_folds = \"0.5..3\"\n", t.w() / "s");
-  EXPECT_NE(r.status, 0);
-  EXPECT_NE(r.err.find("spec.toml:4: clothing_folds"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(t.w() / "s"));
+  for (const auto& [args, says] : cases) test::expect_generate_refused(t, args, says);
+  test::expect_spec_refused(t, "count = 10\nmodel = \"physics\"\nclothing = \"coat\"\nclothing_folds = \"0.5..3\"\n",
+                            "spec.toml:4: clothing_folds");
 }
 
 }  // namespace

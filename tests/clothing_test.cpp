@@ -19,16 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Plan clothed_plan(const std::string& clothing, Tier tier, bool fused) {
-  Plan plan = test::physics_plan(53);
-  plan.model.netd = 0;
-  plan.model.ir_netd = 0;
-  plan.fidelity = tier_fidelity(tier);
-  plan.fidelity.fused = fused;
-  set_knob(plan, *find_knob("clothing"), clothing, "--clothing");
-  return plan;
-}
-
 // Each class is drawn alike, each outfit alike within its class, and every outfit of the
 // table is reached; a fixed class draws only its own outfits. 20,000 draws: each class's
 // share within 4 standard errors (0.011) of 1/5.
@@ -37,7 +27,7 @@ TEST(Clothing, OutfitsAreDrawnByClassThenFabric) {
   ASSERT_EQ(all.class_first.size(), 5u);
   EXPECT_EQ(all.outfits.size(), 1u + 2 + 6 + 6 + 18);
   EXPECT_EQ(all.outfits[0].name(), "none");
-  Plan plan = clothed_plan("random", Tier::standard, true);
+  Plan plan = clothed_plan(53, "random", Tier::standard, true);
   std::vector<int> per_class(5, 0);
   std::set<int> seen;
   const int n = 20000;
@@ -67,33 +57,26 @@ TEST(Clothing, OutfitsAreDrawnByClassThenFabric) {
 // stage kernels, alone and with the illumination and worn time drawn too; the features-only
 // path (untabulated: it leaves its tables) within the tolerance table's.
 TEST(Clothing, OutfitsAreTheReferencesOnEveryPath) {
-  std::vector<Scenario> scenes;
-  for (size_t k = 0; k < kImageScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), k, 6));
-  const SceneBatch batch = test::batch_of(scenes, 700);
-  auto ref = make_reference_backend(catalogue(), assets());
-  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  const auto [batch, ref, ocl] = parity_run(0, 700);
   // The outfits reach the images: the catalogue's clothing gives others.
   expect_drawn_images_parity(
-      *ref, *ocl, batch, [](Tier tier, bool fused) { return clothed_plan("random", tier, fused); },
+      *ref, *ocl, batch, [](Tier tier, bool fused) { return clothed_plan(53, "random", tier, fused); },
       [](Plan& p) { set_knob(p, *find_knob("clothing"), "catalogue", "--clothing"); });
   // Features only, in a window no outfit's body leaves.
   Plan features;
   BatchOutput k;
-  expect_raw_features_parity(*ref, *ocl, batch, clothed_plan("random", Tier::fast, true), "untabulated", features, k);
+  expect_raw_features_parity(*ref, *ocl, batch, clothed_plan(53, "random", Tier::fast, true), "untabulated", features,
+                             k);
 }
 
 // The extremes: no clothing (the base image's skin, every shadow at full depth) and the
 // heaviest coat (leather over wool over cotton: 3.8 dB, 1.21 clo), each on every subject,
 // hold the kernels to the reference as above.
 TEST(Clothing, TheLightestAndHeaviestOutfitsAreTheReferences) {
-  std::vector<Scenario> scenes;
-  for (size_t k = 0; k < kImageScenes; ++k) scenes.push_back(test::random_scenario(catalogue(), 3000 + k, 6));
-  const SceneBatch batch = test::batch_of(scenes, 0);
-  auto ref = make_reference_backend(catalogue(), assets());
-  auto ocl = make_opencl_backend(catalogue(), assets(), test::runtime());
+  const auto [batch, ref, ocl] = parity_run(3000, 0);
   for (const char* clothing : {"none", "coat"}) {
     SCOPED_TRACE(clothing);
-    const Plan plan = clothed_plan(clothing, Tier::standard, true);
+    const Plan plan = clothed_plan(53, clothing, Tier::standard, true);
     BatchOutput r, k;
     ref->run(batch, plan, r);
     ocl->run(batch, plan, k);
@@ -119,7 +102,7 @@ TEST(Clothing, ThickerClothingShowsLess) {
   }
   auto ocl = make_opencl_backend(cat, assets(), test::runtime());
   const auto contrast = [&](const char* clothing, size_t view) {
-    const Plan plan = clothed_plan(clothing, Tier::standard, true);
+    const Plan plan = clothed_plan(53, clothing, Tier::standard, true);
     BatchOutput a, b;
     ocl->run(test::batch_of(with), plan, a);
     ocl->run(test::batch_of(without), plan, b);
@@ -202,16 +185,8 @@ TEST(Clothing, BadValuesAreRefusedNamingTheFlagOrTheLine) {
       {{"--model", "physics", "--clothing", ""}, "--clothing"},
       {{"--clothing", "coat"}, "--clothing: coat applies to the physics model"},
   };
-  for (const auto& [args, says] : cases) {
-    const test::Result r = gen(t, args, t.w() / "o");
-    EXPECT_EQ(r.status, 2) << says;
-    EXPECT_NE(r.err.find(says), std::string::npos) << says << ": " << r.err;
-    EXPECT_FALSE(fs::exists(t.w() / "o")) << says;
-  }
-  const test::Result r = test::generate_spec(t, "count = 10\nmodel = \"physics\"\nclothing = \"kilt\"\n", t.w() / "s");
-  EXPECT_NE(r.status, 0);
-  EXPECT_NE(r.err.find("spec.toml:3: clothing"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(t.w() / "s"));
+  for (const auto& [args, says] : cases) test::expect_generate_refused(t, args, says);
+  test::expect_spec_refused(t, "count = 10\nmodel = \"physics\"\nclothing = \"kilt\"\n", "spec.toml:3: clothing");
 }
 
 }  // namespace

@@ -5,8 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "backend/reference/stages.h"
 #include "base/embedded.h"
@@ -287,13 +285,6 @@ TEST(MetalPhysicsParity, KernelMatchesReferenceExactly) {
       }
 }
 
-std::string catalogue_text() {
-  std::ifstream f(std::string(PORTALSIM_SOURCE_DIR) + "/scenarios/catalogue.toml");
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 // "key = [first," as it stands in the text.
 std::string first_element(const std::string& text, const std::string& key) {
   const size_t at = text.find(key);
@@ -302,7 +293,7 @@ std::string first_element(const std::string& text, const std::string& key) {
 
 // Each bad value is rejected naming file, line and field.
 TEST(MetalPhysicsCatalogue, BadValuesNameFileLineAndField) {
-  const std::string text = catalogue_text();
+  const std::string text = test::default_catalogue_text();
   struct Case {
     std::string from, to, field, line_of;
   };

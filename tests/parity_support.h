@@ -1,11 +1,12 @@
-// Parity checks of the physics model's drawn knobs that several suites share: the kernels'
-// images and the features-only path against the fp64 reference. Apart from support.h,
-// which the tests' precompiled header holds, as these need compare.h.
+// Parity checks of the physics model's drawn knobs that several suites share, and their
+// set-ups: the kernels' images and the features-only path against the fp64 reference.
+// Apart from support.h, which the tests' precompiled header holds, as these need compare.h.
 #pragma once
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,31 @@
 #include "support.h"
 
 namespace portalsim::test {
+
+// The physics model's plan (seed `seed`) without sensor noise, in `tier`, fused or as the
+// chain of stage kernels, with --clothing `clothing`.
+inline Plan clothed_plan(uint64_t seed, const std::string& clothing, Tier tier, bool fused) {
+  Plan plan = physics_plan(seed);
+  plan.model.netd = 0;
+  plan.model.ir_netd = 0;
+  plan.fidelity = tier_fidelity(tier);
+  plan.fidelity.fused = fused;
+  set_knob(plan, *find_knob("clothing"), clothing, "--clothing");
+  return plan;
+}
+
+// A batch of kImageScenes random crowds (random_scenario from k = `from`, up to 6 objects)
+// indexed from `first`, and the default catalogue's reference and OpenCL backends to run it.
+struct ParityRun {
+  SceneBatch batch;
+  std::unique_ptr<Backend> ref, ocl;
+};
+inline ParityRun parity_run(uint64_t from, uint64_t first) {
+  std::vector<Scenario> scenes;
+  for (size_t k = 0; k < kImageScenes; ++k) scenes.push_back(random_scenario(catalogue(), from + k, 6));
+  return {batch_of(scenes, first), make_reference_backend(catalogue(), assets()),
+          make_opencl_backend(catalogue(), assets(), runtime())};
+}
 
 // The kernels' MMW and IR images against the reference's within each camera's parity
 // (expect_camera_parity), for plan_of(tier, fused) in the standard and exact tiers, fused

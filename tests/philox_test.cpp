@@ -158,6 +158,21 @@ std::vector<T> read(OpenCLRuntime& rt, const cl::Buffer& b, size_t n) {
   return v;
 }
 
+// The seed, index, view and pixel of each pixel case, as the test kernels take them.
+struct PixelColumns {
+  std::vector<cl_ulong> seed, index;
+  std::vector<cl_int> view, pixel;
+  template <class Case, size_t N>
+  explicit PixelColumns(const Case (&cases)[N]) {
+    for (const Case& c : cases) {
+      seed.push_back(c.seed);
+      index.push_back(c.index);
+      view.push_back(c.view);
+      pixel.push_back(c.pixel);
+    }
+  }
+};
+
 }  // namespace
 
 TEST(Philox, KnownAnswerVectors) {
@@ -232,22 +247,17 @@ kernel void cells(global const ulong* seed, global const ulong* index, global co
 
 TEST(Philox, PixelGaussianHandComputed) {
   OpenCLRuntime rt;
-  std::vector<cl_ulong> seed, index;
-  std::vector<cl_int> view, pixel;
   for (const PixelCase& c : kPixelCases) {
     SCOPED_TRACE("pixel " + std::to_string(c.pixel));
     const Philox4 r = draw(c.seed, c.index, kStreamPixelNoise, (uint32_t(c.view) << 28) | uint32_t(c.pixel / 2));
     EXPECT_EQ(r[0], c.w0);
     EXPECT_EQ(r[1], c.w1);
     EXPECT_NEAR(reference::pixel_gaussian(c.seed, c.index, c.view, c.pixel), c.g, 1e-12);
-    seed.push_back(c.seed);
-    index.push_back(c.index);
-    view.push_back(c.view);
-    pixel.push_back(c.pixel);
   }
   // The kernels' Box-Muller (box_muller) on their own draw of the pair: float against the
   // hand-computed double.
-  const size_t n = seed.size();
+  const PixelColumns a(kPixelCases);
+  const size_t n = a.seed.size();
   cl::Buffer out(rt.context(), CL_MEM_WRITE_ONLY, n * sizeof(float));
   run(rt, R"(
 kernel void pixels(global const ulong* seed, global const ulong* index, global const int* view,
@@ -259,7 +269,7 @@ kernel void pixels(global const ulong* seed, global const ulong* index, global c
   box_muller(r.x, r.y, &g0, &g1);
   out[i] = pixel[i] % 2 == 0 ? g0 : g1;
 })",
-      "pixels", n, input(rt, seed), input(rt, index), input(rt, view), input(rt, pixel), out);
+      "pixels", n, input(rt, a.seed), input(rt, a.index), input(rt, a.view), input(rt, a.pixel), out);
   const std::vector<float> got = read<float>(rt, out, n);
   for (size_t i = 0; i < n; ++i) EXPECT_NEAR(got[i], kPixelCases[i].g, 2e-5) << "pixel " << kPixelCases[i].pixel;
 }
@@ -289,8 +299,6 @@ constexpr IrwinHallCase kIrwinHallCases[] = {
 
 TEST(Philox, IrwinHallHandComputed) {
   OpenCLRuntime rt;
-  std::vector<cl_ulong> seed, index;
-  std::vector<cl_int> view, pixel;
   for (const IrwinHallCase& c : kIrwinHallCases) {
     SCOPED_TRACE("pixel " + std::to_string(c.pixel));
     const uint32_t w = draw(c.seed, c.index, kStreamPixelNoiseFast, c.element)[c.word];
@@ -298,13 +306,10 @@ TEST(Philox, IrwinHallHandComputed) {
     const uint32_t h = c.half ? w >> 16 : w & 0xffffu;
     EXPECT_EQ(int(h & 0xffu) + int(h >> 8), c.s);
     EXPECT_NEAR(reference::pixel_irwin_hall(c.seed, c.index, c.view, c.pixel), c.g, 1e-11);
-    seed.push_back(c.seed);
-    index.push_back(c.index);
-    view.push_back(c.view);
-    pixel.push_back(c.pixel);
   }
   // The kernels' ih_pixel, and ih128 (the fused path's 128 at once) at the same pixel.
-  const size_t n = seed.size();
+  const PixelColumns a(kIrwinHallCases);
+  const size_t n = a.seed.size();
   cl::Buffer out(rt.context(), CL_MEM_WRITE_ONLY, 2 * n * sizeof(float));
   run(rt, R"(
 kernel void ih(global const ulong* seed, global const ulong* index, global const int* view,
@@ -318,7 +323,7 @@ kernel void ih(global const ulong* seed, global const ulong* index, global const
   for (int j = 0; j < 8; ++j) vstore16(g[j], j, t);
   out[2 * i + 1] = t[pixel[i] & 127];
 })",
-      "ih", n, input(rt, seed), input(rt, index), input(rt, view), input(rt, pixel), out);
+      "ih", n, input(rt, a.seed), input(rt, a.index), input(rt, a.view), input(rt, a.pixel), out);
   const std::vector<float> got = read<float>(rt, out, 2 * n);
   for (size_t i = 0; i < n; ++i) {
     EXPECT_NEAR(got[2 * i], kIrwinHallCases[i].g, kIrwinHallDrawAbs) << "pixel " << kIrwinHallCases[i].pixel;

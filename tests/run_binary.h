@@ -244,6 +244,26 @@ inline Result generate_spec(const TempDir& t, const std::string& toml, const std
   return finish(start(t.cap(), {"generate", "--spec", spec.string(), "--out", out.string()}), 120);
 }
 
+// `portalsim generate ARGS` is refused as a usage error (exit 2) whose message holds `says`,
+// and makes no output folder.
+inline void expect_generate_refused(const TempDir& t, const std::vector<std::string>& args, const std::string& says) {
+  const std::filesystem::path out = t.w() / "refused";
+  const Result r = generate(t, args, out);
+  EXPECT_EQ(r.status, 2) << says;
+  EXPECT_NE(r.err.find(says), std::string::npos) << says << ": " << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out)) << says;
+}
+
+// A spec file holding `toml` is refused naming `where` ("spec.toml:LINE: KEY"), and makes no
+// output folder.
+inline void expect_spec_refused(const TempDir& t, const std::string& toml, const std::string& where) {
+  const std::filesystem::path out = t.w() / "refused";
+  const Result r = generate_spec(t, toml, out);
+  EXPECT_NE(r.status, 0) << where;
+  EXPECT_NE(r.err.find(where), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out)) << where;
+}
+
 // True once the started run has ended (without reaping it).
 inline bool has_ended(const Running& r) {
   siginfo_t info{};
@@ -273,6 +293,15 @@ inline Killed kill_mid_run(const Running& r, const std::filesystem::path& dir, l
   ::kill(r.pid, SIGKILL);
   k.result = finish(r, 60);
   return k;
+}
+
+// Starts `portalsim generate SPEC --batch BATCH --out DIR --quiet` and kills it once its
+// checkpoint reaches `at_least` (kill_mid_run).
+inline Killed kill_generate(const TempDir& t, std::vector<std::string> spec, const std::string& batch,
+                            const std::filesystem::path& dir, long long at_least) {
+  spec.insert(spec.begin(), "generate");
+  spec.insert(spec.end(), {"--batch", batch, "--out", dir.string(), "--quiet"});
+  return kill_mid_run(start(t.cap(), spec), dir, at_least);
 }
 
 // Runs `script` with sh in a private mount namespace (unshare -m, as root) after mounting

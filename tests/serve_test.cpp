@@ -67,6 +67,18 @@ class Serve : public ::testing::Test {
     return client().Post(path.c_str(), body.dump(), "application/json");
   }
   std::string error_of(const httplib::Result& r) const { return json::parse(r->body).value("error", ""); }
+  // The generate job's state (GET /api/generate) once it is no longer running, up to 120 s.
+  json finished_generate() const {
+    json s;
+    portalsim::test::wait_until(
+        [&] {
+          auto g = client().Get("/api/generate");
+          s = g ? json::parse(g->body) : json();
+          return s.value("state", "") != "running";
+        },
+        120, 50);
+    return s;
+  }
   fs::path root() const { return tmp_ / "root"; }
 
   fs::path tmp_;
@@ -147,14 +159,7 @@ TEST_F(ServeRandomBodies, ListsRendersAndGeneratesTheDrawnBodies) {
   auto g = post("/api/generate", {{"objects", kGun}, {"subject", 6}, {"name", "bodies"}, {"count", 20}});
   ASSERT_TRUE(g);
   ASSERT_EQ(g->status, 200) << g->body;
-  json s;
-  portalsim::test::wait_until(
-      [&] {
-        auto st = client().Get("/api/generate");
-        s = st ? json::parse(st->body) : json();
-        return s.value("state", "") != "running";
-      },
-      120, 50);
+  const json s = finished_generate();
   ASSERT_EQ(s["state"], "done") << s.dump();
   const std::string list = slurp(root() / "bodies" / "scenarios.csv");
   EXPECT_NE(list.find(",stature_mm,"), std::string::npos) << "the run's bodies are the drawn ones";
@@ -310,14 +315,7 @@ TEST_F(Serve, GenerateRunsAndLinksItsResults) {
   auto r = post("/api/generate", {{"objects", kGun}, {"rule", "gun"}, {"name", "ds"}, {"count", 200}});
   ASSERT_TRUE(r);
   ASSERT_EQ(r->status, 200) << r->body;
-  json s;
-  portalsim::test::wait_until(
-      [&] {
-        auto g = client().Get("/api/generate");
-        s = g ? json::parse(g->body) : json();
-        return s.value("state", "") != "running";
-      },
-      120, 50);
+  const json s = finished_generate();
   ASSERT_EQ(s["state"], "done") << s.dump();
   EXPECT_EQ(s["done"], 200);
   auto manifest = client().Get("/files/ds/manifest.json");

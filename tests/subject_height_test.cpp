@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include "assets/procedural.h"
@@ -18,21 +17,14 @@
 namespace portalsim {
 namespace {
 
-std::string default_text() {
-  std::ifstream in(std::string(PORTALSIM_SOURCE_DIR) + "/scenarios/catalogue.toml", std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The default catalogue with `line` added to subject k's table (support.h).
 std::string with_subject_line(int k, const std::string& line, int* at = nullptr) {
-  return test::with_subject_line(default_text(), k, line, at);
+  return test::with_subject_line(test::default_catalogue_text(), k, line, at);
 }
 
 // The default catalogue with each subject's height given (1.0 for subjects not listed).
 Catalogue heights_catalogue(const std::vector<double>& heights) {
-  std::string t = default_text();
+  std::string t = test::default_catalogue_text();
   for (size_t j = 0; j < heights.size(); ++j) {
     std::ostringstream line;
     line << "height = " << heights[j];
@@ -41,14 +33,8 @@ Catalogue heights_catalogue(const std::vector<double>& heights) {
   return parse_catalogue(t, "heights.toml", std::string(PORTALSIM_SOURCE_DIR) + "/scenarios");
 }
 
-std::string error_of(const std::string& text) {
-  try {
-    parse_catalogue(text, "h.toml", "");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+// What the catalogue `text`, read as h.toml, is refused with; empty when it is accepted.
+std::string error_of(const std::string& text) { return test::catalogue_error(text, "h.toml"); }
 
 TEST(SubjectHeight, CatalogueReadsHeightAndRefusesBadValues) {
   for (const Subject& s : test::catalogue().subjects) EXPECT_EQ(s.shape.height, 1.0) << s.name << ": the default";

@@ -4,13 +4,16 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "assets/assets.h"
 #include "backend/backend.h"
 #include "backend/opencl/opencl_backend.h"
+#include "base/error.h"
 #include "build_config.h"
 #include "plan/plan.h"
 #include "scene/catalogue.h"
@@ -69,6 +72,24 @@ inline Scenario random_scenario(const Catalogue& cat, uint64_t k, int max_object
   }
   s.label = static_cast<int>(r[2] & 1);
   return s;
+}
+
+// The default catalogue's text, scenarios/catalogue.toml.
+inline std::string default_catalogue_text() {
+  std::ifstream in(std::string(PORTALSIM_SOURCE_DIR) + "/scenarios/catalogue.toml", std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// What parse_catalogue says of `text` read as the file `name`; empty when it is accepted.
+inline std::string catalogue_error(const std::string& text, const std::string& name) {
+  try {
+    parse_catalogue(text, name, "");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 // `text` with the first `from` replaced by `to`; a test failure where it holds none.

@@ -51,6 +51,14 @@ portalsim::test::Result validate(const fs::path& dir, const std::string& sim, co
   return finish(start(dir / "cap", args), 400);
 }
 
+// A run refused with exit `status` (3: a bad input file), its message holding `says`, that
+// leaves no `out`.
+void expect_refused(const portalsim::test::Result& r, int status, const std::string& says, const fs::path& out) {
+  EXPECT_TRUE(r.exited && r.status == status) << portalsim::test::describe(r);
+  EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out)) << says;
+}
+
 // scipy 1.10 (Debian python3-scipy):
 //   a=[80,90,85,70,75,95,88,82,79,91]; b=[78,85,80,72,70,90,84,75,80,86]
 //   stats.ttest_ind(a, b)  -> statistic=1.0991902374394489, pvalue=0.28617004408826807
@@ -267,9 +275,7 @@ TEST(Validate, ReadsCsvAndSelectsFeatureSets) {
   spit(d / "plain.csv", "a,b,class\n1,2,gun\n2,3,none\n");
   r = finish(start(d / "cap", {"validate", "--sim", (d / "plain.csv").string(), "--real", (d / "plain.csv").string(),
                                "--out", (d / "out").string(), "--features", "blocks"}));
-  EXPECT_TRUE(r.exited && r.status == 3) << portalsim::test::describe(r);
-  EXPECT_NE(r.err.find("plain.csv: --features blocks: no block-mean attributes"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(d / "out"));
+  expect_refused(r, 3, "plain.csv: --features blocks: no block-mean attributes", d / "out");
   fs::remove_all(d);
 }
 
@@ -375,9 +381,7 @@ TEST(Validate, ReadsH5AsTheSameRunsArff) {
            {"bad.h5", "bad.h5: not an HDF5 file"}, {"imgs/data.h5", "imgs/data.h5: has no \"features\" dataset"}}) {
     fs::remove_all(d / "out");
     const auto r = validate(d, "g5/data.h5", file);
-    EXPECT_TRUE(r.exited && r.status == 3) << portalsim::test::describe(r);
-    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
-    EXPECT_FALSE(fs::exists(d / "out")) << file;
+    expect_refused(r, 3, message, d / "out");
   }
   fs::remove_all(d);
 }
@@ -563,12 +567,9 @@ TEST(Validate, DemoMakesBothSetsAndTheReport) {
 
   // --demo makes its own inputs; --sim or --real with it, or neither without it, is refused.
   const auto both = finish(start(d / "cap", {"validate", "--demo", "--sim", "x.arff", "--out", (d / "o2").string()}));
-  EXPECT_TRUE(both.exited && both.status != 0) << portalsim::test::describe(both);
-  EXPECT_NE(both.err.find("--sim excludes --demo"), std::string::npos) << both.err;
+  expect_refused(both, 2, "--sim excludes --demo", d / "o2");  // 2: a usage error
   const auto none = finish(start(d / "cap", {"validate", "--out", (d / "o2").string()}));
-  EXPECT_TRUE(none.exited && none.status == 3) << portalsim::test::describe(none);
-  EXPECT_NE(none.err.find("--sim and --real are both needed"), std::string::npos) << none.err;
-  EXPECT_FALSE(fs::exists(d / "o2"));
+  expect_refused(none, 3, "--sim and --real are both needed", d / "o2");
   fs::remove_all(d);
 }
 
@@ -594,18 +595,14 @@ TEST(Validate, BadInputGetsAMessageAndNoReport) {
   };
   for (const auto& [file, message] : cases) {
     const auto r = validate(d, "ok.arff", file);
-    EXPECT_TRUE(r.exited && r.status == 3) << portalsim::test::describe(r);  // 3: a bad input file
-    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
-    EXPECT_FALSE(fs::exists(d / "out")) << file;
+    expect_refused(r, 3, message, d / "out");
   }
   // No java on PATH: the run stops with a message instead of a report.
   const auto r = finish(portalsim::test::start_program(
       d / "cap", "/usr/bin/env",
       {"PATH=/nonexistent", portalsim::test::kBinary, "validate", "--sim", (d / "ok.arff").string(), "--real",
        (d / "ok.arff").string(), "--out", (d / "out").string(), "--folds", "5"}));
-  EXPECT_TRUE(r.exited && r.status == 5) << portalsim::test::describe(r);  // 5: the machine's environment
-  EXPECT_NE(r.err.find("java not found"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(d / "out"));
+  expect_refused(r, 5, "java not found", d / "out");  // 5: the machine's environment
   fs::remove_all(d);
 }
 

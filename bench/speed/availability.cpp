@@ -1,38 +1,31 @@
 #include "speed/availability.h"
 
+#include <iterator>
+
 namespace portalsim::speed {
 
-const char* measure_key(Measure m) {
-  switch (m) {
-    case Measure::kernel:
-      return "kernel";
-    case Measure::exact:
-      return "exact";
-    case Measure::loop:
-      return "loop";
-    case Measure::reference:
-      return "reference";
-    case Measure::end_to_end:
-      return "end_to_end";
-  }
-  return "";
-}
+namespace {
 
-const char* measure_title(Measure m) {
-  switch (m) {
-    case Measure::kernel:
-      return "kernel";
-    case Measure::exact:
-      return "kernel, exact tier";
-    case Measure::loop:
-      return "plain loop";
-    case Measure::reference:
-      return "fp64 reference";
-    case Measure::end_to_end:
-      return "end to end";
-  }
-  return "";
-}
+// Each measure's JSON key and table title, in kMeasures' (the enum's) order.
+struct MeasureNames {
+  const char *key, *title;
+};
+constexpr MeasureNames kNames[] = {{"kernel", "kernel"},
+                                   {"exact", "kernel, exact tier"},
+                                   {"loop", "plain loop"},
+                                   {"reference", "fp64 reference"},
+                                   {"end_to_end", "end to end"}};
+static_assert(std::size(kNames) == std::size(kMeasures) && [] {
+  for (size_t i = 0; i < std::size(kMeasures); ++i)
+    if (kMeasures[i] != static_cast<Measure>(i)) return false;
+  return true;
+}());
+
+}  // namespace
+
+const char* measure_key(Measure m) { return kNames[static_cast<size_t>(m)].key; }
+
+const char* measure_title(Measure m) { return kNames[static_cast<size_t>(m)].title; }
 
 std::string why_not(const SpeedPath& path, Measure m, const OpenCLDeviceInfo& device) {
   if (m == Measure::loop && !path.has_loop) return "no plain loop exists for this model";

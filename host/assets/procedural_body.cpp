@@ -265,6 +265,28 @@ class BodyModel {
   RoundCone neck_{{100, -6}, {100, 17}, 11.5, 13.0}, jaw_{{100, -36}, {100, -10}, 30.0, 19.0};
 };
 
+// A row of a view, walked left to right: the body's field is evaluated only where the last
+// evaluation left the body within reach (skip_pixels), so the room's pixels cost little.
+class RowWalk {
+ public:
+  RowWalk(const BodyModel& model, double vb, double e, double pu, int width)
+      : model_(model), row_(model.row(vb)), e_(e), pu_(pu), width_(width) {}
+  // The body's coverage of pixel x (at u), 0 where it is known to be clear; its field in f.
+  double coverage_at(int x, double u, BodyField& f) {
+    if (x < next_) return 0.0;
+    f = model_.eval(u, row_);
+    next_ = x + 1 + skip_pixels(f.d - e_, pu_, width_);
+    return coverage(f.d, e_);
+  }
+
+ private:
+  const BodyModel& model_;
+  BodyModel::Row row_;
+  double e_, pu_;
+  int width_;
+  int next_ = 0;  // pixels before it are known to be clear of the body
+};
+
 }  // namespace
 
 Image mmw_body(const Body& body, bool upper, int width, int height) {
@@ -287,21 +309,15 @@ Image mmw_view(const Body& body, const Frame& field, Side side, int width, int h
   for (int y = 0; y < height; ++y) {
     const double v = (y + 0.5) * pv + field.y;
     const double vb = model.body_row(v);  // the body drawn here; the room stays at v
-    const BodyModel::Row row = model.row(vb);
+    RowWalk walk(model, vb, e, pu, width);
     NoiseRow room_noise(v / 9.0, seed + 2);
     FbmRow skin_noise(vb / 22.0, seed + 4);
-    int next = 0;  // pixels before `next` are known to be clear of the body
     for (int x = 0; x < width; ++x) {
       const double u = field_u(field, back, pu, x);
       const double room = bg + 2.0 * room_noise(u / 9.0) + 1.5 * hash_signed(x, y, seed + 3);
       double val = room;
-      if (x < next) {
-        img.at(x, y) = to_u8(val);
-        continue;
-      }
-      const BodyField f = model.eval(u, row);
-      next = x + 1 + skip_pixels(f.d - e, pu, width);
-      const double c = coverage(f.d, e);
+      BodyField f{};
+      const double c = walk.coverage_at(x, u, f);
       if (c > 0.0) {
         const double depth = clamp01(-f.d / 26.0);
         const double s = 1.0 - (1.0 - depth) * (1.0 - depth);
@@ -327,21 +343,15 @@ Image ir_view(const Body& body, const Frame& field, Side side, int width, int he
   for (int y = 0; y < height; ++y) {
     const double v = (y + 0.5) * pv + field.y;
     const double vb = model.body_row(v);  // the body drawn here; the room stays at v
-    const BodyModel::Row row = model.row(vb);
+    RowWalk walk(model, vb, e, pu, width);
     NoiseRow room_noise(v / 12.0, seed + 6);
     FbmRow skin_noise(vb / 15.0, seed + 7);
-    int next = 0;
     for (int x = 0; x < width; ++x) {
       const double u = field_u(field, back, pu, x);
       const double back = bg + 3.0 * v / 400.0 + 1.5 * room_noise(u / 12.0);
       double val = back;
-      if (x < next) {
-        img.at(x, y) = to_u8(val);
-        continue;
-      }
-      const BodyField f = model.eval(u, row);
-      next = x + 1 + skip_pixels(f.d - e, pu, width);
-      const double c = coverage(f.d, e);
+      BodyField f{};
+      const double c = walk.coverage_at(x, u, f);
       if (c > 0.0) {
         // Each part's own temperature, blended by how close the point is to each part.
         const double sa = clamp01((vb - 45.0) / 147.0), sl = clamp01((vb - 240.0) / 158.0);

@@ -1,5 +1,6 @@
 #include <cstdio>
 #include <map>
+#include <utility>
 
 #include "base/error.h"
 #include "cli/commands.h"
@@ -39,6 +40,12 @@ bool names_an_argument(std::string_view message, const CLI::App* command) {
   return false;
 }
 
+// The built-in subcommands, in the order `portalsim --help` lists them.
+constexpr std::pair<const char*, std::function<int()> (*)(CLI::App&)> kCommands[] = {
+    {"simulate", add_simulate}, {"catalogue", add_catalogue}, {"generate", add_generate},   {"features", add_features},
+    {"tradeoff", add_tradeoff}, {"serve", add_serve},         {"validate", add_validate},   {"transfer", add_transfer},
+    {"knobs", add_knobs},       {"merge", add_merge},         {"calibrate", add_calibrate}, {"evaluate", add_evaluate}};
+
 }  // namespace
 
 void print_errors(bool on) { g_print_errors = on; }
@@ -48,18 +55,7 @@ int run(int argc, char** argv, const std::map<std::string, AddCommand>& more) {
   app.set_version_flag("--version", std::string("portalsim ") + PORTALSIM_VERSION);
   app.require_subcommand(1);
   std::map<std::string, std::function<int()>> commands;
-  commands["simulate"] = add_simulate(app);
-  commands["catalogue"] = add_catalogue(app);
-  commands["generate"] = add_generate(app);
-  commands["features"] = add_features(app);
-  commands["tradeoff"] = add_tradeoff(app);
-  commands["serve"] = add_serve(app);
-  commands["validate"] = add_validate(app);
-  commands["transfer"] = add_transfer(app);
-  commands["knobs"] = add_knobs(app);
-  commands["merge"] = add_merge(app);
-  commands["calibrate"] = add_calibrate(app);
-  commands["evaluate"] = add_evaluate(app);
+  for (const auto& [name, add] : kCommands) commands[name] = add(app);
   for (const auto& [name, add] : more) commands[name] = add(app);
   try {
     app.parse(argc, argv);

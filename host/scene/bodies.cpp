@@ -24,27 +24,27 @@ struct Survey {
   // Correlations: stature-shoulders, stature-chest, stature-hips, shoulders-chest,
   // shoulders-hips, chest-hips.
   std::array<double, 6> r;
-  double crotch_mean, crotch_sd, arm_mean, arm_sd;
+  struct {
+    double mean, sd;
+  } crotch, arm;
 };
 constexpr Survey kMen{{1756.2, 415.7, 289.4, 345.7},
                       {68.6, 19.2, 18.3, 24.2},
                       {0.53, 0.34, 0.38, 0.58, 0.47, 0.62},
-                      0.4815,
-                      0.0141,
-                      0.4535,
-                      0.0121};
+                      {0.4815, 0.0141},
+                      {0.4535, 0.0121}};
 constexpr Survey kWomen{{1628.5, 365.3, 269.3, 353.8},
                         {64.2, 18.3, 18.6, 26.7},
                         {0.57, 0.35, 0.39, 0.43, 0.30, 0.58},
-                        0.4802,
-                        0.0151,
-                        0.4504,
-                        0.0135};
+                        {0.4802, 0.0151},
+                        {0.4504, 0.0135}};
 // The 1.0 body: 1.75 m tall ([metal.physics] body_height), its breadths and limb fractions
 // the two sexes' mean means, so that men and women sit either side of it.
 constexpr double kUnitStature = 1750.0;
-constexpr std::array<double, 3> kUnitBreadths{(415.7 + 365.3) / 2, (289.4 + 269.3) / 2, (345.7 + 353.8) / 2};
-constexpr double kUnitCrotch = (0.4815 + 0.4802) / 2, kUnitArm = (0.4535 + 0.4504) / 2;
+constexpr std::array<double, 3> kUnitBreadths{(kMen.mean[1] + kWomen.mean[1]) / 2, (kMen.mean[2] + kWomen.mean[2]) / 2,
+                                              (kMen.mean[3] + kWomen.mean[3]) / 2};
+constexpr double kUnitCrotch = (kMen.crotch.mean + kWomen.crotch.mean) / 2,
+                 kUnitArm = (kMen.arm.mean + kWomen.arm.mean) / 2;
 // Skin at 80-100 GHz reflects 0.61 +- 0.09 (Owda & Salmon, SPIE 2020): emissivity 0.39 +-
 // 0.09 between people, kept within the 0.2-0.7 they report.
 constexpr double kSkinEmissivitySd = 0.09, kSkinEmissivityLo = 0.2, kSkinEmissivityHi = 0.7;
@@ -97,8 +97,8 @@ Subject draw_body(const Catalogue& cat, uint64_t seed, uint64_t k, DrawnBody* dr
   d.shoulders_mm = s.mean[1] + s.sd[1] * z[1];
   d.chest_mm = s.mean[2] + s.sd[2] * z[2];
   d.hips_mm = s.mean[3] + s.sd[3] * z[3];
-  d.crotch_ratio = s.crotch_mean + s.crotch_sd * n45[0];
-  d.arm_ratio = s.arm_mean + s.arm_sd * n45[1];
+  d.crotch_ratio = s.crotch.mean + s.crotch.sd * n45[0];
+  d.arm_ratio = s.arm.mean + s.arm.sd * n45[1];
 
   Subject b;
   char name[32];

@@ -113,20 +113,16 @@ ThreatRule::ThreatRule(const Catalogue& cat, const std::string& text, const std:
     }
     return n;
   };
-  term = [&]() {
+  // One or more `item`s joined by `op`: a term (factors, '&') or a rule (terms, '|').
+  const auto joined = [&](Node::Kind kind, const std::function<std::unique_ptr<Node>()>& item, char op) {
     auto n = std::make_unique<Node>();
-    n->kind = Node::all_of;
-    do n->kids.push_back(factor());
-    while (p.eat('&'));
+    n->kind = kind;
+    do n->kids.push_back(item());
+    while (p.eat(op));
     return n;
   };
-  rule = [&]() {
-    auto n = std::make_unique<Node>();
-    n->kind = Node::any_of;
-    do n->kids.push_back(term());
-    while (p.eat('|'));
-    return n;
-  };
+  term = [&] { return joined(Node::all_of, factor, '&'); };
+  rule = [&] { return joined(Node::any_of, term, '|'); };
   root_ = rule();
   p.skip();
   if (p.pos != text.size()) p.fail("unexpected character '" + std::string(1, text[p.pos]) + "'");

@@ -14,6 +14,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "base/recycler.h"
 #include "base/sizes.h"
 #include "schedule/body_pages.h"
 #include "schedule/dataset_card.h"
@@ -42,21 +43,9 @@ struct Job {
   BatchOutput out;
 };
 
-// One-slot hand-over between the compute thread and the writer thread, plus the pool
-// of finished jobs whose buffers the next batch reuses (three jobs at most exist).
+// One-slot hand-over between the compute thread and the writer thread.
 class Handover {
  public:
-  std::unique_ptr<Job> recycled() {
-    std::lock_guard<std::mutex> lock(m_);
-    if (free_.empty()) return std::make_unique<Job>();
-    std::unique_ptr<Job> j = std::move(free_.back());
-    free_.pop_back();
-    return j;
-  }
-  void recycle(std::unique_ptr<Job> j) {
-    std::lock_guard<std::mutex> lock(m_);
-    free_.push_back(std::move(j));
-  }
   void put(std::unique_ptr<Job> j) {
     std::unique_lock<std::mutex> lock(m_);
     cv_.wait(lock, [&] { return !slot_ || failed_; });
@@ -90,7 +79,6 @@ class Handover {
   std::mutex m_;
   std::condition_variable cv_;
   std::unique_ptr<Job> slot_;
-  std::vector<std::unique_ptr<Job>> free_;
   bool closed_ = false, failed_ = false;
 };
 
@@ -205,6 +193,7 @@ void run_batches(const ScenarioSource& source, const Plan& plan, Backend& backen
                  std::atomic<uint64_t>& written) {
   const uint64_t first = written;
   Handover hand;
+  Recycler<Job> jobs;  // three jobs at most exist
   std::exception_ptr writer_error;
   std::thread writer([&] {
     try {
@@ -214,7 +203,7 @@ void run_batches(const ScenarioSource& source, const Plan& plan, Backend& backen
         const uint64_t next = job->scenes.first_index + job->scenes.size();
         checkpoint(next);
         written = next;
-        hand.recycle(std::move(job));
+        jobs.give(std::move(job));
       }
     } catch (...) {
       writer_error = std::current_exception();
@@ -233,7 +222,7 @@ void run_batches(const ScenarioSource& source, const Plan& plan, Backend& backen
         break;
       }
       if (hand.failed()) break;
-      std::unique_ptr<Job> job = hand.recycled();
+      std::unique_ptr<Job> job = jobs.take();
       SceneBatch& b = job->scenes;
       source.fill(at, static_cast<size_t>(n), threads, b);
       const auto tc = Clock::now();

@@ -17,6 +17,7 @@
 
 #include "base/error.h"
 #include "base/parallel.h"
+#include "base/recycler.h"
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "cli/python_requests.h"
@@ -60,29 +61,9 @@ struct Rows {
 };
 
 // Finished batches whose buffers the next one reuses, so that a long stream touches no new
-// pages: at most kKeep are kept.
-class Pool {
- public:
-  std::unique_ptr<Rows> take() {
-    std::lock_guard<std::mutex> lock(m_);
-    if (free_.empty()) return std::make_unique<Rows>();
-    std::unique_ptr<Rows> r = std::move(free_.back());
-    free_.pop_back();
-    return r;
-  }
-  void give(Rows* r) {
-    std::lock_guard<std::mutex> lock(m_);
-    if (free_.size() < kKeep)
-      free_.emplace_back(r);
-    else
-      delete r;
-  }
-
- private:
-  static constexpr size_t kKeep = 4;
-  std::mutex m_;
-  std::vector<std::unique_ptr<Rows>> free_;
-};
+// pages: at most kKeptBatches are kept.
+using Pool = Recycler<Rows>;
+constexpr size_t kKeptBatches = 4;
 
 py::dtype dtype_of(TensorType t) {
   switch (t) {
@@ -314,7 +295,7 @@ class StreamGenerator {
  public:
   StreamGenerator(const std::vector<std::string>& args, bool prefetch,
                   const std::optional<std::vector<std::string>>& datasets)
-      : engine_(args, datasets), pool_(std::make_shared<Pool>()), prefetch_(prefetch) {
+      : engine_(args, datasets), pool_(std::make_shared<Pool>(kKeptBatches)), prefetch_(prefetch) {
     if (prefetch_) worker_ = std::thread([this] { work(); });
   }
   ~StreamGenerator() {
@@ -359,7 +340,7 @@ class StreamGenerator {
     std::weak_ptr<Pool> pool = pool_;
     std::shared_ptr<Rows> shared(r.release(), [pool](Rows* p) {
       if (auto q = pool.lock())
-        q->give(p);
+        q->give(std::unique_ptr<Rows>(p));
       else
         delete p;
     });
