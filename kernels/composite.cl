@@ -49,7 +49,7 @@ inline void place_affine(global int* ly, const PsViewLaunch* L, uint2 seed, ulon
 kernel void place_view(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
-  (void)atlas, (void)bases, (void)alpha, (void)sigma, (void)field, (void)out, (void)phys, (void)raw, (void)scratch;
+  (void)atlas, (void)bases, (void)alpha, (void)field, (void)out, (void)phys, (void)raw, (void)scratch;
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
   const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);
   global const short* objs = objects + (size_t)i * PS_REGIONS;

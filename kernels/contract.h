@@ -77,7 +77,9 @@
 #define PS_STREAM_KNOB_DRAW 12u        /* knobs drawn per scenario (A..B); element = PS_DRAWN_* */
 #define PS_STREAM_BODIES 13u           /* random bodies (host only); index = body, element = draw */
 #define PS_STREAM_GENERATE 16u         /* scenario generators (host only) */
-/* The knobs a run may draw per scenario, each its element of PS_STREAM_KNOB_DRAW. */
+/* The knobs a run may draw per scenario, each its element of PS_STREAM_KNOB_DRAW, declared
+ * with its knob (host/plan/knobs.cpp: drawable): the declarations give each its key, column,
+ * draw and record, and its range to the kernels (PsDrawn). */
 #define PS_DRAWN_METAL_NOISE 0u
 #define PS_DRAWN_IR_NETD 1u
 #define PS_DRAWN_PIXEL_NOISE 2u
@@ -86,8 +88,7 @@
 #define PS_DRAWN_ILLUMINATION 5u
 #define PS_DRAWN_WORN_MINUTES 6u
 /* The outfit of a run whose clothing is drawn (--clothing): its class from word 0, its
- * outfit in the class from word 1 (PsPhys clothing). Not a numeric knob (host/scene/scene.h
- * lists the numeric ones). */
+ * outfit in the class from word 1 (PsPhys clothing). Not a numeric knob. */
 #define PS_DRAWN_CLOTHING 7u
 /* physics: the MMW display window's ends (--window L1..L2/H1..H2), each drawn from its range. */
 #define PS_DRAWN_WINDOW_LO 8u
@@ -238,21 +239,31 @@ typedef struct {
 #else
 #define PS_PARAM double
 #endif
-/* Both kinds' first scalars (kernels/lib/physics.cl reads them for either). */
+/* The range of each knob drawn per scenario, by its element (PS_DRAWN_*): lo its value (where
+ * drawn, its range's low end), hi its range's upper end (its value where fixed); 0 for the
+ * outfit's and the raw grid's elements. The host fills it from the knobs' declarations
+ * (host/plan/knobs.h, drawn_ranges); the kernels draw from it (kernels/lib/philox.cl,
+ * drawn_real and drawn_whole), so a new drawn knob needs no route of its own. */
 typedef struct {
+  PS_PARAM lo[PS_DRAWN_KNOBS], hi[PS_DRAWN_KNOBS];
+} PsDrawn;
+/* Both kinds' first scalars (kernels/lib/physics.cl reads them for either); the thesis model's
+ * view kernels read its drawn ranges alone. */
+typedef struct {
+  PsDrawn drawn;
   PS_PARAM window_min; /* K shown as gray 0 (MMW, drawn window: the lower end of its range) */
   PS_PARAM window_max; /* K shown as gray 255 (likewise) */
   /* Where the illumination or the worn time is drawn per scenario, the offset of the scene
-   * block (0: neither is): whether the illumination is drawn, the worn time's ends (minutes),
-   * then per subject the change of its (gain, offset) over the illumination's range, per
-   * variant its value's change over that range, its change per unit of exp(-worn / tau), 1 / tau
-   * and exp(-worn_lo / tau) (PS_SCENE_*), then (MMW) each subject's bare raw grid's change over
-   * the illumination's range (kernels/lib/physics.cl, scene_draw). */
+   * block (0: neither is): whether the illumination is drawn, then per subject the change of
+   * its (gain, offset) over the illumination's range, per variant its value's change over that
+   * range, its change per unit of exp(-worn / tau), 1 / tau and exp(-worn_lo / tau)
+   * (PS_SCENE_*), then (MMW) each subject's bare raw grid's change over the illumination's
+   * range (kernels/lib/physics.cl, scene_draw). The worn time's range is PsDrawn's. */
   PS_PARAM scene;
   /* Where the clothing is drawn per scenario (--clothing), the offset of the clothing block (0:
    * the catalogue's clothing): its classes C, each outfit's stride, the offset of the MMW gray
-   * grids (0 for IR), the folds' range (--clothing-folds), the offset of the MMW fold grids (0
-   * where the folds are off or for IR), then per class its first outfit, then per class its
+   * grids (0 for IR), the offset of the MMW fold grids (0 where the folds (--clothing-folds)
+   * are off or for IR), then per class its first outfit, then per class its
    * outfits' count (PS_CLOTHING_*), then each outfit's entry (PS_OUTFIT_*): its factor of every
    * IR shadow, the offset in the entry of its scene moves, its folds' factor k and reference
    * temperature T (a fold of share m turns a value v into T + (1 + f k m)(v - T)), then each
@@ -267,19 +278,12 @@ typedef struct {
 typedef struct {
   PsPhys common;
   /* K rms per raw pixel over the frames (kernel_netd) where neither the NETD nor the frames
-   * is drawn; else the NETD's range drawn per scenario (its ends, equal where fixed). */
-  PS_PARAM netd_lo, netd_hi;
-  /* The frames drawn per scenario, lowest and highest (both the knob's where fixed), and 1
-   * where the frames' mean is one draw of NETD / sqrt(frames) (Plan::frames_approximated). */
-  PS_PARAM frames_lo, frames_hi, frames_as_one;
-  /* The display window's ends drawn per scenario (PS_WINDOW_DRAWN): the upper ends of their
-   * ranges (the lower ends are window_min and window_max); the window's ends where fixed. */
-  PS_PARAM window_min_hi, window_max_hi;
+   * is drawn (else the NETD, drawn from its range); 1 where the frames' mean is one draw of
+   * NETD / sqrt(frames) (Plan::frames_approximated). */
+  PS_PARAM netd, frames_as_one;
 } PsPhysMmw;
 typedef struct {
-  PsPhys common;
-  /* K rms per pixel, and where drawn per scenario the upper end of its range (NETD where fixed). */
-  PS_PARAM netd, netd_hi;
+  PsPhys common; /* its NETD: common.drawn's PS_DRAWN_IR_NETD */
 } PsPhysIr;
 /* A third kind joins this union; the tails begin past the largest kind's scalars. */
 typedef union {
@@ -290,16 +294,14 @@ typedef union {
 #define PS_CLOTHING_CLASSES 0
 #define PS_CLOTHING_STRIDE 1
 #define PS_CLOTHING_GRIDS 2
-#define PS_CLOTHING_FOLDS_LO 3
-#define PS_CLOTHING_FOLDS_HI 4
-#define PS_CLOTHING_FOLD_GRIDS 5
-#define PS_CLOTHING_FIRST 6 /* kernels/shared.h: PS_CLOTHING_OUTFITS */
+#define PS_CLOTHING_FOLD_GRIDS 3
+#define PS_CLOTHING_FIRST 4 /* kernels/shared.h: PS_CLOTHING_OUTFITS */
 #define PS_OUTFIT_SHADOW 0
 #define PS_OUTFIT_MOVES 1
 #define PS_OUTFIT_FOLD_K 2
 #define PS_OUTFIT_FOLD_T 3
 #define PS_OUTFIT_HEAD 4
-#define PS_SCENE_SUBJECTS 3 /* kernels/shared.h: PS_SCENE_VARIANTS, PS_SCENE_BARE */
+#define PS_SCENE_SUBJECTS 1 /* kernels/shared.h: PS_SCENE_VARIANTS, PS_SCENE_BARE */
 
 /* A camera view's placement record per scenario, written by place_view and read by
  * every render stage: the objects it draws, in region order, and the noise pattern. */

@@ -48,7 +48,7 @@ kernel void stage_ir_display(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
   (void)atlas, (void)bases, (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)subject,
-      (void)objects, (void)alpha, (void)sigma, (void)records, (void)raw, (void)scratch;
+      (void)objects, (void)alpha, (void)records, (void)raw, (void)scratch;
   const int pixels = L.width * L.height;
   ir_window((global const preal*)field + (size_t)i * pixels, out + (size_t)i * pixels, phys, 0, pixels);
 }

@@ -205,7 +205,7 @@ inline void ir_noisy_window(global const preal* restrict T, global uchar* restri
 kernel void ir_surface_fused(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
-  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
+  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha,
       (void)raw;
   ir_surface_view(i, scenario_index(indices, L.first_lo, L.first_hi, i), &L, atlas, bases, subject, records, field,
                   out, phys, scratch, false);
@@ -214,7 +214,7 @@ kernel void ir_surface_fused(VIEW_STAGE_ARGS) {
 kernel void ir_surface_display_fused(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
-  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
+  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha,
       (void)raw;
   ir_surface_view(i, scenario_index(indices, L.first_lo, L.first_hi, i), &L, atlas, bases, subject, records, field,
                   out, phys, scratch, true);
@@ -224,7 +224,7 @@ kernel void ir_surface_display_fused(VIEW_STAGE_ARGS) {
 // in one pass over it (ir_noisy_window), while it is in cache.
 kernel void ir_surface_noise_display_fused(VIEW_STAGE_ARGS) {
   VIEW_STAGE_SCENARIO;
-  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha, (void)sigma,
+  (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha,
       (void)raw;
   ir_surface_view(i, scenario_index(indices, L.first_lo, L.first_hi, i), &L, atlas, bases, subject, records, field,
                   out, phys, scratch, false);

@@ -5,12 +5,12 @@
 
 kernel void metal_zones(global const uchar* influence, global const uchar* variant_category,
                         global const uchar* base_zones, global const uchar* subject, global const short* objects,
-                        uint n, uint2 seed, uint2 first, global const ulong* indices, int noise_lo, int noise_hi,
+                        uint n, uint2 seed, uint2 first, global const ulong* indices, global const param* drawn,
                         global uchar* out) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const ulong index = scenario_index(indices, first.x, first.y, i);
-  const int noise = metal_noise_of(seed, index, noise_lo, noise_hi);
+  const int noise = metal_noise_of(drawn, seed, index);
   int sum[PS_ZONES];
   for (int z = 0; z < PS_ZONES; ++z) sum[z] = 0;
   for (int r = 0; r < PS_REGIONS; ++r) {

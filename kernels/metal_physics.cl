@@ -41,12 +41,12 @@ inline int metal_deduction(double t) {
 kernel void metal_physics(global const double* zone_rec, global const double* region_rec,
                           global const double* tensors, global const uchar* base_zones, global const uchar* subject,
                           global const short* objects, uint n, uint2 seed, uint2 first, global const ulong* indices,
-                          int noise_lo, int noise_hi, double jitter, double half_width, double scale,
+                          global const param* drawn, double jitter, double half_width, double scale,
                           double body_height, global uchar* out) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const ulong index = scenario_index(indices, first.x, first.y, i);
-  const int noise = metal_noise_of(seed, index, noise_lo, noise_hi);
+  const int noise = metal_noise_of(drawn, seed, index);
   // Objects' positions (metres) and tensors, in region order as the reference.
   double px[PS_REGIONS], pz[PS_REGIONS];
   int variant[PS_REGIONS];

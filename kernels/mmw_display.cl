@@ -180,7 +180,7 @@ kernel void stage_mmw_display(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
   (void)atlas, (void)bases, (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)subject,
-      (void)objects, (void)alpha, (void)sigma, (void)records, (void)field;
+      (void)objects, (void)alpha, (void)records, (void)field;
   const int W = L.width, H = L.height, RW = L.raw_width, RH = L.raw_height, stride = L.tables.display.stride;
   global const preal* grid = (global const preal*)raw + (size_t)i * RH * RW;
   global uchar* o = out + (size_t)i * H * W;

@@ -9,7 +9,7 @@ kernel void physics_raw(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n) return;
   (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)objects, (void)alpha,
-      (void)sigma, (void)field, (void)out;
+      (void)field, (void)out;
   const uint2 seed = (uint2)(L.seed_lo, L.seed_hi);
   const ulong index = scenario_index(indices, L.first_lo, L.first_hi, i);
   global const int* rec = records + (size_t)i * PS_REC_LEN;

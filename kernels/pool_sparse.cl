@@ -333,13 +333,16 @@ kernel void features_sparse(global const uchar* restrict atlas, global const int
 // N(0, sigma^2 / c), clipped to the pixel range. Rounding and clipping of single pixels
 // are not modelled; tradeoff measures what that costs. One work-item per scenario.
 kernel void analytic_noise(global float* features, global const int4* rects, global const int4* grids, uint n,
-                           int block, int npooled, int row_len, float sigma_lo, float sigma_hi, uint2 seed,
+                           int block, int npooled, int row_len, global const param* drawn, uint2 seed,
                            uint2 first, global const ulong* indices) {
   const uint i = (uint)get_global_id(0);
   if (i >= n) return;
   const ulong index = scenario_index(indices, first.x, first.y, i);
-  // The scenario's sigma: the knob's, or its draw (kernels/lib/gauss.cl, pixel_sigma_of).
-  const float sigma = knob_draw(sigma_lo, sigma_hi, seed, index, PS_DRAWN_PIXEL_NOISE);
+  // The scenario's sigma from the run's drawn ranges: the knob's, or its draw, in fp32 in
+  // every build (pixel_sigma_of draws at the parameters' precision).
+  global const PsDrawn* r = phys_drawn(drawn);
+  const float sigma = knob_draw((float)r->lo[PS_DRAWN_PIXEL_NOISE], (float)r->hi[PS_DRAWN_PIXEL_NOISE], seed, index,
+                                PS_DRAWN_PIXEL_NOISE);
   // grids: per pooled view (width, height, blocks across, first column); the regions follow.
   const int4 last = grids[npooled - 1];
   const int block_features = last.w + last.z * ((last.y + block - 1) / block);

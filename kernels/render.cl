@@ -329,7 +329,7 @@ kernel void render_view(VIEW_STAGE_ARGS) {
   const int W = L.width, H = L.height;
   global const uchar* base = base_row(atlas, bases, subject, &L, i, 0);
   global uchar* img = out + (size_t)i * H * W;
-  sigma = pixel_sigma_of(sigma, sigma_hi, seed, index);
+  const param sigma = pixel_sigma_of(phys, seed, index);
 
 #if defined(VECTOR_RENDER)
   // The vector paths: integer placement (no sub-pixel or affine sprites), and rows of at

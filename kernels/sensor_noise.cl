@@ -3,7 +3,7 @@
 kernel void stage_sensor_noise(VIEW_STAGE_ARGS) {
   VIEW_STAGE_ROW;
   if (!(L.flags & PS_FLAG_PIXEL_NOISE)) return;
-  sigma = pixel_sigma_of(sigma, sigma_hi, seed, index);
+  const param sigma = pixel_sigma_of(phys, seed, index);
   const int p0 = y * L.width;
 #if defined(NOISE_DRAW_IH)
   for (int x = 0; x < L.width; ++x)

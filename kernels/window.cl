@@ -35,7 +35,7 @@ kernel void stage_window(VIEW_STAGE_ARGS) {
   const uint i = (uint)get_global_id(0);
   if (i >= L.n || !L.window_auto) return;
   (void)atlas, (void)bases, (void)sprites, (void)places, (void)noise_offsets, (void)noise_gains, (void)subject,
-      (void)objects, (void)alpha, (void)sigma, (void)records, (void)field, (void)out;
+      (void)objects, (void)alpha, (void)records, (void)field, (void)out;
   const int cells = L.raw_width * L.raw_height;
   global preal* restrict r = (global preal*)raw + (size_t)i * cells;
   const preal w0 = (preal)phys_common(phys)->window_min;

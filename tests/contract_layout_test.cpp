@@ -1,6 +1,6 @@
 // The host and the kernels lay out kernels/contract.h's launch records alike: the kernels,
 // built at each parameter precision, write their sizes and offsets, and the host's compile
-// of the same declarations must give them. The physics scalars (PsPhysMmw, PsPhysIr) are
+// of the same declarations must give them. The view's scalars (PsPhysMmw, PsPhysIr, their drawn ranges) are
 // doubles on the host and floats or doubles in the kernels, converted one by one
 // (backend/opencl/buffers.h, params): each field's index must agree, not its byte offset.
 // The program is the runtime's (OpenCLRuntime::source), so tools/mutate.sh reaches it.
@@ -21,15 +21,14 @@ namespace {
 
 // Each a byte offset or size of PsViewLaunch, then an index (offset over PS_PARAM) of the
 // physics scalars, in one order on both sides.
-#define PS_LAYOUT(OFFSET, SIZE, PARAM, SUBJECTS)                                                                      \
-  SIZE(PsViewLaunch), OFFSET(PsViewLaunch, tables), OFFSET(PsViewLaunch, tables.display),                             \
-      OFFSET(PsViewLaunch, tables.display.dyband), OFFSET(PsViewLaunch, frames), OFFSET(PsViewLaunch, rotate_lo),     \
-      OFFSET(PsViewLaunch, ranges_fp64), SIZE(PsPhysTables), PARAM(PsPhysMmw, common.window_min),                     \
-      PARAM(PsPhysMmw, common.window_max), PARAM(PsPhysMmw, common.scene), PARAM(PsPhysMmw, common.clothing),         \
-      PARAM(PsPhysMmw, netd_lo), PARAM(PsPhysMmw, netd_hi), PARAM(PsPhysMmw, frames_lo), PARAM(PsPhysMmw, frames_hi), \
-      PARAM(PsPhysMmw, frames_as_one), PARAM(PsPhysMmw, window_min_hi), PARAM(PsPhysMmw, window_max_hi),              \
-      PARAM(PsPhysIr, common.window_max), PARAM(PsPhysIr, common.clothing), PARAM(PsPhysIr, netd),                    \
-      PARAM(PsPhysIr, netd_hi), SUBJECTS
+#define PS_LAYOUT(OFFSET, SIZE, PARAM, SUBJECTS)                                                                  \
+  SIZE(PsViewLaunch), OFFSET(PsViewLaunch, tables), OFFSET(PsViewLaunch, tables.display),                         \
+      OFFSET(PsViewLaunch, tables.display.dyband), OFFSET(PsViewLaunch, frames), OFFSET(PsViewLaunch, rotate_lo), \
+      OFFSET(PsViewLaunch, ranges_fp64), SIZE(PsPhysTables), PARAM(PsPhysMmw, common.window_min),                 \
+      PARAM(PsPhysMmw, common.window_max), PARAM(PsPhysMmw, common.scene), PARAM(PsPhysMmw, common.clothing),     \
+      PARAM(PsPhysMmw, common.drawn.lo), PARAM(PsPhysMmw, common.drawn.hi), PARAM(PsPhysMmw, netd),               \
+      PARAM(PsPhysMmw, frames_as_one), PARAM(PsPhysIr, common.window_max), PARAM(PsPhysIr, common.clothing),      \
+      PARAM(PsPhysIr, common.drawn.hi), SUBJECTS
 
 #define HOST_OFFSET(T, F) (long)offsetof(T, F)
 #define HOST_SIZE(T) (long)sizeof(T)

@@ -623,6 +623,26 @@ TEST(DrawnKnobs, EachScenariosDrawIsRecordedAndAFixedRangeKeepsTheBytes) {
   EXPECT_EQ(test::slurp(t.w() / "a" / "scenarios.csv"), test::slurp(t.w() / "c" / "scenarios.csv"));
 }
 
+// evaluate reads a data set's scenarios.csv for its regions' labels: a drawn knob's column there
+// is the record it is (plan/knobs.h, drawn_number_keys), not an unknown column.
+TEST(DrawnKnobs, EvaluateReadsTheScenarioListOfARunWithDrawnKnobs) {
+  test::TempDir t;
+  const fs::path data = t.w() / "set", report = t.w() / "report";
+  const test::Result g =
+      test::generate(t, {"--count",   "200",           "--seed", "3",       "--pool",    "gun,metal-plate",
+                         "--objects", "0..2",          "--rule", "gun",     "--balance", "--what",
+                         "features",  "--format",      "csv",    "--block", "40",        "--metal-noise",
+                         "0..8",      "--pixel-noise", "0..4"},
+                     data);
+  ASSERT_EQ(g.status, 0) << test::describe(g);
+  const std::string head = test::slurp(data / "scenarios.csv").substr(0, 4096);
+  EXPECT_NE(head.find("metal_noise"), std::string::npos) << head;
+  const test::Result e = test::finish(
+      test::start(t.cap(), {"evaluate", data.string(), "--bootstrap", "20", "--no-plot", "--out", report.string()}));
+  ASSERT_EQ(e.status, 0) << test::describe(e);
+  EXPECT_TRUE(fs::exists(report / "report.json"));
+}
+
 // The window's drawn ends: a column each in scenarios.csv (the run's draws, drawn_knob_at),
 // float64 datasets in data.h5, the manifest's window as given.
 TEST(DrawnKnobs, WindowEndsDrawnAreRecorded) {

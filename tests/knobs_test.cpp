@@ -5,12 +5,15 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <regex>
 
 #include "base/error.h"
 #include "run_binary.h"
+#include "scene/scenario_list.h"
 #include "schedule/run_spec.h"
+#include "support.h"
 
 namespace portalsim {
 namespace embedded {
@@ -188,6 +191,62 @@ TEST(Knobs, TheDrawnElementsAreTheDeclaredOnesAndTheKernels) {
     if (k.key == "frames") k.draws.clear();
   EXPECT_EQ(refusal(none), "no knob declares drawn element " + std::to_string(PS_DRAWN_FRAMES));
   EXPECT_EQ(index_draws(knobs()).size(), drawn.size());
+}
+
+// The kernels' ranges (PsDrawn) follow from the declarations: each drawn number's low end is
+// its field's value and its upper end the range's, or that value where fixed; the outfit's
+// and the raw grid's elements, which draw no number, are 0.
+TEST(Knobs, TheKernelsDrawnRangesAreTheDeclaredFieldsRanges) {
+  Plan fixed, drawn;
+  std::map<unsigned, std::pair<double, double>> want_fixed, want_drawn;
+  for (const Knob& k : knobs()) {
+    if (k.drawn >= 0) {
+      const bool whole = k.kind == KnobKind::integer;
+      const auto at = [&](double share) {
+        const double v = k.min + (k.max - k.min) * share;
+        return whole ? std::floor(v) : v;
+      };
+      const double a = at(0.25), b = at(0.5);
+      const auto text = [&](double v) { return whole ? std::to_string(int(v)) : std::to_string(v); };
+      set_knob(fixed, k, text(b), k.key);
+      set_knob(drawn, k, text(a) + ".." + text(b), k.key);
+      want_fixed[unsigned(k.drawn)] = {std::stod(text(b)), std::stod(text(b))};
+      want_drawn[unsigned(k.drawn)] = {std::stod(text(a)), std::stod(text(b))};
+    } else if (k.drawn_ends[0] >= 0) {
+      set_knob(fixed, k, "300..310", k.key);
+      set_knob(drawn, k, "280..290/305..306", k.key);
+      want_fixed[unsigned(k.drawn_ends[0])] = {300, 300};
+      want_fixed[unsigned(k.drawn_ends[1])] = {310, 310};
+      want_drawn[unsigned(k.drawn_ends[0])] = {280, 290};
+      want_drawn[unsigned(k.drawn_ends[1])] = {305, 306};
+    }
+  }
+  const PsDrawn f = drawn_ranges(fixed.model), d = drawn_ranges(drawn.model);
+  for (const DrawnKnob& k : drawn_knobs()) {
+    SCOPED_TRACE(k.key.empty() ? "element " + std::to_string(k.element) : k.key);
+    EXPECT_EQ(want_drawn.count(k.element), k.number() ? 1u : 0u);
+    const auto zero = std::make_pair(0.0, 0.0);
+    EXPECT_EQ(std::make_pair(f.lo[k.element], f.hi[k.element]), k.number() ? want_fixed[k.element] : zero);
+    EXPECT_EQ(std::make_pair(d.lo[k.element], d.hi[k.element]), k.number() ? want_drawn[k.element] : zero);
+  }
+}
+
+// A scenario list skips the columns of the drawn numbers it is given (a run's scenarios.csv
+// records its draws there; the seed draws them again), and refuses them as unknown otherwise.
+TEST(Knobs, AScenarioListSkipsTheDrawnNumbersColumns) {
+  std::string head = "subject";
+  for (int r = 1; r <= kBuiltinRegions; ++r) head += ",region" + std::to_string(r);
+  const std::string text =
+      head + ",netd,window_lo\n2,gun,none,none,none,none,none,none,none,none,none,none,none," + "none,1.5,291\n";
+  const std::vector<Scenario> got = parse_scenario_list(test::catalogue(), text, "l.csv", nullptr, drawn_number_keys());
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0].subject, 1);
+  try {
+    parse_scenario_list(test::catalogue(), text, "l.csv");
+    ADD_FAILURE() << "a drawn number's column taken without the drawn numbers' keys";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("l.csv:1: column 15 \"netd\": unknown column"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "base/error.h"
 #include "cli/validate_tables.h"
 #include "io/input_file.h"
+#include "plan/knobs.h"
 #include "scene/scenario_list.h"
 #include "schedule/run_state.h"
 
@@ -209,7 +210,8 @@ EvaluateData read_evaluate_data(const std::string& dir, const Catalogue& cat) {
   }
   // Per region: does it hold a threat? From scenarios.csv, row for row with the table.
   const std::string list_path = (fs::path(dir) / "scenarios.csv").string();
-  const ScenarioListFile list(cat, list_path, manifest["spec"].value("bodies", "") == "per-scenario");
+  const ScenarioListFile list(cat, list_path, manifest["spec"].value("bodies", "") == "per-scenario",
+                              drawn_number_keys());
   if (list.size() != d.label.size())
     throw InputError(list_path + ": " + std::to_string(list.size()) + " scenarios, the feature table " + table_path +
                      " has " + std::to_string(d.label.size()) + " rows");

@@ -4,6 +4,8 @@
 #include <charconv>
 #include <cmath>
 #include <sstream>
+#include <type_traits>
+#include <variant>
 
 #include "base/error.h"
 
@@ -399,10 +401,6 @@ std::vector<DrawnKnob> index_draws(const std::vector<Knob>& list) {
       if (claimed[d.element])
         throw std::logic_error("knobs " + claimed[d.element]->key + " and " + k.key + " both claim drawn element " +
                                std::to_string(d.element));
-      // A scenario list skips a drawn number's column by this key (scene.h), where plan/ is out of reach.
-      if (const std::string key = d.number() ? d.key : ""; key != kDrawnKnobKeys[d.element])
-        throw std::logic_error("knob " + k.key + ": drawn element " + std::to_string(d.element) + " is keyed \"" +
-                               kDrawnKnobKeys[d.element] + "\" in scene.h's kDrawnKnobKeys, not \"" + key + "\"");
       claimed[d.element] = &k;
       by_element[d.element] = d;
     }
@@ -414,6 +412,32 @@ std::vector<DrawnKnob> index_draws(const std::vector<Knob>& list) {
 const std::vector<DrawnKnob>& drawn_knobs() {
   static const std::vector<DrawnKnob> d = index_draws(knobs());
   return d;
+}
+
+std::vector<std::string> drawn_number_keys() {
+  std::vector<std::string> keys;
+  for (const DrawnKnob& d : drawn_knobs())
+    if (d.number()) keys.push_back(d.key);
+  return keys;
+}
+
+PsDrawn drawn_ranges(const ModelSettings& m) {
+  PsDrawn r{};
+  for (const DrawnKnob& d : drawn_knobs()) {
+    if (!d.number()) continue;
+    const double v = std::visit(
+        [&m](auto field) {
+          if constexpr (std::is_same_v<decltype(field), std::monostate>)
+            return 0.0;
+          else
+            return static_cast<double>(m.*field);
+        },
+        d.field);
+    const DrawnRange& range = m.drawn[d.element];
+    r.lo[d.element] = v;
+    r.hi[d.element] = range.varies() ? range.hi : v;
+  }
+  return r;
 }
 
 namespace {

@@ -81,6 +81,12 @@ struct Knob {
 const std::vector<Knob>& knobs();
 // The draws of knobs(), by element: entry e is PS_DRAWN_KNOBS's element e.
 const std::vector<DrawnKnob>& drawn_knobs();
+// The drawn numbers' keys: the columns that record a run's draws (scenarios.csv), which a
+// scenario list skips (ScenarioRows: the seed draws them again).
+std::vector<std::string> drawn_number_keys();
+// Each drawn number's range in `m`, by element, as the kernels draw it (kernels/contract.h,
+// PsDrawn): lo the field's value, hi the drawn range's upper end or that value where fixed.
+PsDrawn drawn_ranges(const ModelSettings& m);
 // The draws of `list`, by element; throws std::logic_error where two claim one element or an
 // element below PS_DRAWN_KNOBS has none (drawn_knobs checks knobs() so).
 std::vector<DrawnKnob> index_draws(const std::vector<Knob>& list);

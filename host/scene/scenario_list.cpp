@@ -42,7 +42,7 @@ std::atomic<uint64_t> g_mark_rows{1u << 16};
 }  // namespace
 
 ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, const std::string& path, size_t lineno,
-                           bool own_bodies)
+                           bool own_bodies, const std::vector<std::string>& drawn)
     : cat_(cat), path_(path), own_bodies_(own_bodies) {
   std::vector<std::string> header;
   header.resize(split_fields(without_line_end(header_line), header, path, lineno));
@@ -74,8 +74,7 @@ ScenarioRows::ScenarioRows(const Catalogue& cat, std::string_view header_line, c
       if (r < 0) throw InputError(column + "there are " + regions + " only");
       col_region_[r - 1] = static_cast<int>(c);
     } else if (h == "index" ||
-               std::any_of(kDrawnKnobKeys.begin(), kDrawnKnobKeys.end(),
-                           [&](const char* k) { return *k && normalise_name(k) == h; }) ||
+               std::any_of(drawn.begin(), drawn.end(), [&](const std::string& k) { return normalise_name(k) == h; }) ||
                std::any_of(kBodyColumns.begin(), kBodyColumns.end(),
                            [&](const char* k) { return normalise_name(k) == h; }) ||
                std::any_of(kClothingColumns.begin(), kClothingColumns.end(),
@@ -175,7 +174,8 @@ Scenario ScenarioRows::parse(std::string_view row, size_t lineno, ListedTransfor
 }
 
 std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view raw, const std::string& path,
-                                          std::vector<ListedTransforms>* transforms) {
+                                          std::vector<ListedTransforms>* transforms,
+                                          const std::vector<std::string>& drawn) {
   // A BOM is allowed: spreadsheets write one. CRLF line ends are too.
   std::string_view text = io::check_text(raw, path, io::Bom::skip);
   size_t lineno = 0;
@@ -191,7 +191,7 @@ std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view
   std::unique_ptr<ScenarioRows> rows;
   while (!rows && next_line(line)) {
     const std::string_view body = without_line_end(line);
-    if (!body.empty() && body[0] != '#') rows = std::make_unique<ScenarioRows>(cat, line, path, lineno);
+    if (!body.empty() && body[0] != '#') rows = std::make_unique<ScenarioRows>(cat, line, path, lineno, false, drawn);
   }
   if (!rows) throw InputError(path + ": empty scenario file (expected a header line)");
   std::vector<Scenario> out;
@@ -272,7 +272,8 @@ void ScenarioListFile::set_piece_bytes_for_tests(size_t bytes, uint64_t mark_row
   g_mark_rows = mark_rows;
 }
 
-ScenarioListFile::ScenarioListFile(const Catalogue& cat, std::string path, bool own_bodies)
+ScenarioListFile::ScenarioListFile(const Catalogue& cat, std::string path, bool own_bodies,
+                                   const std::vector<std::string>& drawn)
     : path_(std::move(path)), mark_rows_(g_mark_rows), cursor_(std::make_unique<Cursor>()) {
   fd_ = io::open_regular_file(path_, "scenario file");
   Cursor& c = *cursor_;
@@ -287,7 +288,7 @@ ScenarioListFile::ScenarioListFile(const Catalogue& cat, std::string path, bool 
     io::check_line(line, path_, c.line);
     const std::string_view body = without_line_end(line);
     if (!body.empty() && body[0] != '#')
-      columns_ = std::make_unique<ScenarioRows>(cat, line, path_, c.line, own_bodies);
+      columns_ = std::make_unique<ScenarioRows>(cat, line, path_, c.line, own_bodies, drawn);
   }
   if (!columns_) throw InputError(path_ + ": empty scenario file (expected a header line)");
   // Count the rows, marking where every mark_rows_-th starts; no row is parsed here.

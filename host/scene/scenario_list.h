@@ -36,8 +36,10 @@ class ScenarioRows {
  public:
   // `header`: the header line (no line end); `line` its line number in `path`. With
   // `own_bodies`, the list of a run of per-scenario bodies: every subject is 0 (its own body).
+  // `drawn`: the columns of the numbers a run draws per scenario (plan/knobs.h,
+  // drawn_number_keys), which record its draws: a list skips them, as the seed draws them again.
   ScenarioRows(const Catalogue& cat, std::string_view header, const std::string& path, size_t line,
-               bool own_bodies = false);
+               bool own_bodies = false, const std::vector<std::string>& drawn = {});
   bool has_transforms() const { return transform_columns_ != 0; }
   // Object tokens already read, per thread: lists repeat a few names millions of times.
   struct TokenHash {
@@ -65,15 +67,17 @@ class ScenarioRows {
 // A whole list in memory (`text`, which `path` names in errors): its scenarios and, where
 // it records them, their transforms.
 std::vector<Scenario> parse_scenario_list(const Catalogue& cat, std::string_view text, const std::string& path,
-                                          std::vector<ListedTransforms>* transforms = nullptr);
+                                          std::vector<ListedTransforms>* transforms = nullptr,
+                                          const std::vector<std::string>& drawn = {});
 
 // A list file of any length, read as a stream: opening it reads the header and counts the
 // rows (by their line ends, with a mark every so many rows); read() parses the rows asked
 // for, from the nearest mark. Memory stays flat whatever the file's length.
 class ScenarioListFile {
  public:
-  // `own_bodies`: as ScenarioRows's (evaluate reads a run of per-scenario bodies' list).
-  ScenarioListFile(const Catalogue& cat, std::string path, bool own_bodies = false);
+  // `own_bodies` and `drawn`: as ScenarioRows's (evaluate reads a run of per-scenario bodies' list).
+  ScenarioListFile(const Catalogue& cat, std::string path, bool own_bodies = false,
+                   const std::vector<std::string>& drawn = {});
   ~ScenarioListFile();
   ScenarioListFile(const ScenarioListFile&) = delete;
   ScenarioListFile& operator=(const ScenarioListFile&) = delete;

@@ -11,14 +11,6 @@ namespace portalsim {
 
 constexpr int16_t kNoObject = -1;
 
-// The keys of the numbers a run may draw per scenario, by their PS_DRAWN_* element, by which
-// a scenario list takes their columns as records. The knobs' declarations are the list
-// (plan/knobs.cpp, drawn_knobs: keys, columns, draws); scene/ cannot read plan/, so it keeps
-// this copy, which drawn_knobs() refuses where it differs. PS_DRAWN_CLOTHING's element draws
-// an outfit and PS_DRAWN_MMW_RAW's a raw grid, no number: their keys are empty here.
-inline constexpr std::array<const char*, PS_DRAWN_KNOBS> kDrawnKnobKeys = {
-    "metal_noise",  "ir_netd", "pixel_noise", "netd",      "frames", "illumination",
-    "worn_minutes", "",        "window_lo",   "window_hi", "",       "clothing_folds"};
 // The columns of scenarios.csv and data.h5 that record a scenario's MMW raw grid where a run
 // draws it from a list (raw_grid_at, plan.h).
 inline constexpr std::array<const char*, 2> kRawGridColumns{"mmw_raw_width", "mmw_raw_height"};

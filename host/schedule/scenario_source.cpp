@@ -7,6 +7,7 @@
 #include "base/error.h"
 #include "base/parallel.h"
 #include "base/spoken_list.h"
+#include "plan/knobs.h"
 
 namespace portalsim {
 
@@ -14,7 +15,7 @@ ScenarioSource::ScenarioSource(const RunSpec& spec, const Catalogue& cat)
     : model_(spec.settings().model), own_bodies_(spec.per_scenario_bodies()), regions_(cat.region_count()) {
   if (!spec.rule.empty()) rule_.emplace(cat, spec.rule, spec.where("rule"));
   if (!spec.scenarios.empty()) {
-    list_ = std::make_shared<ScenarioListFile>(cat, spec.scenarios);
+    list_ = std::make_shared<ScenarioListFile>(cat, spec.scenarios, false, drawn_number_keys());
     path_ = spec.scenarios;
     total_ = list_->size();
   } else {

@@ -282,11 +282,10 @@ inline greal2 gauss_pair(uint2 seed, ulong index, int view, int pair) {
   return gauss_pair_of(seed, index, PS_STREAM_PIXEL_NOISE, view, pair);
 }
 
-// Scenario index's pixel noise sigma (the knob pixel_noise; host: drawn_knob_at): sigma, or
-// where drawn per scenario (sigma_hi above it), sigma + (sigma_hi - sigma) uniform24(word 0)
-// of PS_STREAM_KNOB_DRAW, element PS_DRAWN_PIXEL_NOISE.
-inline param pixel_sigma_of(param lo, param hi, uint2 seed, ulong index) {
-  return knob_draw(lo, hi, seed, index, PS_DRAWN_PIXEL_NOISE);
+// Scenario index's pixel noise sigma (the knob pixel_noise; host: drawn_knob_at), from the
+// view's parameters: the knob's, or where drawn per scenario its draw.
+inline param pixel_sigma_of(global const param* phys, uint2 seed, ulong index) {
+  return drawn_real(phys_drawn(phys), PS_DRAWN_PIXEL_NOISE, seed, index);
 }
 
 #if !defined(PRECISION_FP64)

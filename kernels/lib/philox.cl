@@ -44,3 +44,14 @@ inline double __attribute__((overloadable)) knob_draw(double lo, double hi, uint
 inline int __attribute__((overloadable)) knob_draw(int lo, int hi, uint2 seed, ulong index, uint e) {
   return hi > lo ? lo + (int)below(draw(seed, index, PS_STREAM_KNOB_DRAW, e).x, (uint)(hi - lo) + 1u) : lo;
 }
+// Scenario index's value of the drawn knob e (PS_DRAWN_*) from its range in d (PsDrawn, which
+// the host fills from the knobs' declarations): a real knob's at the parameters' precision
+// (the physics model's preal, the pixel noise's param), a whole one's.
+inline PS_PARAM drawn_real(global const PsDrawn* d, uint e, uint2 seed, ulong index) {
+  return knob_draw(d->lo[e], d->hi[e], seed, index, e);
+}
+inline int drawn_whole(global const PsDrawn* d, uint e, uint2 seed, ulong index) {
+  return knob_draw((int)d->lo[e], (int)d->hi[e], seed, index, e);
+}
+// A view's drawn ranges: the head of its parameters (PsPhys::drawn), in either model.
+inline global const PsDrawn* phys_drawn(global const PS_PARAM* phys) { return &((global const PsPhys*)phys)->drawn; }

@@ -3,11 +3,9 @@
 // window, the tabulated-features test, and the IR camera's shadows, NETD and window: each
 // used by a stage kernel and a fast path.
 
-// The view's scalars (kernels/contract.h): either kind's first ones, the MMW camera's, the
-// IR camera's.
+// The view's scalars (kernels/contract.h): either kind's first ones, the MMW camera's.
 inline global const PsPhys* phys_common(global const param* phys) { return (global const PsPhys*)phys; }
 inline global const PsPhysMmw* phys_mmw(global const param* phys) { return (global const PsPhysMmw*)phys; }
-inline global const PsPhysIr* phys_ir(global const param* phys) { return (global const PsPhysIr*)phys; }
 
 // The illumination, worn time and outfit of a scenario where drawn per scenario (PsPhys's scene
 // and clothing; host: drawn_knob_at, outfit_at): at, the scene
@@ -45,9 +43,8 @@ inline SceneDraw scene_draw(global const param* phys, uint2 seed, ulong index) {
     d.outfit = (int)c[PS_CLOTHING_FIRST + k] + (int)below(w.y, (uint)c[PS_CLOTHING_FIRST + classes + k]);
     global const param* e = c + PS_CLOTHING_OUTFITS(classes) + (size_t)d.outfit * (size_t)c[PS_CLOTHING_STRIDE];
     d.shadow = (preal)e[PS_OUTFIT_SHADOW];
-    if (c[PS_CLOTHING_FOLDS_HI] > 0) {
-      const preal f = knob_draw((preal)c[PS_CLOTHING_FOLDS_LO], (preal)c[PS_CLOTHING_FOLDS_HI], seed, index,
-                                PS_DRAWN_CLOTHING_FOLDS);
+    if (phys_drawn(phys)->hi[PS_DRAWN_CLOTHING_FOLDS] > 0) {
+      const preal f = drawn_real(phys_drawn(phys), PS_DRAWN_CLOTHING_FOLDS, seed, index);
       d.fold = f * (preal)e[PS_OUTFIT_FOLD_K];
       d.fold_t = (preal)e[PS_OUTFIT_FOLD_T];
     }
@@ -57,7 +54,7 @@ inline SceneDraw scene_draw(global const param* phys, uint2 seed, ulong index) {
   if (d.at == 0) return d;
   global const param* b = phys + d.at;
   if (b[0] != 0) d.t = (preal)uniform24(draw(seed, index, PS_STREAM_KNOB_DRAW, PS_DRAWN_ILLUMINATION).x);
-  d.w = knob_draw((preal)b[1], (preal)b[2], seed, index, PS_DRAWN_WORN_MINUTES);
+  d.w = drawn_real(phys_drawn(phys), PS_DRAWN_WORN_MINUTES, seed, index);
   return d;
 }
 
@@ -150,13 +147,14 @@ inline preal mmw_noise_drawn(preal lo, preal hi, int flo, int fhi, bool as_one, 
 // kframes where nothing is drawn) of the returned sd each.
 inline preal mmw_noise_of(global const param* phys, int kframes, uint2 seed, ulong index, int* frames) {
   global const PsPhysMmw* p = phys_mmw(phys);
-  const preal lo = (preal)p->netd_lo, hi = (preal)p->netd_hi;
-  const int flo = (int)p->frames_lo, fhi = (int)p->frames_hi;
-  if (hi <= lo && fhi <= flo) {
+  global const PsDrawn* r = phys_drawn(phys);
+  const preal hi = (preal)r->hi[PS_DRAWN_NETD];
+  const int flo = (int)r->lo[PS_DRAWN_FRAMES], fhi = (int)r->hi[PS_DRAWN_FRAMES];
+  if (hi <= (preal)r->lo[PS_DRAWN_NETD] && fhi <= flo) {
     *frames = kframes;
-    return lo / (preal)kframes;
+    return (preal)p->netd / (preal)kframes;
   }
-  return mmw_noise_drawn(lo, hi, flo, fhi, p->frames_as_one != 0, seed, index, frames);
+  return mmw_noise_drawn((preal)p->netd, hi, flo, fhi, p->frames_as_one != 0, seed, index, frames);
 }
 
 // The netd stage over a scenario's whole raw grid v (physics_raw): L.frames frames of sd
@@ -212,13 +210,11 @@ inline void netd_frames(global preal* restrict v, int cells, preal sd, int frame
 #endif
 }
 
-// Scenario `index`'s drawn window ends (PS_WINDOW_DRAWN; host: drawn_knob_at),
-// each uniform over its range: from PsPhysMmw's window_min to window_min_hi, and window_max
-// to window_max_hi.
+// Scenario `index`'s drawn window ends (PS_WINDOW_DRAWN; host: drawn_knob_at), each uniform
+// over its range (the lower ends are PsPhys's window_min and window_max).
 inline void drawn_window(global const param* phys, uint2 seed, ulong index, preal* lo, preal* hi) {
-  global const PsPhysMmw* p = phys_mmw(phys);
-  *lo = knob_draw((preal)p->common.window_min, (preal)p->window_min_hi, seed, index, PS_DRAWN_WINDOW_LO);
-  *hi = knob_draw((preal)p->common.window_max, (preal)p->window_max_hi, seed, index, PS_DRAWN_WINDOW_HI);
+  *lo = drawn_real(phys_drawn(phys), PS_DRAWN_WINDOW_LO, seed, index);
+  *hi = drawn_real(phys_drawn(phys), PS_DRAWN_WINDOW_HI, seed, index);
 }
 
 // Kelvin t through a display window (lo, scale = 255 / (max - lo)) to a level 0..255,
@@ -273,11 +269,10 @@ inline void shadow_values(const Layers* Ly, const PsViewLaunch* L, global const 
   }
 }
 
-// The scenario's IR NETD: the knob's, or where it is drawn per scenario (PsPhysIr netd_hi
-// above netd), NETD + (hi - NETD) uniform24(word 0) of PS_STREAM_KNOB_DRAW (host:
+// The scenario's IR NETD: the knob's, or where it is drawn per scenario its draw (host:
 // drawn_knob_at).
 inline preal ir_netd_of(global const param* phys, uint2 seed, ulong index) {
-  return knob_draw((preal)phys_ir(phys)->netd, (preal)phys_ir(phys)->netd_hi, seed, index, PS_DRAWN_IR_NETD);
+  return drawn_real(phys_drawn(phys), PS_DRAWN_IR_NETD, seed, index);
 }
 
 // The IR display window, kelvin to temperature index 0..255 (window_level), over pixels

@@ -10,7 +10,8 @@
 //            subject's height (Sensor::subject_dy)
 //   records: the view's placement record per scenario (kernels/contract.h, PS_REC_*)
 //   field:   the view's values before display, n * height * width, at the build's precision
-//   phys:    the physics model's parameters (kernels/contract.h, PsPhysMmw and PsPhysIr)
+//   phys:    the view's parameters (kernels/contract.h): its drawn ranges (PsPhys::drawn), and
+//            the physics model's (PsPhysMmw and PsPhysIr)
 //   raw:     physics: the MMW raw grid, n * raw_height * raw_width
 //   scratch: physics: a second field, for stages that cannot work in place
 //   indices: each scenario's global index where the batch is not contiguous, else null
@@ -18,7 +19,7 @@
 #define VIEW_STAGE_ARGS                                                                                          \
   global const uchar *atlas, global const int *bases, global const int4 *sprites, global const int2 *places,     \
       global const int *noise_offsets, global const float *noise_gains, global const uchar *subject,             \
-      global const short *objects, PsViewLaunch L, param alpha, param sigma, param sigma_hi, global int *records,                 \
+      global const short *objects, PsViewLaunch L, param alpha, global int *records,                                     \
       global real *field, global uchar *out, global const param *phys, global real *raw, global real *scratch,   \
       global const ulong *indices
 

@@ -69,8 +69,6 @@ inline void check_count(cl::Kernel& k, cl_uint given) {
   X(cl::Buffer, objects)       \
   X(PsViewLaunch, L)           \
   X(Real, alpha)               \
-  X(Real, sigma)               \
-  X(Real, sigma_hi)            \
   X(cl::Buffer, records)       \
   X(cl::Buffer, field)         \
   X(cl::Buffer, out)           \
@@ -117,8 +115,7 @@ PS_KERNEL_ARGS(PoolRegionsArgs, PS_POOL_REGIONS_ARGS)
   X(cl_uint2, seed)               \
   X(cl_uint2, first)              \
   X(cl::Buffer, indices)          \
-  X(cl_int, noise_lo)             \
-  X(cl_int, noise_hi)             \
+  X(cl::Buffer, drawn)            \
   X(cl::Buffer, out)
 PS_KERNEL_ARGS(MetalZonesArgs, PS_METAL_ZONES_ARGS)
 
@@ -134,8 +131,7 @@ PS_KERNEL_ARGS(MetalZonesArgs, PS_METAL_ZONES_ARGS)
   X(cl_uint2, seed)              \
   X(cl_uint2, first)             \
   X(cl::Buffer, indices)         \
-  X(cl_int, noise_lo)            \
-  X(cl_int, noise_hi)            \
+  X(cl::Buffer, drawn)           \
   X(cl_double, jitter)           \
   X(cl_double, half_width)       \
   X(cl_double, scale)            \
@@ -244,8 +240,7 @@ PS_KERNEL_ARGS(FeaturesSparseArgs, PS_FEATURES_SPARSE_ARGS)
   X(cl_int, block)                \
   X(cl_int, npooled)              \
   X(cl_int, row_len)              \
-  X(cl_float, sigma_lo)           \
-  X(cl_float, sigma_hi)           \
+  X(cl::Buffer, drawn)            \
   X(cl_uint2, seed)               \
   X(cl_uint2, first)              \
   X(cl::Buffer, indices)

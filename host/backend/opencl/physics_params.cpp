@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <stdexcept>
 
 #include "backend/opencl/gauss_table.h"
+#include "plan/knobs.h"
 #include "shared.h"
 
 namespace portalsim::opencl {
@@ -111,38 +113,30 @@ PsPhysMmw mmw_scalars(const Plan& plan, const ModelSettings& m) {
   PsPhysMmw h{};
   h.common.window_min = m.window_lo;
   h.common.window_max = m.window_hi;
-  // The window's ends drawn per scenario (stage_window): their ranges' upper ends.
-  const DrawnRange &window_lo = m.drawn[PS_DRAWN_WINDOW_LO], &window_hi = m.drawn[PS_DRAWN_WINDOW_HI];
-  h.window_min_hi = window_lo.varies() ? window_lo.hi : m.window_lo;
-  h.window_max_hi = window_hi.varies() ? window_hi.hi : m.window_hi;
-  // The NETD, and its range and the frames' where drawn per scenario (mmw_noise_of).
+  // The NETD over the frames where neither is drawn (mmw_noise_of).
   const MmwNoise noise = mmw_noise(plan, m);
-  h.netd_lo = noise.netd_lo;
-  h.netd_hi = noise.netd_hi;
-  h.frames_lo = noise.frames_lo;
-  h.frames_hi = noise.frames_hi;
+  h.netd = noise.netd_lo;
   h.frames_as_one = noise.as_one;
   return h;
 }
 
 // The IR camera's scalars, likewise.
-PsPhysIr ir_scalars(const PhysicsConfig& pc, const ModelSettings& m) {
+PsPhysIr ir_scalars(const PhysicsConfig& pc) {
   PsPhysIr h{};
   h.common.window_min = pc.ir_display_min;
   h.common.window_max = pc.ir_display_max;
-  // The NETD, and its range's upper end where drawn per scenario (ir_netd_of).
-  const DrawnRange& drawn = m.drawn[PS_DRAWN_IR_NETD];
-  h.netd = m.ir_netd;
-  h.netd_hi = drawn.varies() ? drawn.hi : m.ir_netd;
   return h;
 }
 
 // Writes a kind's scalars at the parameters' start (PS_PARAM each: the layout's every field
-// is a double on the host, so params() converting each keeps every field's index).
+// is a double on the host, so params() converting each keeps every field's index), and the
+// view's drawn ranges from the knobs' declarations (PsPhys::drawn: every kind begins with PsPhys).
 template <class Scalars>
-void put_scalars(std::vector<double>& p, const Scalars& h) {
+void put_scalars(std::vector<double>& p, const Scalars& h, const ModelSettings& m) {
   static_assert(sizeof(Scalars) % sizeof(double) == 0 && sizeof(Scalars) <= sizeof(PsPhysKinds));
   std::memcpy(p.data(), &h, sizeof h);
+  const PsDrawn drawn = drawn_ranges(m);
+  std::memcpy(p.data() + offsetof(PsPhys, drawn) / sizeof(double), &drawn, sizeof drawn);
 }
 
 // Per subject, its base image's value to kelvin: the IR index map (under an outfit, its
@@ -212,8 +206,8 @@ void append_moves(std::vector<double>& out, const Derive& d, double tc) {
 // scenario's moves from them. Empty where neither is drawn.
 std::vector<double> scene_block(const Derive& d) {
   if (!scene_drawn(d.m)) return {};
-  const DrawnRange &ill = d.m.drawn[PS_DRAWN_ILLUMINATION], &worn = d.m.drawn[PS_DRAWN_WORN_MINUTES];
-  std::vector<double> scene = {ill.varies() ? 1.0 : 0.0, d.m.worn_minutes, worn.varies() ? worn.hi : d.m.worn_minutes};
+  const DrawnRange& ill = d.m.drawn[PS_DRAWN_ILLUMINATION];
+  std::vector<double> scene = {ill.varies() ? 1.0 : 0.0};
   append_moves(scene, d, d.pc.clothing_transmission);
   return scene;
 }
@@ -228,12 +222,10 @@ std::vector<double> clothing_block(const Derive& d, const AssetSet& assets) {
   const bool scene = scene_drawn(d.m);
   const size_t C = outfits.class_first.size(), S = d.cat.subjects.size(), V = d.cat.variant_list.size();
   const size_t stride = PS_OUTFIT_HEAD + 2 * S + V + (scene ? 2 * S + 4 * V : 0);
-  const DrawnRange& folds = d.m.drawn[PS_DRAWN_CLOTHING_FOLDS];
   // The kernels read each view's fold pattern from the atlas (fold_row).
   if (d.m.has_folds() && assets.folds.empty())
     throw std::logic_error("--clothing-folds: the assets were built without fold patterns");
-  std::vector<double> clothing = {
-      double(C), double(stride), 0.0, d.m.clothing_folds, folds.varies() ? folds.hi : d.m.clothing_folds, 0.0};
+  std::vector<double> clothing = {double(C), double(stride), 0.0, 0.0};
   for (int f : outfits.class_first) clothing.push_back(f);
   for (int n : outfits.class_count) clothing.push_back(n);
   for (const Outfit& o : outfits.outfits) {
@@ -324,7 +316,7 @@ void append_mmw_grids(PhysicsTables& t, const Derive& d, const AssetSet& assets,
   for (size_t k = 0; k < S; ++k) unit[2 * k] = 1;
   clothing[PS_CLOTHING_GRIDS] = append(p, bare_grids(unit.data()));
   // The fold grids: each subject's fold share m (0 .. 1) times its gray, then m alone.
-  if (clothing[PS_CLOTHING_FOLDS_HI] > 0) {
+  if (d.m.has_folds()) {
     std::vector<double> folds = grids_of([&](size_t subj, int x, int y) {
       return assets.folds[subj][view].at(x, y) / 255.0 * assets.bases[subj][view].at(x, y);
     });
@@ -357,17 +349,23 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   t.at.gauss = append(p, gauss_table());  // the sensor noise's table Gaussians
   std::vector<double> scene = scene_block(d), clothing = clothing_block(d, assets);
   if (d.ir) {
-    PsPhysIr h = ir_scalars(d.pc, m);
+    PsPhysIr h = ir_scalars(d.pc);
     t.at.off_body = append(p, off_body_block(d));
     if (!scene.empty()) h.common.scene = append(p, scene);
     if (!clothing.empty()) h.common.clothing = append(p, clothing);
-    put_scalars(p, h);
+    put_scalars(p, h, m);
     return t;
   }
   PsPhysMmw h = mmw_scalars(plan, m);
   append_mmw_grids(t, d, assets, s, view, psf, scene, clothing, h.common);
-  put_scalars(p, h);
+  put_scalars(p, h, m);
   return t;
+}
+
+std::vector<double> drawn_params(const ModelSettings& m) {
+  std::vector<double> p(PS_PHYS_SUBJECTS, 0.0);
+  put_scalars(p, PsPhys{}, m);
+  return p;
 }
 
 }  // namespace portalsim::opencl

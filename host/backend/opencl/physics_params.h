@@ -21,6 +21,10 @@ struct PhysicsTables {
 };
 PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const Plan& plan, const ModelSettings& m,
                              int view);
+// Parameters that hold `m`'s drawn ranges alone (PsPhys::drawn; the kinds' scalars zero): the
+// thesis model's view parameters (kernels/lib/gauss.cl, pixel_sigma_of), and the run's for the
+// kernels of no view (metal_zones, metal_physics, analytic_noise).
+std::vector<double> drawn_params(const ModelSettings& m);
 
 // stage_mmw_display's scratch values per scenario: each view row's vertically
 // interpolated raw row, then 16 values per raw row for the pixels after the last run of 16.

@@ -85,7 +85,7 @@ std::shared_ptr<ViewDerived> ViewDerivations::operator()(const Plan& plan, int v
         std::max({s.pixels(), size_t(s.width) + m.raw_width, mmw_display_scratch(s, m.raw_width, m.raw_height),
                   s.pixels() + 2 * size_t(s.height)});
   } else {
-    d->phys = constant(ctx_, std::vector<cl_double>(2, 0.0));
+    d->phys = params(ctx_, fp64, drawn_params(m));
   }
   entry = d;
   return d;

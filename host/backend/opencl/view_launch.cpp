@@ -38,8 +38,6 @@ ViewLaunch::ViewLaunch(Device& d, Kernels& K, const Plan& p, int view, const Dev
                         .objects = b.objects,
                         .L = L,
                         .alpha = {d.cat.images.alpha},
-                        .sigma = {derived->model.pixel_sigma},
-                        .sigma_hi = {derived->model.pixel_sigma_hi()},
                         .records = records,
                         .field = field,
                         .out = out,

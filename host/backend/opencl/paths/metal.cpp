@@ -1,9 +1,11 @@
 // The metal detector's zones: the thesis model's influence tables (kernels/metal.cl), or
 // the physics model's coil fields and polarizability tensors (kernels/metal_physics.cl, in
 // fp64).
+#include "backend/opencl/buffers.h"
 #include "backend/opencl/launch.h"
 #include "backend/opencl/metal_map.h"
 #include "backend/opencl/paths/paths.h"
+#include "backend/opencl/physics_params.h"
 #include "base/error.h"
 
 namespace portalsim::opencl {
@@ -48,9 +50,8 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
   const Catalogue& cat = d_.cat;
   cl::Buffer& metal = out_.at_least(d_.ctx(), b.n * cat.zones);
   const cl_uint n = static_cast<cl_uint>(b.n);
-  // The detector noise's range: the kernels draw each scenario's from it (drawn_knob_at).
-  const DrawnRange& drawn = plan.model.drawn[PS_DRAWN_METAL_NOISE];
-  const cl_int noise_hi = drawn.varies() ? static_cast<cl_int>(drawn.hi) : plan.model.metal_noise;
+  // The run's drawn ranges: the kernels draw each scenario's detector noise from them.
+  const cl::Buffer drawn = params(d_.ctx(), K.fp64(), drawn_params(plan.model));
   if (plan.model.model == Model::physics) {
     if (!d_.rt.has_fp64())
       throw EnvironmentError("--model physics computes metal zones in fp64, and " + d_.rt.device_name() +
@@ -69,8 +70,7 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
                              .seed = b.seed,
                              .first = b.first,
                              .indices = b.indices,
-                             .noise_lo = plan.model.metal_noise,
-                             .noise_hi = noise_hi,
+                             .drawn = drawn,
                              .jitter = plan.model.jitter,
                              .half_width = kFieldWidth / 2.0,
                              .scale = cat.metres_per_field_unit(),
@@ -88,8 +88,7 @@ void MetalPath::run(Kernels& K, const Plan& plan, const DeviceBatch& b, BatchOut
                            .seed = b.seed,
                            .first = b.first,
                            .indices = b.indices,
-                           .noise_lo = plan.model.metal_noise,
-                           .noise_hi = noise_hi,
+                           .drawn = drawn,
                            .out = metal},
             b.n);
   }

@@ -1,8 +1,10 @@
 // The features of plans that no features path takes: each pooled view rendered by its view
 // path, then its block and region means (kernels/pool.cl); and the block-mean noise model,
 // which every features path's means get where it is chosen (kernels/pool_sparse.cl).
+#include "backend/opencl/buffers.h"
 #include "backend/opencl/launch.h"
 #include "backend/opencl/paths/paths.h"
+#include "backend/opencl/physics_params.h"
 
 namespace portalsim::opencl {
 
@@ -56,8 +58,7 @@ void block_mean_noise(Device& d, Kernels& K, const Plan& plan, const DeviceBatch
                             .block = lay.block,
                             .npooled = static_cast<cl_int>(lay.pooled.size()),
                             .row_len = lay.image_features(),
-                            .sigma_lo = static_cast<cl_float>(plan.model.pixel_sigma),
-                            .sigma_hi = static_cast<cl_float>(plan.model.pixel_sigma_hi()),
+                            .drawn = params(d.ctx(), K.fp64(), drawn_params(plan.model)),
                             .seed = b.seed,
                             .first = b.first,
                             .indices = b.indices},
