@@ -21,6 +21,8 @@ struct PhysicsTables {
 };
 PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const Plan& plan, const ModelSettings& m,
                              int view);
+// Whether `kind`'s CameraKind::physics_fill names one of the fill steps physics_tables knows.
+bool has_physics_fill(const CameraKind& kind);
 
 // stage_mmw_display's scratch values per scenario: each view row's vertically
 // interpolated raw row, then 16 values per raw row for the pixels after the last run of 16.
