@@ -366,7 +366,7 @@ TEST(Bodies, BothBackendsAgreeOnDrawnAndExtremeBodies) {
       cl->run(batch, p, k);
       const OutputDiff d = compare_outputs(k, r);
       EXPECT_EQ(check_tolerance(d, model_tolerance(model, Tier::standard)), "");  // plan/tolerance.h
-      EXPECT_GT(d.ir.pixels, 0u);
+      EXPECT_GT(d.of(Camera::ir).pixels, 0u);
       EXPECT_EQ(d.metal_exact, 1.0);
     }
     // The bodies reach the images: the same scenes on the catalogue's five subjects give

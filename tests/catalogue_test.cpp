@@ -3,7 +3,11 @@
 
 #include <algorithm>
 
+#include "backend/compare.h"
+#include "backend/opencl/physics_params.h"
+#include "backend/stages.h"
 #include "base/error.h"
+#include "plan/knobs.h"
 #include "scene/camera_kind.h"
 #include "scene/rules.h"
 #include "support.h"
@@ -129,6 +133,59 @@ TEST(CameraKinds, ListedInCameraOrderUnderDistinctNames) {
   }
   EXPECT_EQ(camera_kind_names(), "\"mmw\" or \"ir\"");
   EXPECT_EQ(camera_kind_named("thermal"), nullptr);
+}
+
+// Each kind answers every question code asks of it, so a new kind's declaration is whole
+// where its answers name something: a NETD knob whose bound is the kind's, registered
+// stages, a physics fill step; and the catalogue and the comparisons hold a slot per kind.
+TEST(CameraKinds, EachAnswersEveryQuestion) {
+  const Catalogue& c = catalogue();
+  const OutputDiff diff;
+  EXPECT_EQ(diff.cameras.size(), camera_kinds().size());
+  for (const CameraKind* kind : camera_kinds()) {
+    SCOPED_TRACE(kind->name);
+    ASSERT_NE(kind->label, nullptr);
+    EXPECT_STRNE(kind->label, "");
+    for (const char* noun : kind->nouns) EXPECT_NE(noun, nullptr);
+    // Its NETD knob is a number knob bounded as a view's own netd is.
+    const DrawnKnob& netd = drawn_knobs().at(kind->netd_knob);
+    EXPECT_NE(std::get_if<double ModelSettings::*>(&netd.field), nullptr);
+    ASSERT_NE(find_knob(netd.key), nullptr);
+    EXPECT_EQ(find_knob(netd.key)->max, kind->netd_max);
+    for (const std::string& stage : kind->physics_chain) EXPECT_NO_THROW(view_stage(stage)) << stage;
+    EXPECT_TRUE(opencl::has_physics_fill(*kind)) << kind->physics_fill;
+    for (const Object& o : c.objects) {
+      EXPECT_EQ(o.levels.size(), camera_kinds().size()) << o.name;
+      for (const Variant& v : o.variants) EXPECT_EQ(v.images.size(), camera_kinds().size()) << o.name;
+    }
+  }
+  // Two kinds told apart in messages.
+  for (const CameraKind* a : camera_kinds())
+    for (const CameraKind* b : camera_kinds())
+      if (a != b) {
+        EXPECT_STRNE(a->label, b->label);
+      }
+}
+
+// A view's own netd replaces its kind's NETD knob, and only that one, for the view's launch.
+TEST(CameraKinds, OwnNetdReplacesTheKindsKnob) {
+  for (const CameraKind* kind : camera_kinds()) {
+    SCOPED_TRACE(kind->name);
+    ModelSettings run;
+    for (DrawnRange& d : run.drawn) d = {.lo = 0.0, .hi = 0.01};
+    Sensor view;
+    view.camera = kind->camera;
+    view.netd = 0.005;
+    const ModelSettings m = run.for_view(view);
+    for (unsigned e = 0; e < PS_DRAWN_KNOBS; ++e) {
+      const auto* field = std::get_if<double ModelSettings::*>(&drawn_knobs().at(e).field);
+      SCOPED_TRACE(drawn_knobs().at(e).key);
+      EXPECT_EQ(m.drawn[e].varies(), e != kind->netd_knob);
+      if (field) {
+        EXPECT_EQ(m.**field, e == kind->netd_knob ? 0.005 : run.**field);
+      }
+    }
+  }
 }
 
 }  // namespace

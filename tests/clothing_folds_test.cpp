@@ -88,8 +88,8 @@ TEST(ClothingFolds, TheExtremesAreTheReferences) {
     ref->run(batch, plan, r);
     ocl->run(batch, plan, k);
     const OutputDiff d = compare_outputs(k, r);
-    test::expect_camera_parity(d.mmw);
-    test::expect_camera_parity(d.ir);
+    test::expect_camera_parity(d.of(Camera::mmw));
+    test::expect_camera_parity(d.of(Camera::ir));
     Plan plain = plan;
     set_knob(plain, *find_knob("clothing_folds"), "0", "--clothing-folds");
     ocl->run(batch, plain, smooth);
@@ -119,7 +119,7 @@ TEST(ClothingFolds, AssetsWithoutPatternsRefuseFolds) {
   BatchOutput k, r;
   ocl->run(batch, folded_plan("coat", "0", Tier::standard, true), k);
   ref->run(batch, folded_plan("coat", "0", Tier::standard, true), r);
-  test::expect_camera_parity(compare_outputs(k, r).mmw);
+  test::expect_camera_parity(compare_outputs(k, r).of(Camera::mmw));
 }
 
 // In IR a fold holds more of the skin's warmth in: the surface is cooler where the pattern

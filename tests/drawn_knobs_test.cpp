@@ -201,8 +201,8 @@ TEST(DrawnKnobs, IrNetdDrawnPerScenarioIsTheReferencesOnEveryPath) {
     const Plan drawn = plan_of("0..0.6", fused, tier);
     BatchOutput k;
     const OutputDiff d = b.compare(batch, drawn, drawn, k);
-    EXPECT_GT(d.ir.pixels, 0u);
-    test::expect_camera_parity(d.ir);
+    EXPECT_GT(d.of(Camera::ir).pixels, 0u);
+    test::expect_camera_parity(d.of(Camera::ir));
     // A range of one value is that value, to the byte.
     BatchOutput one, fixed;
     b.ocl->run(batch, plan_of("0.2..0.2", fused, tier), one);
@@ -241,8 +241,8 @@ TEST(DrawnKnobs, MmwNetdAndFramesDrawnPerScenarioAreTheReferencesOnEveryPath) {
     const Plan drawn = plan_of("0.2..2", "1..9", fused, tier);
     BatchOutput k;
     const OutputDiff d = b.compare(batch, drawn, drawn, k);
-    EXPECT_GT(d.mmw.pixels, 0u);
-    test::expect_camera_parity(d.mmw);
+    EXPECT_GT(d.of(Camera::mmw).pixels, 0u);
+    test::expect_camera_parity(d.of(Camera::mmw));
     // A range of one value is that value, to the byte.
     BatchOutput one, fixed;
     b.ocl->run(batch, plan_of("1.5..1.5", "4..4", fused, tier), one);
@@ -329,10 +329,10 @@ TEST(DrawnKnobs, IlluminationAndWornTimeDrawnPerScenarioAreTheReferencesOnEveryP
     const Plan drawn = plan_of("280..310", "0..60", fused, tier);
     BatchOutput k;
     const OutputDiff d = b.compare(batch, drawn, drawn, k);
-    EXPECT_GT(d.mmw.pixels, 0u);
-    EXPECT_GT(d.ir.pixels, 0u);
-    test::expect_camera_parity(d.mmw);
-    test::expect_camera_parity(d.ir);
+    EXPECT_GT(d.of(Camera::mmw).pixels, 0u);
+    EXPECT_GT(d.of(Camera::ir).pixels, 0u);
+    test::expect_camera_parity(d.of(Camera::mmw));
+    test::expect_camera_parity(d.of(Camera::ir));
     // A range of one value is that value, to the byte.
     BatchOutput one, fixed;
     b.ocl->run(batch, plan_of("300..300", "20..20", fused, tier), one);
@@ -494,8 +494,8 @@ TEST(DrawnKnobs, WindowEndsDrawnPerScenarioAreTheReferencesOnEveryPath) {
   };
   const size_t upper = static_cast<size_t>(catalogue().sensor_index("upper"));
   const auto mmw_within = [](const OutputDiff& d) {
-    EXPECT_GT(d.mmw.pixels, 0u);
-    test::expect_camera_parity(d.mmw);
+    EXPECT_GT(d.of(Camera::mmw).pixels, 0u);
+    test::expect_camera_parity(d.of(Camera::mmw));
     EXPECT_EQ(d.metal_exact, 1.0);
   };
   each_path({Tier::standard, Tier::exact, Tier::fast}, [&](Tier tier, bool fused) {

@@ -723,7 +723,8 @@ TEST(ExtremeAlpha, ExactTierKeepsTheCataloguesAlpha) {
     w->cl->run(batch, images_plan(model(5, false), Tier::exact), exact);
     const OutputDiff d = compare_outputs(exact, ref);
     EXPECT_EQ(check_tolerance(d, tier_tolerance(Tier::exact)), "")
-        << "MMW pixels differing: " << d.mmw.share_differing * d.mmw.pixels << " of " << d.mmw.pixels;
+        << "MMW pixels differing: " << d.of(Camera::mmw).share_differing * d.of(Camera::mmw).pixels << " of "
+        << d.of(Camera::mmw).pixels;
   }
 }
 

@@ -111,8 +111,8 @@ TEST(IrPhysics, KernelsMatchTheReferenceInEveryTier) {
     make_opencl_backend(c.world->cat, c.world->assets, test::runtime())->run(batch, plan, k);
     const OutputDiff d = compare_outputs(k, r);
     // Stated tolerance: IR pixels (temperature index) within 1 level, at most 0.5% off by one.
-    EXPECT_GT(d.ir.pixels, 0u);
-    test::expect_camera_parity(d.ir);
+    EXPECT_GT(d.of(Camera::ir).pixels, 0u);
+    test::expect_camera_parity(d.of(Camera::ir));
   }
 }
 
@@ -191,7 +191,7 @@ TEST(IrPhysics, EachStageOfTheChainDoesSomethingInBothBackends) {
     BatchOutput r, k;
     make_reference_backend(cat, assets())->run(batch, plan, r);
     make_opencl_backend(cat, assets(), test::runtime())->run(batch, plan, k);
-    EXPECT_LE(compare_outputs(k, r).ir.max_abs, 1);
+    EXPECT_LE(compare_outputs(k, r).of(Camera::ir).max_abs, 1);
     EXPECT_NE(r.view("ir").pixels, whole.view("ir").pixels) << "the stage changes nothing";
     EXPECT_EQ(r.view("upper").pixels, whole.view("upper").pixels) << "an IR stage changed the MMW view";
   }

@@ -64,10 +64,10 @@ inline void expect_drawn_images_parity(Backend& ref, Backend& ocl, const SceneBa
         ref.run(batch, plan, r);
         ocl.run(batch, plan, k);
         const OutputDiff d = compare_outputs(k, r);
-        EXPECT_GT(d.mmw.pixels, 0u);
-        EXPECT_GT(d.ir.pixels, 0u);
-        expect_camera_parity(d.mmw);
-        expect_camera_parity(d.ir);
+        EXPECT_GT(d.of(Camera::mmw).pixels, 0u);
+        EXPECT_GT(d.of(Camera::ir).pixels, 0u);
+        expect_camera_parity(d.of(Camera::mmw));
+        expect_camera_parity(d.of(Camera::ir));
         BatchOutput other;
         Plan plain_plan = plan;
         plain(plain_plan);

@@ -310,7 +310,7 @@ TEST(Parity, PlacementJitterIntegerAndBilinear) {
   p.model.bilinear = true;
   BatchOutput c;
   cl->run(test::batch_of(scenes), p, c);
-  EXPECT_LE(compare_outputs(c, still).mmw.max_abs, 1);
+  EXPECT_LE(compare_outputs(c, still).of(Camera::mmw).max_abs, 1);
 }
 
 }  // namespace

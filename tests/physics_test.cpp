@@ -82,7 +82,7 @@ TEST(Physics, KernelsMatchTheReferenceInEveryTier) {
     // The tolerance table (plan/tolerance.h), and the MMW camera's own: pixels within 1
     // gray level, at most 0.5% of them off by one; metal zones exact.
     EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, c.tier)), "");
-    test::expect_camera_parity(d.mmw);
+    test::expect_camera_parity(d.of(Camera::mmw));
     EXPECT_EQ(d.metal_exact, 1.0);
   }
 }
@@ -112,9 +112,9 @@ TEST(Physics, FastTierDrawsMatchTheReference) {
     make_opencl_backend(catalogue(), assets(), test::runtime())->run(batch, *plan, k);
     const OutputDiff d = compare_outputs(k, r);
     EXPECT_EQ(check_tolerance(d, model_tolerance(Model::physics, Tier::fast)), "");
-    EXPECT_GT(d.ir.pixels, 0u);
-    test::expect_camera_parity(d.mmw);
-    test::expect_camera_parity(d.ir);
+    EXPECT_GT(d.of(Camera::ir).pixels, 0u);
+    test::expect_camera_parity(d.of(Camera::mmw));
+    test::expect_camera_parity(d.of(Camera::ir));
     EXPECT_NE(k.view("ir").pixels, box_muller.view("ir").pixels) << "the draws must not be the table's";
   }
 }
@@ -380,7 +380,7 @@ TEST(Physics, FastPathMatchesTheChainOfStageKernels) {
       plan.fidelity.fused = false;
       cl->run(batch, plan, staged);
       const OutputDiff d = compare_outputs(fast, staged);
-      test::expect_camera_parity(d.mmw);
+      test::expect_camera_parity(d.of(Camera::mmw));
     }
 }
 
@@ -400,7 +400,7 @@ TEST(Physics, EachStageOfTheChainDoesSomethingInBothBackends) {
     make_reference_backend(cat, assets())->run(batch, plan, r);
     make_opencl_backend(cat, assets(), test::runtime())->run(batch, plan, k);
     const OutputDiff d = compare_outputs(k, r);
-    EXPECT_LE(d.mmw.max_abs, 1);
+    EXPECT_LE(d.of(Camera::mmw).max_abs, 1);
     EXPECT_NE(r.view("upper").pixels, whole.view("upper").pixels) << "the stage changes nothing";
   }
 }
@@ -700,7 +700,7 @@ TEST(Physics, AutoWindowOnAFlatGridKeepsItsMinimumSpan) {
     make_reference_backend(w.cat, w.assets)->run(batch, plan, r);
     make_opencl_backend(w.cat, w.assets, test::runtime())->run(batch, plan, k);
     const OutputDiff d = compare_outputs(k, r);
-    test::expect_camera_parity(d.mmw);
+    test::expect_camera_parity(d.of(Camera::mmw));
     const std::vector<uint8_t>& px = k.view("upper").pixels;
     const auto [lo, hi] = std::minmax_element(px.begin(), px.begin() + 200 * 200);
     EXPECT_GT(*hi - *lo, 20) << "the noise must show";
@@ -737,7 +737,7 @@ TEST(Physics, Extremes) {
   plate.objects[1] = static_cast<int16_t>(variant_of(w.cat, "metal-plate"));
   make_reference_backend(w.cat, w.assets)->run(test::batch_of({plate}), wide, r);
   make_opencl_backend(w.cat, w.assets, test::runtime())->run(test::batch_of({plate}), wide, k);
-  EXPECT_LE(compare_outputs(k, r).mmw.max_abs, 1);
+  EXPECT_LE(compare_outputs(k, r).of(Camera::mmw).max_abs, 1);
   const auto [lo, hi] = std::minmax_element(k.view("upper").pixels.begin(), k.view("upper").pixels.end());
   EXPECT_LE(*hi - *lo, 20);
 }

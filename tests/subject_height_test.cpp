@@ -205,7 +205,7 @@ TEST(SubjectHeight, BothBackendsAgreeAndMetalFollows) {
     if (model == Model::thesis) {
       EXPECT_EQ(check_tolerance(d, tier_tolerance(Tier::standard)), "");
     } else {  // the physics model's stated tolerance (physics_test.cpp)
-      test::expect_camera_parity(d.mmw);
+      test::expect_camera_parity(d.of(Camera::mmw));
       EXPECT_LE(d.feature_max_abs, 1.0);
     }
     EXPECT_EQ(d.metal_exact, 1.0);

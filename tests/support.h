@@ -33,7 +33,7 @@ inline const Catalogue& catalogue() {
   return c;
 }
 // The first MMW view that sees region r (index into Catalogue::sensors), and its rectangle.
-inline int mmw_view_of(const Catalogue& cat, int r) { return first_view(cat.sensors, r, Camera::mmw); }
+inline int mmw_view_of(const Catalogue& cat, int r) { return first_feature_view(cat.sensors, r); }
 inline const Rect& mmw_rect(const Catalogue& cat, int r) { return cat.sensors.at(mmw_view_of(cat, r)).rects[r]; }
 
 inline const AssetSet& assets() {

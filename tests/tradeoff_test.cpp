@@ -147,16 +147,16 @@ void errors_are_against_the_same_models_reference(const json& report, const fs::
     cl->run(batch, plan, exact);
     const OutputDiff d = compare_outputs(exact, refs[m]);
     const json& r = row(report, model_name(m), "exact");
-    EXPECT_EQ(r["mmw_max_abs"].get<int>(), d.mmw.max_abs);
-    EXPECT_DOUBLE_EQ(r["mmw_rmse_mean"].get<double>(), d.mmw.rmse_mean);
-    EXPECT_DOUBLE_EQ(r["mmw_share_differing"].get<double>(), d.mmw.share_differing);
-    EXPECT_EQ(r["ir_max_abs"].get<int>(), d.ir.max_abs);
+    EXPECT_EQ(r["mmw_max_abs"].get<int>(), d.of(Camera::mmw).max_abs);
+    EXPECT_DOUBLE_EQ(r["mmw_rmse_mean"].get<double>(), d.of(Camera::mmw).rmse_mean);
+    EXPECT_DOUBLE_EQ(r["mmw_share_differing"].get<double>(), d.of(Camera::mmw).share_differing);
+    EXPECT_EQ(r["ir_max_abs"].get<int>(), d.of(Camera::ir).max_abs);
     // Within the model's stated tolerance (plan/tolerance.h).
     EXPECT_EQ(check_tolerance(d, model_tolerance(m, Tier::exact)), "");
     // Against the other model's reference the same images are far off.
     const OutputDiff other = compare_outputs(exact, refs[m == Model::thesis ? Model::physics : Model::thesis]);
-    EXPECT_GT(other.mmw.max_abs, 1);
-    EXPECT_GT(other.mmw.rmse_mean, 10 * std::max(d.mmw.rmse_mean, 0.01));
+    EXPECT_GT(other.of(Camera::mmw).max_abs, 1);
+    EXPECT_GT(other.of(Camera::mmw).rmse_mean, 10 * std::max(d.of(Camera::mmw).rmse_mean, 0.01));
   }
   // The physics exact tier within the physics camera's bounds: 1 gray level, 0.5% of pixels.
   const json& p = row(report, "physics", "exact");

@@ -59,7 +59,7 @@ TEST(RandomisedObjects, KernelsMatchTheReferenceInEveryTier) {
       ref->run(test::batch_of(sc), p, b);
       const OutputDiff d = compare_outputs(a, b);
       EXPECT_EQ(check_tolerance(d, tier_tolerance(tier)), "");
-      EXPECT_GT(compare_outputs(a, still).mmw.max_abs, 50) << "the transforms must change the images";
+      EXPECT_GT(compare_outputs(a, still).of(Camera::mmw).max_abs, 50) << "the transforms must change the images";
       EXPECT_EQ(a.metal, still.metal) << "transforms leave the metal detector as it was";
     }
 }

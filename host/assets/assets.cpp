@@ -24,6 +24,11 @@ Image load(const ImageSource& src) { return read_image(src.path, src.origin); }
 
 Image sized(Image img, int w, int h) { return resize_image(img, w, h); }
 
+// A file as a view of `kind` stores it: temperature indices (nearest palette colour), or gray.
+Image as_stored(const CameraKind& kind, const Image& img, const Palette& palette, bool keep_alpha) {
+  return kind.palette ? to_temperature(img, palette, keep_alpha) : to_gray(img, keep_alpha);
+}
+
 Image mirrored(const Image& img) {
   Image out(img.width, img.height, img.channels);
   for (int y = 0; y < img.height; ++y)
@@ -97,14 +102,13 @@ void draw_subjects(AssetSet& a, const Catalogue& cat, bool fold_patterns) {
     body.ir_limb = sub.ir_limb;
     std::vector<Image>& views = a.bases[s];
     for (const Sensor& view : cat.sensors) {
-      const bool ir = view.camera == Camera::ir;
+      const CameraKind& kind = camera_kind(view.camera);
       const ImageSource& src = sub.image(view.name);
       if (!src.path.empty())
-        views.push_back(sized(ir ? to_temperature(load(src), a.palette, false) : to_gray(load(src), false), view.width,
-                              view.height));
+        views.push_back(sized(as_stored(kind, load(src), a.palette, false), view.width, view.height));
       else
-        views.push_back(ir ? procedural::ir_view(body, view.field, view.side, view.width, view.height)
-                           : procedural::mmw_view(body, view.field, view.side, view.width, view.height));
+        views.push_back(kind.palette ? procedural::ir_view(body, view.field, view.side, view.width, view.height)
+                                     : procedural::mmw_view(body, view.field, view.side, view.width, view.height));
     }
   };
   const bool files =
@@ -112,8 +116,9 @@ void draw_subjects(AssetSet& a, const Catalogue& cat, bool fold_patterns) {
   parallel_for(cat.subjects.size(), files ? 1 : default_threads(), [&](size_t begin, size_t end) {
     for (size_t s = begin; s < end; ++s) draw(s);
   });
-  // Each base's folds over its body: MMW pixels nearer the subject's body gray than the room's,
-  // IR pixels warmer than halfway from the room to the skin (as the contact shadow's test).
+  // Each base's folds over its body: gray pixels nearer the subject's body gray than the
+  // room's, temperature indices warmer than halfway from the room to the skin (as the IR
+  // contact shadow's test).
   if (fold_patterns) {
     const PhysicsConfig& pc = cat.physics;
     a.folds.resize(cat.subjects.size());
@@ -124,8 +129,9 @@ void draw_subjects(AssetSet& a, const Catalogue& cat, bool fold_patterns) {
         const int bg = pc.base_background_gray, level = sub.mmw_level, mid = (bg + level + 1) / 2;
         for (size_t v = 0; v < cat.sensors.size(); ++v) {
           const Sensor& view = cat.sensors[v];
-          const bool ir = view.camera == Camera::ir;
-          const int lo = ir ? pc.ir_body_index() : (level >= bg ? mid : 0), hi = ir ? 255 : (level >= bg ? 255 : mid);
+          const bool index = view.palette;
+          const int lo = index ? pc.ir_body_index() : (level >= bg ? mid : 0);
+          const int hi = index ? 255 : (level >= bg ? 255 : mid);
           a.folds[s].push_back(procedural::fold_pattern(a.bases[s][v], view, lo, hi, texture));
         }
       }
@@ -157,21 +163,23 @@ AssetSet build_assets(const Catalogue& cat, bool fold_patterns) {
   const auto draw_sprite = [&](size_t job) {
     const SpriteSet& set = cat.sprite_sets[job / V];
     const size_t v = job % V;
-    const bool ir = set.camera == Camera::ir;
+    const CameraKind& kind = camera_kind(set.camera);
     const Object& o = cat.object_of(static_cast<int>(v));
     const Variant& var = cat.variant(static_cast<int>(v));
     const bool vertical = var.code == "v";
     const int w = vertical ? o.height : o.width, h = vertical ? o.width : o.height;
     const int sw = std::max(1, static_cast<int>(std::lround(w * set.scale_x)));
     const int sh = std::max(1, static_cast<int>(std::lround(h * set.scale_y)));
-    const ImageSource& file = ir ? var.ir : var.mmw;
-    Image sp = !file.path.empty() ? (ir ? to_temperature(load(file), a.palette, true) : to_gray(load(file), true))
-                                  : procedural::sprite(o.shape, vertical, sw, sh, ir ? o.ir_level : o.mmw_level);
+    const auto k = static_cast<size_t>(set.camera);
+    const ImageSource& file = var.images[k];
+    Image sp = !file.path.empty() ? as_stored(kind, load(file), a.palette, true)
+                                  : procedural::sprite(o.shape, vertical, sw, sh, o.levels[k]);
     a.sprites[job / V][v] = set.mirrored ? mirrored(sp) : std::move(sp);
   };
   const bool sprite_files = std::any_of(cat.objects.begin(), cat.objects.end(), [](const Object& o) {
-    return std::any_of(o.variants.begin(), o.variants.end(),
-                       [](const Variant& v) { return !v.mmw.path.empty() || !v.ir.path.empty(); });
+    return std::any_of(o.variants.begin(), o.variants.end(), [](const Variant& v) {
+      return std::any_of(v.images.begin(), v.images.end(), [](const ImageSource& s) { return !s.path.empty(); });
+    });
   });
   parallel_for(cat.sprite_sets.size() * V, sprite_files ? 1 : default_threads(), [&](size_t begin, size_t end) {
     for (size_t job = begin; job < end; ++job) draw_sprite(job);

@@ -47,8 +47,9 @@ OutputDiff compare_outputs(const BatchOutput& test, const BatchOutput& ref) {
   e.features_only = !test.features.empty() &&
                     std::all_of(test.views.begin(), test.views.end(), [](const ViewImages& v) { return v.empty(); });
   // Per camera, over all its views: a view one side has and the other lacks is no match.
-  for (Camera cam : {Camera::mmw, Camera::ir}) {
+  for (const CameraKind* kind : camera_kinds()) {
     if (e.features_only) break;
+    const Camera cam = kind->camera;
     std::vector<uint8_t> a, b;
     size_t per_image = 0;
     bool mismatch = test.views.size() != ref.views.size();
@@ -61,7 +62,7 @@ OutputDiff compare_outputs(const BatchOutput& test, const BatchOutput& ref) {
       a.insert(a.end(), test.views[k].pixels.begin(), test.views[k].pixels.end());
       b.insert(b.end(), ref.views[k].pixels.begin(), ref.views[k].pixels.end());
     }
-    ImageDiff& d = cam == Camera::ir ? e.ir : e.mmw;
+    ImageDiff& d = e.cameras[static_cast<size_t>(cam)];
     d = compare_images(a, b, per_image);
     if (mismatch) d.max_abs = 256;
   }
@@ -89,7 +90,9 @@ OutputDiff compare_outputs(const BatchOutput& test, const BatchOutput& ref) {
 
 std::string check_tolerance(const OutputDiff& d, const Tolerance& t) {
   std::string why;
-  for (auto [name, img] : {std::pair{"MMW", &d.mmw}, std::pair{"IR", &d.ir}}) {
+  for (const CameraKind* kind : camera_kinds()) {
+    const char* name = kind->label;
+    const ImageDiff* img = &d.of(kind->camera);
     if (img->mean_abs > t.pixel_mean_abs)
       why += std::string(name) + " mean abs " + std::to_string(img->mean_abs) + " > " +
              std::to_string(t.pixel_mean_abs) + "; ";

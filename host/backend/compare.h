@@ -3,6 +3,7 @@
 #pragma once
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "backend/backend.h"
 #include "plan/tolerance.h"
@@ -21,7 +22,9 @@ struct ImageDiff {
 };
 
 struct OutputDiff {
-  ImageDiff mmw, ir;
+  // Per camera kind (camera_kinds()' order), over all its views.
+  std::vector<ImageDiff> cameras = std::vector<ImageDiff>(camera_kinds().size());
+  const ImageDiff& of(Camera c) const { return cameras.at(static_cast<size_t>(c)); }
   double feature_max_abs = 0, feature_mean_abs = 0;
   double metal_exact = 1;      // share of scenarios whose zones all match
   bool features_only = false;  // the test run rendered no images: its features came from a features-only path

@@ -111,7 +111,7 @@ void check_captures(const Captures& c) {
 std::vector<std::string> mmw_views(const Catalogue& cat) {
   std::vector<std::string> names;
   for (const Sensor& s : cat.sensors)
-    if (s.camera == Camera::mmw) names.push_back(s.name);
+    if (camera_kind(s.camera).raw_grid) names.push_back(s.name);  // the fit is of a raw grid
   return names;
 }
 

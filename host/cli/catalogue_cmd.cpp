@@ -37,8 +37,8 @@ int list(CatalogueOptions& o) {
                 c.subjects[i].shape.height);
   std::printf("\nregions:\n");
   for (const Region& r : c.regions) {
-    // The MMW view whose rectangles hold it, named in the views line.
-    const int view = first_view(c.sensors, r.id - 1, Camera::mmw);
+    // The features' view whose rectangles hold it, named in the views line.
+    const int view = first_feature_view(c.sensors, r.id - 1);
     std::printf("  %2d  %-15s %s\n", r.id, r.name.c_str(), view < 0 ? "" : c.sensors[view].name.c_str());
   }
   std::printf("\nobjects (name [variants] metal category, class, family, * in the default pool: aliases):\n");

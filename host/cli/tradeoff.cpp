@@ -286,16 +286,16 @@ struct ModelRows {
     r["noise_draw"] = irwin_hall ? "irwin-hall" : m == Model::physics ? "table Gaussian" : "box-muller";
     r["features_per_s"] = run.feat_rate;
     r["images_per_s"] = run.img_rate;
-    r["mmw_max_abs"] = run.img_err.mmw.max_abs;
-    r["mmw_rmse_mean"] = run.img_err.mmw.rmse_mean;
-    r["mmw_rmse_max"] = run.img_err.mmw.rmse_max;
-    r["mmw_psnr_db"] = run.img_err.mmw.psnr;
-    r["mmw_share_off_by_more_than_1"] = run.img_err.mmw.share_off_by_more_than_1;
-    r["mmw_share_differing"] = run.img_err.mmw.share_differing;
-    r["ir_max_abs"] = run.img_err.ir.max_abs;
-    r["ir_rmse_mean"] = run.img_err.ir.rmse_mean;
-    r["ir_psnr_db"] = run.img_err.ir.psnr;
-    r["ir_share_off_by_more_than_1"] = run.img_err.ir.share_off_by_more_than_1;
+    r["mmw_max_abs"] = run.img_err.of(Camera::mmw).max_abs;
+    r["mmw_rmse_mean"] = run.img_err.of(Camera::mmw).rmse_mean;
+    r["mmw_rmse_max"] = run.img_err.of(Camera::mmw).rmse_max;
+    r["mmw_psnr_db"] = run.img_err.of(Camera::mmw).psnr;
+    r["mmw_share_off_by_more_than_1"] = run.img_err.of(Camera::mmw).share_off_by_more_than_1;
+    r["mmw_share_differing"] = run.img_err.of(Camera::mmw).share_differing;
+    r["ir_max_abs"] = run.img_err.of(Camera::ir).max_abs;
+    r["ir_rmse_mean"] = run.img_err.of(Camera::ir).rmse_mean;
+    r["ir_psnr_db"] = run.img_err.of(Camera::ir).psnr;
+    r["ir_share_off_by_more_than_1"] = run.img_err.of(Camera::ir).share_off_by_more_than_1;
     r["feature_max_abs"] = run.feat_err.feature_max_abs;
     r["feature_mean_abs"] = run.feat_err.feature_mean_abs;
     r["metal_exact_rate"] = run.feat_err.metal_exact;
@@ -346,9 +346,9 @@ struct ModelRows {
     if (!frames_approximated) {
       const OutputDiff held = other_draws ? compare_outputs(*run.img_out, same_draw_ref(f.draw)) : run.img_err;
       if (other_draws) {
-        r["same_draw_mmw_max_abs"] = held.mmw.max_abs;
-        r["same_draw_mmw_rmse_mean"] = held.mmw.rmse_mean;
-        r["same_draw_mmw_share_differing"] = held.mmw.share_differing;
+        r["same_draw_mmw_max_abs"] = held.of(Camera::mmw).max_abs;
+        r["same_draw_mmw_rmse_mean"] = held.of(Camera::mmw).rmse_mean;
+        r["same_draw_mmw_share_differing"] = held.of(Camera::mmw).share_differing;
       }
       if (const std::string broke = check_tolerance(held, tol); !broke.empty()) why += "images run: " + broke;
     }

@@ -72,16 +72,14 @@ bool good_name(const std::string& n) {
 constexpr const char* kCnnInputs[] = {"mmw", "ir", "metal"};
 constexpr const char* kDefaultCnnInputs = "mmw,ir,metal";
 
-// The data.h5 datasets each image sensor's branch reads, from the catalogue's views: every
-// MMW view (a front-and-back portal's four), and each IR view's palette indices.
-struct CnnDatasets {
-  std::vector<std::string> mmw, ir;
-};
+// The data.h5 datasets each camera kind's branch reads (by Camera), from the catalogue's
+// views: each of its views (a front-and-back portal's four MMW views), a palette view's indices.
+using CnnDatasets = std::vector<std::vector<std::string>>;
 const std::vector<std::string> kMetalDatasets{"metal"};
 CnnDatasets cnn_datasets(const Catalogue& cat) {
-  CnnDatasets d;
+  CnnDatasets d(camera_kinds().size());
   for (const Sensor& s : cat.sensors)
-    (s.camera == Camera::mmw ? d.mmw : d.ir).push_back(s.palette ? s.name + "_index" : s.name);
+    d[static_cast<size_t>(s.camera)].push_back(s.palette ? s.name + "_index" : s.name);
   return d;
 }
 
@@ -92,9 +90,11 @@ std::string joined(const std::vector<std::string>& v, const char* sep) {
 }
 
 std::string cnn_input_words(const std::string& sensor, const CnnDatasets& d) {
-  if (sensor == "mmw") return "the MMW views (" + joined(d.mmw, ", ") + ")";
-  if (sensor == "ir") return (d.ir.size() == 1 ? "the IR image (" : "the IR images (") + joined(d.ir, ", ") + ")";
-  return "the metal detector's zones";
+  const CameraKind* kind = camera_kind_named(sensor);
+  if (!kind) return "the metal detector's zones";
+  const std::vector<std::string>& views = d[static_cast<size_t>(kind->camera)];
+  return std::string("the ") + kind->label + " " + kind->nouns[views.size() == 1 ? 0 : 1] + " (" + joined(views, ", ") +
+         ")";
 }
 
 // --cnn-inputs' value, checked: distinct names of kCnnInputs, in the order given.
@@ -122,15 +122,19 @@ Cnn cnn_of(const Options& o) {
   c.sensors = cnn_inputs(o.cnn_inputs.empty() ? kDefaultCnnInputs : o.cnn_inputs);
   const CnnDatasets d = cnn_datasets(o.catalogue.empty() ? default_catalogue() : load_catalogue(o.catalogue));
   for (const std::string& sensor : c.sensors) {
-    const std::vector<std::string>& read = sensor == "mmw" ? d.mmw : sensor == "ir" ? d.ir : kMetalDatasets;
+    const CameraKind* kind = camera_kind_named(sensor);
+    const std::vector<std::string>& read = kind ? d[static_cast<size_t>(kind->camera)] : kMetalDatasets;
     if (read.empty())
       throw InputError("--cnn-inputs: " + sensor + ", but the catalogue (" +
-                       (o.catalogue.empty() ? std::string("built-in") : o.catalogue) + ") has no " +
-                       (sensor == "mmw" ? "MMW" : "IR") + " view");
+                       (o.catalogue.empty() ? std::string("built-in") : o.catalogue) + ") has no " + kind->label +
+                       " view");
     c.words.push_back(cnn_input_words(sensor, d));
     for (const std::string& ds : read) c.datasets.push_back(ds);
   }
-  c.args = {"--inputs", joined(c.sensors, ","), "--mmw-views", joined(d.mmw, ","), "--ir-views", joined(d.ir, ",")};
+  c.args = {"--inputs", joined(c.sensors, ",")};
+  for (const CameraKind* kind : camera_kinds())  // --mmw-views, --ir-views
+    c.args.insert(c.args.end(),
+                  {std::string("--") + kind->name + "-views", joined(d[static_cast<size_t>(kind->camera)], ",")});
   return c;
 }
 

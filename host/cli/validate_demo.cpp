@@ -89,7 +89,7 @@ nlohmann::json make_demo_sets(const std::string& dir, uint64_t count, uint64_t s
   for (size_t i = 0; i < cat.subjects.size(); ++i)
     for (size_t k = 0; k < cat.sensors.size(); ++k) {
       const Sensor& view = cat.sensors[k];
-      if (view.camera != Camera::mmw) continue;  // the features are MMW (and metal) only
+      if (!camera_kind(view.camera).feature_views) continue;  // the features' views (and metal) only
       const std::string name = subject_image_name(i, view);
       const Image img = read_image((fs::path(dump) / name).string(), "validate --demo");
       write_image((d / "images" / name).string(), alter(img, static_cast<uint32_t>(i * cat.sensors.size() + k)));

@@ -131,8 +131,12 @@ std::vector<std::string> FeatureLayout::names() const {
 
 ModelSettings ModelSettings::for_view(const Sensor& s) const {
   ModelSettings m = *this;
-  if (s.netd) (s.camera == Camera::ir ? m.ir_netd : m.netd) = *s.netd;
-  if (s.netd) m.drawn[s.camera == Camera::ir ? PS_DRAWN_IR_NETD : PS_DRAWN_NETD] = {};  // its own, never drawn
+  if (s.netd) {
+    // Its kind's NETD knob (CameraKind::netd_knob) takes the view's own, never drawn.
+    const unsigned knob = camera_kind(s.camera).netd_knob;
+    m.*std::get<double ModelSettings::*>(drawn_knobs().at(knob).field) = *s.netd;
+    m.drawn[knob] = {};
+  }
   if (s.raw) {
     // its own, never drawn
     m.raw_width = (*s.raw)[0];
@@ -191,7 +195,7 @@ void validate(const Plan& plan, const Catalogue& cat) {
   if (grids.empty()) grids.push_back({plan.model.raw_width, plan.model.raw_height});
   for (const Sensor& s : cat.sensors)
     for (const auto& [w, h] : grids)
-      if (s.camera == Camera::mmw && !s.raw && (w > s.width || h > s.height))
+      if (camera_kind(s.camera).raw_grid && !s.raw && (w > s.width || h > s.height))
         throw InputError("--mmw-raw: " + std::to_string(w) + "x" + std::to_string(h) + " is finer than the " + s.name +
                          " view (" + std::to_string(s.width) + "x" + std::to_string(s.height) + ")");
 }

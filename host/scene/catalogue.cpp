@@ -548,6 +548,23 @@ void read_materials(const Reader& rd, const toml::table& root, Catalogue& cat) {
   }
 }
 
+// [[objects]]' keys, each camera kind's in the registry's order: <kind>_level, <kind>, then
+// <kind>_h and <kind>_v (the order "did you mean" prefers among equally near keys).
+const std::vector<std::string_view>& object_keys() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> k{"name", "aliases", "class", "family", "material", "metal", "shape", "size"};
+    for (const CameraKind* kind : camera_kinds()) k.push_back(kind->name + std::string("_level"));
+    k.push_back("variants");
+    for (const CameraKind* kind : camera_kinds()) k.push_back(kind->name);
+    for (const CameraKind* kind : camera_kinds())
+      for (const char* sfx : {"_h", "_v"}) k.push_back(kind->name + std::string(sfx));
+    k.push_back("metal_anisotropy");
+    return k;
+  }();
+  static const std::vector<std::string_view> keys(names.begin(), names.end());
+  return keys;
+}
+
 // [[objects]]: after [metal] and [[materials]], which they name.
 void read_objects(const Reader& rd, const toml::table& root, Catalogue& cat) {
   const toml::array& objects = rd.array_of_tables(root, "objects");
@@ -555,10 +572,7 @@ void read_objects(const Reader& rd, const toml::table& root, Catalogue& cat) {
   for (size_t i = 0; i < objects.size(); ++i) {
     const toml::table& t = *objects.get(i)->as_table();
     const std::string f = "objects[" + std::to_string(i + 1) + "]";
-    io::reject_unknown_keys(t,
-                            {"name", "aliases", "class", "family", "material", "metal", "shape", "size", "mmw_level",
-                             "ir_level", "variants", "mmw", "ir", "mmw_h", "mmw_v", "ir_h", "ir_v", "metal_anisotropy"},
-                            rd.file, f);
+    io::reject_unknown_keys(t, object_keys(), rd.file, f);
     Object o;
     o.name = rd.string(t, "name", f);
     for (const char* reserved : {"", "none", "all", "class", "family"})  // words of pools and rules
@@ -605,8 +619,8 @@ void read_objects(const Reader& rd, const toml::table& root, Catalogue& cat) {
     o.width = size[0];
     o.height = size[1];
     o.metal_anisotropy = rd.number(t, "metal_anisotropy", f, 1.0, 1000.0, 1.0);
-    o.mmw_level = rd.integer(t, "mmw_level", f, 0, 255);
-    o.ir_level = rd.integer(t, "ir_level", f, 0, 255);
+    for (const CameraKind* kind : camera_kinds())
+      o.levels.push_back(rd.integer(t, kind->name + std::string("_level"), f, 0, 255));
     std::vector<std::string> codes;
     if (const toml::node* vn = t.get("variants")) {
       const toml::array* va = vn->as_array();
@@ -624,13 +638,14 @@ void read_objects(const Reader& rd, const toml::table& root, Catalogue& cat) {
     } else {
       codes.push_back("");
     }
-    const bool file_images =
-        t.get("mmw") || t.get("ir") || t.get("mmw_h") || t.get("mmw_v") || t.get("ir_h") || t.get("ir_v");
+    bool file_images = false;
+    for (const CameraKind* kind : camera_kinds())
+      for (const char* sfx : {"", "_h", "_v"}) file_images |= t.get(kind->name + std::string(sfx)) != nullptr;
     if (!is_procedural_shape(o.shape) && !file_images)
       rd.fail(t.get("shape"), f + ".shape", "unknown shape \"" + o.shape + "\" and no image files given");
     if (codes.size() > 1)
-      for (const char* key : {"mmw", "ir"})
-        if (t.get(key))
+      for (const CameraKind* kind : camera_kinds())
+        if (const std::string key = kind->name; t.get(key))
           rd.fail(t.get(key), f + "." + key,
                   rd.image(t, key, f).path + ": this object has several drawings; name one file per drawing (" + key +
                       "_h, " + key + "_v)");
@@ -639,12 +654,10 @@ void read_objects(const Reader& rd, const toml::table& root, Catalogue& cat) {
       Variant v;
       v.code = codes[k];
       const std::string sfx = v.code.empty() ? "" : "_" + v.code;
-      v.mmw = rd.image(t, "mmw" + sfx, f);
-      v.ir = rd.image(t, "ir" + sfx, f);
-      if (codes.size() == 1) {
-        if (v.mmw.path.empty()) v.mmw = rd.image(t, "mmw", f);
-        if (v.ir.path.empty()) v.ir = rd.image(t, "ir", f);
-      }
+      for (const CameraKind* kind : camera_kinds()) v.images.push_back(rd.image(t, kind->name + sfx, f));
+      if (codes.size() == 1)  // one drawing may be given without its code
+        for (size_t c = 0; c < v.images.size(); ++c)
+          if (v.images[c].path.empty()) v.images[c] = rd.image(t, camera_kinds()[c]->name, f);
       o.variants.push_back(v);
       cat.variant_list.push_back({static_cast<int>(cat.objects.size()), static_cast<int>(k)});
     }

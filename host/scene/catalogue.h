@@ -49,8 +49,8 @@ struct Region {
 };
 
 struct Variant {
-  std::string code;  // "h", "v", or "" for an object with one drawing
-  ImageSource mmw, ir;
+  std::string code;                 // "h", "v", or "" for an object with one drawing
+  std::vector<ImageSource> images;  // per camera kind (by Camera): its file (key <kind>_<code>), or none
 };
 
 // A material of the physics model (docs/model/physics-mmw.md): its emissivity at 94 GHz
@@ -108,7 +108,7 @@ struct Object {
   int metal = 0;         // index into Catalogue::metal_categories
   std::string shape;
   int width = 0, height = 0;  // MMW sprite of the horizontal drawing
-  int mmw_level = 0, ir_level = 0;
+  std::vector<int> levels;    // per camera kind (by Camera): its drawing's level (key <kind>_level)
   // --model physics: polarizability along the drawing's long axis over across it (1: isotropic).
   double metal_anisotropy = 1.0;
   // What rules and pools can name it by (`class:threat`, `family:knife`); empty where the

@@ -46,9 +46,15 @@ void derive_places(const Catalogue& cat, Sensor& s) {
     }
 }
 
-int first_view(const std::vector<Sensor>& views, int region, std::optional<Camera> camera) {
+int first_view(const std::vector<Sensor>& views, int region) {
   for (size_t k = 0; k < views.size(); ++k)
-    if (views[k].sees(region) && (!camera || views[k].camera == *camera)) return static_cast<int>(k);
+    if (views[k].sees(region)) return static_cast<int>(k);
+  return -1;
+}
+
+int first_feature_view(const std::vector<Sensor>& views, int region) {
+  for (size_t k = 0; k < views.size(); ++k)
+    if (views[k].sees(region) && camera_kind(views[k].camera).feature_views) return static_cast<int>(k);
   return -1;
 }
 

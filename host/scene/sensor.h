@@ -106,9 +106,11 @@ struct Sensor {
   double field_per_row() const { return 1.0 / jitter_scale_y; }
 };
 
-// The first view that sees region r (of camera `camera`, where given), -1 where none does.
-// The metal detector places a region's object where its first view draws it.
-int first_view(const std::vector<Sensor>& views, int region, std::optional<Camera> camera = std::nullopt);
+// The first view that sees region r, -1 where none does. The metal detector places a
+// region's object where its first view draws it.
+int first_view(const std::vector<Sensor>& views, int region);
+// The same among the views of kinds whose views are the features' (CameraKind::feature_views).
+int first_feature_view(const std::vector<Sensor>& views, int region);
 
 struct Catalogue;
 // What a catalogue's [[views]] entry leaves to be derived: the chains and flags of its

@@ -386,9 +386,9 @@ struct Server::Impl {
     j["regions"] = json::array();
     for (size_t k = 0; k < c.regions.size(); ++k) {
       const Region& r = c.regions[k];
-      // The MMW view whose rectangles hold the region (else its first view), named in the
-      // views table.
-      int s = first_view(c.sensors, static_cast<int>(k), Camera::mmw);
+      // The features' view whose rectangles hold the region (else its first view), named in
+      // the views table.
+      int s = first_feature_view(c.sensors, static_cast<int>(k));
       if (s < 0) s = first_view(c.sensors, static_cast<int>(k));
       const Sensor& view = c.sensors[static_cast<size_t>(s)];
       // Where the region holds an object on each subject: the rectangle moved with the

@@ -105,7 +105,7 @@ struct Derive {
   const Catalogue& cat;
   const PhysicsConfig& pc;
   const ModelSettings& m;
-  bool ir;
+  bool ir;  // the IR surface model's formulas (its kind's FillStep::surface)
 };
 
 // The MMW camera's scalars; scene and clothing are set once their blocks are placed.
@@ -328,7 +328,63 @@ void append_mmw_grids(PhysicsTables& t, const Derive& d, const AssetSet& assets,
   common.clothing = append(p, clothing);
 }
 
+// What a kind's fill step takes: the tables so far (the head, the PSF's taps and the
+// Gaussians) and the scene and clothing blocks, which it places.
+struct FillArgs {
+  PhysicsTables& t;
+  const Derive& d;
+  const AssetSet& assets;
+  const Plan& plan;
+  const Sensor& s;
+  int view;
+  const std::vector<double>& psf;
+  std::vector<double>&scene, &clothing;
+};
+
+// The IR surface model: the off-body shadows and PsPhysIr.
+void fill_ir_surface(const FillArgs& a) {
+  std::vector<double>& p = a.t.values;
+  PsPhysIr h = ir_scalars(a.d.pc);
+  a.t.at.off_body = append(p, off_body_block(a.d));
+  if (!a.scene.empty()) h.common.scene = append(p, a.scene);
+  if (!a.clothing.empty()) h.common.clothing = append(p, a.clothing);
+  put_scalars(p, h, a.d.m);
+}
+
+// The MMW radiometry on a raw grid: the grid's tables and PsPhysMmw.
+void fill_mmw_raw_grid(const FillArgs& a) {
+  PsPhysMmw h = mmw_scalars(a.plan, a.d.m);
+  append_mmw_grids(a.t, a.d, a.assets, a.s, a.view, a.psf, a.scene, a.clothing, h.common);
+  put_scalars(a.t.values, h, a.d.m);
+}
+
+// The fill steps a camera kind may name (CameraKind::physics_fill). `surface`: the shared
+// steps above take the IR surface model's formulas (the index map, the contact shadow, the
+// surface under clothing), else the MMW radiometry's.
+struct FillStep {
+  const char* name;
+  bool surface;
+  void (*fill)(const FillArgs&);
+};
+constexpr FillStep kFillSteps[] = {
+    {"mmw_raw_grid", false, fill_mmw_raw_grid},
+    {"ir_surface", true, fill_ir_surface},
+};
+
+const FillStep& fill_step(const Sensor& s) {
+  const char* name = camera_kind(s.camera).physics_fill;
+  for (const FillStep& f : kFillSteps)
+    if (std::strcmp(f.name, name) == 0) return f;
+  throw std::logic_error(std::string("camera kind ") + camera_name(s.camera) + ": no physics fill step " + name);
+}
+
 }  // namespace
+
+bool has_physics_fill(const CameraKind& kind) {
+  for (const FillStep& f : kFillSteps)
+    if (std::strcmp(f.name, kind.physics_fill) == 0) return true;
+  return false;
+}
 
 size_t mmw_display_scratch(const Sensor& s, int raw_width, int raw_height) {
   return PS_MMW_DISPLAY_SCRATCH(s.width, s.height, raw_width, raw_height);
@@ -337,7 +393,8 @@ size_t mmw_display_scratch(const Sensor& s, int raw_width, int raw_height) {
 PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const Plan& plan, const ModelSettings& m,
                              int view) {
   const Sensor& s = cat.sensors[view];
-  const Derive d{cat, cat.physics, m, s.camera == Camera::ir};
+  const FillStep& step = fill_step(s);
+  const Derive d{cat, cat.physics, m, step.surface};
   PhysicsTables t;
   std::vector<double>& p = t.values;
   p.assign(PS_PHYS_SUBJECTS, 0.0);
@@ -348,17 +405,7 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
   const std::vector<double> psf(p.begin() + static_cast<std::ptrdiff_t>(taps), p.end());
   t.at.gauss = append(p, gauss_table());  // the sensor noise's table Gaussians
   std::vector<double> scene = scene_block(d), clothing = clothing_block(d, assets);
-  if (d.ir) {
-    PsPhysIr h = ir_scalars(d.pc);
-    t.at.off_body = append(p, off_body_block(d));
-    if (!scene.empty()) h.common.scene = append(p, scene);
-    if (!clothing.empty()) h.common.clothing = append(p, clothing);
-    put_scalars(p, h, m);
-    return t;
-  }
-  PsPhysMmw h = mmw_scalars(plan, m);
-  append_mmw_grids(t, d, assets, s, view, psf, scene, clothing, h.common);
-  put_scalars(p, h, m);
+  step.fill({t, d, assets, plan, s, view, psf, scene, clothing});
   return t;
 }
 

@@ -25,6 +25,8 @@ PhysicsTables physics_tables(const Catalogue& cat, const AssetSet& assets, const
 // thesis model's view parameters (kernels/lib/gauss.cl, pixel_sigma_of), and the run's for the
 // kernels of no view (metal_zones, metal_physics, analytic_noise).
 std::vector<double> drawn_params(const ModelSettings& m);
+// Whether `kind`'s CameraKind::physics_fill names one of the fill steps physics_tables knows.
+bool has_physics_fill(const CameraKind& kind);
 
 // stage_mmw_display's scratch values per scenario: each view row's vertically
 // interpolated raw row, then 16 values per raw row for the pixels after the last run of 16.

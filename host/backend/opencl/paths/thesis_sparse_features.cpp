@@ -19,16 +19,16 @@ class ThesisSparseFeatures final : public FeaturePath {
   const char* name() const override { return "thesis_sparse_features"; }
   enum Variant { kNoPatterns, kPatterns };
   // Features only, thesis model, sparse pooling, no per-pixel noise, sprites at their places,
-  // and the chain the tables implement: thesis_images's; with pattern noise, the tables hold
-  // a footprint's change per noise pattern and each scenario's patterns are drawn first.
+  // and the chain the tables implement: thesis_images's, on a view whose kind has the noise
+  // patterns; with pattern noise, the tables hold a footprint's change per noise pattern and
+  // each scenario's patterns are drawn first.
   // Block sums stay exact in fp32 (255 * 256^2 < 2^24). Not for subjects of their own: a
   // subject's tables take about 19 ms, rendering and pooling a scenario about 0.2 ms.
   Gate gate(const Plan& plan, const Sensor& sensor) const override {
     const bool plan_ok = plan.features && plan.images == 0 && plan.model.model == Model::thesis && !plan.own_subjects &&
                          plan.fidelity.pooling == Pooling::sparse && !plan.pixel_noise_per_pixel() &&
                          plan.model.block <= 256 && !plan.model.moves_sprites();
-    if (!plan_ok || sensor.camera != Camera::mmw ||
-        sensor.chain_for(plan.model.model) != thesis_images_path().chain() ||
+    if (!plan_ok || !sensor.pattern_noise || sensor.chain_for(plan.model.model) != thesis_images_path().chain() ||
         !FeatureLayout::of(d_.cat, plan.model.block).uniform)
       return {};
     if (plan.model.pattern_noise) return {.runs = true, .variant = kPatterns, .variant_name = "pattern noise"};
