@@ -4,11 +4,18 @@
 
 namespace portalsim {
 
+// The kinds, one X(NAME) each, in the order of Camera: NAME is camera_NAME.cpp, which
+// defines NAME_camera(), the kind's declaration.
+#define PORTALSIM_CAMERA_KINDS(X) X(mmw) X(ir)
+
+#define PORTALSIM_DECLARE_CAMERA_KIND(name) const CameraKind& name##_camera();
+PORTALSIM_CAMERA_KINDS(PORTALSIM_DECLARE_CAMERA_KIND)
+#undef PORTALSIM_DECLARE_CAMERA_KIND
+
 const std::vector<const CameraKind*>& camera_kinds() {
-  static const std::vector<const CameraKind*> kinds = {
-      &mmw_camera(),
-      &ir_camera(),
-  };
+#define PORTALSIM_CAMERA_KIND_ADDRESS(name) &name##_camera(),
+  static const std::vector<const CameraKind*> kinds = {PORTALSIM_CAMERA_KINDS(PORTALSIM_CAMERA_KIND_ADDRESS)};
+#undef PORTALSIM_CAMERA_KIND_ADDRESS
   return kinds;
 }
 

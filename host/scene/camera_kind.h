@@ -13,7 +13,8 @@
 namespace portalsim {
 
 // Which sprites and palette a view uses: the camera it belongs to (its kind's index in the
-// registry).
+// registry). The two enumerators name the thesis's kinds for the code and tests that speak of
+// them; a kind added later needs none: its value is Camera{its index}, which its file sets.
 enum class Camera : int { mmw = 0, ir = 1 };
 
 struct CameraKind {
@@ -41,10 +42,6 @@ struct CameraKind {
   // registry of fills), as the chain names its stages.
   const char* physics_fill;
 };
-
-// Each kind's declaration (one file each).
-const CameraKind& mmw_camera();
-const CameraKind& ir_camera();
 
 // Every kind, in the order of Camera; the kind of `c`; the kind named `name`, or null.
 const std::vector<const CameraKind*>& camera_kinds();
