@@ -27,6 +27,7 @@
 #include "cli/validate_demo.h"
 #include "cli/validate_stats.h"
 #include "cli/validate_tables.h"
+#include "cli/weka.h"
 #include "sink/feature_rows.h"
 #include "sink/h5_file.h"
 #include "sink/staging.h"
@@ -90,16 +91,6 @@ void check_usable(const Table& a, int folds) {
                      std::to_string(folds) + " cross-validation folds");
 }
 
-bool on_path(const std::string& program) {
-  const char* path = std::getenv("PATH");
-  if (!path) return false;
-  std::istringstream dirs(path);
-  std::string dir;
-  while (std::getline(dirs, dir, ':'))
-    if (!dir.empty() && ::access((fs::path(dir) / program).c_str(), X_OK) == 0) return true;
-  return false;
-}
-
 const std::vector<std::pair<std::string, std::string>> kClassifiers = {
     {"j48", "J48"}, {"mlp", "MultilayerPerceptron"}, {"svm", "SMO"}};
 
@@ -146,16 +137,14 @@ nlohmann::json run_weka(const Options& o, const std::string& classifiers, const 
   const std::string real_arff = (fs::path(work) / (".real-" + key + ".arff")).string();
   write_arff(sim, classes, sim_arff);
   write_arff(real, classes, real_arff);
-  const std::string program = (fs::path(work) / "Weka.java").string();
   const std::string weka_out = (fs::path(work) / (".weka-" + key + ".json")).string();
-  write_text_atomic(program, std::string(embedded::weka_program));
   std::fprintf(stderr, "validate: %s (%s, %zu attributes)\n", key.c_str(), feature_set(key).title.c_str(),
                sim.names.size() - 1);
-  const std::string cmd = "java -Xmx2g -cp /usr/share/java/weka.jar " + shell_quote(program) + " --real " +
-                          shell_quote(real_arff) + " --sim " + shell_quote(sim_arff) + " --folds " +
-                          std::to_string(o.folds) + " --runs " + std::to_string(o.runs) + " --seed " +
-                          std::to_string(o.seed) + " --classifiers " + classifiers + " --curve-steps " +
-                          std::to_string(o.curve_steps) + " > " + shell_quote(weka_out);
+  const std::string cmd = weka_command(work, "2g") + " --real " + shell_quote(real_arff) + " --sim " +
+                          shell_quote(sim_arff) + " --folds " + std::to_string(o.folds) + " --runs " +
+                          std::to_string(o.runs) + " --seed " + std::to_string(o.seed) + " --classifiers " +
+                          classifiers + " --curve-steps " + std::to_string(o.curve_steps) + " > " +
+                          shell_quote(weka_out);
   if (std::system(cmd.c_str()) != 0) throw std::runtime_error("WEKA failed (its messages are above)");
   std::ifstream in(weka_out);
   return nlohmann::json::parse(in);
@@ -295,9 +284,7 @@ std::string markdown(const Options& o, const nlohmann::json& report) {
 
 int run_validate(Options o) {
   if (!o.grid.empty()) o.block = block_for_grid(o.grid, o.catalogue);
-  const char* jar = "/usr/share/java/weka.jar";
-  if (!fs::exists(jar)) throw EnvironmentError(std::string(jar) + " not found (apt-get install weka)");
-  if (!on_path("java")) throw EnvironmentError("java not found on PATH (apt-get install default-jdk-headless)");
+  if (const auto missing = weka_missing()) throw EnvironmentError(*missing);
   std::string classifiers;
   for (const std::string& c : split_commas(lower(o.classifiers))) {
     if (std::none_of(kClassifiers.begin(), kClassifiers.end(), [&](const auto& k) { return k.first == c; }))

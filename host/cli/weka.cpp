@@ -1,5 +1,7 @@
 #include "cli/weka.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -17,6 +19,16 @@ namespace portalsim::cli {
 
 namespace {
 
+bool on_path(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  if (!path) return false;
+  std::istringstream dirs(path);
+  std::string dir;
+  while (std::getline(dirs, dir, ':'))
+    if (!dir.empty() && ::access((std::filesystem::path(dir) / program).c_str(), X_OK) == 0) return true;
+  return false;
+}
+
 // Whether a line holds more than it should.
 bool one_more(std::istringstream& fields) {
   std::string rest;
@@ -28,9 +40,15 @@ bool one_more(std::istringstream& fields) {
 std::optional<std::string> weka_missing() {
   if (!std::filesystem::exists("/usr/share/java/weka.jar"))
     return "/usr/share/java/weka.jar not found (apt-get install weka)";
-  if (std::system("command -v java >/dev/null 2>&1") != 0)
-    return "java not found on PATH (apt-get install default-jre-headless)";
+  // Weka.java runs as a single-file source program: the JDK's compiler, not a JRE alone.
+  if (!on_path("java")) return "java not found on PATH (apt-get install default-jdk-headless)";
   return std::nullopt;
+}
+
+std::string weka_command(const std::string& dir, const char* heap) {
+  const std::string program = (std::filesystem::path(dir) / "Weka.java").string();
+  write_text_atomic(program, std::string(embedded::weka_program));
+  return std::string("java -Xmx") + heap + " -cp /usr/share/java/weka.jar " + shell_quote(program);
 }
 
 std::optional<std::vector<std::vector<WekaScore>>> weka_scores(const std::vector<WekaJob>& jobs, std::string& why) {
@@ -39,9 +57,7 @@ std::optional<std::vector<std::vector<WekaScore>>> weka_scores(const std::vector
     return std::nullopt;
   }
   const WorkDir work;
-  const std::string program = (std::filesystem::path(work.path) / "Weka.java").string();
   const std::string list = (std::filesystem::path(work.path) / "jobs.tsv").string();
-  write_text_atomic(program, std::string(embedded::weka_program));
   std::string lines;
   for (const WekaJob& j : jobs) {
     lines += j.classifier + "\t" + j.train + "\t" + std::to_string(j.folds) + "\t" + std::to_string(j.seed);
@@ -50,8 +66,7 @@ std::optional<std::vector<std::vector<WekaScore>>> weka_scores(const std::vector
   }
   write_text_atomic(list, lines);
   const std::string errors = (std::filesystem::path(work.path) / "stderr.txt").string();
-  const std::string cmd = "java -Xmx4g -cp /usr/share/java/weka.jar " + shell_quote(program) + " --jobs " +
-                          shell_quote(list) + " 2>" + shell_quote(errors);
+  const std::string cmd = weka_command(work.path, "4g") + " --jobs " + shell_quote(list) + " 2>" + shell_quote(errors);
   FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) {
     why = "cannot run java";

@@ -10,6 +10,10 @@ namespace portalsim::cli {
 // Why WEKA cannot run here (weka.jar or java missing), or nothing when it can.
 std::optional<std::string> weka_missing();
 
+// tools/Weka.java (embedded), written into the folder `dir`, and the command that runs it
+// with WEKA's jar and a heap of `heap` ("4g"), to which its arguments are appended.
+std::string weka_command(const std::string& dir, const char* heap);
+
 struct WekaScore {
   long correct = 0;
   long misclassified = 0;
